@@ -1,0 +1,136 @@
+"""Plane rotations and double rotations in 4-D (pure numpy).
+
+Conventions (Kageyama, *Keyboard based control of four dimensional rotations*):
+
+* Axes x, y, z, w are indices 0, 1, 2, 3 (the paper numbers them 1..4).
+* ``simple_rotation(plane, angle)`` has ``cos, -sin`` / ``sin, cos`` in rows and
+  columns (i, j) of ``plane`` -- eq. (5) of the paper for ``"xy"``.
+* A double rotation is the (commuting) product of two simple rotations in
+  absolutely perpendicular planes -- eq. (4) for ``"xy,zw"``.
+* Composition is **extrinsic**: a step about the fixed frame is applied on the
+  left, ``new = step @ old``.  Points are rows, rotated as ``points @ matrix.T``.
+
+Every function returns a fresh (4, 4) float64 array.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "AXES",
+    "PLANES",
+    "DOUBLE_PLANES",
+    "simple_rotation",
+    "double_rotation",
+    "as_rotation_matrix",
+    "reorthonormalize",
+]
+
+AXES = "xyzw"
+PLANES = ("xy", "xz", "xw", "yz", "yw", "zw")
+#: The three double rotations of the paper's Table 1, keyed by their planes.
+DOUBLE_PLANES = ("xy,zw", "xz,yw", "xw,yz")
+
+_PLANE_AXES = {p: (AXES.index(p[0]), AXES.index(p[1])) for p in PLANES}
+
+#: How far from orthogonal a user-supplied matrix may be (max |M M^T - I|).
+ORTHOGONALITY_TOLERANCE = 1e-6
+
+
+def _check_angle(name: str, value) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"Expected `{name}` to be a real number (radians), got {type(value).__name__}")
+    value = float(value)
+    if not np.isfinite(value):
+        raise ValueError(f"Expected `{name}` to be a finite number of radians, got {value}")
+    return value
+
+
+def _plane_axes(plane) -> tuple[int, int]:
+    try:
+        return _PLANE_AXES[plane]
+    except (KeyError, TypeError):
+        raise ValueError(
+            f"Unknown rotation plane {plane!r}; expected one of {', '.join(map(repr, PLANES))}"
+        ) from None
+
+
+def simple_rotation(plane: str, angle: float) -> np.ndarray:
+    """Rotation by ``angle`` (radians) in ``plane``, one of ``"xy" "xz" "xw" "yz" "yw" "zw"``.
+
+    Returns a (4, 4) float64 matrix R with ``R[i, i] = R[j, j] = cos(angle)``,
+    ``R[i, j] = -sin(angle)``, ``R[j, i] = sin(angle)`` for the plane's axes i < j,
+    and the identity elsewhere (the paper's eqs. (3), (5), (6)).
+    """
+    i, j = _plane_axes(plane)
+    angle = _check_angle("angle", angle)
+    c, s = np.cos(angle), np.sin(angle)
+    m = np.eye(4)
+    m[i, i] = c
+    m[i, j] = -s
+    m[j, i] = s
+    m[j, j] = c
+    return m
+
+
+def double_rotation(planes: str, alpha: float, beta: float) -> np.ndarray:
+    """Double rotation in two absolutely perpendicular planes, e.g. ``"xy,zw"``.
+
+    ``planes`` is one of ``"xy,zw" "xz,yw" "xw,yz"``; ``alpha`` turns the first
+    plane and ``beta`` the second.  The two factors commute, so the result is
+    ``simple_rotation(p1, alpha) @ simple_rotation(p2, beta)`` in either order
+    (eq. (4) of the paper for ``"xy,zw"``).
+    """
+    if planes not in DOUBLE_PLANES:
+        raise ValueError(
+            f"Unknown double-rotation planes {planes!r}; expected one of "
+            f"{', '.join(map(repr, DOUBLE_PLANES))}"
+        )
+    p1, p2 = planes.split(",")
+    alpha = _check_angle("alpha", alpha)
+    beta = _check_angle("beta", beta)
+    # The two blocks touch disjoint rows/columns: write both into one identity.
+    m = simple_rotation(p1, alpha)
+    i, j = _PLANE_AXES[p2]
+    c, s = np.cos(beta), np.sin(beta)
+    m[i, i] = c
+    m[i, j] = -s
+    m[j, i] = s
+    m[j, j] = c
+    return m
+
+
+def as_rotation_matrix(matrix, name: str = "matrix") -> np.ndarray:
+    """Validate a 4-D rotation: (4, 4), finite, orthogonal with det +1.
+
+    Returns it as a C-contiguous float64 array.  Raises ``TypeError`` for
+    non-numeric input and ``ValueError`` naming what is expected otherwise.
+    """
+    try:
+        m = np.asarray(matrix, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"Expected `{name}` to be a (4, 4) array of real numbers") from None
+    if m.shape != (4, 4):
+        raise ValueError(f"Expected `{name}` to have shape (4, 4), got {m.shape}")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"Expected `{name}` to be finite, got non-finite entries")
+    err = np.abs(m @ m.T - np.eye(4)).max()
+    if err > ORTHOGONALITY_TOLERANCE:
+        raise ValueError(
+            f"Expected `{name}` to be orthogonal (|M M^T - I| <= {ORTHOGONALITY_TOLERANCE:g}), "
+            f"got deviation {err:.3g}"
+        )
+    if np.linalg.det(m) < 0:
+        raise ValueError(f"Expected `{name}` to be a rotation (det +1), got a reflection (det -1)")
+    return np.ascontiguousarray(m)
+
+
+def reorthonormalize(matrix: np.ndarray) -> np.ndarray:
+    """One Newton-Schulz step towards the nearest orthogonal matrix.
+
+    ``M <- M (3 I - M^T M) / 2`` squares the deviation from orthogonality, so
+    applied after every composed step it keeps ``|M M^T - I|`` at rounding level
+    however many steps are taken (without it the error grows like sqrt(steps)).
+    """
+    return 1.5 * matrix - 0.5 * (matrix @ (matrix.T @ matrix))
