@@ -1,0 +1,177 @@
+"""Keys of the paper's Tables 1 and 2 through RotationState.press."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rot4d_widget import DEFAULT_KEYMAP, Keymap, RotationState, double_rotation, simple_rotation
+from rot4d_widget.state import ALPHA_STEP_FRACTION, DEFAULT_THETA0, PAPER_ALPHA_RATIO, THETA0_FACTOR
+
+SIMPLE_KEYS = {"2": "xy", "3": "xz", "4": "xw", "6": "yz", "8": "yw", "c": "zw"}
+DOUBLE_KEYS = {"y": "xy,zw", "z": "xz,yw", "w": "xw,yz"}
+
+
+def explicit_simple(plane, a):
+    """Eq. (5)-style matrix written out independently of rot4d_widget."""
+    i, j = "xyzw".index(plane[0]), "xyzw".index(plane[1])
+    m = np.eye(4)
+    m[i, i] = m[j, j] = math.cos(a)
+    m[i, j], m[j, i] = -math.sin(a), math.sin(a)
+    return m
+
+
+@pytest.mark.parametrize("key, plane", SIMPLE_KEYS.items())
+def test_simple_keys_and_their_shift_inverse(key, plane):
+    st = RotationState(theta0=0.1)
+    assert st.press(key) is True
+    np.testing.assert_allclose(st.matrix, explicit_simple(plane, 0.1), atol=1e-15)
+    st.reset()
+    assert st.press(key, shift=True)
+    np.testing.assert_allclose(st.matrix, explicit_simple(plane, -0.1), atol=1e-15)
+    if key.isalpha():
+        st.reset()
+        assert st.press(key.upper(), shift=False)  # "C": upper case counts as shifted
+        np.testing.assert_allclose(st.matrix, explicit_simple(plane, -0.1), atol=1e-15)
+
+
+@pytest.mark.parametrize("key, planes", DOUBLE_KEYS.items())
+def test_double_keys_use_alpha_and_beta_and_shift_negates_both(key, planes):
+    st = RotationState(theta0=0.3, alpha=0.1)
+    assert st.beta == pytest.approx(0.2)
+    p1, p2 = planes.split(",")
+    st.press(key)
+    np.testing.assert_allclose(st.matrix, explicit_simple(p1, 0.1) @ explicit_simple(p2, 0.2), atol=1e-15)
+    st.reset()
+    st.press(key.upper())
+    np.testing.assert_allclose(st.matrix, explicit_simple(p1, -0.1) @ explicit_simple(p2, -0.2), atol=1e-15)
+    np.testing.assert_allclose(st.matrix, double_rotation(planes, 0.1, 0.2).T, atol=1e-15)
+
+
+def test_composition_is_extrinsic():
+    st = RotationState(theta0=0.2)
+    st.press("2")
+    st.press("4")
+    expected = explicit_simple("xw", 0.2) @ explicit_simple("xy", 0.2)
+    np.testing.assert_allclose(st.matrix, expected, atol=1e-15)
+    assert not np.allclose(expected, explicit_simple("xy", 0.2) @ explicit_simple("xw", 0.2))
+
+
+def test_32_presses_of_4_at_pi_over_16_return_to_identity():
+    st = RotationState(theta0=math.pi / 16)
+    for k in range(1, 33):
+        st.press("4")
+        if k < 32:
+            assert np.abs(st.matrix - np.eye(4)).max() > 1e-3
+    np.testing.assert_allclose(st.matrix, np.eye(4), atol=1e-13)
+
+
+def test_many_random_presses_stay_orthogonal():
+    rng = np.random.default_rng(42)
+    st = RotationState(theta0=0.37)
+    keys = list(SIMPLE_KEYS) + list(DOUBLE_KEYS)
+    choice = rng.integers(0, len(keys), size=200_000)
+    shifts = rng.random(200_000) < 0.5
+    for k, s in zip(choice, shifts):
+        st.press(keys[k], shift=bool(s))
+    m = st.matrix
+    assert np.linalg.norm(m @ m.T - np.eye(4)) < 1e-13
+
+
+def test_alpha_keys_keep_sum_and_are_not_clamped():
+    st = RotationState(theta0=0.2, alpha=0.01)
+    step = 0.2 * ALPHA_STEP_FRACTION
+    st.press("k")
+    assert st.alpha == pytest.approx(0.01 + step) and st.alpha + st.beta == pytest.approx(0.2)
+    for _ in range(10):
+        st.press("j")
+    assert st.alpha < 0 and st.alpha + st.beta == pytest.approx(0.2)
+    np.testing.assert_allclose(st.matrix, np.eye(4))  # parameter keys do not rotate
+    before = st.alpha
+    st.press("J")  # shift has no effect on parameter keys
+    assert st.alpha == pytest.approx(before - step)
+
+
+def test_c0_keys_step_and_shift_does_nothing_special():
+    st = RotationState(c0_step=0.05)
+    st.press("l")
+    st.press("l")
+    st.press("H")
+    assert st.c0 == pytest.approx(0.05)
+    np.testing.assert_allclose(st.matrix, np.eye(4))
+
+
+def test_theta0_keys_keep_alpha_ratio():
+    st = RotationState(theta0=0.2, alpha=0.05)
+    st.press("+")
+    assert st.theta0 == pytest.approx(0.2 * THETA0_FACTOR)
+    assert st.alpha / st.theta0 == pytest.approx(0.25)
+    st.press("-")
+    st.press("-")
+    assert st.theta0 == pytest.approx(0.2 / THETA0_FACTOR)
+    st.theta0 = 1.0
+    assert st.alpha == pytest.approx(0.25)
+
+
+def test_defaults_are_documented_values():
+    st = RotationState()
+    assert st.theta0 == DEFAULT_THETA0 == math.pi / 64
+    assert st.alpha == pytest.approx(math.pi / 64 * math.pi * math.sqrt(2) / (8 * math.sqrt(3)))
+    assert 0 < st.alpha < st.theta0 and st.beta == st.theta0 - st.alpha
+    assert PAPER_ALPHA_RATIO == pytest.approx(0.3206, abs=1e-4)
+    assert st.c0 == 0.0
+
+
+def test_unbound_and_help_keys_change_nothing():
+    st = RotationState()
+    st.press("4")
+    snapshot = (st.matrix.copy(), st.theta0, st.alpha, st.c0)
+    for key in ["q", "5", "@", "Enter", "?"]:
+        assert st.press(key) is False
+    assert np.array_equal(st.matrix, snapshot[0]) and (st.theta0, st.alpha, st.c0) == snapshot[1:]
+
+
+def test_reset_restores_the_constructed_state():
+    st = RotationState(theta0=0.1, alpha=0.03, c0=0.2)
+    for key in "24ykl+":
+        st.press(key)
+    st.press("r")
+    np.testing.assert_array_equal(st.matrix, np.eye(4))
+    assert (st.theta0, st.alpha, st.c0) == (0.1, 0.03, 0.2)
+
+
+def test_custom_keymap():
+    km = DEFAULT_KEYMAP.replace(q="xw", **{"4": None})
+    st = RotationState(theta0=0.1, keymap=km)
+    assert st.press("4") is False
+    assert st.press("q")
+    np.testing.assert_allclose(st.matrix, simple_rotation("xw", 0.1))
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, match",
+    [
+        ({"theta0": float("nan")}, ValueError, "theta0.*finite"),
+        ({"theta0": 0.0}, ValueError, r"\(0, pi\]"),
+        ({"theta0": -1.0}, ValueError, r"\(0, pi\]"),
+        ({"theta0": "fast"}, TypeError, "real number"),
+        ({"alpha": float("inf")}, ValueError, "alpha"),
+        ({"c0": float("nan")}, ValueError, "c0"),
+        ({"c0_step": -0.1}, ValueError, "c0_step"),
+        ({"keymap": {"4": "xw"}}, TypeError, "Keymap"),
+        ({"matrix": np.eye(3)}, ValueError, r"\(4, 4\)"),
+    ],
+)
+def test_bad_state_input(kwargs, exc, match):
+    with pytest.raises(exc, match=match):
+        RotationState(**kwargs)
+
+
+def test_bad_assignments():
+    st = RotationState()
+    with pytest.raises(ValueError, match="orthogonal"):
+        st.matrix = np.ones((4, 4))
+    with pytest.raises(ValueError, match="finite"):
+        st.c0 = float("inf")
+    with pytest.raises(TypeError, match="string"):
+        st.press(4)
