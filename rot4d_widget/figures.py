@@ -1,0 +1,476 @@
+"""Static matplotlib renderings of w = c0 slices: one panel, key sequences, the paper's figures.
+
+No browser and no widget library: the slice is drawn with matplotlib 2-D artists in a perspective
+view from the paper's viewpoint, the point (x, y, z) = (0, 0, ``distance``) looking down -z
+(``distance`` = 5 in the paper).  A 3-D point is projected by hand,
+
+    x' = x d / (d - z),    y' = y d / (d - z),
+
+and every radius at that point is multiplied by the same factor ``d / (d - z)``.  Artists are
+painted back to front (painter's algorithm, by the depth of a ball's centre, a bar's midpoint, a
+face's centroid), so nearer things cover farther ones.
+
+* balls at slice vertices (circles, with a small highlight),
+* bars along slice edges (trapezoids whose width follows the perspective of each end),
+* translucent faces (slice polygons), coloured by the 4-D cell they are cut from.
+
+``render_key_sequence(key, n_panels)`` shows what holding a key does: panel k is drawn after k
+presses; :func:`paper_figure_3` and :func:`paper_figure_4` reproduce the paper's figures.
+
+Functions build :class:`matplotlib.figure.Figure` objects directly and never touch
+``matplotlib.pyplot``, so they work under any backend and leave pyplot's state alone.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import string
+from dataclasses import dataclass, field
+from numbers import Integral, Real
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.colors import Colormap, ListedColormap, to_rgba
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Polygon
+
+from .polytopes import Polytope, pentachoron
+from .polytopes import polytope as _named_polytope
+from .slicing import Slice, slice_polytope
+from .state import PAPER_ALPHA_RATIO, RotationState
+
+__all__ = [
+    "CAMERA_DISTANCE",
+    "REFERENCE_RADIUS",
+    "FIG3_THETA0",
+    "FIG4_THETA0",
+    "FIG4_ALPHA",
+    "SliceDrawing",
+    "perspective",
+    "draw_slice",
+    "render_slice",
+    "render_key_sequence",
+    "paper_figure_3",
+    "paper_figure_4",
+]
+
+#: The paper's viewpoint: the eye at (0, 0, 5) looking down -z.
+CAMERA_DISTANCE = 5.0
+#: Circumradius of the paper's pentachoron (edge a = 2): sqrt(2/5) * a.  Other polytopes are
+#: scaled to this circumradius by default so that they appear the same size.
+REFERENCE_RADIUS = 2.0 * math.sqrt(2.0 / 5.0)
+#: Fig. 3: key "4" (R_xw) with theta0 = pi/16.
+FIG3_THETA0 = math.pi / 16
+#: Fig. 4: key "z" (R_xz,yw) with alpha = pi sqrt2 / (8 sqrt3) and "beta = 1 - alpha",
+#: i.e. alpha + beta = theta0 = 1 rad.
+FIG4_THETA0 = 1.0
+FIG4_ALPHA = PAPER_ALPHA_RATIO * FIG4_THETA0
+
+#: Extra figure height (inches) for a title above the panels.
+TITLE_HEIGHT = 0.4
+_SAVE_FORMATS = (".png", ".pdf", ".svg")
+
+# Painter's order: zorder = _Z_BASE + depth + a tiny offset per kind, so at equal depth a ball is
+# drawn over a bar, and a bar over a face.  Labels stay above everything.
+_Z_BASE = 10.0
+_Z_KIND = {"face": 0.0, "bar": 1e-4, "ball": 2e-4}
+_Z_LABEL = 1e6
+
+
+# --------------------------------------------------------------------------- validation helpers
+def _real(name: str, value, *, minimum=None, inclusive=True, maximum=None) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real):
+        raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"Expected `{name}` to be finite, got {value}")
+    if minimum is not None:
+        if (inclusive and value < minimum) or (not inclusive and value <= minimum):
+            op = ">=" if inclusive else ">"
+            raise ValueError(f"Expected `{name}` {op} {minimum:g}, got {value:g}")
+    if maximum is not None and value > maximum:
+        raise ValueError(f"Expected `{name}` <= {maximum:g}, got {value:g}")
+    return value
+
+
+def _count(name: str, value, *, minimum: int = 1) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral):
+        raise TypeError(f"Expected `{name}` to be an integer, got {type(value).__name__}")
+    value = int(value)
+    if value < minimum:
+        raise ValueError(f"Expected `{name}` >= {minimum}, got {value}")
+    return value
+
+
+def _as_polytope(value) -> Polytope:
+    if isinstance(value, str):
+        return _named_polytope(value)
+    if isinstance(value, Polytope):
+        return value
+    raise TypeError(
+        f"Expected `polytope` to be a name such as '5-cell' or a rot4d_widget.Polytope, "
+        f"got {type(value).__name__}"
+    )
+
+
+def _as_colormap(cmap) -> Colormap:
+    if isinstance(cmap, Colormap):
+        return cmap
+    if isinstance(cmap, str):
+        import matplotlib
+
+        try:
+            return matplotlib.colormaps[cmap]
+        except KeyError:
+            raise ValueError(f"Unknown matplotlib colormap {cmap!r} for `cmap`") from None
+    raise TypeError(f"Expected `cmap` to be a colormap name or a matplotlib Colormap, got {type(cmap).__name__}")
+
+
+def _cell_colors(cell_ids: np.ndarray, cmap: Colormap) -> np.ndarray:
+    """(P, 4) RGBA per polygon: the same 4-D cell always gets the same colour."""
+    ids = np.asarray(cell_ids, dtype=np.int64)
+    if isinstance(cmap, ListedColormap):  # qualitative maps: cycle through the list
+        return np.asarray(cmap(ids % cmap.N))
+    # continuous maps: spread consecutive ids with the golden ratio
+    return np.asarray(cmap(np.mod(ids * 0.6180339887498949, 1.0)))
+
+
+# --------------------------------------------------------------------------- projection
+def perspective(points, distance: float = CAMERA_DISTANCE):
+    """Project 3-D points seen from (0, 0, ``distance``) looking down -z onto the plane z = 0.
+
+    ``points`` is (n, 3) float64 (x, y, z).  Returns ``(xy, factor)``: ``xy`` (n, 2) float64 with
+    ``xy = (x, y) * factor`` and ``factor`` (n,) float64 ``= distance / (distance - z)``, the
+    magnification of anything of size 1 at that point.  Raises ``ValueError`` if a point is at or
+    behind the eye (z >= distance).
+    """
+    d = _real("distance", distance, minimum=0.0, inclusive=False)
+    try:
+        p = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError("Expected `points` to be an (n, 3) array of real numbers") from None
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"Expected `points` to have shape (n, 3), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("Expected `points` to be finite")
+    depth = d - p[:, 2]
+    if p.shape[0] and depth.min() <= 0.0:
+        z = p[np.argmin(depth), 2]
+        raise ValueError(
+            f"A point at z = {z:.6g} is at or behind the eye at z = {d:g}; scale the scene down "
+            "or move the eye back (`distance`)"
+        )
+    factor = d / depth
+    return p[:, :2] * factor[:, None], factor
+
+
+def _view_limit(radius: float, distance: float, margin: float) -> float:
+    """Half-width of the view that holds a sphere of ``radius`` at the origin, plus ``margin``."""
+    if radius >= distance:
+        raise ValueError(
+            f"Expected `radius` < `distance` ({distance:g}) so the eye is outside the scene, got {radius:g}"
+        )
+    return distance * radius / math.sqrt(distance**2 - radius**2) + margin
+
+
+# --------------------------------------------------------------------------- one panel
+@dataclass
+class SliceDrawing:
+    """What :func:`draw_slice` added to the axes, in drawing (painter's) order per kind.
+
+    ``centers`` (n, 2) and ``factors`` (n,) are the projected slice vertices and their perspective
+    factors; ``balls[i]`` is the circle of slice vertex ``i``; ``bars[j]`` the patch of edge ``j``;
+    ``faces[k]`` the polygon of ``slice.polygons[k]``.
+    """
+
+    centers: np.ndarray
+    factors: np.ndarray
+    balls: list = field(default_factory=list)
+    bars: list = field(default_factory=list)
+    faces: list = field(default_factory=list)
+    highlights: list = field(default_factory=list)
+    limit: float = 0.0
+
+
+def draw_slice(
+    ax,
+    slice: Slice,
+    *,
+    scale: float = 1.0,
+    distance: float = CAMERA_DISTANCE,
+    radius: float | None = None,
+    ball_radius: float = 0.07,
+    bar_radius: float = 0.025,
+    face_alpha: float = 0.35,
+    ball_color="#c8102e",
+    bar_color="#4a4a4a",
+    cmap="tab10",
+    label: str | None = None,
+) -> SliceDrawing:
+    """Draw one slice on a matplotlib ``ax`` in the paper's perspective view.
+
+    ``slice`` is a :class:`rot4d_widget.Slice`; its vertices are multiplied by ``scale`` first.
+    ``ball_radius`` and ``bar_radius`` are 3-D sizes (after scaling), shrunk with distance like
+    everything else.  ``radius`` fixes the axis limits to a sphere of that radius (after scaling)
+    so that panels of one sequence share a frame; by default the limits fit this slice.
+    Faces are coloured by ``slice.cell_ids`` through ``cmap`` (a name or a Colormap).
+
+    Returns a :class:`SliceDrawing` listing the artists; they also carry the gids "ball", "bar",
+    "face" and "highlight" (kept in SVG output).
+    """
+    if not isinstance(ax, Axes):
+        raise TypeError(f"Expected `ax` to be a matplotlib Axes, got {type(ax).__name__}")
+    if not isinstance(slice, Slice):
+        raise TypeError(f"Expected `slice` to be a rot4d_widget.Slice, got {type(slice).__name__}")
+    scale = _real("scale", scale, minimum=0.0, inclusive=False)
+    d = _real("distance", distance, minimum=0.0, inclusive=False)
+    ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+    bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
+    face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    if radius is not None:
+        radius = _real("radius", radius, minimum=0.0, inclusive=False)
+    if label is not None and not isinstance(label, str):
+        raise TypeError(f"Expected `label` to be a string or None, got {type(label).__name__}")
+    colormap = _as_colormap(cmap)
+    ball_rgba = to_rgba(ball_color)
+    bar_rgba = to_rgba(bar_color)
+
+    pts = np.asarray(slice.vertices, dtype=np.float64).reshape(-1, 3) * scale
+    xy, fac = perspective(pts, d) if len(pts) else (np.zeros((0, 2)), np.zeros(0))
+    z = pts[:, 2]
+    drawing = SliceDrawing(centers=xy, factors=fac)
+
+    # faces: convex polygons (a cell meets a hyperplane in a convex polygon); order the corners
+    # around the projected centroid so the drawing does not depend on the slicer's corner order.
+    polygons = list(slice.polygons)
+    colors = _cell_colors(np.asarray(slice.cell_ids), colormap) if polygons else []
+    for poly, rgba in zip(polygons, colors):
+        idx = np.asarray(poly, dtype=np.int64)
+        if len(idx) < 3:
+            continue
+        p2 = xy[idx]
+        c2 = p2.mean(axis=0)
+        order = np.argsort(np.arctan2(p2[:, 1] - c2[1], p2[:, 0] - c2[0]))
+        depth = z[idx].mean()
+        patch = Polygon(
+            p2[order], closed=True, facecolor=(*rgba[:3], face_alpha), edgecolor="none",
+            zorder=_Z_BASE + depth + _Z_KIND["face"], gid="face",
+        )
+        ax.add_patch(patch)
+        drawing.faces.append(patch)
+
+    # bars: a trapezoid from end a to end b, half-width bar_radius * factor at each end
+    edge_rgba = tuple(0.6 * np.asarray(bar_rgba[:3])) + (bar_rgba[3],)
+    if bar_radius > 0:
+        for a, b in np.asarray(slice.edges, dtype=np.int64).reshape(-1, 2):
+            pa, pb = xy[a], xy[b]
+            ra, rb = bar_radius * fac[a], bar_radius * fac[b]
+            u = pb - pa
+            length = math.hypot(*u)
+            zo = _Z_BASE + 0.5 * (z[a] + z[b]) + _Z_KIND["bar"]
+            if length <= 1e-12:  # edge along the line of sight: its end-on disc
+                patch = Circle(pa, max(ra, rb), facecolor=bar_rgba, edgecolor="none", zorder=zo, gid="bar")
+            else:
+                n = np.array([-u[1], u[0]]) / length
+                corners = [pa + n * ra, pb + n * rb, pb - n * rb, pa - n * ra]
+                patch = Polygon(corners, closed=True, facecolor=bar_rgba, edgecolor=edge_rgba,
+                                linewidth=0.3, zorder=zo, gid="bar")
+            ax.add_patch(patch)
+            drawing.bars.append(patch)
+
+    # balls: circles of radius ball_radius * factor, with a highlight towards the upper left
+    if ball_radius > 0:
+        dark = tuple(0.55 * np.asarray(ball_rgba[:3])) + (ball_rgba[3],)
+        for i in range(len(pts)):
+            r = ball_radius * fac[i]
+            zo = _Z_BASE + z[i] + _Z_KIND["ball"]
+            ball = Circle(xy[i], r, facecolor=ball_rgba, edgecolor=dark, linewidth=0.4, zorder=zo, gid="ball")
+            shine = Circle(xy[i] + np.array([-0.35, 0.35]) * r, 0.3 * r, facecolor=(1, 1, 1, 0.55),
+                           edgecolor="none", zorder=zo + 1e-5, gid="highlight")
+            ax.add_patch(ball)
+            ax.add_patch(shine)
+            drawing.balls.append(ball)
+            drawing.highlights.append(shine)
+
+    # frame: a fixed sphere if given, else this slice
+    margin = max(ball_radius, bar_radius)
+    if radius is not None:
+        limit = _view_limit(radius, d, margin * d / (d - radius))
+    elif len(pts):
+        limit = float(np.max(np.abs(xy) + (margin * fac)[:, None]))
+        limit = max(limit * 1.05, 1e-3)
+    else:
+        limit = 1.0
+    ax.set_xlim(-limit, limit)
+    ax.set_ylim(-limit, limit)
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    drawing.limit = limit
+    if label:
+        ax.text(0.03, 0.97, label, transform=ax.transAxes, ha="left", va="top", fontsize=10,
+                zorder=_Z_LABEL)
+    return drawing
+
+
+# --------------------------------------------------------------------------- grids of panels
+def _panel_label(k: int) -> str:
+    return f"({string.ascii_lowercase[k]})" if k < 26 else f"({k + 1})"
+
+
+def _grid_figure(n_panels: int, ncols: int, panel_size: float, dpi: float, title: str | None):
+    ncols = min(ncols, n_panels)
+    nrows = -(-n_panels // ncols)
+    top = TITLE_HEIGHT if title else 0.0
+    width, height = ncols * panel_size, nrows * panel_size + top
+    fig = Figure(figsize=(width, height), dpi=dpi)
+    axes = []
+    for k in range(nrows * ncols):
+        r, c = divmod(k, ncols)
+        # [left, bottom, width, height] in figure fractions: panels tile the figure exactly
+        rect = [c * panel_size / width, (height - top - (r + 1) * panel_size) / height,
+                panel_size / width, panel_size / height]
+        ax = fig.add_axes(rect)
+        ax.set_axis_off()
+        axes.append(ax)
+    if title:
+        fig.text(0.5, 1.0 - 0.5 * TITLE_HEIGHT / height, title, ha="center", va="center", fontsize=11)
+    return fig, axes
+
+
+def _check_grid_args(ncols, panel_size, dpi, title):
+    ncols = _count("ncols", ncols)
+    panel_size = _real("panel_size", panel_size, minimum=0.0, inclusive=False)
+    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    if title is not None and not isinstance(title, str):
+        raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
+    return ncols, panel_size, dpi
+
+
+def _default_scale(poly: Polytope, scale):
+    if scale is None:
+        return REFERENCE_RADIUS / float(poly.circumradius)
+    return _real("scale", scale, minimum=0.0, inclusive=False)
+
+
+def render_slice(
+    polytope="5-cell",
+    matrix=None,
+    c0: float = 0.0,
+    *,
+    scale: float | None = None,
+    panel_size: float = 3.0,
+    dpi: float = 100,
+    title: str | None = None,
+    **draw_kwargs,
+) -> Figure:
+    """One panel: the slice w = ``c0`` of ``polytope`` turned by ``matrix`` (identity by default).
+
+    ``polytope`` is a name ("5-cell" ... "600-cell") or a Polytope; ``scale`` defaults to
+    ``REFERENCE_RADIUS / circumradius`` (every polytope appears the size of the paper's
+    pentachoron).  Other keywords go to :func:`draw_slice`.
+    """
+    poly = _as_polytope(polytope)
+    matrix = np.eye(4) if matrix is None else matrix
+    c0 = _real("c0", c0)
+    s = _default_scale(poly, scale)
+    _, panel_size, dpi = _check_grid_args(1, panel_size, dpi, title)
+    fig, (ax,) = _grid_figure(1, 1, panel_size, dpi, title)
+    draw_kwargs.setdefault("radius", s * float(poly.circumradius))
+    draw_slice(ax, slice_polytope(poly, matrix, c0), scale=s, **draw_kwargs)
+    return fig
+
+
+def render_key_sequence(
+    key: str,
+    n_panels: int = 16,
+    *,
+    state: RotationState | None = None,
+    polytope="5-cell",
+    shift: bool = False,
+    ncols: int = 4,
+    scale: float | None = None,
+    panel_size: float = 2.0,
+    dpi: float = 100,
+    labels: bool = True,
+    title: str | None = None,
+    **draw_kwargs,
+) -> Figure:
+    """A grid of panels showing what pressing ``key`` repeatedly does.
+
+    Panel k (k = 0 ... ``n_panels`` - 1, labelled (a), (b), ...) shows the slice w = c0 after k
+    presses of ``key`` (with ``shift`` for the inverse) starting from ``state`` (default: a fresh
+    :class:`RotationState`).  ``state`` is copied, never modified.  Any bound key works: "4" turns
+    in the x-w plane, "z" is a double rotation, "l" raises c0.  ``ncols`` panels per row
+    (fewer if there are fewer panels), each ``panel_size`` inches square at ``dpi``; all panels
+    share one frame.  Other keywords go to :func:`draw_slice`.
+    """
+    if not isinstance(key, str):
+        raise TypeError(f"Expected `key` to be a string such as '4' or 'z', got {type(key).__name__}")
+    n_panels = _count("n_panels", n_panels)
+    ncols, panel_size, dpi = _check_grid_args(ncols, panel_size, dpi, title)
+    if state is None:
+        state = RotationState()
+    elif not isinstance(state, RotationState):
+        raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+    state = copy.deepcopy(state)
+    if state.keymap.resolve(key, bool(shift)) is None:
+        bound = " ".join(sorted(k for k in state.keymap if len(k) == 1))
+        raise ValueError(f"Key {key!r} is not bound to an action; bound keys: {bound}")
+    poly = _as_polytope(polytope)
+    s = _default_scale(poly, scale)
+    draw_kwargs.setdefault("radius", s * float(poly.circumradius))
+
+    fig, axes = _grid_figure(n_panels, ncols, panel_size, dpi, title)
+    for k in range(n_panels):
+        if k:
+            state.press(key, shift=bool(shift))
+        label = _panel_label(k) if labels else None
+        draw_slice(axes[k], slice_polytope(poly, state.matrix, state.c0), scale=s, label=label,
+                   **draw_kwargs)
+    return fig
+
+
+def _save(fig: Figure, path) -> None:
+    if path is None:
+        return
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"Expected `path` to be a file path or None, got {type(path).__name__}")
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext not in _SAVE_FORMATS:
+        raise ValueError(f"Expected `path` to end in one of {', '.join(_SAVE_FORMATS)}, got {os.fspath(path)!r}")
+    fig.savefig(path, dpi=fig.dpi, facecolor="white")
+
+
+def paper_figure_3(path=None, *, panel_size: float = 2.0, dpi: float = 100, title: bool = True) -> Figure:
+    """The paper's Fig. 3: 16 slices w = 0 of the a = 2 pentachoron under key "4" (R_xw, theta0 = pi/16).
+
+    Panel k shows the slice after k presses; panel (a) is the regular tetrahedron of edge 1.6.
+    (The paper's caption says R_yw; its key table, which wins, binds "4" to R_xw.)
+    Saved to ``path`` (.png, .pdf or .svg) if given.
+    """
+    fig = render_key_sequence(
+        "4", 16, state=RotationState(theta0=FIG3_THETA0), polytope=pentachoron(2.0), ncols=4,
+        scale=1.0, panel_size=panel_size, dpi=dpi,
+        title="Fig. 3: key \u201c4\u201d, R_xw(\u03c0/16) per panel; pentachoron a = 2, slice w = 0"
+        if title else None,
+    )
+    _save(fig, path)
+    return fig
+
+
+def paper_figure_4(path=None, *, panel_size: float = 2.0, dpi: float = 100, title: bool = True) -> Figure:
+    """The paper's Fig. 4: 16 slices w = 0 of the a = 2 pentachoron under key "z" (R_xz,yw).
+
+    alpha = pi sqrt2 / (8 sqrt3) and beta = 1 - alpha (theta0 = 1 rad); alpha/beta is irrational, so
+    the sequence never returns to panel (a).  Saved to ``path`` (.png, .pdf or .svg) if given.
+    """
+    fig = render_key_sequence(
+        "z", 16, state=RotationState(theta0=FIG4_THETA0, alpha=FIG4_ALPHA), polytope=pentachoron(2.0),
+        ncols=4, scale=1.0, panel_size=panel_size, dpi=dpi,
+        title="Fig. 4: key \u201cz\u201d, R_xz,yw(\u03b1, \u03b2), \u03b1 = \u03c0\u221a2/(8\u221a3), "
+        "\u03b2 = 1 \u2212 \u03b1; w = 0" if title else None,
+    )
+    _save(fig, path)
+    return fig
