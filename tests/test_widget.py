@@ -1,0 +1,664 @@
+"""Rot4DWidget without a browser: key handling, held keys, flow control, errors.
+
+The rendering path is replaced by fakes here (a Scene that records what it is
+asked to show, a Companion whose "drawn" / "focus lost" callbacks the test
+fires), so these tests pin the widget's own logic.  Events reach the widget
+the way ipyevents delivers them: as a custom comm message to the Event model.
+tests/test_widget_scene.py runs the real Scene and Companion.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+import uuid
+
+import comm as comm_package
+import ipywidgets
+import numpy as np
+import pytest
+from ipywidgets import CallbackDispatcher
+from ipywidgets.widgets import widget as ipywidget_module
+from jupyter_client.session import json_packer
+from ipykernel.jsonutil import json_clean
+
+from rot4d_widget import polytope, simple_rotation, slice_polytope
+from rot4d_widget import widget as wmod
+from rot4d_widget.state import DEFAULT_THETA0
+from rot4d_widget.widget import Rot4DWidget
+
+
+# --------------------------------------------------------------------- comms
+class RecordingComm:
+    """Stands in for the kernel's comm: records what a widget sends, serialised like the real one."""
+
+    kernel = "Truthy"  # ipywidgets sends only when the comm has a kernel
+    log: list = []  # every message of every comm: (comm_id, data, n_bytes)
+
+    def __init__(self, *args, comm_id=None, **kwargs):
+        self.comm_id = comm_id or uuid.uuid4().hex
+        self.handler = None
+        self.closed = False
+
+    def open(self, *args, **kwargs):
+        pass
+
+    def on_msg(self, callback):
+        self.handler = callback
+
+    def on_close(self, callback):
+        pass
+
+    def send(self, data=None, metadata=None, buffers=None):
+        content = json_clean(dict(data=data, comm_id=self.comm_id))
+        n = len(json_packer(content)) + sum(memoryview(b).nbytes for b in (buffers or ()))
+        RecordingComm.log.append((self.comm_id, data, n))
+
+    def close(self, *args, **kwargs):
+        self.closed = True
+
+
+@pytest.fixture(autouse=True)
+def recording_comms(monkeypatch):
+    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: RecordingComm(*a, **k))
+    RecordingComm.log = []
+    yield RecordingComm.log
+
+
+# --------------------------------------------------------------------- fakes
+class FakeScene:
+    instances: list = []
+
+    def __init__(self, polytope, **options):
+        self.polytope = polytope
+        self.options = options
+        self.renderer = ipywidgets.Box()  # a DOMWidget, as ipyevents requires
+        self.scale = 1.0
+        self.shown = []  # the Slices passed to show()
+        self.closed = False
+        FakeScene.instances.append(self)
+
+    def show(self, s):
+        self.shown.append(s)
+        return 1000
+
+    def close(self):
+        self.closed = True
+        self.renderer.close()
+
+
+class FakeCompanion(ipywidgets.DOMWidget):
+    def __init__(self, scene):
+        super().__init__()
+        self.scene = scene
+        self._drawn = CallbackDispatcher()
+        self._focus = CallbackDispatcher()
+
+    def on_drawn(self, callback, remove=False):
+        self._drawn.register_callback(callback, remove=remove)
+
+    def on_focus_lost(self, callback, remove=False):
+        self._focus.register_callback(callback, remove=remove)
+
+    def drawn(self, *args):
+        self._drawn(*args)
+
+    def focus_lost(self):
+        self._focus({"event": "blur"})
+
+
+@pytest.fixture(autouse=True)
+def fake_rendering(monkeypatch):
+    FakeScene.instances = []
+    monkeypatch.setattr(wmod, "_scene_classes", lambda: (FakeScene, FakeCompanion))
+
+
+class FakeClock:
+    def __init__(self, t=100.0):
+        self.t = t
+
+    def __call__(self):
+        return self.t
+
+
+@pytest.fixture
+def clock():
+    return FakeClock()
+
+
+@pytest.fixture
+def make(clock):
+    made = []
+
+    def _make(*args, **kwargs):
+        kwargs.setdefault("clock", clock)
+        kwargs.setdefault("autotick", False)
+        w = Rot4DWidget(*args, **kwargs)
+        made.append(w)
+        return w
+
+    yield _make
+    for w in made:
+        w.close()
+
+
+# -------------------------------------------------------------------- events
+_CODES = {"?": "Slash", "@": "Digit2", "+": "Equal", "-": "Minus"}
+
+
+def key_event(kind, key, code=None, shift=False, repeat=False, t=0.0, **extra):
+    """The dict ipyevents 2.0.4 sends for a key event."""
+    if code is None:
+        code = _CODES.get(key) or (f"Digit{key}" if key.isdigit() else f"Key{key.upper()}")
+    ev = {
+        "type": kind, "event": kind, "key": key, "code": code, "shiftKey": shift,
+        "altKey": False, "ctrlKey": False, "metaKey": False, "repeat": repeat,
+        "timeStamp": t * 1000.0, "location": 0, "target": {},
+    }
+    ev.update(extra)
+    return ev
+
+
+def deliver(w, event):
+    """Deliver ``event`` as the front end does: a custom message on the Event's comm."""
+    msg = {"content": {"data": {"method": "custom", "content": event}}, "buffers": []}
+    w.events.comm.handler(msg)
+
+
+def down(w, key, **kw):
+    deliver(w, key_event("keydown", key, **kw))
+
+
+def up(w, key, **kw):
+    deliver(w, key_event("keyup", key, **kw))
+
+
+def run_ticker(w, clock, until):
+    """Do what the ticker thread does, with the fake clock: wake at each deadline up to ``until``."""
+    while True:
+        deadline = w._service()
+        if deadline is None or deadline > until:
+            clock.t = until
+            w._service()
+            return
+        clock.t = max(clock.t, deadline)
+
+
+def xw_steps(w):
+    """How many R_xw steps (theta0 each) the state's matrix is from the identity."""
+    m = w.state.matrix
+    return round(math.atan2(m[3, 0], m[0, 0]) / w.state.theta0)
+
+
+def n_messages(log, since):
+    return len(log) - since
+
+
+# ===================================================================== tests
+def test_builds_a_displayable_hbox_with_canvas_readout_help(make):
+    w = make()
+    assert isinstance(w, ipywidgets.HBox)
+    assert w.polytope is polytope("5-cell")
+    assert w.state.theta0 == DEFAULT_THETA0 and w.state.c0 == 0.0
+    assert w.state.c0_step == pytest.approx(polytope("5-cell").circumradius / 64)
+    canvas, side = w.children
+    assert canvas.children == (w.scene.renderer, w.companion)
+    assert side.children == (w.readout, w.help_panel, w.errors)
+    assert w.events.source is w.scene.renderer
+    assert set(w.events.watched_events) >= {"keydown", "keyup", "mouseleave"}
+    assert w.events.prevent_default_action
+    # the initial slice is the regular tetrahedron of the paper's Fig. 3(a)
+    assert len(w.scene.shown) == 1 and w.scene.shown[0] is w.slice
+    assert w.slice.face_census() == {3: 4}
+    assert not w.in_flight
+    assert "4 triangles" in w.readout.value and "c0" in w.readout.value
+    assert not w.help_visible
+
+
+def test_accepts_a_name_alias_or_polytope_and_options(make):
+    p = polytope("24-cell")
+    w = make(p, theta0=0.1, alpha=0.03, c0=0.5, width=320, height=240, background="white", foo=1)
+    assert w.polytope is p and w.state.theta0 == 0.1 and w.state.alpha == 0.03 and w.state.c0 == 0.5
+    assert w.scene.options == {"width": 320, "height": 240, "background": "white", "foo": 1}
+    assert w.state.c0_step == pytest.approx(p.circumradius / 64)
+    assert make("tesseract").polytope is polytope("8-cell")
+    assert make(c0_step=0.25).state.c0_step == 0.25
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, match",
+    [
+        ({"polytope": "7-cell"}, ValueError, "5-cell.*120-cell"),
+        ({"polytope": 5}, TypeError, "polytope name"),
+        ({"theta0": float("nan")}, ValueError, "theta0"),
+        ({"theta0": float("inf")}, ValueError, "theta0"),
+        ({"theta0": -0.1}, ValueError, r"theta0.*\(0, pi\]"),
+        ({"theta0": "fast"}, TypeError, "theta0"),
+        ({"alpha": float("nan")}, ValueError, "alpha"),
+        ({"c0": None}, TypeError, "c0"),
+        ({"c0_step": -1.0}, ValueError, "c0_step"),
+        ({"width": -10}, ValueError, "width.*positive integer"),
+        ({"height": 0}, ValueError, "height.*positive integer"),
+        ({"width": 300.5}, TypeError, "width.*positive integer"),
+        ({"ball_radius": -0.1}, ValueError, "ball_radius.*> 0"),
+        ({"bar_radius": float("nan")}, ValueError, "bar_radius"),
+        ({"face_opacity": 1.5}, ValueError, r"face_opacity.*\[0, 1\]"),
+        ({"hold_delay": 0}, ValueError, "hold_delay"),
+        ({"tick_rate": float("inf")}, ValueError, "tick_rate"),
+        ({"tick_rate": 10_000}, ValueError, "tick_rate"),
+        ({"ack_timeout": -1}, ValueError, "ack_timeout"),
+        ({"clock": 3}, TypeError, "clock"),
+        ({"keymap": {"4": "xw"}}, TypeError, "Keymap"),
+    ],
+)
+def test_bad_options_raise_naming_what_is_allowed(kwargs, exc, match):
+    before = len(ipywidget_module._instances)
+    with pytest.raises(exc, match=match):
+        Rot4DWidget(autotick=False, **kwargs)
+    assert len(ipywidget_module._instances) == before  # nothing half-built left open
+
+
+def test_keydown_steps_once_at_once_and_a_tap_is_one_step(make, clock):
+    w = make()
+    down(w, "4")
+    assert np.allclose(w.state.matrix, simple_rotation("xw", w.state.theta0))
+    assert len(w.scene.shown) == 2 and w.in_flight
+    clock.t += 0.1
+    up(w, "4")
+    run_ticker(w, clock, clock.t + 2.0)
+    assert xw_steps(w) == 1
+    assert w.held_keys == ()
+
+
+def test_shift_inverts_whatever_the_browser_reports_for_shift_digit(make):
+    w = make()
+    down(w, "@", code="Digit2", shift=True)  # a US keyboard's Shift+2
+    up(w, "@", code="Digit2", shift=True)
+    down(w, "2", code="Digit2", shift=True)  # Playwright's "Shift+2"
+    up(w, "2", code="Digit2", shift=True)
+    assert np.allclose(w.state.matrix, simple_rotation("xy", -2 * w.state.theta0))
+    down(w, "C", code="KeyC", shift=True)
+    up(w, "C", code="KeyC", shift=True)
+    assert np.allclose(w.state.matrix, simple_rotation("zw", -w.state.theta0) @ simple_rotation("xy", -2 * w.state.theta0))
+
+
+def test_held_key_repeats_at_the_tick_rate_after_the_hold_delay(make, clock):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    run_ticker(w, clock, t0 + w.hold_delay - 0.01)
+    assert xw_steps(w) == 1  # nothing more before the hold delay
+    run_ticker(w, clock, t0 + 1.0)
+    up(w, "4")
+    # one step on keydown, then one at hold_delay and every 1/tick_rate up to 1 s
+    expected = 1 + math.floor((1.0 - w.hold_delay) * w.tick_rate) + 1
+    assert xw_steps(w) == expected == 24
+    run_ticker(w, clock, clock.t + 1.0)
+    assert xw_steps(w) == expected  # stops on keyup
+
+
+def test_browser_auto_repeat_adds_nothing(make, clock):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    for i in range(1, 30):  # repeats at 30 Hz, like a real keyboard
+        clock.t = t0 + i / 30
+        w._service()
+        down(w, "4", repeat=True)
+    clock.t = t0 + 1.0
+    w._service()
+    up(w, "4")
+    assert xw_steps(w) == 24  # the same as without repeats
+
+
+def test_repeat_keydown_without_a_press_does_not_start_a_hold(make, clock):
+    w = make()
+    down(w, "4", repeat=True)  # the key was already down when the pointer entered
+    run_ticker(w, clock, clock.t + 1.0)
+    assert xw_steps(w) == 0 and w.held_keys == ()
+
+
+def test_keyup_releases_by_code_whatever_shift_did(make, clock):
+    w = make()
+    down(w, "C", code="KeyC", shift=True)
+    assert w.held_keys == ("KeyC",)
+    up(w, "c", code="KeyC", shift=False)  # Shift released first
+    assert w.held_keys == ()
+    down(w, "2", code="Digit2")
+    up(w, "@", code="Digit2", shift=True)  # Shift pressed meanwhile
+    assert w.held_keys == ()
+
+
+@pytest.mark.parametrize("stop", ["mouseleave", "focus"])
+def test_rotation_stops_on_mouseleave_and_on_focus_loss(make, clock, stop):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    run_ticker(w, clock, t0 + 0.5)
+    n = xw_steps(w)
+    assert n > 2
+    if stop == "mouseleave":
+        deliver(w, {"type": "mouseleave", "event": "mouseleave", "target": {}})
+    else:
+        w.companion.focus_lost()
+    run_ticker(w, clock, t0 + 2.0)
+    assert xw_steps(w) == n and w.held_keys == ()
+
+
+def test_two_held_keys_compose_in_the_order_pressed(make, clock):
+    w = make()
+    th = w.state.theta0
+    a, b = simple_rotation("xw", th), simple_rotation("xy", th)
+    down(w, "4")
+    down(w, "2")
+    run_ticker(w, clock, clock.t + 0.5)
+    up(w, "4")
+    up(w, "2")
+    n = 1 + math.floor((0.5 - w.hold_delay) * w.tick_rate) + 1
+    expected = np.linalg.matrix_power(b @ a, n)
+    reverse = np.linalg.matrix_power(a @ b, n)
+    assert np.allclose(w.state.matrix, expected, atol=1e-9)
+    assert not np.allclose(w.state.matrix, reverse, atol=1e-6)
+
+
+def test_parameter_keys_repeat_but_step_angle_keys_do_not(make, clock):
+    w = make()
+    c0, step = w.state.c0, w.state.c0_step
+    down(w, "l")
+    run_ticker(w, clock, clock.t + 1.0)
+    up(w, "l")
+    assert w.state.c0 == pytest.approx(c0 + 24 * step)
+    theta0 = w.state.theta0
+    down(w, "+", code="Equal", shift=True)
+    run_ticker(w, clock, clock.t + 1.0)
+    up(w, "+", code="Equal", shift=True)
+    assert w.state.theta0 == pytest.approx(theta0 * math.sqrt(2))
+
+
+def test_at_most_one_update_in_flight_and_the_next_is_the_latest_state(make, clock):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    assert len(w.scene.shown) == 2 and w.in_flight
+    run_ticker(w, clock, t0 + 0.45)  # state moves on, but nothing is sent without an ack
+    assert xw_steps(w) > 3
+    assert len(w.scene.shown) == 2
+    w.companion.drawn()
+    assert len(w.scene.shown) == 3 and w.in_flight
+    latest = slice_polytope(w.polytope, w.state.matrix, w.state.c0)
+    assert np.allclose(w.scene.shown[-1].vertices, latest.vertices)
+    w.companion.drawn()  # acknowledges update 3: nothing changed since, so nothing is sent
+    w.companion.drawn()
+    assert len(w.scene.shown) == 3 and not w.in_flight
+
+
+def test_duplicate_acknowledgements_release_nothing_extra(make, clock):
+    w = make()
+    down(w, "4")
+    up(w, "4")
+    assert w.in_flight and len(w.scene.shown) == 2
+    down(w, "4")
+    up(w, "4")  # a second step while the first is in flight: pending
+    assert len(w.scene.shown) == 2
+    w.companion.drawn(1)  # view A acknowledges update 1 -> update 2 goes out
+    assert len(w.scene.shown) == 3
+    w.companion.drawn(1)  # view B's late acknowledgement of update 1: ignored
+    assert w.in_flight
+    down(w, "4")
+    up(w, "4")
+    assert len(w.scene.shown) == 3  # still waiting for update 2's acknowledgement
+    w.companion.drawn({"seq": 2})
+    assert len(w.scene.shown) == 4
+
+
+def test_after_release_the_view_settles_at_once(make, clock):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    for i in range(10):  # the page acknowledges every 0.1 s while the key is held
+        run_ticker(w, clock, t0 + 0.1 * (i + 1))
+        w.companion.drawn()
+    up(w, "4")
+    final = w.state.matrix.copy()
+    w.companion.drawn()  # the update in flight when the key was released
+    shown = len(w.scene.shown)
+    for i in range(5):
+        run_ticker(w, clock, clock.t + 0.2)
+        w.companion.drawn()
+    assert len(w.scene.shown) == shown  # no replay, no trailing updates
+    assert np.allclose(w.scene.shown[-1].vertices, slice_polytope(w.polytope, final, 0.0).vertices)
+    assert not w.in_flight
+
+
+def test_without_acknowledgements_the_latest_state_is_sent_after_the_timeout(make, clock):
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    run_ticker(w, clock, t0 + w.ack_timeout - 0.01)
+    assert len(w.scene.shown) == 2
+    run_ticker(w, clock, t0 + w.ack_timeout + 0.001)
+    assert len(w.scene.shown) == 3 and w.n_timeouts == 1
+    run_ticker(w, clock, t0 + 0.7)
+    up(w, "4")
+    run_ticker(w, clock, t0 + 10.0)
+    # the steps taken after the first timeout go out one timeout later; then nothing
+    assert w.n_timeouts == 2 and len(w.scene.shown) == 4
+    assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
+
+
+def test_scripting_press_redraws_and_respects_flow_control(make, clock):
+    w = make()
+    assert w.press("4") is True
+    assert len(w.scene.shown) == 2
+    assert w.press("C") is True  # R_zw inverted; pending while update 1 is in flight
+    assert w.press("c", shift=True) is True
+    expected = simple_rotation("zw", -2 * w.state.theta0) @ simple_rotation("xw", w.state.theta0)
+    assert np.allclose(w.state.matrix, expected)
+    assert np.allclose(w.slice.vertices, slice_polytope(w.polytope, expected, 0.0).vertices)
+    assert len(w.scene.shown) == 2
+    clock.t += w.ack_timeout  # no view (nbval): the timeout sends the latest
+    w._service()
+    assert len(w.scene.shown) == 3 and w.scene.shown[-1] is w.slice
+    assert w.press("q") is False
+    with pytest.raises(TypeError, match="key"):
+        w.press(4)
+
+
+def test_unbound_keys_and_keyups_send_no_message(make, recording_comms):
+    w = make()
+    n0 = len(recording_comms)
+    for key, code, shift in [("q", "KeyQ", False), ("Shift", "ShiftLeft", True), ("F5", "F5", False),
+                             ("Enter", "Enter", True), ("m", "KeyM", False)]:
+        down(w, key, code=code, shift=shift)
+        up(w, key, code=code, shift=shift)
+    down(w, "4", ctrlKey=True)  # a chord is not ours
+    up(w, "4")
+    assert n_messages(recording_comms, n0) == 0
+    assert len(w.scene.shown) == 1
+
+
+def test_nothing_changed_sends_nothing(make, recording_comms):
+    w = make(theta0=math.pi)
+    n0 = len(recording_comms)
+    down(w, "+", code="Equal", shift=True)  # theta0 is already at its maximum
+    up(w, "+", code="Equal", shift=True)
+    assert n_messages(recording_comms, n0) == 0
+    down(w, "k")  # alpha changes: the readout, not the geometry
+    up(w, "k")
+    assert len(w.scene.shown) == 1
+    assert [cid for cid, _, _ in recording_comms[n0:]] == [w.readout.comm.comm_id]
+
+
+def test_readout_shows_parameters_last_action_census_and_volume(make):
+    w = make()
+    for _ in range(3):
+        down(w, "4")
+        up(w, "4")
+        w.companion.drawn()
+    text = w.readout.value
+    assert "R_xw \u00d73" in text
+    for label in ("\u03b80", "\u03b1", "\u03b2", "c0", "volume"):
+        assert label in text
+    assert f"{w.state.theta0:.5f}" in text and f"{w.state.beta:.5f}" in text
+    assert f"{w.slice.volume:.4f}" in text
+    census = w.slice.face_census()
+    assert str(sum(census.values())) in text or any(f"{c} " in text for c in census.values())
+    down(w, "2", code="Digit2", shift=True)
+    w.companion.drawn()
+    assert "R_xy\u207b\u00b9" in w.readout.value and "\u00d7" not in w.readout.value
+    down(w, "l")
+    w.companion.drawn()
+    assert f"{w.state.c0:.4f}" in w.readout.value and "c0+" in w.readout.value
+
+
+def test_readout_names_an_empty_slice(make):
+    w = make(c0=10.0)
+    assert "empty" in w.readout.value and "0.0000" in w.readout.value
+
+
+def test_help_key_toggles_the_key_table(make):
+    w = make()
+    assert not w.help_visible
+    down(w, "?", code="Slash", shift=True)
+    up(w, "?", code="Slash", shift=True)
+    assert w.help_visible
+    for key, label, _ in w.state.keymap.help_rows():
+        assert f"<kbd>{key}</kbd>" in w.help_panel.value
+        assert label in w.help_panel.value
+    w.press("?")
+    assert not w.help_visible
+
+
+@pytest.mark.parametrize(
+    "event",
+    [
+        None, 42, "keydown", [], {}, {"type": 5}, {"type": "keydown"},
+        {"type": "keydown", "key": None, "code": None},
+        {"type": "keydown", "key": 4, "code": ["Digit4"]},
+        {"type": "keydown", "key": "4", "code": "Digit4", "shiftKey": "yes", "repeat": "no"},
+        {"type": "keyup", "key": {}, "code": 7},
+        {"type": "wheel", "deltaY": 3},
+        {"event": "keydown", "key": "", "code": ""},
+    ],
+)
+def test_malformed_events_are_ignored(make, event):
+    w = make()
+    before = w.state.matrix.copy()
+    w._handle_event(event)
+    if isinstance(event, dict) and event.get("key") == "4" and event.get("code") == "Digit4":
+        assert np.allclose(w.state.matrix, simple_rotation("xw", w.state.theta0))  # usable: used
+    else:
+        assert np.array_equal(w.state.matrix, before)
+    assert w.errors.outputs == ()
+
+
+def test_errors_in_key_handling_are_shown_not_lost(make, clock):
+    w = make()
+
+    def broken(s):
+        raise RuntimeError("scene exploded")
+
+    w.scene.show = broken
+    down(w, "4")  # must not raise into the kernel's comm handler
+    assert len(w.errors.outputs) == 1
+    out = w.errors.outputs[0]
+    assert out["name"] == "stderr" and "RuntimeError: scene exploded" in out["text"]
+    assert w.held_keys == ()  # a failing key does not keep firing
+    for _ in range(10):
+        down(w, "2")
+    assert len(w.errors.outputs) == wmod.MAX_ERRORS_SHOWN  # bounded
+
+
+def test_errors_in_the_ticker_are_shown_and_stop_the_hold(make, clock):
+    w = make()
+    down(w, "4")
+    w.companion.drawn()
+    w.scene.show = lambda s: 1 / 0
+    run_ticker(w, clock, clock.t + 1.0)
+    assert any("ZeroDivisionError" in o["text"] for o in w.errors.outputs)
+    assert w.held_keys == ()
+
+
+def test_rerunning_the_cell_makes_independent_widgets(make):
+    w1 = make()
+    w2 = make()
+    assert w1.scene.renderer is not w2.scene.renderer and w1.events is not w2.events
+    down(w2, "4")
+    up(w2, "4")
+    assert xw_steps(w2) == 1 and xw_steps(w1) == 0
+    w1.close()
+    down(w2, "4")
+    up(w2, "4")
+    assert xw_steps(w2) == 2
+
+
+def test_close_stops_the_thread_and_closes_every_child(recording_comms):
+    w = Rot4DWidget(hold_delay=0.01, tick_rate=200)
+    children = [w.events, w.companion, w.scene.renderer, w.readout, w.help_panel, w.errors, *w.children]
+    down(w, "4")
+    thread = w._thread
+    assert thread is not None and thread.is_alive()
+    time.sleep(0.05)
+    w.close()
+    assert not thread.is_alive()
+    assert w.scene.closed
+    assert all(c.comm is None for c in children) and w.comm is None
+    n = xw_steps(w)
+    w._handle_event(key_event("keydown", "4"))  # a late event acts on nothing
+    w._handle_drawn()
+    time.sleep(0.02)
+    assert xw_steps(w) == n
+    with pytest.raises(RuntimeError, match="closed"):
+        w.press("4")
+    w.close()  # idempotent
+
+
+def test_the_ticker_thread_rotates_in_real_time_and_stops_on_keyup():
+    w = Rot4DWidget(hold_delay=0.02, tick_rate=200, ack_timeout=0.005)
+    try:
+        down(w, "4")
+        time.sleep(0.2)
+        up(w, "4")
+        n = xw_steps(w)
+        # 1 + ~200 * 0.18 = 37 in theory; be generous on a loaded 2-core machine
+        assert 10 <= n <= 45
+        time.sleep(0.05)
+        assert xw_steps(w) == n
+        assert w.errors.outputs == ()
+        # with no acknowledgement (no view), the timeout still delivered the latest state
+        assert w.n_timeouts >= 1
+        assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
+    finally:
+        w.close()
+
+
+def test_no_thread_until_needed_and_none_for_a_scripting_widget_at_rest():
+    w = Rot4DWidget()
+    try:
+        assert w._thread is None
+        w.press("k")  # readout only: nothing in flight, nothing to wait for
+        assert w._thread is None
+    finally:
+        w.close()
+
+
+def test_events_from_the_thread_and_the_kernel_interleave_safely():
+    w = Rot4DWidget(hold_delay=0.001, tick_rate=240, ack_timeout=0.002)
+    try:
+        rng = np.random.default_rng(1)
+        keys = ["2", "3", "4", "6", "8", "c", "y", "z", "w", "j", "k", "l", "h", "q"]
+        for i in range(400):
+            k = keys[rng.integers(len(keys))]
+            kind = "keydown" if rng.random() < 0.6 else "keyup"
+            deliver(w, key_event(kind, k, shift=bool(rng.random() < 0.3)))
+            if rng.random() < 0.3:
+                w._handle_drawn()
+            if i % 50 == 0:
+                time.sleep(0.003)
+        deliver(w, {"type": "mouseleave"})
+        m = w.state.matrix
+        assert np.allclose(m @ m.T, np.eye(4), atol=1e-12)
+        assert w.errors.outputs == ()
+    finally:
+        w.close()
