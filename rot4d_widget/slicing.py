@@ -196,11 +196,11 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     on = ~(pos | neg)
     ea, eb = t.ea, t.eb
     crossing = bool(pos.any() and neg.any())
-    on_idx = np.flatnonzero(on)
+    on_idx = on.nonzero()[0]
     fv_on = on[t.fv_vert]
     if crossing:
         cross_e = (pos[ea] & neg[eb]) | (neg[ea] & pos[eb])
-        ce_idx = np.flatnonzero(cross_e)
+        ce_idx = cross_e.nonzero()[0]
         a, b = ea[ce_idx], eb[ce_idx]
         ha = h[a]
         s = (ha / (ha - h[b]))[:, None]
@@ -220,7 +220,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
 
     # edges of S: chords of crossing 2-faces, then polytope edges lying in H
     e_on = on[ea] & on[eb]
-    in_h_edges = np.stack([vert_sv[ea[e_on]], vert_sv[eb[e_on]]], axis=1)
+    in_h_edges = vert_sv[np.stack([ea[e_on], eb[e_on]], axis=1)] if e_on.any() else t.empty_i2
     if crossing:
         fv_pos = pos[t.fv_vert]
         fv_neg = neg[t.fv_vert]
@@ -231,7 +231,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         seg_sv = np.concatenate([edge_sv[t.fe_edge[m1]], vert_sv[t.fv_vert[m2]]])
         order = np.argsort(seg_face, kind="stable")
         sf = seg_face[order]
-        if len(sf) % 2 or np.any(sf[0::2] != sf[1::2]):
+        if len(sf) % 2 or (sf[0::2] != sf[1::2]).any():
             raise _Inconsistent
         edges = np.concatenate([seg_sv[order].reshape(-1, 2), in_h_edges])
     else:
@@ -243,10 +243,10 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
 
     # polygons of S: one per crossing cell, one per 2-face lying in H
     C = t.C
-    centre = vertices.mean(axis=0)
+    centre = vertices.sum(axis=0) / len(vertices)
     f_on = np.logical_and.reduceat(fv_on, t.f_starts)
     k3 = f_on[t.fv_face]
-    face_ids = np.flatnonzero(f_on)
+    face_ids = f_on.nonzero()[0]
     if len(face_ids):
         abc = x[t.face_abc[face_ids], :3]  # (nf, 3, 3)
         fn = np.cross(abc[:, 1] - abc[:, 0], abc[:, 2] - abc[:, 1])
@@ -271,32 +271,45 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     normals[C + face_ids] = fn
 
     present = np.bincount(poly_id, minlength=C + t.F)
-    ids = np.flatnonzero(present)
+    ids = present.nonzero()[0]
     counts = present[ids]
-    rank_of = np.cumsum(present > 0) - 1
+    n_poly = len(ids)
+    rank_of = np.empty(C + t.F, dtype=np.intp)
+    rank_of[ids] = np.arange(n_poly)
     rank = rank_of[poly_id]
     pts = vertices[poly_sv]
-    # angular order about each polygon's (outward) normal, around its corner mean
-    cx = np.bincount(rank, weights=pts[:, 0]) / counts
-    cy = np.bincount(rank, weights=pts[:, 1]) / counts
-    cz = np.bincount(rank, weights=pts[:, 2]) / counts
+    # Angular order about each polygon's outward normal n, around its corner mean.
+    # In-plane axes u = n x e_x (or n x e_y when n is near e_x) and v = n x u,
+    # written out: they need not be unit, a linear map of positive determinant
+    # keeps the cyclic order of directions.
+    centres = np.empty((n_poly, 3))
+    centres[:, 0] = np.bincount(rank, weights=pts[:, 0])
+    centres[:, 1] = np.bincount(rank, weights=pts[:, 1])
+    centres[:, 2] = np.bincount(rank, weights=pts[:, 2])
+    centres /= counts[:, None]
     n = normals[ids]
-    n /= np.sqrt(np.einsum("ij,ij->i", n, n))[:, None]
-    # u: any unit vector in the polygon's plane; v = n x u
-    ref = np.zeros_like(n)
-    ref[np.arange(len(n)), np.argmin(np.abs(n), axis=1)] = 1.0
-    u = np.cross(n, ref)
-    v = np.cross(n, u)
-    d = pts - np.stack([cx, cy, cz], axis=1)[rank]
-    ang = np.arctan2(np.einsum("ij,ij->i", d, v[rank]), np.einsum("ij,ij->i", d, u[rank]))
+    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
+    use_x = nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)
+    uv = np.empty((n_poly, 6))
+    uv[:, 0] = np.where(use_x, 0.0, -nz)
+    uv[:, 1] = np.where(use_x, nz, 0.0)
+    uv[:, 2] = np.where(use_x, -ny, nx)
+    uv[:, 3] = np.where(use_x, -(ny * ny + nz * nz), nx * ny)
+    uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
+    uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
+    d = pts - centres[rank]
+    uvr = uv[rank]
+    ang = np.arctan2(
+        np.einsum("ij,ij->i", d, uvr[:, 3:]), np.einsum("ij,ij->i", d, uvr[:, :3])
+    )
     order = np.argsort(rank * _TWO_PI_PLUS + ang)
     flat = poly_sv[order]
-    offsets = np.zeros(len(ids) + 1, dtype=np.intp)
+    offsets = np.zeros(n_poly + 1, dtype=np.intp)
     np.cumsum(counts, out=offsets[1:])
 
     cell_ids = ids.copy()
-    is_face = ids >= C
-    if is_face.any():
+    if ids[-1] >= C:
+        is_face = ids >= C
         fc = t.face_cells[ids[is_face] - C]
         # prefer a cell lying in H (the whole-cell case), else the lower-numbered one
         c_on = np.logical_and.reduceat(on[t.cv_vert], t.c_starts)
@@ -306,13 +319,21 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     prank = rank[order]
     start = offsets[prank]
     pos_in = np.arange(len(flat)) - start
-    fan = (pos_in >= 1) & (pos_in <= counts[prank] - 2)
-    j = np.flatnonzero(fan)
-    triangles = np.stack([flat[start[j]], flat[j], flat[j + 1]], axis=1)
+    j = ((pos_in >= 1) & (pos_in <= counts[prank] - 2)).nonzero()[0]
+    triangles = np.empty((len(j), 3), dtype=np.intp)
+    triangles[:, 0] = flat[start[j]]
+    triangles[:, 1] = flat[j]
+    triangles[:, 2] = flat[j + 1]
     triangle_cells = cell_ids[prank[j]]
 
     # volume by the divergence theorem, about the vertex centroid (keeps slivers exact)
-    q = vertices - centre
-    A, B, D = q[triangles[:, 0]], q[triangles[:, 1]], q[triangles[:, 2]]
-    volume = float(np.einsum("ij,ij->", A, np.cross(B, D))) / 6.0
+    tri = (vertices - centre)[triangles]
+    A, B, D = tri[:, 0], tri[:, 1], tri[:, 2]
+    volume = float(
+        (
+            A[:, 0] * (B[:, 1] * D[:, 2] - B[:, 2] * D[:, 1])
+            + A[:, 1] * (B[:, 2] * D[:, 0] - B[:, 0] * D[:, 2])
+            + A[:, 2] * (B[:, 0] * D[:, 1] - B[:, 1] * D[:, 0])
+        ).sum()
+    ) / 6.0
     return Slice(vertices, edges, flat, offsets, cell_ids, triangles, triangle_cells, volume, 3)
