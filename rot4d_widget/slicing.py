@@ -139,9 +139,6 @@ class Slice:
         """The polygons as a list of vertex-index arrays (for iteration; not on the hot path)."""
         return np.split(self.polygon_indices, self.polygon_offsets[1:-1]) if len(self.cell_ids) else []
 
-    def __iter__(self):
-        raise TypeError("iterate over `slice.polygons`, not the Slice itself")
-
     @property
     def polygon_sizes(self) -> np.ndarray:
         return np.diff(self.polygon_offsets)
