@@ -50,6 +50,7 @@ __all__ = [
     "SliceDrawing",
     "perspective",
     "draw_slice",
+    "panel_style",
     "render_slice",
     "render_key_sequence",
     "paper_figure_3",
@@ -354,6 +355,23 @@ def _default_scale(poly: Polytope, scale):
     return _real("scale", scale, minimum=0.0, inclusive=False)
 
 
+def panel_style(polytope, scale: float | None = None) -> dict:
+    """Keywords for :func:`draw_slice` that suit ``polytope``: ``scale``, ``radius``, ball and bar sizes.
+
+    ``scale`` defaults to ``REFERENCE_RADIUS / circumradius`` (every polytope the size of the paper's
+    pentachoron); the frame ``radius`` is the scaled circumradius; balls and bars follow the scaled
+    edge length (the pentachoron's 0.07 and 0.025 at most, so that the 600 vertices of the 120-cell
+    do not merge).  Use as ``draw_slice(ax, s, **panel_style(p))``.
+    """
+    poly = _as_polytope(polytope)
+    s = _default_scale(poly, scale)
+    e = np.asarray(poly.edges, dtype=np.int64).reshape(-1, 2)
+    edge = float(np.linalg.norm(poly.vertices[e[:, 0]] - poly.vertices[e[:, 1]], axis=1).mean()) if len(e) else 1.0
+    ball = min(0.07, max(0.02, 0.035 * edge * s))
+    return {"scale": s, "radius": s * float(poly.circumradius), "ball_radius": ball,
+            "bar_radius": ball * 0.025 / 0.07}
+
+
 def render_slice(
     polytope="5-cell",
     matrix=None,
@@ -369,7 +387,7 @@ def render_slice(
 
     ``polytope`` is a name ("5-cell" ... "600-cell") or a Polytope; ``scale`` defaults to
     ``REFERENCE_RADIUS / circumradius`` (every polytope appears the size of the paper's
-    pentachoron).  Other keywords go to :func:`draw_slice`.
+    pentachoron), sizes to :func:`panel_style`.  Other keywords go to :func:`draw_slice`.
     """
     poly = _as_polytope(polytope)
     matrix = np.eye(4) if matrix is None else matrix
@@ -377,8 +395,8 @@ def render_slice(
     s = _default_scale(poly, scale)
     _, panel_size, dpi = _check_grid_args(1, panel_size, dpi, title)
     fig, (ax,) = _grid_figure(1, 1, panel_size, dpi, title)
-    draw_kwargs.setdefault("radius", s * float(poly.circumradius))
-    draw_slice(ax, slice_polytope(poly, matrix, c0), scale=s, **draw_kwargs)
+    kwargs = {**panel_style(poly, s), **draw_kwargs}
+    draw_slice(ax, slice_polytope(poly, matrix, c0), **kwargs)
     return fig
 
 
@@ -404,7 +422,7 @@ def render_key_sequence(
     :class:`RotationState`).  ``state`` is copied, never modified.  Any bound key works: "4" turns
     in the x-w plane, "z" is a double rotation, "l" raises c0.  ``ncols`` panels per row
     (fewer if there are fewer panels), each ``panel_size`` inches square at ``dpi``; all panels
-    share one frame.  Other keywords go to :func:`draw_slice`.
+    share one frame.  Sizes default to :func:`panel_style`; other keywords go to :func:`draw_slice`.
     """
     if not isinstance(key, str):
         raise TypeError(f"Expected `key` to be a string such as '4' or 'z', got {type(key).__name__}")
@@ -419,16 +437,14 @@ def render_key_sequence(
         bound = " ".join(sorted(k for k in state.keymap if len(k) == 1))
         raise ValueError(f"Key {key!r} is not bound to an action; bound keys: {bound}")
     poly = _as_polytope(polytope)
-    s = _default_scale(poly, scale)
-    draw_kwargs.setdefault("radius", s * float(poly.circumradius))
+    kwargs = {**panel_style(poly, scale), **draw_kwargs}
 
     fig, axes = _grid_figure(n_panels, ncols, panel_size, dpi, title)
     for k in range(n_panels):
         if k:
             state.press(key, shift=bool(shift))
         label = _panel_label(k) if labels else None
-        draw_slice(axes[k], slice_polytope(poly, state.matrix, state.c0), scale=s, label=label,
-                   **draw_kwargs)
+        draw_slice(axes[k], slice_polytope(poly, state.matrix, state.c0), label=label, **kwargs)
     return fig
 
 

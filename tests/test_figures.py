@@ -260,7 +260,7 @@ def test_parameter_key_sequence_moves_the_hyperplane():
 
 
 def test_default_scale_makes_every_polytope_the_pentachoron_size():
-    fig = render_slice("24-cell")
+    fig = render_slice("24-cell", ball_radius=0.07, bar_radius=0.025)  # the pentachoron's sizes
     ax = fig.axes[0]
     fig5 = render_slice(pentachoron(A))
     assert ax.get_xlim() == pytest.approx(fig5.axes[0].get_xlim())
@@ -341,3 +341,12 @@ def test_module_exports():
         assert hasattr(figures, name)
     assert isinstance(render_slice(), Figure)
     assert all(isinstance(b, Circle) for b in _patches(render_slice().axes[0], "ball"))
+
+
+def test_panel_style_keeps_dense_polytopes_readable():
+    five, dense = figures.panel_style(pentachoron(A)), figures.panel_style("120-cell")
+    assert five == pytest.approx({"scale": 1.0, "radius": figures.REFERENCE_RADIUS, "ball_radius": 0.07,
+                                  "bar_radius": 0.025})
+    assert dense["radius"] == pytest.approx(figures.REFERENCE_RADIUS)
+    assert 0.02 <= dense["ball_radius"] < five["ball_radius"]
+    assert dense["bar_radius"] < dense["ball_radius"]
