@@ -1,0 +1,119 @@
+"""The committed notebooks are fit to be run by nbval (`--nbval-lax --nbval-current-env`).
+
+nbval re-runs every notebook and, in lax mode, compares only the cells marked
+``# NBVAL_CHECK_OUTPUT`` with their committed outputs.  It silently skips the comparison for a
+cell saved without an execution count, and a cell saved without outputs compares as "nothing to
+check".  So the stated facts are only tested if the committed copies carry what is checked here:
+execution counts, outputs, no errors, and rounded (platform-independent) numbers.
+"""
+
+import re
+import sys
+from pathlib import Path
+
+import nbformat
+import pytest
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    tomllib = None
+
+ROOT = Path(__file__).resolve().parents[1]
+NB_DIR = ROOT / "notebooks"
+NOTEBOOKS = sorted(NB_DIR.glob("*.ipynb"))
+EXPECTED = ["01_pentachoron.ipynb", "02_regular_polychora.ipynb", "03_paper_figures.ipynb"]
+MARKER = "NBVAL_CHECK_OUTPUT"
+WIDGET_MIME = "application/vnd.jupyter.widget-view+json"
+
+
+def _is_marked(cell) -> bool:
+    """nbval's rule: a comment line that is exactly the marker, or the cell tag nbval-check-output."""
+    for line in cell.source.splitlines():
+        line = line.strip()
+        if line.startswith("#") and line.lstrip("#").strip() == MARKER:
+            return True
+    return "nbval-check-output" in cell.get("metadata", {}).get("tags", [])
+
+
+def _text(output) -> str:
+    if output.output_type == "stream":
+        return output.text
+    return output.get("data", {}).get("text/plain", "")
+
+
+def _load(path):
+    nb = nbformat.read(path, as_version=4)
+    nbformat.validate(nb)
+    return nb
+
+
+@pytest.fixture(params=NOTEBOOKS, ids=lambda p: p.name)
+def notebook(request):
+    return request.param, _load(request.param)
+
+
+def test_the_numbered_notebooks_are_there():
+    names = [p.name for p in NOTEBOOKS]
+    assert names[: len(EXPECTED)] == EXPECTED
+    for i, name in enumerate(names, start=1):
+        assert re.fullmatch(r"\d\d_[a-z0-9_]+\.ipynb", name), name
+        assert int(name[:2]) == i, f"notebooks are numbered 01, 02, ... without gaps: {names}"
+
+
+def test_every_notebook_states_checked_facts(notebook):
+    path, nb = notebook
+    assert any(c.cell_type == "code" and _is_marked(c) for c in nb.cells), f"{path.name} checks nothing"
+    assert nb.metadata.get("kernelspec", {}).get("name") == "python3"
+
+
+def test_marked_cells_have_execution_count_and_outputs(notebook):
+    path, nb = notebook
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "code" or not _is_marked(cell):
+            continue
+        where = f"{path.name} cell {i}"
+        assert isinstance(cell.execution_count, int), f"{where}: no execution count, nbval would skip it"
+        assert cell.outputs, f"{where}: no outputs, nbval would compare nothing"
+        assert any(_text(o).strip() for o in cell.outputs), f"{where}: no text output to compare"
+        assert "assert" in cell.source, f"{where}: a printed fact must also be asserted"
+        for out in cell.outputs:
+            assert out.output_type != "error", f"{where}: committed with an error"
+            assert WIDGET_MIME not in out.get("data", {}), f"{where}: widget views differ between runs"
+            text = _text(out)
+            # platform-independent: rounded numbers, no object addresses
+            assert not re.search(r"\d\.\d{7,}", text), f"{where}: unrounded number in {text!r}"
+            assert not re.search(r"0x[0-9a-f]{6,}", text), f"{where}: object address in {text!r}"
+            assert "-0.0000" not in text, f"{where}: negative zero in {text!r}"
+
+
+def test_executed_top_to_bottom_without_errors(notebook):
+    """Committed outputs come from one fresh run (counts 1, 2, 3, ...), so they agree with each other."""
+    path, nb = notebook
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert [c.execution_count for c in code] == list(range(1, len(code) + 1)), path.name
+    for c in code:
+        assert all(o.output_type != "error" for o in c.outputs), f"{path.name}: {c.source[:60]!r}"
+
+
+def test_notebooks_stay_small(notebook):
+    path, _ = notebook
+    assert path.stat().st_size < 1_000_000, f"{path.name} is {path.stat().st_size} bytes"
+
+
+def test_notebook_01_has_the_live_widget_cell():
+    nb = _load(NB_DIR / "01_pentachoron.ipynb")
+    cells = [c for c in nb.cells if c.cell_type == "code" and 'Rot4DWidget("5-cell")' in c.source]
+    assert cells, "01_pentachoron.ipynb must display Rot4DWidget(\"5-cell\")"
+    assert not any(_is_marked(c) for c in cells), "a widget view cannot be compared by nbval"
+
+
+@pytest.mark.skipif(tomllib is None, reason="tomllib needs Python 3.11")
+def test_the_default_test_command_runs_the_notebooks():
+    """`python -m pytest` must collect notebooks/ with nbval, or the checks above test nothing."""
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    addopts = conf.get("addopts", "")
+    addopts = " ".join(addopts) if isinstance(addopts, list) else addopts
+    assert "--nbval-lax" in addopts.split()
+    assert "--nbval-current-env" in addopts.split()
+    assert "notebooks" in conf.get("testpaths", [])
