@@ -182,7 +182,8 @@ class Rot4DWidget(widgets.HBox):
         autotick: bool = True,
         **scene_options,
     ):
-        # -- validate everything before any widget exists ------------------
+        # -- validate before any widget exists (the Scene checks its own options
+        #    before it builds anything) -----------------------------------------
         poly = _get_polytope(polytope)
         self.hold_delay = _positive_finite("hold_delay", hold_delay)
         self.tick_rate = _positive_finite("tick_rate", tick_rate)
@@ -194,22 +195,6 @@ class Rot4DWidget(widgets.HBox):
         if c0_step is None:
             c0_step = poly.circumradius * C0_STEP_FRACTION
         state = RotationState(theta0, alpha, c0, keymap=keymap, c0_step=c0_step)
-        for name, value in (("width", width), ("height", height)):
-            if value is not None:
-                if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-                    raise TypeError(f"Expected `{name}` to be a positive integer (pixels), got {type(value).__name__}")
-                if value <= 0:
-                    raise ValueError(f"Expected `{name}` to be a positive integer (pixels), got {value}")
-        for name, value in (("ball_radius", ball_radius), ("bar_radius", bar_radius)):
-            if value is not None:
-                _positive_finite(name, value)
-        if face_opacity is not None:
-            if isinstance(face_opacity, (bool, np.bool_)) or not isinstance(
-                face_opacity, (int, float, np.integer, np.floating)
-            ):
-                raise TypeError(f"Expected `face_opacity` to be a number in [0, 1], got {type(face_opacity).__name__}")
-            if not 0.0 <= float(face_opacity) <= 1.0:
-                raise ValueError(f"Expected `face_opacity` in [0, 1], got {face_opacity}")
         options = dict(
             width=width, height=height, ball_radius=ball_radius, bar_radius=bar_radius,
             face_opacity=face_opacity, background=background, cell_colors=cell_colors,
@@ -229,9 +214,8 @@ class Rot4DWidget(widgets.HBox):
         self._held: dict[str, _Held] = {}
         self._order = 0
         self._dirty = False
-        self._in_flight = None  # sequence number of the update awaiting "drawn"
+        self._in_flight = None  # scene.update_id of the update awaiting "drawn"
         self._sent_at = -math.inf
-        self._seq = 0
         self._shown = None  # (matrix, c0) the scene shows
         self._slice_cache = None  # (matrix, c0, Slice)
         self._last_label = None
@@ -338,6 +322,15 @@ class Rot4DWidget(widgets.HBox):
             self._wake()
             return changed
 
+    def refresh(self) -> None:
+        """Redraw after changing `state` directly (``w.state.matrix = m``); obeys the flow control."""
+        with self._lock:
+            if self._closed:
+                raise RuntimeError("This Rot4DWidget is closed")
+            self._dirty = True
+            self._flush(self._clock())
+            self._wake()
+
     def release_keys(self) -> None:
         """Forget every held key (what mouseleave and focus loss do)."""
         with self._lock:
@@ -367,13 +360,13 @@ class Rot4DWidget(widgets.HBox):
         finally:
             # The Event first, so its document listeners go before the canvas does.
             for w in parts:
-                if w is None:
-                    continue
-                try:
-                    w.close()
-                except Exception:  # closing must never fail halfway
-                    log.debug("closing %r failed", w, exc_info=True)
+                if w is not None:
+                    _close_quietly(w)
+            layout, style = getattr(self, "layout", None), getattr(self, "style", None)
             super().close()
+            for w in (layout, style):
+                if w is not None:
+                    _close_quietly(w)
 
     def __repr__(self) -> str:
         return (
@@ -398,10 +391,11 @@ class Rot4DWidget(widgets.HBox):
         except Exception as exc:  # shown, never lost, never raised into the kernel
             self._report_error(exc)
 
-    def _handle_drawn(self, *args, **kwargs) -> None:
-        """Companion: the page rendered a frame containing the latest buffer."""
+    def _handle_drawn(self, seq=None) -> None:
+        """Companion: the page rendered a frame containing update ``seq`` (``scene.update_id``)."""
         try:
-            seq = _ack_sequence(args, kwargs)
+            if isinstance(seq, bool) or not isinstance(seq, (int, type(None))):
+                return
             with self._lock:
                 if self._closed or self._in_flight is None:
                     return  # late, duplicate (another view) or after a timeout
@@ -512,13 +506,15 @@ class Rot4DWidget(widgets.HBox):
         shown = self._shown
         if shown is None or not (c0 == shown[1] and np.array_equal(m, shown[0])):
             s = self._current_slice()
-            self.last_update_bytes = self.scene.show(s)
+            scene = self.scene
+            nbytes = scene.show(s)
             self._shown = (m, c0)
-            self.n_updates += 1
-            if expect_ack:
-                self._seq += 1
-                self._in_flight = self._seq
-                self._sent_at = now
+            if nbytes:  # 0: the picture did not change, nothing sent, no ack will come
+                self.last_update_bytes = nbytes
+                self.n_updates += 1
+                if expect_ack:
+                    self._in_flight = scene.update_id
+                    self._sent_at = now
         self.readout.value = self._readout_html()
 
     def _current_slice(self):
@@ -612,6 +608,21 @@ class Rot4DWidget(widgets.HBox):
 
 
 # ------------------------------------------------------------------ helpers
+def _close_quietly(w) -> None:
+    """Close a widget and its own Layout / Style widgets; never raises (close() must not stop halfway)."""
+    subs = [getattr(w, name, None) for name in ("layout", "style")] if isinstance(w, widgets.Widget) else []
+    try:
+        w.close()
+    except Exception:
+        log.debug("closing %r failed", w, exc_info=True)
+    for sub in subs:
+        if isinstance(sub, widgets.Widget):
+            try:
+                sub.close()
+            except Exception:
+                log.debug("closing %r failed", sub, exc_info=True)
+
+
 def _key_id(event: Mapping):
     """A held key's identity: its ``code`` (physical key), else its lower-cased ``key``."""
     code = event.get("code")
@@ -620,19 +631,6 @@ def _key_id(event: Mapping):
     key = event.get("key")
     if isinstance(key, str) and key:
         return "key:" + key.lower()
-    return None
-
-
-def _ack_sequence(args, kwargs):
-    """The update number an acknowledgement names, if it names one."""
-    for value in (*args, *kwargs.values()):
-        if isinstance(value, Mapping):
-            for name in ("seq", "sequence", "update", "frame"):
-                v = value.get(name)
-                if isinstance(v, int) and not isinstance(v, bool):
-                    return v
-        elif isinstance(value, int) and not isinstance(value, bool):
-            return value
     return None
 
 

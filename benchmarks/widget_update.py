@@ -1,0 +1,133 @@
+"""Kernel-side cost of one key press in Rot4DWidget, per regular polychoron.
+
+For each polytope: the time from the event dict arriving at the ipyevents
+model's comm handler to the last message of the update being handed to the
+comm (keymap lookup, state step, slice, buffers, scene assignment, readout,
+JSON + buffer serialisation as ipykernel's comm does it), median and 90th
+percentile over many presses at random orientations; and the messages and
+total bytes (JSON + binary buffers) one update sends.
+
+    /work/venv/bin/python benchmarks/widget_update.py [--presses 300] [--seed 0]
+
+Targets (issue 3): <= 2 ms for the 120-cell and 600-cell, <= 64 KB per update.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+import uuid
+
+import comm as comm_package
+import numpy as np
+from ipykernel.jsonutil import json_clean
+from jupyter_client.session import json_packer
+from scipy.stats import special_ortho_group
+
+from rot4d_widget.polytopes import POLYTOPE_NAMES
+from rot4d_widget.widget import Rot4DWidget
+
+KEYS = [("4", "Digit4"), ("2", "Digit2"), ("c", "KeyC"), ("z", "KeyZ"), ("w", "KeyW"), ("8", "Digit8")]
+
+
+class SerialisingComm:
+    """A comm that serialises each message as ipykernel's does, and records its size."""
+
+    kernel = "Truthy"
+    sent: list = []  # (comm_id, n_bytes)
+
+    def __init__(self, *args, comm_id=None, **kwargs):
+        self.comm_id = comm_id or uuid.uuid4().hex
+        self.handler = None
+
+    def open(self, *args, **kwargs):
+        pass
+
+    def on_msg(self, callback):
+        self.handler = callback
+
+    def on_close(self, callback):
+        pass
+
+    def close(self, *args, **kwargs):
+        pass
+
+    def send(self, data=None, metadata=None, buffers=None):
+        content = json_clean(dict(data=data, comm_id=self.comm_id))
+        packed = json_packer(content)
+        size = len(packed) + sum(memoryview(b).nbytes for b in (buffers or ()))
+        SerialisingComm.sent.append((self.comm_id, size))
+
+
+def key_msg(kind, key, code, t):
+    event = {
+        "type": kind, "event": kind, "key": key, "code": code, "shiftKey": False,
+        "altKey": False, "ctrlKey": False, "metaKey": False, "repeat": False,
+        "timeStamp": t, "location": 0, "target": {},
+    }
+    return {"content": {"data": {"method": "custom", "content": event}}, "buffers": []}
+
+
+def bench(name, presses, rng):
+    w = Rot4DWidget(name, autotick=False)
+    handler = w.events.comm.handler
+    orientations = special_ortho_group.rvs(4, size=presses + 20, random_state=rng)
+    times, sizes, counts = [], [], []
+    try:
+        for i, m in enumerate(orientations):
+            key, code = KEYS[i % len(KEYS)]
+            w.state.matrix = m
+            w._handle_drawn()  # the previous update was drawn: this one goes out at once
+            n0 = len(SerialisingComm.sent)
+            t0 = time.perf_counter()
+            handler(key_msg("keydown", key, code, float(i)))
+            t1 = time.perf_counter()
+            update = SerialisingComm.sent[n0:]
+            handler(key_msg("keyup", key, code, float(i)))
+            if i < 20:  # warm-up
+                continue
+            if not w.in_flight:
+                raise RuntimeError(f"{name}: a key press sent no scene update")
+            times.append(t1 - t0)
+            sizes.append(sum(n for _, n in update))
+            counts.append(len(update))
+        s = w.slice
+        return {
+            "name": name,
+            "median_ms": 1e3 * statistics.median(times),
+            "p90_ms": 1e3 * float(np.percentile(times, 90)),
+            "messages": statistics.median(counts),
+            "median_kb": statistics.median(sizes) / 1024,
+            "max_kb": max(sizes) / 1024,
+            "slice": f"V={len(s.vertices)} E={len(s.edges)} F={len(s.cell_ids)} T={len(s.triangles)}",
+        }
+    finally:
+        w.close()
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--presses", type=int, default=300)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    comm_package.create_comm = lambda *a, **k: SerialisingComm(*a, **k)
+    rng = np.random.default_rng(args.seed)
+    rows = [bench(name, args.presses, rng) for name in POLYTOPE_NAMES]
+    print(f"Rot4DWidget: event dict -> update handed to the comm, {args.presses} presses at random orientations")
+    print(f"{'polytope':<10} {'median ms':>10} {'p90 ms':>8} {'msgs':>5} {'KB/update':>10} {'max KB':>7}  last slice")
+    ok = True
+    for r in rows:
+        print(
+            f"{r['name']:<10} {r['median_ms']:>10.3f} {r['p90_ms']:>8.3f} {r['messages']:>5.0f} "
+            f"{r['median_kb']:>10.1f} {r['max_kb']:>7.1f}  {r['slice']}"
+        )
+        if r["max_kb"] > 64 or (r["name"] in ("120-cell", "600-cell") and r["median_ms"] > 2.0):
+            ok = False
+    print("targets (<= 2 ms for 120/600-cell, <= 64 KB per update):", "met" if ok else "NOT MET")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
