@@ -1,0 +1,86 @@
+"""`Companion`: the few lines of front-end JavaScript the widget needs (anywidget).
+
+An invisible widget (display it next to the scene's renderer, e.g. in the
+same box) whose module, ``companion.js``, ships in the package (no build
+step) and does three things in JupyterLab 4 and Notebook 7 alike:
+
+1. **drawn acknowledgement** -- after the page has *rendered* a frame
+   containing the latest buffer assignment (the pythreejs Scene's
+   ``afterRender`` following the buffer's ``change:array``; not merely on
+   arrival) it sends ``{"event": "drawn", "seq": n}``, n being the scene's
+   ``update_id`` of that buffer.  Callbacks registered with `on_drawn` get
+   ``n``.  Acknowledgements coalesce: if two updates arrive before one
+   frame, only the later one is acknowledged.  Each displayed view of the
+   companion acknowledges (several views: several acks with the same n).
+   No view, a hidden tab or a frozen WebGL context: no acknowledgement.
+2. **focus loss** -- window ``blur`` or ``document.visibilityState ==
+   "hidden"`` sends ``{"event": "focus_lost", "reason": "blur" | "hidden"}``;
+   `on_focus_lost` callbacks get the reason.
+3. **Notebook 7 shortcut guard** -- while the pointer is over the canvas
+   (found by its per-scene CSS class, ``Scene.canvas_class``) a
+   capture-phase ``keydown``/``keypress``/``keyup`` listener on ``window``
+   calls ``preventDefault()``, so Notebook 7's command shortcuts (m turns
+   the cell to markdown, x cuts it, ...) skip the key, while ipyevents still
+   receives it.  Ctrl/Meta/Alt chords pass untouched.
+
+Listeners are removed when the view is removed.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+import anywidget
+from ipywidgets import CallbackDispatcher, Layout
+from traitlets import Unicode
+
+__all__ = ["Companion"]
+
+
+class Companion(anywidget.AnyWidget):
+    """Invisible front-end helper for one `Scene`.
+
+    ``Companion(scene)`` reads ``scene.buffer_model_id``,
+    ``scene.scene_model_id`` and ``scene.canvas_class``; they can also be given
+    as keyword arguments.
+    """
+
+    _esm = pathlib.Path(__file__).with_name("companion.js")
+
+    buffer_model_id = Unicode("").tag(sync=True)
+    scene_model_id = Unicode("").tag(sync=True)
+    canvas_class = Unicode("").tag(sync=True)
+
+    def __init__(self, scene=None, **kwargs):
+        if scene is not None:
+            try:
+                kwargs.setdefault("buffer_model_id", scene.buffer_model_id)
+                kwargs.setdefault("scene_model_id", scene.scene_model_id)
+                kwargs.setdefault("canvas_class", scene.canvas_class)
+            except AttributeError:
+                raise TypeError(f"Expected `scene` to be a rot4d_widget Scene, got {type(scene).__name__}") from None
+        kwargs.setdefault("layout", Layout(display="none", width="0px", height="0px"))
+        super().__init__(**kwargs)
+        self._drawn_handlers = CallbackDispatcher()
+        self._focus_handlers = CallbackDispatcher()
+        self.on_msg(self._handle_message)
+
+    def on_drawn(self, callback, remove=False):
+        """Call ``callback(update_id)`` when the page has drawn that update."""
+        self._drawn_handlers.register_callback(callback, remove=remove)
+
+    def on_focus_lost(self, callback, remove=False):
+        """Call ``callback(reason)`` (``"blur"`` or ``"hidden"``) when the page loses focus."""
+        self._focus_handlers.register_callback(callback, remove=remove)
+
+    def _handle_message(self, _widget, content, _buffers=None):
+        if not isinstance(content, dict):
+            return
+        event = content.get("event")
+        if event == "drawn":
+            seq = content.get("seq")
+            if isinstance(seq, int) and not isinstance(seq, bool):
+                self._drawn_handlers(seq)
+        elif event == "focus_lost":
+            reason = content.get("reason")
+            self._focus_handlers(reason if isinstance(reason, str) else "")
