@@ -81,6 +81,8 @@ MAX_ERRORS_SHOWN = 5
 
 #: Child objects, in the order close() closes them (the Event first).
 _PARTS = ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box")
+#: compact table cells (Jupyter's rendered-HTML CSS pads them generously)
+_TD = "padding:1px 0.5em 1px 0;line-height:1.3;text-align:left;vertical-align:top"
 _REPEATING_KINDS = frozenset({"rotate", "alpha", "c0"})
 _WATCHED_EVENTS = ["keydown", "keyup", "mouseleave"]
 _POLYGON_NAMES = {
@@ -236,7 +238,7 @@ class Rot4DWidget(widgets.HBox):
             built.append(self.scene)
             self.companion = Companion(self.scene)
             built.append(self.companion)
-            self.readout = widgets.HTML(layout=widgets.Layout(min_width="15em"))
+            self.readout = widgets.HTML()
             self.help_panel = widgets.HTML(
                 _help_html(keymap, self.hold_delay, self.tick_rate), layout=widgets.Layout(display="none")
             )
@@ -249,10 +251,13 @@ class Rot4DWidget(widgets.HBox):
                 ignore_modifier_key_events=True,
             )
             built.append(self.events)
-            self._canvas_box = widgets.VBox([self.scene.renderer, self.companion])
+            # the canvas keeps its size; the side panel wraps below it when narrow
+            self._canvas_box = widgets.VBox(
+                [self.scene.renderer, self.companion], layout=widgets.Layout(flex="0 0 auto")
+            )
             self._side_box = widgets.VBox(
                 [self.readout, self.help_panel, self.errors],
-                layout=widgets.Layout(padding="0 0 0 1em"),
+                layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
             )
             built += [self._canvas_box, self._side_box]
         except BaseException:
@@ -262,7 +267,10 @@ class Rot4DWidget(widgets.HBox):
                 except Exception:
                     pass
             raise
-        super().__init__([self._canvas_box, self._side_box])
+        super().__init__(
+            [self._canvas_box, self._side_box],
+            layout=widgets.Layout(flex_flow="row wrap", align_items="flex-start"),
+        )
 
         self.events.on_dom_event(self._handle_event)
         self.companion.on_drawn(self._handle_drawn)
@@ -586,11 +594,11 @@ class Rot4DWidget(widgets.HBox):
             ("volume", f"{s.volume:.4f}"),
         ]
         body = "".join(
-            f"<tr><td style='padding-right:0.6em'>{k}</td><td>{v}</td></tr>" for k, v in rows
+            f"<tr><td style='{_TD}'>{k}</td><td style='{_TD}'>{v}</td></tr>" for k, v in rows
         )
         return (
             f"<div class='rot4d-readout'><b>{html.escape(self.polytope.name)}</b>"
-            f"<table style='font-family:monospace'>{body}</table>"
+            f"<table style='font-family:monospace;border-collapse:collapse;margin:0'>{body}</table>"
             "<small>mouse over the view; ? for keys</small></div>"
         )
 
@@ -655,11 +663,12 @@ def _help_html(keymap: Keymap, hold_delay: float, tick_rate: float) -> str:
     for (label, description), keys in groups.items():
         shown = " ".join(f"<kbd>{html.escape(k)}</kbd>" for k in keys)
         rows.append(
-            f"<tr><td>{shown}</td><td style='padding:0 0.6em'>{html.escape(label)}</td>"
-            f"<td>{html.escape(description)}</td></tr>"
+            f"<tr><td style='{_TD}'>{shown}</td><td style='{_TD}'>{html.escape(label)}</td>"
+            f"<td style='{_TD}'>{html.escape(description)}</td></tr>"
         )
     return (
-        "<div class='rot4d-help'><table>" + "".join(rows) + "</table>"
+        "<div class='rot4d-help' style='font-size:90%'>"
+        "<table style='border-collapse:collapse;margin:0.5em 0'>" + "".join(rows) + "</table>"
         f"<small>Shift inverts a rotation. Hold a key: it repeats after {hold_delay * 1000:.0f} ms, "
         f"{tick_rate:g} steps/s.</small></div>"
     )
