@@ -117,3 +117,13 @@ def test_the_default_test_command_runs_the_notebooks():
     assert "--nbval-lax" in addopts.split()
     assert "--nbval-current-env" in addopts.split()
     assert "notebooks" in conf.get("testpaths", [])
+
+
+def test_no_dangling_widget_views(notebook):
+    """A widget view saved without its model shows "model not found" until the cell is re-run."""
+    path, nb = notebook
+    saved_state = "application/vnd.jupyter.widget-state+json" in nb.metadata.get("widgets", {})
+    for cell in nb.cells:
+        for out in cell.get("outputs", []):
+            if WIDGET_MIME in out.get("data", {}):
+                assert saved_state, f"{path.name}: widget view without saved widget state"
