@@ -1,0 +1,267 @@
+"""rot4d_widget.companion: the Python side, and companion.js run under Node with a fake page.
+
+The JavaScript is exercised without a browser: Node imports the shipped ES
+module and calls its ``render`` with a fake anywidget model, fake pythreejs
+models (Backbone-style ``on``/``off``/``trigger``), a fake ``window`` and
+``document`` and a manual ``requestAnimationFrame`` queue.  (The real-browser
+proof, in JupyterLab 4 and Notebook 7, is described in the scene module's
+report; it needs Chromium.)
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import shutil
+import subprocess
+import uuid
+
+import comm as comm_package
+import pytest
+
+import rot4d_widget
+from rot4d_widget.companion import Companion
+
+JS = pathlib.Path(rot4d_widget.__file__).with_name("companion.js")
+
+
+class Recorder:
+    kernel = "Truthy"
+
+    def __init__(self, *args, comm_id=None, **kwargs):
+        self.comm_id = comm_id or uuid.uuid4().hex
+        self.handler = None
+
+    def open(self, *args, **kwargs):
+        pass
+
+    def on_msg(self, callback):
+        self.handler = callback
+
+    def on_close(self, callback):
+        pass
+
+    def send(self, *args, **kwargs):
+        pass
+
+    def close(self, *args, **kwargs):
+        pass
+
+
+@pytest.fixture(autouse=True)
+def recording_comms(monkeypatch):
+    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: Recorder(*a, **k))
+
+
+class FakeScene:
+    buffer_model_id = "buf123"
+    scene_model_id = "scn456"
+    canvas_class = "rot4d-canvas-abc"
+
+
+def from_page(w, content):
+    """Deliver a message from the companion's JavaScript as the front end does."""
+    w.comm.handler({"content": {"data": {"method": "custom", "content": content}}, "buffers": []})
+
+
+# ------------------------------------------------------------------ Python side
+def test_reads_the_scene_and_is_invisible():
+    c = Companion(FakeScene())
+    assert (c.buffer_model_id, c.scene_model_id, c.canvas_class) == ("buf123", "scn456", "rot4d-canvas-abc")
+    assert c.layout.display == "none"
+    with pytest.raises(TypeError, match="Expected `scene` to be a rot4d_widget Scene"):
+        Companion(object())
+
+
+def test_on_drawn_and_on_focus_lost_dispatch_and_can_be_removed():
+    c = Companion(FakeScene())
+    drawn, lost = [], []
+    c.on_drawn(drawn.append)
+    c.on_focus_lost(lost.append)
+    from_page(c, {"event": "drawn", "seq": 7})
+    from_page(c, {"event": "focus_lost", "reason": "hidden"})
+    assert drawn == [7] and lost == ["hidden"]
+    c.on_drawn(drawn.append, remove=True)
+    from_page(c, {"event": "drawn", "seq": 8})
+    assert drawn == [7]
+
+
+@pytest.mark.parametrize(
+    "content",
+    [{"event": "drawn"}, {"event": "drawn", "seq": "3"}, {"event": "drawn", "seq": True}, {"event": "other"}, ["drawn"], "x", None],
+)
+def test_malformed_messages_are_ignored(content):
+    c = Companion(FakeScene())
+    got = []
+    c.on_drawn(got.append)
+    c.on_focus_lost(got.append)
+    from_page(c, content)
+    assert got == []
+
+
+def test_a_failing_callback_does_not_escape(caplog):
+    c = Companion(FakeScene())
+    got = []
+
+    def bad(seq):
+        raise RuntimeError("boom")
+
+    c.on_drawn(bad)
+    c.on_drawn(got.append)
+    from_page(c, {"event": "drawn", "seq": 1})  # must not raise
+    assert got == [1]
+
+
+def test_the_module_ships_inside_the_package():
+    assert JS.is_file()
+    assert JS.parent == pathlib.Path(rot4d_widget.__file__).parent  # hatch packages the whole folder
+    text = JS.read_text()
+    assert "export default" in text
+    assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped file
+
+
+# ------------------------------------------------------------------ JavaScript under Node
+DRIVER = r"""
+import { pathToFileURL } from "node:url";
+const out = {};
+function target() {
+  const L = {};
+  return {
+    L,
+    addEventListener(t, f, capture) { (L[t] ||= []).push([f, !!capture]); },
+    removeEventListener(t, f, capture) { L[t] = (L[t] || []).filter(([g, c]) => !(g === f && c === !!capture)); },
+    fire(t, ev) { for (const [f] of (L[t] || []).slice()) f(ev); },
+    count() { return Object.values(L).reduce((n, a) => n + a.length, 0); },
+  };
+}
+function backbone(attrs) {
+  const L = {};
+  return {
+    L, attrs,
+    get: (k) => attrs[k],
+    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); },
+    on(t, f) { (L[t] ||= []).push(f); },
+    off(t, f) { L[t] = (L[t] || []).filter((g) => g !== f); },
+    trigger(t) { (L[t] || []).slice().forEach((f) => f()); },
+    count() { return Object.values(L).reduce((n, a) => n + a.length, 0); },
+  };
+}
+const CLS = "rot4d-canvas-abc";
+let hovered = false;
+globalThis.window = target();
+globalThis.document = Object.assign(target(), {
+  visibilityState: "visible",
+  querySelector: (sel) => (hovered && sel === "." + CLS + ":hover" ? {} : null),
+});
+globalThis.CSS = { escape: (s) => s };
+let raf = [];
+globalThis.requestAnimationFrame = (f) => raf.push(f);
+const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
+
+const buffer = backbone({ _rot4d_seq: 0, array: "a0" });
+const scene = backbone({});
+const sent = [];
+const model = {
+  get: (k) => ({ buffer_model_id: "IPY_MODEL_buf", scene_model_id: "scn", canvas_class: CLS })[k],
+  send: (m) => sent.push(m),
+  widget_manager: { get_model: async (id) => ({ buf: buffer, scn: scene })[id] },
+};
+const el = { style: {} };
+const mod = await import(pathToFileURL(process.argv[2]).href);
+const cleanup = await mod.default.render({ model, el });
+out.display = el.style.display;
+
+// 3. shortcut guard
+const key = (type, extra = {}) => { const ev = { type, prevented: false, ctrlKey: false, metaKey: false, altKey: false, ...extra, preventDefault() { this.prevented = true; } }; window.fire(type, ev); return ev.prevented; };
+out.capture = ["keydown", "keyup", "keypress"].map((t) => (window.L[t] || []).map(([, c]) => c));
+out.notHovered = key("keydown");
+hovered = true;
+out.hovered = ["keydown", "keypress", "keyup"].map((t) => key(t));
+out.ctrl = key("keydown", { ctrlKey: true });
+out.meta = key("keydown", { metaKey: true });
+hovered = false;
+
+// 1. drawn acknowledgement
+const step = (label) => { out[label] = sent.splice(0); };
+buffer.setState({ _rot4d_seq: 5, array: "a1" });
+step("beforeRender");
+scene.trigger("afterRender");
+step("sameFrame");
+frame();
+step("nextFrame");
+scene.trigger("afterRender"); frame();
+step("renderWithoutChange");
+buffer.setState({ _rot4d_seq: 6, array: "a2" });
+buffer.setState({ _rot4d_seq: 7, array: "a3" });
+scene.trigger("afterRender"); frame();
+step("coalesced");
+buffer.setState({ array: "a4" });  // growth step (a): same id
+scene.trigger("afterRender"); frame();
+step("sameId");
+buffer.setState({ _rot4d_seq: 8, array: "a5" });
+frame();
+step("noRenderNoAck");
+scene.trigger("afterRender"); frame();
+step("late");
+
+// 2. focus loss
+window.fire("blur", {});
+document.visibilityState = "hidden"; document.fire("visibilitychange", {});
+document.visibilityState = "visible"; document.fire("visibilitychange", {});
+step("focus");
+
+// cleanup
+cleanup();
+out.left = { window: window.count(), document: document.count(), buffer: buffer.count(), scene: scene.count() };
+buffer.setState({ _rot4d_seq: 9, array: "a6" }); scene.trigger("afterRender"); frame();
+window.fire("blur", {});
+hovered = true;
+out.afterCleanupPrevented = key("keydown");
+step("afterCleanup");
+console.log(JSON.stringify(out));
+"""
+
+
+@pytest.fixture(scope="module")
+def js_run(tmp_path_factory):
+    node = shutil.which("node") or shutil.which("nodejs")
+    if node is None:
+        pytest.skip("Node.js is not installed: companion.js unit test not run (apt-get install nodejs)")
+    d = tmp_path_factory.mktemp("companion")
+    driver = d / "driver.mjs"
+    driver.write_text(DRIVER)
+    proc = subprocess.run([node, str(driver), str(JS)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_js_is_invisible(js_run):
+    assert js_run["display"] == "none"
+
+
+def test_js_shortcut_guard_prevents_only_while_hovered(js_run):
+    assert js_run["capture"] == [[True], [True], [True]]  # capture phase on window
+    assert js_run["notHovered"] is False
+    assert js_run["hovered"] == [True, True, True]
+    assert js_run["ctrl"] is False and js_run["meta"] is False
+
+
+def test_js_drawn_ack_waits_for_a_rendered_and_presented_frame(js_run):
+    assert js_run["beforeRender"] == []  # arrival is not drawing
+    assert js_run["sameFrame"] == []  # rendered; sent once that frame is presented
+    assert js_run["nextFrame"] == [{"event": "drawn", "seq": 5}]
+    assert js_run["renderWithoutChange"] == []  # orbiting the camera acknowledges nothing
+    assert js_run["coalesced"] == [{"event": "drawn", "seq": 7}]
+    assert js_run["sameId"] == [{"event": "drawn", "seq": 7}]  # re-sent picture keeps its id
+    assert js_run["noRenderNoAck"] == []
+    assert js_run["late"] == [{"event": "drawn", "seq": 8}]
+
+
+def test_js_focus_loss(js_run):
+    assert js_run["focus"] == [{"event": "focus_lost", "reason": "blur"}, {"event": "focus_lost", "reason": "hidden"}]
+
+
+def test_js_cleanup_removes_every_listener(js_run):
+    assert js_run["left"] == {"window": 0, "document": 0, "buffer": 0, "scene": 0}
+    assert js_run["afterCleanupPrevented"] is False
+    assert js_run["afterCleanup"] == []

@@ -1,0 +1,314 @@
+"""rot4d_widget.scene without a browser: what the scene is made of and what one update sends.
+
+Comm messages are recorded by a comm that serialises like ipykernel's (the
+ipywidgets tests' dummy-comm pattern), so counts and sizes are those a kernel
+would send.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import uuid
+
+import comm as comm_package
+import numpy as np
+import pytest
+import pythreejs as p3
+from ipykernel.jsonutil import json_clean
+from ipywidgets.widgets import widget as ipywidget_module
+from jupyter_client.session import json_packer
+
+from rot4d_widget import buffers as bf
+from rot4d_widget import polytope, slice_polytope
+from rot4d_widget.polytopes import POLYTOPE_NAMES
+from rot4d_widget.scene import PENTACHORON_CIRCUMRADIUS, Scene
+
+
+class Recorder:
+    """A comm that records (comm_id, data, size in bytes) like ipykernel would send it."""
+
+    kernel = "Truthy"
+    log: list = []
+
+    def __init__(self, *args, comm_id=None, **kwargs):
+        self.comm_id = comm_id or uuid.uuid4().hex
+        self.handler = None
+
+    def open(self, *args, **kwargs):
+        pass
+
+    def on_msg(self, callback):
+        self.handler = callback
+
+    def on_close(self, callback):
+        pass
+
+    def send(self, data=None, metadata=None, buffers=None):
+        content = json_clean(dict(data=data, comm_id=self.comm_id))
+        n = len(json_packer(content)) + sum(memoryview(b).nbytes for b in (buffers or ()))
+        Recorder.log.append((self.comm_id, data, n, [np.frombuffer(b, dtype=np.uint8).copy() for b in buffers or ()]))
+
+    def close(self, *args, **kwargs):
+        pass
+
+
+@pytest.fixture(autouse=True)
+def log(monkeypatch):
+    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: Recorder(*a, **k))
+    Recorder.log = []
+    yield Recorder.log
+
+
+def random_rotation(rng):
+    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+@pytest.fixture
+def scenes():
+    made = []
+
+    def make(name="24-cell", **kw):
+        s = Scene(polytope(name) if isinstance(name, str) else name, **kw)
+        made.append(s)
+        return s
+
+    yield make
+    for s in made:
+        s.close()
+
+
+def live_widgets():
+    return len(ipywidget_module._instances)
+
+
+def walk(obj):
+    yield obj
+    for child in getattr(obj, "children", ()):
+        yield from walk(child)
+
+
+# ----------------------------------------------------------------- structure
+def test_camera_controls_renderer_as_the_paper_and_the_issue_ask(scenes):
+    sc = scenes("5-cell", width=420, height=300)
+    cam = sc.renderer.camera
+    assert isinstance(cam, p3.PerspectiveCamera)
+    assert tuple(cam.position) == (0.0, 0.0, 5.0)
+    assert tuple(cam.quaternion) == (0.0, 0.0, 0.0, 1.0)  # looking down -z
+    assert cam.aspect == pytest.approx(420 / 300)
+    (controls,) = sc.renderer.controls
+    assert isinstance(controls, p3.OrbitControls) and controls.enableKeys is False
+    assert controls.controlling is cam
+    assert (sc.renderer.width, sc.renderer.height) == (420, 300)
+    assert "rot4d-canvas" in sc.renderer._dom_classes
+    assert sc.canvas_class in sc.renderer._dom_classes and sc.canvas_class.startswith("rot4d-canvas-")
+    assert scenes("5-cell").canvas_class != sc.canvas_class
+
+
+def test_no_directional_light_and_shaders_do_the_lighting(scenes):
+    sc = scenes("5-cell")
+    objects = list(walk(sc.three_scene))
+    assert not any(isinstance(o, p3.DirectionalLight) for o in objects)
+    meshes = [o for o in objects if isinstance(o, p3.Mesh)]
+    assert [m.name for m in meshes] == ["balls", "bars", "faces"]
+    for m in meshes:
+        assert m.frustumCulled is False
+        assert isinstance(m.material, p3.ShaderMaterial)
+        assert "shade(" in m.material.fragmentShader
+        assert {"u_ambient", "u_sky", "u_ground", "u_light_position"} <= set(m.material.uniforms)
+    faces = meshes[2].material
+    assert faces.transparent and faces.depthWrite is False and faces.side == "DoubleSide"
+    assert faces.uniforms["u_opacity"]["value"] == pytest.approx(0.35)
+
+
+def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
+    sc = scenes("24-cell")
+    geos = [m.geometry for m in sc.three_scene.children if isinstance(m, p3.Mesh)]
+    buffers = set()
+    for g in geos:
+        assert isinstance(g, p3.InstancedBufferGeometry)
+        assert g.maxInstancedCount == sc.capacity
+        for name, attr in g.attributes.items():
+            if isinstance(attr, p3.InterleavedBufferAttribute):
+                buffers.add(attr.data.model_id)
+                assert (attr.offset, attr.itemSize) == bf.COLUMNS[name]
+    assert buffers == {sc.buffer_model_id}
+    arr = sc._buffer.array
+    assert arr.dtype == np.float32 and arr.shape == (sc.capacity, 20)
+    # no sphere or cylinder per instance: the templates are small and fixed
+    assert geos[0].attributes["position"].array.shape == (6, 3)
+    assert geos[2].attributes["position"].array.shape == (3, 3)
+
+
+def test_shader_attributes_match_the_columns(scenes):
+    sc = scenes("5-cell")
+    decl = {}
+    for m in sc.three_scene.children:
+        if isinstance(m, p3.Mesh):
+            for typ, name in re.findall(r"attribute (vec[234]|float) (\w+);", m.material.vertexShader):
+                decl[name] = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}[typ]
+    assert decl == {name: size for name, (col, size) in bf.COLUMNS.items()}
+
+
+@pytest.mark.parametrize("name", POLYTOPE_NAMES)
+def test_every_polytope_appears_the_size_of_the_pentachoron(scenes, name):
+    p = polytope(name)
+    sc = scenes(p, capacity=16)
+    assert sc.scale * p.circumradius == pytest.approx(PENTACHORON_CIRCUMRADIUS)
+    assert PENTACHORON_CIRCUMRADIUS == pytest.approx(polytope("5-cell").circumradius)
+    s = slice_polytope(p, np.eye(4), 0.0)
+    sc.show(s)
+    np.testing.assert_allclose(sc.rows[: len(s.vertices), :3], s.vertices * sc.scale, rtol=1e-6, atol=1e-7)
+    if name == "120-cell":
+        assert p.circumradius == pytest.approx(7.4, abs=0.01)
+
+
+# ----------------------------------------------------------------- updates
+def test_one_show_is_one_message_to_the_buffer(scenes, log):
+    rng = np.random.default_rng(1)
+    p = polytope("120-cell")
+    sc = scenes(p)
+    before = live_widgets()
+    for k in range(1, 6):
+        log.clear()
+        s = slice_polytope(p, random_rotation(rng), 0.0)
+        sent = sc.show(s)
+        assert len(log) == 1
+        cid, data, n, bufs = log[0]
+        assert cid == sc.buffer_model_id
+        assert data["method"] == "update"
+        assert set(data["state"]) == {"array", "_rot4d_seq"}
+        assert data["state"]["_rot4d_seq"] == sc.update_id == k
+        assert data["state"]["array"]["dtype"] == "float32"
+        assert tuple(data["state"]["array"]["shape"]) == (sc.capacity, 20)
+        assert len(bufs) == 1 and bufs[0].nbytes == sc.capacity * 80
+        rows = bufs[0].view(np.float32).reshape(sc.capacity, 20)
+        np.testing.assert_array_equal(rows, bf.slice_rows(s, scale=sc.scale, cell_rgb=sc._cell_rgb, capacity=sc.capacity))
+        assert abs(sent - n) < 200  # show() reports the payload the comm sends
+        assert n <= 40 * 1024
+    assert live_widgets() == before  # show() never creates widgets
+
+
+@pytest.mark.parametrize("name", POLYTOPE_NAMES)
+def test_bytes_per_update_at_most_64KB(scenes, log, name):
+    rng = np.random.default_rng(4)
+    p = polytope(name)
+    sc = scenes(p)
+    sizes = []
+    for _ in range(8):
+        log.clear()
+        sc.show(slice_polytope(p, random_rotation(rng), 0.0))
+        sizes += [n for cid, data, n, b in log]
+    assert max(sizes) <= 64 * 1024
+
+
+def test_unchanged_slice_sends_nothing_unless_forced(scenes, log):
+    p = polytope("24-cell")
+    sc = scenes(p)
+    s = slice_polytope(p, np.eye(4), 0.0)
+    assert sc.show(s) > 0 and sc.update_id == 1
+    log.clear()
+    assert sc.show(slice_polytope(p, np.eye(4), 0.0)) == 0
+    assert log == [] and sc.update_id == 1
+    assert sc.show(s, force=True) > 0 and sc.update_id == 2 and len(log) == 1
+
+
+def test_growth_keeps_every_intermediate_state_whole(scenes, log):
+    """Capacity growth: old picture padded (same id) -> counts -> new picture (new id)."""
+    p = polytope("600-cell")
+    sc = scenes(p, capacity=32)
+    small = slice_polytope(p, np.eye(4), 0.9 * p.circumradius)
+    assert 0 < bf.rows_needed(small) <= 32
+    sc.show(small)
+    old = sc.rows.copy()
+    widgets_before = live_widgets()
+    log.clear()
+    big = slice_polytope(p, random_rotation(np.random.default_rng(0)), 0.0)
+    sc.show(big)
+    assert live_widgets() == widgets_before
+    geo_ids = {g.model_id for g in sc._geometries.values()}
+    kinds = [("buffer" if cid == sc.buffer_model_id else "geometry" if cid in geo_ids else cid) for cid, *_ in log]
+    assert kinds == ["buffer", "geometry", "geometry", "geometry", "buffer"]
+    cap = sc.capacity
+    assert cap >= bf.rows_needed(big) and cap % 16 == 0
+    # (a) the picture already shown, padded with hidden rows; its id unchanged
+    first = log[0]
+    assert "_rot4d_seq" not in first[1]["state"]
+    a = first[3][0].view(np.float32).reshape(cap, 20)
+    np.testing.assert_array_equal(a[:32], old)
+    assert old.any() and not a[32:].any()
+    # (b) the drawn count follows, for balls, bars and faces
+    assert [d["state"] for _, d, *_ in log[1:4]] == [{"maxInstancedCount": cap}] * 3
+    # (c) the new slice with the next id
+    assert log[4][1]["state"]["_rot4d_seq"] == sc.update_id == 2
+    # afterwards, normal updates are one message again
+    log.clear()
+    sc.show(slice_polytope(p, random_rotation(np.random.default_rng(1)), 0.0))
+    assert len(log) == 1
+
+
+def test_show_after_close_raises_and_close_closes_everything(scenes):
+    sc = scenes("5-cell")
+    widgets = list(sc._widgets)
+    assert all(w.comm is not None for w in widgets)
+    sc.close()
+    assert all(w.comm is None for w in widgets)
+    sc.close()  # idempotent
+    with pytest.raises(RuntimeError, match="closed"):
+        sc.show(slice_polytope(polytope("5-cell"), np.eye(4), 0.0))
+
+
+def test_default_radii_follow_the_displayed_edge(scenes):
+    big = scenes("5-cell")
+    dense = scenes("120-cell")
+    assert big.ball_radius == pytest.approx(0.07)
+    edge120 = 2.0 * dense.scale
+    assert dense.ball_radius == pytest.approx(0.1 * edge120)
+    assert dense.bar_radius == pytest.approx(0.4 * dense.ball_radius)
+    custom = scenes("5-cell", ball_radius=0.1, bar_radius=0.02, face_opacity=1, background=(0, 0, 0))
+    assert (custom.ball_radius, custom.bar_radius, custom.face_opacity) == (0.1, 0.02, 1.0)
+    assert custom.renderer.clearColor == "#000000"
+
+
+# ----------------------------------------------------------------- bad options
+@pytest.mark.parametrize(
+    "kw,exc,match",
+    [
+        ({"ball_radius": -0.1}, ValueError, r"`ball_radius` in \(0, 10.0\]"),
+        ({"bar_radius": 0}, ValueError, r"`bar_radius` in \(0, 10.0\]"),
+        ({"ball_radius": math.nan}, ValueError, "`ball_radius`"),
+        ({"ball_radius": "big"}, TypeError, "`ball_radius` to be a positive number"),
+        ({"width": 0}, ValueError, r"`width` to be an int number of pixels in \[16, 8192\]"),
+        ({"height": 600.5}, TypeError, "`height` to be an int"),
+        ({"face_opacity": 1.5}, ValueError, r"`face_opacity` to be a number in \[0, 1\]"),
+        ({"background": "blue-ish"}, ValueError, r"`background` to be '#rgb', '#rrggbb'"),
+        ({"ball_color": (1, 0)}, ValueError, "`ball_color`"),
+        ({"cell_colors": ["#ff0000"] * 4}, ValueError, r"at least 24 colours \(one per cell\), got 4"),
+        ({"cell_colors": "#ff0000"}, ValueError, "sequence of colours"),
+        ({"capacity": 0}, ValueError, r"`capacity` to be an int >= 1 or None"),
+        ({"antialias": "yes"}, TypeError, "`antialias` to be True or False"),
+    ],
+)
+def test_bad_options_raise_naming_what_is_allowed(kw, exc, match):
+    with pytest.raises(exc, match=match):
+        Scene(polytope("24-cell"), **kw)
+
+
+def test_not_a_polytope():
+    with pytest.raises(TypeError, match="`polytope` to be a rot4d_widget.Polytope"):
+        Scene("24-cell")
+
+
+def test_cell_colors_are_used(scenes):
+    p = polytope("5-cell")
+    colors = ["#ff0000", "#00ff00", "#0000ff", "#ffff00", "#00ffff"]
+    sc = scenes(p, cell_colors=colors)
+    s = slice_polytope(p, np.eye(4), 0.0)
+    sc.show(s)
+    got = bf.unpack_rgb(sc.rows[: len(s.triangles), 19])
+    want = np.array([[int(c[i : i + 2], 16) for i in (1, 3, 5)] for c in colors], dtype=np.uint8)
+    np.testing.assert_array_equal(got, want[s.triangle_cells])
