@@ -20,9 +20,12 @@ points, triangle corners + packed colour).  Each mesh is an
 template built once -- a billboard square (balls), a unit cylinder (bars), a
 barycentric triangle (faces) -- and whose per-instance attributes are
 `InterleavedBufferAttribute`s into the shared buffer.  `ShaderMaterial`s
-(GLSL ES 1.0) place each instance: the ball shader ray-casts a sphere
-impostor (exact perspective silhouette, depth written with
-``gl_FragDepthEXT`` where available), the bar shader stretches the cylinder
+(GLSL ES 1.0 style; three r97 runs them on a WebGL2 context when it gets
+one, prefixing ``#version 300 es`` and compatibility defines) place each
+instance: the ball shader ray-casts a sphere impostor (exact perspective
+silhouette; the depth of the sphere's surface is written with
+``gl_FragDepthEXT``, which is ``gl_FragDepth`` under WebGL2 and the
+EXT_frag_depth extension under WebGL1), the bar shader stretches the cylinder
 between the two end points, the face shader interpolates the three corners
 and unpacks the colour.  No sphere or cylinder mesh is ever sent.
 
@@ -189,7 +192,7 @@ void main() {
     if (disc < 0.0) discard;
     vec3 hit = (b - sqrt(disc)) * ray;
     vec3 n = (hit - v_centre) / u_ball_radius;
-#ifdef GL_EXT_frag_depth
+#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300
     vec4 clip = projectionMatrix * vec4(hit, 1.0);
     gl_FragDepthEXT = 0.5 + 0.5 * clip.z / clip.w;
 #endif

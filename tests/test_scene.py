@@ -144,6 +144,16 @@ def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
     assert geos[2].attributes["position"].array.shape == (3, 3)
 
 
+def test_ball_shader_writes_sphere_depth_under_webgl1_and_webgl2(scenes):
+    """three r97 in pythreejs runs on WebGL2 when it can (seen in Chromium): there the
+    extension macro is undefined and gl_FragDepthEXT is #defined to gl_FragDepth."""
+    sc = scenes("5-cell")
+    frag = sc._materials[0].fragmentShader
+    assert "#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300" in frag
+    assert "gl_FragDepthEXT =" in frag
+    assert sc._materials[0].extensions == {"fragDepth": True}
+
+
 def test_shader_attributes_match_the_columns(scenes):
     sc = scenes("5-cell")
     decl = {}
