@@ -38,6 +38,13 @@ on keyup, on mouseleave, and when the companion reports that the page or
 window lost focus (a keyup after that never arrives).  Rotations, j/k and l/h
 repeat; the step-angle keys (+/-), reset (r) and help (?) act once per press.
 
+A widget whose canvas views are all gone (the cell was re-run) ignores key
+events: ipyevents leaves its document key listener behind when a view is
+destroyed while hovered, and those keys must not turn an invisible widget.
+The widget learns the number of views from ipywidgets' ``_view_count``
+(requested on the renderer); front ends that do not keep it are never
+filtered.
+
 Every handler runs under one lock, whether it is called by the kernel's comm
 handlers (keys, acknowledgements) or the ticker thread.  Exceptions raised
 while handling a key are shown in the widget's ``errors`` output area (and
@@ -275,6 +282,15 @@ class Rot4DWidget(widgets.HBox):
         self.events.on_dom_event(self._handle_event)
         self.companion.on_drawn(self._handle_drawn)
         self.companion.on_focus_lost(self._handle_focus_lost)
+        # Count the canvas's views (ipywidgets' _view_count, kept by the front end).
+        # A view destroyed while hovered leaves ipyevents' document key listener
+        # behind, so a widget whose every view is gone still receives keys: it
+        # must act on nothing.  See _has_no_view.
+        self._was_displayed = False
+        renderer = self.scene.renderer
+        renderer.observe(self._view_count_changed, names="_view_count")
+        if renderer._view_count is None:
+            renderer._view_count = 0
 
         # The initial picture is part of the models' state: not "in flight".
         with self._lock:
@@ -365,6 +381,9 @@ class Rot4DWidget(widgets.HBox):
             if companion is not None:
                 companion.on_drawn(self._handle_drawn, remove=True)
                 companion.on_focus_lost(self._handle_focus_lost, remove=True)
+            scene = getattr(self, "scene", None)
+            if scene is not None and "_was_displayed" in self.__dict__:
+                scene.renderer.unobserve(self._view_count_changed, names="_view_count")
         finally:
             # The Event first, so its document listeners go before the canvas does.
             for w in parts:
@@ -423,9 +442,29 @@ class Rot4DWidget(widgets.HBox):
             self._report_error(exc)
 
     # -------------------------------------------------------------- keys
+    def _view_count_changed(self, change) -> None:
+        try:
+            n = change["new"]
+            if isinstance(n, int) and n > 0:
+                self._was_displayed = True
+            elif n == 0:
+                self.release_keys()  # no view left: no keyup will come
+        except Exception as exc:
+            self._report_error(exc)
+
+    def _has_no_view(self) -> bool:
+        """True when the canvas was displayed and every view of it is gone.
+
+        Front ends that do not keep ``_view_count`` leave it at 0 and never
+        set ``_was_displayed``: their keys are always accepted.
+        """
+        return self._was_displayed and self.scene.renderer._view_count == 0
+
     def _key_down(self, event: Mapping) -> None:
         if event.get("repeat") is True:
             return  # browser auto-repeat: the ticker repeats, not the browser
+        if self._has_no_view():
+            return  # a listener leaked by a destroyed view (ipyevents): act on nothing
         found = self.state.keymap.lookup(event)
         if found is None:
             return

@@ -666,3 +666,34 @@ def test_events_from_the_thread_and_the_kernel_interleave_safely():
         assert w.errors.outputs == ()
     finally:
         w.close()
+
+
+def front_end_view_count(w, n):
+    """The front end reports the canvas's number of views (ipywidgets' _view_count)."""
+    msg = {"content": {"data": {"method": "update", "state": {"_view_count": n}, "buffer_paths": []}}, "buffers": []}
+    w.scene.renderer.comm.handler(msg)
+
+
+def test_a_widget_whose_views_are_all_gone_acts_on_nothing(make, clock):
+    w = make()
+    assert w.scene.renderer._view_count == 0  # counting requested from the front end
+    front_end_view_count(w, 1)  # displayed
+    down(w, "4")
+    assert xw_steps(w) == 1 and w.held_keys == ("Digit4",)
+    front_end_view_count(w, 0)  # the cell was re-run: the view is gone (maybe while hovered)
+    assert w.held_keys == ()  # no keyup can come any more
+    run_ticker(w, clock, clock.t + 1.0)
+    down(w, "4")  # from ipyevents' leaked document listener
+    up(w, "4")
+    assert xw_steps(w) == 1
+    assert w.press("4") and xw_steps(w) == 2  # scripting still works
+    front_end_view_count(w, 2)  # shown again (e.g. a second output view)
+    down(w, "4")
+    assert xw_steps(w) == 3
+
+
+def test_a_front_end_that_does_not_count_views_still_gets_keys(make):
+    w = make()
+    assert w.scene.renderer._view_count == 0 and not w._was_displayed
+    down(w, "4")
+    assert xw_steps(w) == 1
