@@ -50,6 +50,7 @@ _CANVAS_STATS = """
   const ctx = tmp.getContext('2d');
   ctx.drawImage(c, 0, 0);
   const d = ctx.getImageData(0, 0, w, h).data;
+  if (!bg) bg = [d[0], d[1], d[2]];
   let x0 = w, y0 = h, x1 = -1, y1 = -1, n = 0, hash = 2166136261;
   for (let y = 0; y < h; y++) for (let x = 0; x < w; x++) {
     const i = 4 * (y * w + x);
@@ -129,8 +130,12 @@ class JupyterPage:
             " sources: Array.from({length: p.content.model.cells.length}, (_, i) => p.content.model.cells.get(i).sharedModel.getSource())}; }"
         )
 
-    def canvas_stats(self, selector: str, background=(255, 255, 255)) -> dict | None:
-        return self.page.evaluate(_CANVAS_STATS, [selector, list(background)])
+    def canvas_stats(self, selector: str, background=None) -> dict | None:
+        """Pixel statistics of a canvas: size, bbox of non-background pixels, a hash.
+
+        The background is the top-left pixel unless given as (r, g, b).
+        """
+        return self.page.evaluate(_CANVAS_STATS, [selector, list(background) if background else None])
 
     def wait_for(self, predicate, timeout: float = 10.0, interval: float = 0.05):
         deadline = time.monotonic() + timeout

@@ -1,0 +1,332 @@
+"""What a user sees and does, in JupyterLab 4 and Notebook 7 (each case runs in both).
+
+Bounds here are behaviours with generous margins, not speed targets: speed
+lives in benchmarks/browser_latency.py.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+
+import numpy as np
+import pytest
+
+from jupyter_page import JupyterPage, write_notebook
+from rot4d_widget import DEFAULT_KEYMAP, RotationState, polytope, slice_polytope
+
+HARMLESS_CONSOLE = (
+    "Unsatisfied version",
+    "Error setting state: t.on is not a function",
+    "GPU stall due to ReadPixels",
+    "Cannot read properties of undefined (reading 'schema')",
+    "[.WebGL-",  # SwiftShader performance notes
+    "Download the React DevTools",
+    "WebGL: INVALID_OPERATION: readPixels",
+)
+
+PAPER_KEYS = ["2", "3", "4", "6", "8", "c", "y", "z", "w"]
+PARAM_KEYS = ["k", "j", "l", "h"]
+
+
+def _state(jp, var="w"):
+    return jp.kernel_json(
+        f"dict(m={var}.state.matrix.tolist(), theta0={var}.state.theta0, alpha={var}.state.alpha, "
+        f"c0={var}.state.c0, readout={var}.readout.value)"
+    )
+
+
+def _open_case(page, server, name, polytope_name="5-cell", extra_cells=()):
+    write_notebook(
+        server.root / name,
+        [
+            "from rot4d_widget import Rot4DWidget\nimport numpy as np\nws = []",
+            f"w = Rot4DWidget({polytope_name!r})\nws.append(w)\nw",
+            *extra_cells,
+        ],
+    )
+    jp = JupyterPage(page, server, name).open()
+    jp.run_all()
+    return jp
+
+
+def _canvas(jp, var="w"):
+    cls = jp.kernel(f"print({var}.scene.canvas_class)").strip()
+    sel = f".{cls} canvas"
+    jp.page.wait_for_selector(sel, timeout=60_000)
+    jp.wait_for(lambda: (s := jp.canvas_stats(sel)) and s["count"] > 50, timeout=30)
+    return sel
+
+
+def _hover(jp, sel):
+    box = jp.page.locator(sel).bounding_box()
+    jp.page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    time.sleep(0.2)
+    return box
+
+
+def _wait_kernel_change(jp, before, var="w", timeout=5.0):
+    deadline = time.monotonic() + timeout
+    while True:
+        now = _state(jp, var)
+        if now["m"] != before["m"] or now["alpha"] != before["alpha"] or now["c0"] != before["c0"]:
+            return now
+        if time.monotonic() > deadline:
+            return now
+        time.sleep(0.05)
+
+
+def _wait_pixels_change(jp, sel, old_hash, timeout=5.0):
+    return jp.wait_for(lambda: (s := jp.canvas_stats(sel))["hash"] != old_hash and s, timeout=timeout)
+
+
+def _bad_console(page):
+    bad = [t for kind, t in page.console_messages if kind == "error" and not any(h in t for h in HARMLESS_CONSOLE)]
+    bad += [e for e in page.page_errors if not any(h in e for h in HARMLESS_CONSOLE)]
+    return bad
+
+
+# 1 -------------------------------------------------------------------------
+def test_notebook_01_draws_the_w0_tetrahedron(jupyter_server, page, artifacts):
+    jp = JupyterPage(page, jupyter_server, "01_pentachoron.ipynb").open()
+    jp.run_all(timeout=300)
+    sel = _canvas(jp, "widget")
+    webgl = page.evaluate(
+        "(sel) => { const c = document.querySelector(sel);"
+        " const gl = c.getContext('webgl') || c.getContext('webgl2') || c.getContext('experimental-webgl');"
+        " return gl ? {ok: !gl.isContextLost(), renderer: gl.getParameter(gl.RENDERER)} : null; }",
+        sel,
+    )
+    assert webgl and webgl["ok"], webgl
+    info = jp.kernel_json(
+        "dict(m=widget.state.matrix.tolist(), c0=widget.state.c0, fov=widget.scene.camera.fov,"
+        " pos=list(widget.scene.camera.position), scale=widget.scene.scale, r=widget.scene.ball_radius,"
+        " w=widget.scene.width, h=widget.scene.height)"
+    )
+    np.testing.assert_allclose(info["m"], np.eye(4), atol=1e-9)  # the notebook ends on a full turn
+    stats = jp.canvas_stats(sel)
+    page.locator(sel).screenshot(path=str(artifacts / f"case1-tetrahedron-{jupyter_server.kind}.png"))
+    # the silhouette of the balls, projected by an independent pinhole camera at (0, 0, 5)
+    verts = slice_polytope("5-cell", np.eye(4), 0.0).vertices * info["scale"]
+    W, H = stats["width"], stats["height"]
+    f = (H / 2) / math.tan(math.radians(info["fov"]) / 2)
+    d = info["pos"][2] - verts[:, 2]
+    px = W / 2 + f * verts[:, 0] / d
+    py = H / 2 - f * verts[:, 1] / d
+    pr = f * info["scale"] * info["r"] / np.sqrt(np.maximum(d**2 - (info["scale"] * info["r"]) ** 2, 1e-9))
+    expected = [min(px - pr), min(py - pr), max(px + pr), max(py + pr)]
+    got = stats["bbox"]
+    assert got is not None
+    assert np.allclose(got, expected, atol=4.0), (got, expected)
+
+
+# 2 -------------------------------------------------------------------------
+@pytest.mark.parametrize("shift_style", ["Shift+{}", "Shift+Digit{}"])
+def test_every_key_and_its_inverse(jupyter_server, page, artifacts, shift_style):
+    jp = _open_case(page, jupyter_server, f"keys-{shift_style[6]}.ipynb")
+    sel = _canvas(jp)
+    _hover(jp, sel)
+    model = RotationState()
+    for key in PAPER_KEYS:
+        for shifted in (False, True):
+            if shifted:
+                name = shift_style.format(key) if key.isdigit() else f"Shift+{key.upper()}"
+            else:
+                name = key
+            before = _state(jp)
+            old_hash = jp.canvas_stats(sel)["hash"]
+            page.keyboard.press(name)
+            after = _wait_kernel_change(jp, before)
+            model.matrix = np.array(before["m"])
+            model.theta0, model.alpha = before["theta0"], before["alpha"]
+            model.press(key, shift=shifted)
+            np.testing.assert_allclose(after["m"], model.matrix, atol=1e-12, err_msg=f"key {name}")
+            assert _wait_pixels_change(jp, sel, old_hash), f"pixels did not change for {name}"
+    page.locator(sel).screenshot(path=str(artifacts / f"case2-after-keys-{jupyter_server.kind}.png"))
+    # parameter keys: alpha and c0 move by their steps, the readout follows, nothing rotates
+    for key, field in (("k", "alpha"), ("j", "alpha"), ("l", "c0"), ("h", "c0")):
+        before = _state(jp)
+        page.keyboard.press(key)
+        after = _wait_kernel_change(jp, before)
+        step = jp.kernel_json(f"w.state.{'alpha_step' if field == 'alpha' else 'c0_step'}")
+        sign = 1 if key in "kl" else -1
+        assert after[field] == pytest.approx(before[field] + sign * step), key
+        assert after["m"] == before["m"]
+        assert after["readout"] != before["readout"]
+    assert not _bad_console(page), _bad_console(page)
+
+
+# 3 -------------------------------------------------------------------------
+def test_no_notebook_shortcut_fires_while_hovering(jupyter_server, page):
+    jp = _open_case(page, jupyter_server, "shortcuts.ipynb")
+    sel = _canvas(jp)
+    page.evaluate("() => { window.__executed.length = 0; }")
+    model_before = jp.notebook_model()
+    _hover(jp, sel)
+    keys = [*PAPER_KEYS, *PARAM_KEYS, "r", "?", "?", "m", "a", "b", "x", "d", "Enter", "Shift+Enter", "Shift+M"]
+    for key in keys:
+        page.keyboard.press(key)
+        time.sleep(0.05)
+    time.sleep(0.5)
+    assert jp.executed_commands() == []
+    assert jp.notebook_model() == model_before
+    assert page.locator(sel).count() == 1  # the canvas is still there
+
+
+# 4 -------------------------------------------------------------------------
+def _steps_of_xw(m_before, m_after, theta0):
+    r = np.array(m_after) @ np.array(m_before).T
+    np.testing.assert_allclose(r[1:3, 1:3], np.eye(2), atol=1e-9)  # a pure x-w rotation
+    return math.atan2(r[3, 0], r[0, 0]) / theta0
+
+
+@pytest.mark.parametrize("autorepeat", [False, True])
+def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_server, page, artifacts, autorepeat):
+    jp = _open_case(page, jupyter_server, f"hold-{int(autorepeat)}.ipynb")
+    sel = _canvas(jp)
+    _hover(jp, sel)
+    timing = jp.kernel_json("dict(delay=w.hold_delay, rate=w.tick_rate)")
+    before = _state(jp)
+    t0 = time.monotonic()
+    page.keyboard.down("4")
+    if autorepeat:
+        while time.monotonic() - t0 < 1.0:
+            time.sleep(1 / 30)
+            page.keyboard.down("4")  # Playwright sends these with repeat=true
+    else:
+        time.sleep(1.0)
+    page.keyboard.up("4")
+    released = time.monotonic()
+    page.locator(sel).screenshot(path=str(artifacts / f"case4-held-{jupyter_server.kind}-{int(autorepeat)}.png"))
+    # the canvas stops changing within 0.5 s of the release
+    last_change, h = released, jp.canvas_stats(sel)["hash"]
+    while time.monotonic() - released < 1.5:
+        s = jp.canvas_stats(sel)["hash"]
+        if s != h:
+            last_change, h = time.monotonic(), s
+        time.sleep(0.02)
+    assert last_change - released < 0.5
+    after = _state(jp)
+    time.sleep(0.5)
+    assert _state(jp)["m"] == after["m"]  # no further step in the kernel
+    steps = _steps_of_xw(before["m"], after["m"], before["theta0"])
+    expected = 1 + timing["rate"] * (1.0 - timing["delay"])
+    assert abs(steps - expected) <= 5, (steps, expected)
+
+
+# 5 -------------------------------------------------------------------------
+@pytest.mark.parametrize("how", ["mouseleave", "blur"])
+def test_rotation_stops_when_the_pointer_leaves_or_the_page_blurs(jupyter_server, page, how):
+    jp = _open_case(page, jupyter_server, f"stop-{how}.ipynb")
+    sel = _canvas(jp)
+    box = _hover(jp, sel)
+    page.keyboard.down("8")
+    time.sleep(0.6)
+    if how == "mouseleave":
+        page.mouse.move(box["x"] + box["width"] + 200, box["y"] - 50)
+    else:
+        page.evaluate("() => { window.dispatchEvent(new FocusEvent('blur')); }")
+    time.sleep(0.3)
+    a = _state(jp)["m"]
+    time.sleep(0.6)
+    b = _state(jp)["m"]
+    page.keyboard.up("8")
+    assert a == b
+    assert a != np.eye(4).tolist()
+
+
+# 6 -------------------------------------------------------------------------
+def test_rerunning_the_cell_makes_independent_widgets(jupyter_server, page):
+    jp = _open_case(page, jupyter_server, "rerun.ipynb")
+    _canvas(jp)
+    for _ in range(2):
+        page.evaluate(
+            "() => { const p = window.jupyterapp.shell.currentWidget; p.content.activeCellIndex = 1;"
+            " return window.jupyterapp.commands.execute('notebook:run-cell'); }"
+        )
+        jp.wait_idle()
+    assert jp.kernel_json("len(ws)") == 3
+    sel = _canvas(jp, "ws[2]")
+    assert page.locator("canvas").count() >= 1
+    _hover(jp, sel)
+    page.keyboard.press("4")
+    time.sleep(1.0)
+    mats = jp.kernel_json("[x.state.matrix.tolist() for x in ws]")
+    model = RotationState()
+    model.press("4")
+    np.testing.assert_allclose(mats[2], model.matrix, atol=1e-12)
+    assert mats[0] == np.eye(4).tolist() and mats[1] == np.eye(4).tolist()
+
+
+# 7 -------------------------------------------------------------------------
+def test_key_storm_on_the_600_cell(jupyter_server, page):
+    jp = _open_case(
+        page,
+        jupyter_server,
+        "storm.ipynb",
+        polytope_name="600-cell",
+        extra_cells=[
+            "import ipywidgets\n"
+            "def live_models():\n"
+            "    from ipywidgets.widgets.widget import _instances\n"
+            "    return len(_instances)\n"
+            "def rss_kb():\n"
+            "    for line in open('/proc/self/status'):\n"
+            "        if line.startswith('VmRSS'):\n"
+            "            return int(line.split()[1])"
+        ],
+    )
+    sel = _canvas(jp)
+    _hover(jp, sel)
+    cdp = page.context.new_cdp_session(page)
+    models_before = jp.kernel_json("live_models()")
+
+    def heap():
+        cdp.send("HeapProfiler.collectGarbage")
+        return cdp.send("Runtime.getHeapUsage")["usedSize"]
+
+    rng = random.Random(2026)
+    bound = PAPER_KEYS + PARAM_KEYS
+    unbound = ["q", "5", "7", "e", "t", "u"]
+    held: list[str] = []
+    shift = False
+    first = None
+    for i in range(2000):
+        r = rng.random()
+        if r < 0.35 and len(held) < 3:
+            k = rng.choice(bound + unbound)
+            if k not in held:
+                page.keyboard.down(k)
+                held.append(k)
+        elif r < 0.7 and held:
+            page.keyboard.up(held.pop(rng.randrange(len(held))))
+        elif r < 0.8:
+            (page.keyboard.up if shift else page.keyboard.down)("Shift")
+            shift = not shift
+        else:
+            page.keyboard.press(rng.choice(bound + unbound))
+        time.sleep(0.01)
+        if i == 199:
+            first = (jp.kernel_json("rss_kb()"), heap())
+    for k in held:
+        page.keyboard.up(k)
+    if shift:
+        page.keyboard.up("Shift")
+    last_event = time.monotonic()
+    # the view settles within 2 s of the last event
+    h, settled_at = jp.canvas_stats(sel)["hash"], time.monotonic()
+    while time.monotonic() - last_event < 3.0:
+        s = jp.canvas_stats(sel)["hash"]
+        if s != h:
+            h, settled_at = s, time.monotonic()
+        time.sleep(0.05)
+    assert settled_at - last_event < 2.0
+    m = np.array(_state(jp)["m"])
+    assert np.abs(m @ m.T - np.eye(4)).max() < 1e-12
+    assert jp.kernel_json("len(w.errors.outputs)") == 0
+    assert jp.kernel_json("live_models()") == models_before
+    rss_end, heap_end = jp.kernel_json("rss_kb()"), heap()
+    assert rss_end <= 1.2 * first[0], (first, rss_end)
+    assert heap_end <= 1.2 * first[1], (first, heap_end)
+    assert not _bad_console(page), _bad_console(page)
