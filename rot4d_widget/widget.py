@@ -88,8 +88,16 @@ MAX_ERRORS_SHOWN = 5
 
 #: Child objects, in the order close() closes them (the Event first).
 _PARTS = ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box")
-#: compact table cells (Jupyter's rendered-HTML CSS pads them generously)
-_TD = "padding:1px 0.5em 1px 0;line-height:1.3;text-align:left;vertical-align:top"
+#: Compact tables (Jupyter's rendered-HTML CSS pads cells generously).  Sent
+#: once, with the help panel (a <style> applies while its container is hidden),
+#: so the readout sent with every update stays small.
+_STYLE = (
+    "<style>.rot4d-side table{border-collapse:collapse;margin:0}"
+    ".rot4d-side .rot4d-readout td,.rot4d-side .rot4d-help td"
+    "{padding:1px 0.5em 1px 0;line-height:1.3;text-align:left;vertical-align:top}"
+    ".rot4d-side .rot4d-readout table{font-family:monospace}"
+    ".rot4d-side .rot4d-help{font-size:90%}</style>"
+)
 _REPEATING_KINDS = frozenset({"rotate", "alpha", "c0"})
 _WATCHED_EVENTS = ["keydown", "keyup", "mouseleave"]
 _POLYGON_NAMES = {
@@ -266,6 +274,7 @@ class Rot4DWidget(widgets.HBox):
                 [self.readout, self.help_panel, self.errors],
                 layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
             )
+            self._side_box.add_class("rot4d-side")
             built += [self._canvas_box, self._side_box]
         except BaseException:
             for w in reversed(built):
@@ -633,11 +642,11 @@ class Rot4DWidget(widgets.HBox):
             ("volume", f"{s.volume:.4f}"),
         ]
         body = "".join(
-            f"<tr><td style='{_TD}'>{k}</td><td style='{_TD}'>{v}</td></tr>" for k, v in rows
+            f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows
         )
         return (
             f"<div class='rot4d-readout'><b>{html.escape(self.polytope.name)}</b>"
-            f"<table style='font-family:monospace;border-collapse:collapse;margin:0'>{body}</table>"
+            f"<table>{body}</table>"
             "<small>mouse over the view; ? for keys</small></div>"
         )
 
@@ -702,12 +711,10 @@ def _help_html(keymap: Keymap, hold_delay: float, tick_rate: float) -> str:
     for (label, description), keys in groups.items():
         shown = " ".join(f"<kbd>{html.escape(k)}</kbd>" for k in keys)
         rows.append(
-            f"<tr><td style='{_TD}'>{shown}</td><td style='{_TD}'>{html.escape(label)}</td>"
-            f"<td style='{_TD}'>{html.escape(description)}</td></tr>"
+            f"<tr><td>{shown}</td><td>{html.escape(label)}</td><td>{html.escape(description)}</td></tr>"
         )
     return (
-        "<div class='rot4d-help' style='font-size:90%'>"
-        "<table style='border-collapse:collapse;margin:0.5em 0'>" + "".join(rows) + "</table>"
+        _STYLE + "<div class='rot4d-help'><table style='margin:0.5em 0'>" + "".join(rows) + "</table>"
         f"<small>Shift inverts a rotation. Hold a key: it repeats after {hold_delay * 1000:.0f} ms, "
         f"{tick_rate:g} steps/s.</small></div>"
     )
