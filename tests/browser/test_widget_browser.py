@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from jupyter_page import JupyterPage, write_notebook
-from rot4d_widget import DEFAULT_KEYMAP, RotationState, polytope, slice_polytope
+from rot4d_widget import RotationState, double_rotation, simple_rotation, slice_polytope
 
 HARMLESS_CONSOLE = (
     "Unsatisfied version",
@@ -26,7 +26,18 @@ HARMLESS_CONSOLE = (
     "WebGL: INVALID_OPERATION: readPixels",
 )
 
-PAPER_KEYS = ["2", "3", "4", "6", "8", "c", "y", "z", "w"]
+# The paper's Table 1, written out here (not read from the package's keymap)
+PAPER_TABLE = {"2": "xy", "3": "xz", "4": "xw", "6": "yz", "8": "yw", "c": "zw",
+               "y": "xy,zw", "z": "xz,yw", "w": "xw,yz"}
+PAPER_KEYS = list(PAPER_TABLE)
+
+
+def paper_step(key, shifted, theta0, alpha):
+    sign = -1.0 if shifted else 1.0
+    planes = PAPER_TABLE[key]
+    if "," in planes:
+        return double_rotation(planes, sign * alpha, sign * (theta0 - alpha))
+    return simple_rotation(planes, sign * theta0)
 PARAM_KEYS = ["k", "j", "l", "h"]
 
 
@@ -127,7 +138,6 @@ def test_every_key_and_its_inverse(jupyter_server, page, artifacts, shift_style)
     jp = _open_case(page, jupyter_server, f"keys-{shift_style[6]}.ipynb")
     sel = _canvas(jp)
     _hover(jp, sel)
-    model = RotationState()
     for key in PAPER_KEYS:
         for shifted in (False, True):
             if shifted:
@@ -138,10 +148,8 @@ def test_every_key_and_its_inverse(jupyter_server, page, artifacts, shift_style)
             old_hash = jp.canvas_stats(sel)["hash"]
             page.keyboard.press(name)
             after = _wait_kernel_change(jp, before)
-            model.matrix = np.array(before["m"])
-            model.theta0, model.alpha = before["theta0"], before["alpha"]
-            model.press(key, shift=shifted)
-            np.testing.assert_allclose(after["m"], model.matrix, atol=1e-12, err_msg=f"key {name}")
+            expected = paper_step(key, shifted, before["theta0"], before["alpha"]) @ np.array(before["m"])
+            np.testing.assert_allclose(after["m"], expected, atol=1e-12, err_msg=f"key {name}")
             assert _wait_pixels_change(jp, sel, old_hash), f"pixels did not change for {name}"
     page.locator(sel).screenshot(path=str(artifacts / f"case2-after-keys-{jupyter_server.kind}.png"))
     # parameter keys: alpha and c0 move by their steps, the readout follows, nothing rotates
@@ -253,10 +261,75 @@ def test_rerunning_the_cell_makes_independent_widgets(jupyter_server, page):
     page.keyboard.press("4")
     time.sleep(1.0)
     mats = jp.kernel_json("[x.state.matrix.tolist() for x in ws]")
-    model = RotationState()
-    model.press("4")
-    np.testing.assert_allclose(mats[2], model.matrix, atol=1e-12)
+    theta0 = jp.kernel_json("ws[2].state.theta0")
+    np.testing.assert_allclose(mats[2], simple_rotation("xw", theta0), atol=1e-12)
     assert mats[0] == np.eye(4).tolist() and mats[1] == np.eye(4).tolist()
+
+
+# flow control ---------------------------------------------------------------
+_WATCH_ACKS = """
+(sel) => {
+  window.__acks = [];
+  const canvas = document.querySelector(sel);
+  const hash = () => {
+    const t = document.createElement('canvas'); t.width = canvas.width; t.height = canvas.height;
+    const ctx = t.getContext('2d'); ctx.drawImage(canvas, 0, 0);
+    const d = ctx.getImageData(0, 0, t.width, t.height).data;
+    let h = 2166136261; for (let i = 0; i < d.length; i += 4) h = Math.imul(h ^ (d[i] + 3 * d[i + 1] + 7 * d[i + 2]), 16777619) >>> 0;
+    return h;
+  };
+  const orig = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    let text = '';
+    try { text = typeof data === 'string' ? data : new TextDecoder().decode(data); } catch (e) {}
+    if (text.includes('"drawn"')) window.__acks.push({t: performance.now(), hash: hash()});
+    return orig.call(this, data);
+  };
+}
+"""
+
+
+def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server, page):
+    """Flow control on a page made slow on purpose (CPU throttled 6x, 600-cell).
+
+    The page draws slower than the tick rate: without one-update-in-flight the
+    kernel would queue updates and the view would keep moving after release.
+    """
+    jp = _open_case(page, jupyter_server, "flow.ipynb", polytope_name="600-cell")
+    sel = _canvas(jp)
+    page.evaluate(_WATCH_ACKS, sel)
+    initial = jp.canvas_stats(sel)["hash"]
+    _hover(jp, sel)
+    cdp = page.context.new_cdp_session(page)
+    cdp.send("Emulation.setCPUThrottlingRate", {"rate": 6})
+    start = jp.kernel_json("dict(u=w.n_updates, a=w.n_acks, t=w.n_timeouts)")
+    page.keyboard.down("4")
+    time.sleep(2.0)
+    page.keyboard.up("4")
+    released = time.monotonic()
+    last_change, h = released, jp.canvas_stats(sel)["hash"]
+    while time.monotonic() - released < 2.5:
+        s = jp.canvas_stats(sel)["hash"]
+        if s != h:
+            last_change, h = time.monotonic(), s
+        time.sleep(0.05)
+    cdp.send("Emulation.setCPUThrottlingRate", {"rate": 1})
+    final = jp.canvas_stats(sel)["hash"]
+    end = jp.kernel_json("dict(u=w.n_updates, a=w.n_acks, t=w.n_timeouts)")
+    acks = page.evaluate("() => window.__acks")
+    updates = end["u"] - start["u"]
+    assert updates >= 3
+    # at most one update in flight: every update but the last was answered (or timed out) first
+    assert updates <= (end["a"] - start["a"]) + (end["t"] - start["t"]) + 1, (start, end)
+    # after release the view settles at once (the update in flight, nothing queued)
+    assert last_change - released < 1.5
+    # an acknowledgement leaves only once the canvas shows its update: no ack while the
+    # first picture is still up, each ack on a new picture, the last one on the final picture
+    assert len(acks) >= 3
+    hashes = [a["hash"] for a in acks]
+    assert initial not in hashes
+    assert all(a != b for a, b in zip(hashes, hashes[1:]))
+    assert hashes[-1] == final
 
 
 # 7 -------------------------------------------------------------------------
