@@ -10,7 +10,6 @@ tests/test_widget_scene.py runs the real Scene and Companion.
 from __future__ import annotations
 
 import math
-import threading
 import time
 import uuid
 

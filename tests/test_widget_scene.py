@@ -16,10 +16,10 @@ import pytest
 from ipywidgets.widgets import widget as ipywidget_module
 
 from rot4d_widget import buffers as bf
-from rot4d_widget import polytope, slice_polytope
+from rot4d_widget import slice_polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.widget import Rot4DWidget
-from test_widget import FakeClock, RecordingComm, deliver, down, run_ticker, up, xw_steps
+from test_widget import FakeClock, RecordingComm, down, run_ticker, up, xw_steps
 
 
 @pytest.fixture(autouse=True)
