@@ -1,0 +1,897 @@
+"""Key -> pixel latency, held-key frame rate and bytes per update, in a real browser.
+
+One run, one JupyterLab 4 server, one headless Chromium (SwiftShader WebGL):
+a baseline -- a bare pythreejs tetrahedron (Mesh + BufferGeometry) whose
+ipyevents keydown handler assigns a new float32 position array -- and
+``Rot4DWidget(name)`` for each of the six regular polychora.
+
+    /work/venv/bin/python benchmarks/browser_latency.py [--presses 40] [--hold 2]
+        [--tap 60-120] [--cases 5-cell,600-cell] [--seed 0] [--rev HEAD]
+        [--nodelay] [--json out.json]
+
+About 4 minutes for the default run (headless, runs as root).
+
+Each polychoron gets a notebook (own kernel, own page, same server and
+browser) showing the baseline canvas and the widget's canvas, both 600 x 500,
+both on screen.  Single presses alternate between the two canvases in random
+order, so the baseline is measured in the same minute as the widget: the
+machine is shared and its load drifts; the excess is taken against this
+*paired* baseline.  The baseline row pools every pairing.
+
+``--rev REV`` measures a clean ``git archive`` of that revision (first on the
+kernel's PYTHONPATH) instead of the working tree, so uncommitted edits
+elsewhere in the checkout do not leak into the numbers.  ``--nodelay``
+starts the server with TCP_NODELAY on the kernel WebSockets (through
+``ServerApp.kernel_websocket_connection_class``); jupyter_server does not set
+it, and Nagle's algorithm then holds every frame of a burst after the first
+(kernel status, comm updates) until the browser's delayed ACK, up to 40 ms.
+
+How each quantity is measured (clocks: the page's performance.now()):
+
+key -> pixel
+    A requestAnimationFrame loop posts, every frame, a task that runs after
+    that frame's rendering step (pythreejs renders in its own rAF callback):
+    it draws the active WebGL canvas (preserveDrawingBuffer) into a 2-D
+    canvas, hashes every pixel and stamps the time after the read (the read
+    waits for the GL draw).  A capture-phase keydown listener on ``window``
+    stamps the key.  Latency = first frame whose hash differs from the last
+    frame before the key, minus the key stamp.  ``--presses`` single presses
+    per canvas (random rotation keys; keyup ``--tap`` ms after keydown, a
+    human tap -- an instant keyup would carry the TCP ACK that releases the
+    Nagle-held reply and hide the stall), each 0.1-0.3 s (random: the frame
+    phase averages out) after the mouse moved onto the canvas.
+    Reported: median (p10-p90), mean +- std; excess = widget minus paired
+    baseline, mean (median).
+key -> msg, msg -> px, kernel
+    A WebSocket wrapper installed before the app loads (page init script)
+    stamps every kernel-channel message on arrival (and its size); the update
+    is the first ``comm_msg`` with binary buffers after the key.  key -> msg =
+    page -> kernel -> page; msg -> px = deserialise + wait for a frame + draw
+    + read-back.  kernel = time per update in the kernel (the widget's
+    ``_render``: slice + scene.show + readout; the baseline's handler), timed
+    by wrapping it from the notebook (benchmark side only).  The widget's
+    probe also stamps, with time.time() (the page's timeOrigin + now() is the
+    same wall clock, checked to < 1 ms), when the key and each "drawn" ack
+    reach the widget and when each update is computed: key -> kernel, kernel
+    handling, sent -> arrival.
+held fps
+    Hold "4" on the canvas for ``--hold`` s (headless Chromium sends no
+    auto-repeat): frames whose hash changed per second over [keydown + 0.5 s,
+    keyup] (past the 0.25 s hold delay).  The cycle of one held update is
+    split with the same stamps: update arrives -> page sends its "drawn" ack
+    (page: deserialise, frame, draw, one more frame) -> ack reaches the
+    widget -> next update computed (or waits for a tick) -> arrives.  The baseline (first notebook
+    only) repeats from a kernel thread at 30 Hz after 0.25 s, no flow control.
+after release
+    Frames whose hash changed after the keyup stamp (2 s watched) and when the
+    last one came.  The widget's kernel also records, at keyup, whether an
+    update was in flight, and afterwards whether the state moved after keyup
+    and how many updates were sent after it.  ok = no step after keyup, at
+    most 2 frames (the update in flight, then the latest state it held back),
+    the last within 0.5 s.
+bytes/update
+    Every byte the page receives on the kernel WebSocket during the hold and
+    the 2 s after it (updates, readouts, kernel status and echo messages),
+    divided by the updates the kernel sent meanwhile; in brackets the median
+    size of the update message itself.
+
+Targets (issue 4): mean key -> pixel at most 16.7 ms (one frame) above the
+baseline for the 5-, 8-, 16- and 24-cell, 50 ms for the 600- and 120-cell;
+held >= 20 frames/s (>= 10 for the 600- and 120-cell); nothing drawn after
+release beyond the update in flight.  Quote medians; run it more than once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import bisect
+import json
+import math
+import os
+import pathlib
+import platform
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "browser"))
+
+from conftest import (  # noqa: E402  (the browser tests' building blocks)
+    CHROMIUM_FLAGS,
+    INSTALL_HINT,
+    JupyterServer,
+    _apt_install_chromium,
+    _installed_chromium,
+    _playwright_chromium,
+)
+from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook  # noqa: E402
+
+POLYCHORA = ["5-cell", "8-cell", "16-cell", "24-cell", "600-cell", "120-cell"]
+LARGE = {"600-cell", "120-cell"}
+FRAME_MS = 1000.0 / 60.0
+PRESS_KEYS = ["2", "3", "4", "6", "8", "c", "y", "z", "w"]
+HOLD_KEY = "4"
+FPS_SKIP = 0.5  # s after keydown before the held frame rate is counted
+WATCH_AFTER = 2.0  # s watched after keyup
+VIEWPORT = {"width": 1400, "height": 1500}  # both canvases on screen
+BASE, WIDGET = 0, 1
+
+# -- page side ----------------------------------------------------------------
+
+#: Installed before any page script: stamps kernel-channel WebSocket traffic.
+WS_HOOK = r"""
+(() => {
+  if (window.__wsLog) return;
+  const L = window.__wsLog = {on: false, log: [], acks: []};
+  const Orig = window.WebSocket;
+  const dec = new TextDecoder('utf-8', {fatal: false});
+  const UPDATE = /"buffer_paths"\s*:\s*\[\s*\[/;
+  const ACK = /"event"\s*:\s*"drawn"/;
+  const head = (d) => {
+    if (typeof d === 'string') return d.slice(0, 8192);
+    if (d instanceof ArrayBuffer) return dec.decode(new Uint8Array(d, 0, Math.min(d.byteLength, 8192)));
+    if (ArrayBuffer.isView(d)) return dec.decode(new Uint8Array(d.buffer, d.byteOffset, Math.min(d.byteLength, 8192)));
+    return '';
+  };
+  const onMessage = (e) => {
+    if (!L.on) return;
+    const t = performance.now();
+    const d = e.data;
+    const n = typeof d === 'string' ? d.length : (d.byteLength !== undefined ? d.byteLength : (d.size || 0));
+    const h = head(d);
+    L.log.push([t, n, h.includes('comm_msg') && UPDATE.test(h) ? 1 : 0]);
+  };
+  class HookedWebSocket extends Orig {
+    constructor(url, protocols) {
+      super(url, protocols);
+      this.__kernel = String(url).includes('/channels');
+      if (this.__kernel) this.addEventListener('message', onMessage);  // before the app's own
+    }
+    send(d) {
+      if (L.on && this.__kernel && ACK.test(head(d))) L.acks.push(performance.now());
+      return super.send(d);
+    }
+  }
+  window.WebSocket = HookedWebSocket;
+})();
+"""
+
+#: Reads the active canvas back after every frame's rendering step; stamps keys.
+RECORDER = r"""
+(sels) => {
+  if (window.__bench && window.__bench.stop) window.__bench.stop();
+  const cs = sels.map((s) => document.querySelector(s));
+  if (cs.some((c) => !c)) return null;
+  const B = window.__bench = {t: [], h: [], g: [], cost: [], keys: [], lastChange: -1, lastKey: -1,
+                              run: true, cur: 0};
+  const tmps = cs.map((c) => {
+    const tmp = document.createElement('canvas');
+    tmp.width = c.width; tmp.height = c.height;
+    return tmp.getContext('2d', {willReadFrequently: true});
+  });
+  let prev = null;
+  B.setTarget = (i) => { B.cur = i; prev = null; };
+  const ch = new MessageChannel();
+  ch.port1.onmessage = () => {
+    if (!B.run) return;
+    const g = B.cur, c = cs[g], ctx = tmps[g];
+    const t0 = performance.now();
+    ctx.drawImage(c, 0, 0);
+    const d = new Int32Array(ctx.getImageData(0, 0, c.width, c.height).data.buffer);
+    let h = -2128831035;
+    for (let i = 0; i < d.length; i++) h = Math.imul(h ^ d[i], 16777619);
+    const t = performance.now();
+    B.t.push(t); B.h.push(h); B.g.push(g); B.cost.push(t - t0);
+    if (prev !== null && h !== prev) B.lastChange = t;
+    prev = h;
+  };
+  const loop = () => { if (!B.run) return; requestAnimationFrame(loop); ch.port2.postMessage(0); };
+  requestAnimationFrame(loop);
+  const onKey = (e) => {
+    const t = performance.now();
+    B.keys.push([e.type, t, e.code, e.repeat]);
+    if (e.type === 'keydown' && !e.repeat) B.lastKey = t;
+  };
+  window.addEventListener('keydown', onKey, true);
+  window.addEventListener('keyup', onKey, true);
+  B.stop = () => {
+    B.run = false;
+    window.removeEventListener('keydown', onKey, true);
+    window.removeEventListener('keyup', onKey, true);
+  };
+  const gl = cs[1].getContext('webgl2') || cs[1].getContext('webgl');
+  let renderer = null;
+  if (gl) {
+    const ext = gl.getExtension('WEBGL_debug_renderer_info');
+    renderer = gl.getParameter(ext ? ext.UNMASKED_RENDERER_WEBGL : gl.RENDERER);
+  }
+  return {width: cs[1].width, height: cs[1].height, dpr: window.devicePixelRatio, renderer,
+          timeOrigin: performance.timeOrigin};
+}
+"""
+
+# -- kernel side --------------------------------------------------------------
+
+#: Written next to the notebooks and imported by them: the baseline and the probes.
+HELPERS = r'''
+"""Helpers for benchmarks/browser_latency.py (generated; imported by its notebooks)."""
+import json, threading, time
+import numpy as np
+import pythreejs as p3
+from ipyevents import Event
+
+# -- baseline: a bare pythreejs tetrahedron, a new float32 position array per key --
+_T = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], dtype=np.float64) * 0.73
+_FACES = np.array([(0, 1, 2), (0, 3, 1), (0, 2, 3), (1, 3, 2)]).ravel()
+_axis = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+_K = np.array([[0, -_axis[2], _axis[1]], [_axis[2], 0, -_axis[0]], [-_axis[1], _axis[0], 0]])
+_th = np.pi / 64
+_STEP = np.eye(3) + np.sin(_th) * _K + (1 - np.cos(_th)) * _K @ _K
+
+def _positions(R):
+    return np.ascontiguousarray((_T @ R.T)[_FACES], dtype=np.float32)
+
+_colors = np.repeat(np.array([[.78, .06, .18], [.2, .4, .8], [.2, .7, .3], [.9, .7, .1]], dtype=np.float32),
+                    3, axis=0)
+geometry = p3.BufferGeometry(attributes={
+    "position": p3.BufferAttribute(array=_positions(np.eye(3))),
+    "color": p3.BufferAttribute(array=_colors),
+})
+mesh = p3.Mesh(geometry, p3.MeshBasicMaterial(vertexColors="VertexColors", side="DoubleSide"),
+               frustumCulled=False)
+camera = p3.PerspectiveCamera(position=[0, 0, 5], fov=40, aspect=600 / 500, near=0.1, far=100)
+renderer = p3.Renderer(camera=camera, scene=p3.Scene(children=[mesh, camera]), width=600, height=500,
+                       antialias=True, background="#ffffff", background_opacity=1.0, clearColor="#ffffff",
+                       controls=[p3.OrbitControls(controlling=camera, enableKeys=False)])
+renderer.add_class("bench-baseline")
+_lock = threading.Lock()
+_st = {"R": np.eye(3), "held": {}}
+_base = {"kernel": [], "up": None, "n": 0}
+
+def _step():
+    with _lock:
+        t0 = time.perf_counter()
+        _st["R"] = _STEP @ _st["R"]
+        geometry.attributes["position"].array = _positions(_st["R"])
+        _base["n"] += 1
+        _base["kernel"].append(time.perf_counter() - t0)
+
+def _repeat(code, token):
+    # held: repeat at 30 Hz after 0.25 s, like the widget, but with no flow control
+    due = time.monotonic() + 0.25
+    while True:
+        time.sleep(max(0.0, due - time.monotonic()))
+        if _st["held"].get(code) is not token:
+            return
+        _step()
+        due += 1 / 30
+
+def _on_event(ev):
+    if ev.get("type") == "keydown":
+        if ev.get("repeat"):
+            return
+        _step()
+        token = object()
+        _st["held"][ev.get("code")] = token
+        threading.Thread(target=_repeat, args=(ev.get("code"), token), daemon=True).start()
+    elif ev.get("type") == "keyup":
+        _st["held"].pop(ev.get("code"), None)
+        _base["up"] = {"n": _base["n"], "in_flight": None, "R": _st["R"].tolist()}
+
+events = Event(source=renderer, watched_events=["keydown", "keyup"], prevent_default_action=True)
+events.on_dom_event(_on_event)
+
+def read_baseline():
+    print(json.dumps(dict(n_updates=_base["n"], kernel_ms=[1000 * x for x in _base["kernel"]],
+                          up=_base["up"], final=_st["R"].tolist())))
+
+# -- probes around a Rot4DWidget (timing only; the widget's behaviour is unchanged) --
+def probe(w):
+    # epoch stamps (time.time(), same clock as the page's timeOrigin + now()) of: key events and
+    # "drawn" acks as they reach the widget, and every update's computation (start, end, thread)
+    rec = {"kernel": [], "up": None, "keys": [], "acks": [], "renders": []}
+    main = threading.main_thread()
+    render = w._render
+    def timed_render(*a, **k):  # slice + scene.show + readout, once per update
+        e0, t0 = time.time(), time.perf_counter()
+        try:
+            return render(*a, **k)
+        finally:
+            rec["kernel"].append(time.perf_counter() - t0)
+            rec["renders"].append((e0, time.time(), threading.current_thread() is main))
+    w._render = timed_render
+    handle_event, handle_drawn = w._handle_event, w._handle_drawn
+    def stamped_event(ev):
+        if isinstance(ev, dict) and ev.get("type") == "keydown" and not ev.get("repeat"):
+            rec["keys"].append(time.time())
+        return handle_event(ev)
+    def stamped_drawn(*a, **k):
+        rec["acks"].append(time.time())
+        return handle_drawn(*a, **k)
+    w.events.on_dom_event(handle_event, remove=True)
+    w.events.on_dom_event(stamped_event)
+    w.companion.on_drawn(handle_drawn, remove=True)
+    w.companion.on_drawn(stamped_drawn)
+    def on_keyup(ev):  # registered after the widget's own handler: runs after it
+        if isinstance(ev, dict) and ev.get("type") == "keyup":
+            rec["up"] = {"n": w.n_updates, "in_flight": w.in_flight, "R": w.state.matrix.tolist()}
+    w.events.on_dom_event(on_keyup)
+    w._bench_probe = rec
+    return w
+
+def read_widget(w):
+    rec = w._bench_probe
+    print(json.dumps(dict(n_updates=w.n_updates, kernel_ms=[1000 * x for x in rec["kernel"]], up=rec["up"],
+                          final=w.state.matrix.tolist(), acks=w.n_acks, timeouts=w.n_timeouts,
+                          capacity=w.scene.capacity, canvas_class=w.scene.canvas_class,
+                          stamps={k: rec[k] for k in ("keys", "acks", "renders")})))
+'''
+
+#: ``--nodelay``: jupyter_server (tornado) never calls ``set_nodelay(True)`` on the kernel
+#: WebSocket, so Nagle's algorithm holds the 2nd and later frames of a burst (status busy,
+#: comm update, readout, status idle) until the browser's delayed ACK (40 ms on Linux).
+#: This sets it through a supported hook, ``ServerApp.kernel_websocket_connection_class``.
+NODELAY_MODULE = """
+from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
+
+
+class NoDelayConnection(ZMQChannelsWebsocketConnection):
+    def connect(self):
+        self.websocket_handler.set_nodelay(True)
+        return super().connect()
+"""
+NODELAY_CONFIG = 'c.ServerApp.kernel_websocket_connection_class = "rot4d_bench_nodelay.NoDelayConnection"\n'
+
+CELLS = [
+    "import rot4d_bench_helpers as bench\nbench.renderer",
+    "from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({name!r}))\nw",
+]
+READ = {BASE: "bench.read_baseline()", WIDGET: "bench.read_widget(w)"}
+
+
+# -- helpers ------------------------------------------------------------------
+
+
+def pct(xs, q):
+    xs = sorted(xs)
+    if not xs:
+        return math.nan
+    k = (len(xs) - 1) * q
+    lo, hi = math.floor(k), math.ceil(k)
+    return xs[lo] + (xs[hi] - xs[lo]) * (k - lo)
+
+
+def median(xs):
+    return statistics.median(xs) if xs else math.nan
+
+
+def mean(xs):
+    return statistics.fmean(xs) if xs else math.nan
+
+
+def find_chromium() -> str:
+    path = _installed_chromium() or _apt_install_chromium() or _playwright_chromium()
+    if not path:
+        sys.exit(INSTALL_HINT)
+    return path
+
+
+def export_revision(rev: str, dest: pathlib.Path) -> str:
+    """A clean copy of the package at ``rev`` under ``dest``; returns its description."""
+    dest.mkdir(parents=True)
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "rot4d_widget"], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    sha = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", rev], check=True,
+                         capture_output=True, text=True).stdout.strip()
+    return f"git archive {rev} ({sha})"
+
+
+def working_tree_description() -> str:
+    try:
+        sha = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], check=True,
+                             capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", "rot4d_widget"],
+                               check=True, capture_output=True, text=True).stdout.strip()
+        return f"working tree at {sha}" + (" + uncommitted changes in rot4d_widget/" if dirty else "")
+    except Exception:
+        return "installed package"
+
+
+def cpu_name() -> str:
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "?"
+
+
+def ws_on(page):
+    page.evaluate("() => { const L = window.__wsLog; L.log = []; L.acks = []; L.on = true; }")
+
+
+# -- one notebook: the baseline and one polychoron, interleaved -----------------
+
+
+def run_case(context, server, case: str, args, rng: random.Random, hold_baseline: bool) -> dict:
+    name = f"bench_{case.replace('-', '_')}.ipynb"
+    write_notebook(server.root / name, [c.format(name=case) for c in CELLS])
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: None if page.__dict__.get("closing") else errors.append(str(e)))
+    try:
+        jp = JupyterPage(page, server, name).open(timeout=180)
+        jp.run_all(timeout=300)
+        cls = jp.kernel("print(w.scene.canvas_class)").strip()
+        sels = [".bench-baseline canvas", f".{cls} canvas"]
+        for sel in sels:
+            page.wait_for_selector(sel, timeout=120_000)
+            if not jp.wait_for(lambda: (s := jp.canvas_stats(sel)) and s["count"] > 50, timeout=60):
+                raise RuntimeError(f"{case}: nothing drawn on {sel}")
+        page.locator(sels[WIDGET]).scroll_into_view_if_needed()
+        time.sleep(0.3)
+        centres = []
+        for sel in sels:
+            box = page.locator(sel).bounding_box()
+            if box["y"] < 0 or box["y"] + box["height"] > VIEWPORT["height"]:
+                raise RuntimeError(f"{case}: canvas {sel} is not on screen ({box})")
+            centres.append((box["x"] + box["width"] / 2, box["y"] + box["height"] / 2))
+        info = page.evaluate(RECORDER, sels)
+
+        def hover(g):
+            page.evaluate("(g) => window.__bench.setTarget(g)", g)
+            page.mouse.move(*centres[g], steps=2)
+
+        hover(WIDGET)
+        time.sleep(1.0)  # idle frames: the page's frame rate
+        before = {g: kernel_read(jp, READ[g]) for g in (BASE, WIDGET)}
+
+        # -- single presses, alternating canvases in random order --------------
+        order = []
+        for _ in range(args.presses):
+            pair = [BASE, WIDGET]
+            rng.shuffle(pair)
+            order += pair
+        ws_on(page)
+        for g in order:
+            hover(g)
+            time.sleep(rng.uniform(0.1, 0.3))
+            page.keyboard.press(rng.choice(PRESS_KEYS), delay=rng.uniform(*args.tap))
+            try:
+                page.wait_for_function("() => window.__bench.lastChange > window.__bench.lastKey",
+                                       polling=10, timeout=5000)
+            except Exception:
+                pass  # counted as a miss
+        time.sleep(0.5)
+        page.evaluate("() => { window.__wsLog.on = false; }")
+        ws_presses = page.evaluate("() => window.__wsLog.log.slice()")
+        after_presses = {g: kernel_read(jp, READ[g]) for g in (BASE, WIDGET)}
+
+        # -- holds: the widget, then (first notebook only) the baseline ----------
+        holds = {}
+        for g in ([WIDGET, BASE] if hold_baseline else [WIDGET]):
+            hover(g)
+            time.sleep(0.5)
+            ws_on(page)
+            page.keyboard.down(HOLD_KEY)
+            time.sleep(args.hold)
+            page.keyboard.up(HOLD_KEY)
+            time.sleep(WATCH_AFTER + 0.2)
+            page.evaluate("() => { window.__wsLog.on = false; }")
+            holds[g] = {
+                "ws": page.evaluate("() => window.__wsLog.log.slice()"),
+                "acks": page.evaluate("() => window.__wsLog.acks.slice()"),
+                "kernel": kernel_read(jp, READ[g]),
+            }
+        rec = page.evaluate("() => { const B = window.__bench; B.stop();"
+                            " return {t: B.t, h: B.h, g: B.g, cost: B.cost, keys: B.keys}; }")
+        page.__dict__["closing"] = True  # "Cannot send" from views of a kernel being shut down
+        try:
+            page.evaluate("async () => { const f = " + _FIND_PANEL + "; await f().sessionContext.shutdown(); }")
+        except Exception:
+            pass
+    finally:
+        page.close()
+    return analyse(case, info, rec, order, ws_presses, holds, before, after_presses, args, errors)
+
+
+def kernel_read(jp: JupyterPage, code: str):
+    """Run ``code`` (it prints one JSON document) in the kernel; the parsed document."""
+    return json.loads(jp.kernel(code))
+
+
+# -- analysis -----------------------------------------------------------------
+
+
+def _frames(rec, g):
+    t = [x for x, gg in zip(rec["t"], rec["g"]) if gg == g]
+    h = [x for x, gg in zip(rec["h"], rec["g"]) if gg == g]
+    return t, h
+
+
+def _changes(rec, g):
+    """Times of frames of canvas g whose hash differs from the previous frame of the same canvas."""
+    out = []
+    t, h, gs = rec["t"], rec["h"], rec["g"]
+    for i in range(1, len(t)):
+        if gs[i] == g and gs[i - 1] == g and h[i] != h[i - 1]:
+            out.append(t[i])
+    return out
+
+
+def _first_after(xs, x, slack=0.0):
+    """The first element of sorted ``xs`` that is >= x - slack (None if none)."""
+    i = bisect.bisect_left(xs, x - slack)
+    return xs[i] if i < len(xs) else None
+
+
+def _kernel_stamps(kernel_read, origin):
+    """The probe's epoch stamps as page times (ms since the page's timeOrigin)."""
+    st = (kernel_read or {}).get("stamps") or {}
+    conv = lambda e: 1000.0 * e - origin  # noqa: E731
+    renders = sorted((conv(a), conv(b), main) for a, b, main in st.get("renders", []))
+    return {
+        "keys": sorted(conv(x) for x in st.get("keys", [])),
+        "acks": sorted(conv(x) for x in st.get("acks", [])),
+        "render_start": [r[0] for r in renders],
+        "renders": renders,
+    }
+
+
+SLACK = 2.0  # ms: page and kernel clocks are the same wall clock, read in different processes
+
+
+def _press_latencies(rec, downs, order, ws, g, ks):
+    t_all, h_all, g_all = rec["t"], rec["h"], rec["g"]
+    updates = sorted(m[0] for m in ws if m[2])
+    out = {k: [] for k in ("latency_ms", "key_msg_ms", "msg_px_ms", "key_kernel_ms", "kernel_handling_ms",
+                           "sent_arrival_ms")}
+    misses = 0
+    for i, (tk, gi) in enumerate(zip(downs, order)):
+        if gi != g:
+            continue
+        limit = downs[i + 1] if i + 1 < len(downs) else math.inf
+        h0, hit = None, None
+        for tf, hf, gf in zip(t_all, h_all, g_all):
+            if gf != g:
+                continue
+            if tf <= tk:
+                h0 = hf
+            elif tf >= limit:
+                break
+            elif h0 is not None and hf != h0:
+                hit = tf
+                break
+        if hit is None:
+            misses += 1
+            continue
+        out["latency_ms"].append(hit - tk)
+        msg = _first_after(updates, tk)
+        if msg is None or msg > hit:
+            continue
+        out["key_msg_ms"].append(msg - tk)
+        out["msg_px_ms"].append(hit - msg)
+        if ks and ks["keys"]:
+            kk = _first_after(ks["keys"], tk, SLACK)
+            j = bisect.bisect_left(ks["render_start"], kk - SLACK) if kk is not None else None
+            if kk is not None and kk < msg and j is not None and j < len(ks["renders"]):
+                r_end = ks["renders"][j][1]
+                if r_end <= msg + SLACK:
+                    out["key_kernel_ms"].append(kk - tk)
+                    out["kernel_handling_ms"].append(r_end - kk)
+                    out["sent_arrival_ms"].append(msg - r_end)
+    out["misses"] = misses
+    return out
+
+
+def _hold(rec, g, t_down, t_up, hold, n_before, ks):
+    changes = _changes(rec, g)
+    w0 = t_down + 1000 * FPS_SKIP
+    held = [x for x in changes if w0 <= x <= t_up]
+    after = [x for x in changes if t_up < x <= t_up + 1000 * WATCH_AFTER]
+    ws, acks = hold["ws"], hold["acks"]
+    arrivals = sorted(m[0] for m in ws if m[2] and w0 <= m[0] <= t_up)
+    acks_in = sorted(a for a in acks if w0 <= a <= t_up)
+    cyc = {k: [] for k in ("page_ms", "ack_kernel_ms", "kernel_wait_ms", "compute_ms", "sent_arrival_ms")}
+    for u in arrivals:  # arrival -> the page's "drawn" ack for it
+        a = _first_after(acks_in, u)
+        if a is not None:
+            cyc["page_ms"].append(a - u)
+    n_ticker = n_renders = 0
+    if ks:
+        for a in acks_in:  # ack sent -> reaches the widget -> next update computed -> arrives
+            ka = _first_after(ks["acks"], a, SLACK)
+            if ka is None:
+                continue
+            cyc["ack_kernel_ms"].append(ka - a)
+            j = bisect.bisect_left(ks["render_start"], ka - 0.5)
+            if j < len(ks["renders"]) and ks["renders"][j][0] <= t_up:
+                cyc["kernel_wait_ms"].append(max(0.0, ks["renders"][j][0] - ka))
+        for r0, r1, main in ks["renders"]:
+            if w0 <= r0 <= t_up:
+                n_renders += 1
+                n_ticker += not main
+                cyc["compute_ms"].append(r1 - r0)
+                u = _first_after(arrivals, r1)
+                if u is not None:
+                    cyc["sent_arrival_ms"].append(u - r1)
+    k = hold["kernel"]
+    up = k.get("up") or {}
+    n_updates = k["n_updates"] - n_before
+    window = [m for m in ws if t_down <= m[0] <= t_up + 1000 * WATCH_AFTER]
+    return {
+        "fps": len(held) / ((t_up - w0) / 1000) if t_up > w0 else math.nan,
+        "frames": len([x for x in changes if t_down <= x <= t_up]),
+        "seconds": (t_up - t_down) / 1000,
+        "updates": n_updates,
+        "interval_ms": median([b - a for a, b in zip(arrivals, arrivals[1:])]),
+        **{key: median(v) for key, v in cyc.items()},
+        "ticker_share": n_ticker / n_renders if n_renders else math.nan,
+        "after_frames": len(after),
+        "settle_ms": (after[-1] - t_up) if after else 0.0,
+        "in_flight_at_up": up.get("in_flight"),
+        "moved_after_up": bool(up) and up.get("R") != k.get("final"),
+        "sent_after_up": k["n_updates"] - up["n"] if up else None,
+        "bytes_per_update": sum(m[1] for m in window) / n_updates if n_updates else math.nan,
+        "update_msg_bytes": median([m[1] for m in window if m[2]]),
+        "msgs_per_update": len(window) / n_updates if n_updates else math.nan,
+    }
+
+
+def analyse(case, info, rec, order, ws_presses, holds, before, after_presses, args, errors) -> dict:
+    downs = [k[1] for k in rec["keys"] if k[0] == "keydown" and not k[3]]
+    ups = [k[1] for k in rec["keys"] if k[0] == "keyup"]
+    n = len(order)
+    origin = (info or {}).get("timeOrigin", 0.0)
+    ks = _kernel_stamps(holds[WIDGET]["kernel"], origin)
+    out = {"case": case, "canvas": info, "page_errors": errors}
+    for g, label in ((BASE, "base"), (WIDGET, "widget")):
+        side = _press_latencies(rec, downs[:n], order, ws_presses, g, ks if g == WIDGET else None)
+        k0, k1 = before[g], after_presses[g]
+        side.update(presses=order.count(g), kernel_ms=k1["kernel_ms"][len(k0["kernel_ms"]):],
+                    press_updates=k1["n_updates"] - k0["n_updates"], hold=None)
+        out[label] = side
+    hold_order = [WIDGET, BASE][: len(holds)]
+    for j, g in enumerate(hold_order):
+        label = "widget" if g == WIDGET else "base"
+        out[label]["hold"] = _hold(rec, g, downs[n + j], ups[n + j], holds[g], after_presses[g]["n_updates"],
+                                   ks if g == WIDGET else None)
+    first = downs[0] if downs else math.inf
+    idle = [x for x in rec["t"] if x < first]
+    out["idle_fps"] = (len(idle) - 1) / ((idle[-1] - idle[0]) / 1000) if len(idle) > 2 else math.nan
+    out["readback_ms"] = median(rec["cost"])
+    final = holds[WIDGET]["kernel"]
+    out["widget_kernel_final"] = {k: final.get(k) for k in ("acks", "timeouts", "capacity")}
+    return out
+
+
+# -- report -------------------------------------------------------------------
+
+
+def fmt(x, nd=0):
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
+
+
+def fmt_opt(x):
+    if x is None:
+        return "–"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    return str(x)
+
+
+def _spread(lat, misses):
+    s = f"{fmt(median(lat))} ({fmt(pct(lat, 0.1))}–{fmt(pct(lat, 0.9))})"
+    return s + (f", {misses} missed" if misses else "")
+
+
+def report(results: dict, meta: dict) -> str:
+    ok = lambda b: "ok" if b else "MISSED"  # noqa: E731
+    base_lat = [x for r in results.values() for x in r["base"]["latency_ms"]]
+    base_miss = sum(r["base"]["misses"] for r in results.values())
+    base_hold = next((r["base"]["hold"] for r in results.values() if r["base"]["hold"]), None)
+    lines = [
+        "| case | key→px median (p10–p90) ms | mean ± std ms | paired baseline median / mean ms "
+        "| excess mean (median) ms | target | ok | held fps | target | ok "
+        "| after release: frames, last at | ok | bytes/update (update msg) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    bh = base_hold or {}
+    lines.append(
+        f"| baseline (tetrahedron, all pairings) | {_spread(base_lat, base_miss)} "
+        f"| {fmt(mean(base_lat))} ± {fmt(statistics.stdev(base_lat) if len(base_lat) > 1 else math.nan)} | — | — "
+        f"| — | — | {fmt(bh.get('fps'), 1)} (30 Hz push) | — | — "
+        f"| {bh.get('after_frames', '–')}, {fmt(bh.get('settle_ms'))} ms | — "
+        f"| {fmt(bh.get('bytes_per_update'))} ({fmt(bh.get('update_msg_bytes'))}) |"
+    )
+    for case, r in results.items():
+        w, b = r["widget"], r["base"]
+        lat, blat = w["latency_ms"], b["latency_ms"]
+        large = case in LARGE
+        lat_target = 3 * FRAME_MS if large else FRAME_MS
+        fps_target = 10 if large else 20
+        excess, excess_med = mean(lat) - mean(blat), median(lat) - median(blat)
+        h = w["hold"]
+        lat_ok = excess <= lat_target and not w["misses"]
+        fps_ok = h["fps"] >= fps_target
+        rel_ok = (not h["moved_after_up"]) and h["after_frames"] <= 2 and h["settle_ms"] <= 500
+        after = f"{h['after_frames']}, {fmt(h['settle_ms'])} ms" + (", state moved after keyup" if h["moved_after_up"] else "")
+        std = statistics.stdev(lat) if len(lat) > 1 else math.nan
+        lines.append(
+            f"| {case} | {_spread(lat, w['misses'])} | {fmt(mean(lat))} ± {fmt(std)} "
+            f"| {fmt(median(blat))} / {fmt(mean(blat))} | {excess:+.0f} ({excess_med:+.0f}) | ≤ {lat_target:.1f} "
+            f"| {ok(lat_ok)} | {fmt(h['fps'], 1)} | ≥ {fps_target} | {ok(fps_ok)} | {after} | {ok(rel_ok)} "
+            f"| {fmt(h['bytes_per_update'])} ({fmt(h['update_msg_bytes'])}) |"
+        )
+    prof = [
+        "",
+        "Single presses, medians (ms): key→msg = page → kernel → page; msg→px = deserialise + frame + draw + "
+        "read-back. Widget only (kernel stamps): key→kernel, kernel handling (key in → update computed and "
+        "sent), sent→arrival.",
+        "",
+        "| case | key→px | key→msg | msg→px | key→kernel | kernel handling | sent→arrival | kernel per update "
+        "| idle page fps | read-back per frame |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for case, r in results.items():
+        for label, side in ((f"baseline ({case} nb)", r["base"]), (case, r["widget"])):
+            prof.append(
+                f"| {label} | {fmt(median(side['latency_ms']), 1)} | {fmt(median(side['key_msg_ms']), 1)} "
+                f"| {fmt(median(side['msg_px_ms']), 1)} | {fmt(median(side['key_kernel_ms']), 1)} "
+                f"| {fmt(median(side['kernel_handling_ms']), 1)} | {fmt(median(side['sent_arrival_ms']), 1)} "
+                f"| {fmt(median(side['kernel_ms']), 2)} | {fmt(r['idle_fps'])} | {fmt(r['readback_ms'], 1)} |"
+            )
+    prof += [
+        "",
+        "Held key, one update's cycle, medians (ms): arrival → \"drawn\" ack sent (page: deserialise, frame, "
+        "draw, one more frame) → ack reaches the widget → next update starts (waits for a tick if no step "
+        "is pending) → computed → arrives.",
+        "",
+        "| case | updates / hold | update→update | arrival→ack (page) | ack→kernel | kernel wait | compute "
+        "| sent→arrival | from ticker thread | WS msgs/update | in flight at keyup | sent after keyup |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for case, r in results.items():
+        for label, side in ((f"baseline ({case} nb)", r["base"]), (case, r["widget"])):
+            h = side["hold"]
+            if not h:
+                continue
+            share = h.get("ticker_share")
+            prof.append(
+                f"| {label} | {h['updates']} / {fmt(h['seconds'], 2)} s | {fmt(h['interval_ms'], 1)} "
+                f"| {fmt(h['page_ms'], 1)} | {fmt(h['ack_kernel_ms'], 1)} | {fmt(h['kernel_wait_ms'], 1)} "
+                f"| {fmt(h['compute_ms'], 1)} | {fmt(h['sent_arrival_ms'], 1)} "
+                f"| {'–' if share is None or math.isnan(share) else f'{100 * share:.0f} %'} "
+                f"| {fmt(h['msgs_per_update'], 1)} | {fmt_opt(h['in_flight_at_up'])} | {fmt_opt(h['sent_after_up'])} |"
+            )
+    m = meta
+    note = [
+        "",
+        f"Machine: {m['cpus']} CPUs ({m['cpu']}), load average (1/5/15 min) "
+        f"{' '.join(f'{x:.1f}' for x in m['load_before'])} before, "
+        f"{' '.join(f'{x:.1f}' for x in m['load_after'])} after; {m['chromium']}, headless, WebGL "
+        f"{m.get('renderer') or '?'}; canvas {m.get('canvas')}; code: {m['code']}; "
+        f"server: {m['server']}; {m['presses']} presses per canvas per notebook, taps "
+        f"{m['tap'][0]:g}–{m['tap'][1]:g} ms, hold {m['hold']} s; run took {m['elapsed']:.0f} s. "
+        "Shared, noisy machine: compare medians across runs.",
+    ]
+    errs = [f"{c}: {e}" for c, r in results.items() for e in r["page_errors"]]
+    if errs:
+        note.append("Page errors: " + "; ".join(errs[:5]))
+    return "\n".join(lines + prof + note)
+
+
+# -- main ---------------------------------------------------------------------
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--presses", type=int, default=40, help="single presses per canvas per notebook (default 40)")
+    ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six)")
+    ap.add_argument("--tap", default="60-120",
+                    help="ms between keydown and keyup of a single press, a range drawn uniformly "
+                         "(default 60-120, a human tap; 0 = Playwright's instant press)")
+    ap.add_argument("--nodelay", action="store_true",
+                    help="start the server with TCP_NODELAY on kernel WebSockets (not jupyter_server's default)")
+    ap.add_argument("--seed", type=int, default=None, help="random seed for keys, order and spacing")
+    ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision (e.g. HEAD)")
+    ap.add_argument("--json", default=None, help="also write the raw results here")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary directory (server log)")
+    args = ap.parse_args(argv)
+    if args.presses < 1 or args.hold <= FPS_SKIP:
+        ap.error(f"need --presses >= 1 and --hold > {FPS_SKIP}")
+    try:
+        lo, _, hi = args.tap.partition("-")
+        args.tap = (float(lo), float(hi or lo))
+        assert 0 <= args.tap[0] <= args.tap[1] < 250  # shorter than the widget's hold delay
+    except (ValueError, AssertionError):
+        ap.error("--tap: milliseconds 'A' or 'A-B', 0 <= A <= B < 250")
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    unknown = [c for c in cases if c not in POLYCHORA]
+    if unknown or not cases:
+        ap.error(f"unknown cases {unknown}; choose from {', '.join(POLYCHORA)}")
+    rng = random.Random(args.seed)
+
+    from playwright.sync_api import sync_playwright
+
+    started = time.monotonic()
+    meta: dict = {"presses": args.presses, "hold": args.hold, "cpus": os.cpu_count(), "cpu": cpu_name(),
+                  "load_before": os.getloadavg(), "code": working_tree_description()}
+    chromium = find_chromium()
+    version = subprocess.run([chromium, "--version"], capture_output=True, text=True).stdout.strip()
+    meta["chromium"] = version.split(" built")[0] or chromium
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-latency-"))
+    server = JupyterServer("lab", tmp / "server")
+    (server.root / "rot4d_bench_helpers.py").write_text(HELPERS)
+    pythonpath = [server.env.get("PYTHONPATH")]
+    if args.nodelay:
+        (tmp / "serverlib").mkdir()
+        (tmp / "serverlib" / "rot4d_bench_nodelay.py").write_text(NODELAY_MODULE)
+        (pathlib.Path(server.env["JUPYTER_CONFIG_DIR"]) / "jupyter_server_config.py").write_text(NODELAY_CONFIG)
+        pythonpath.insert(0, str(tmp / "serverlib"))
+    meta["server"] = "TCP_NODELAY on kernel WebSockets (--nodelay)" if args.nodelay else "jupyter_server defaults"
+    meta["tap"] = args.tap
+    if args.rev:
+        meta["code"] = export_revision(args.rev, tmp / "src")
+        pythonpath.insert(0, str(tmp / "src"))
+    if any(pythonpath):
+        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, pythonpath))
+    results: dict = {}
+    failed: dict = {}
+    try:
+        server.start()
+        with sync_playwright() as p:
+            context = p.chromium.launch_persistent_context(
+                str(tmp / "chromium-profile"), executable_path=chromium, headless=True,
+                args=CHROMIUM_FLAGS, viewport=VIEWPORT,
+            )
+            context.add_init_script(WS_HOOK)
+            try:
+                for case in cases:
+                    t0 = time.monotonic()
+                    try:
+                        r = run_case(context, server, case, args, rng, hold_baseline=not results)
+                    except Exception as exc:  # report the others; say which failed and why
+                        failed[case] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+                        print(f"{case}: FAILED {failed[case]}", file=sys.stderr, flush=True)
+                        continue
+                    results[case] = r
+                    c = r["canvas"] or {}
+                    meta.setdefault("renderer", c.get("renderer"))
+                    meta.setdefault("canvas", f"{c.get('width')}×{c.get('height')} px, dpr {c.get('dpr')}")
+                    print(f"{case}: key→px median {fmt(median(r['widget']['latency_ms']))} ms "
+                          f"(paired baseline {fmt(median(r['base']['latency_ms']))} ms), "
+                          f"held {fmt(r['widget']['hold']['fps'], 1)} fps, "
+                          f"{r['widget']['hold']['after_frames']} frames after release "
+                          f"[{time.monotonic() - t0:.0f} s]", file=sys.stderr, flush=True)
+            finally:
+                context.close()
+    finally:
+        server.stop()
+        if args.keep:
+            print(f"kept {tmp}", file=sys.stderr)
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+    meta["load_after"] = os.getloadavg()
+    meta["elapsed"] = time.monotonic() - started
+    if results:
+        print(report(results, meta))
+    for case, why in failed.items():
+        print(f"\n{case}: not measured ({why})")
+    if args.json:
+        pathlib.Path(args.json).write_text(
+            json.dumps({"meta": meta, "results": results, "failed": failed}, indent=1, default=str)
+        )
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
