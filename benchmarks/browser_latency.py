@@ -510,12 +510,6 @@ def kernel_read(jp: JupyterPage, code: str):
 # -- analysis -----------------------------------------------------------------
 
 
-def _frames(rec, g):
-    t = [x for x, gg in zip(rec["t"], rec["g"]) if gg == g]
-    h = [x for x, gg in zip(rec["h"], rec["g"]) if gg == g]
-    return t, h
-
-
 def _changes(rec, g):
     """Times of frames of canvas g whose hash differs from the previous frame of the same canvas."""
     out = []
