@@ -1,5 +1,7 @@
 """The widget draws in a real JupyterLab 4 and Notebook 7 page."""
 
+import pathlib
+
 from jupyter_page import JupyterPage, write_notebook
 
 
@@ -14,3 +16,6 @@ def test_widget_draws(jupyter_server, page, artifacts):
     stats = jp.wait_for(lambda: (s := jp.canvas_stats(f".{cls} canvas")) and s["count"] > 100 and s, timeout=30)
     page.screenshot(path=str(artifacts / f"smoke-{jupyter_server.kind}.png"))
     assert stats and stats["count"] > 100, stats
+    # the package's server extension is active: kernel WebSockets without Nagle's delay
+    jupyter_server.log.flush()
+    assert "TCP_NODELAY" in pathlib.Path(jupyter_server.log.name).read_text()
