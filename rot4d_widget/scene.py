@@ -208,40 +208,109 @@ _BAR_VERTEX = """
 attribute vec3 bar_a;
 attribute vec3 bar_b;
 uniform float u_bar_radius;
-varying vec3 v_normal;
 varying vec3 v_point;
+varying vec3 v_a;
+varying vec3 v_w;
+varying float v_len;
+void widen(vec3 c, vec2 e, vec2 f, inout vec4 box, inout float near) {
+    float z = max(-c.z, 1.0e-4);
+    vec2 q = c.xy / z;
+    float pe = dot(q, e);
+    float pf = dot(q, f);
+    box = vec4(min(box.x, pe), max(box.y, pe), min(box.z, pf), max(box.w, pf));
+    near = min(near, z);
+}
 void main() {
-    vec3 axis = bar_b - bar_a;
+    vec3 a = (modelViewMatrix * vec4(bar_a, 1.0)).xyz;
+    vec3 b = (modelViewMatrix * vec4(bar_b, 1.0)).xyz;
+    vec3 axis = b - a;
     float len = length(axis);
     if (len < 1.0e-12) {
-        v_normal = vec3(0.0, 0.0, 1.0);
         v_point = vec3(0.0);
+        v_a = vec3(0.0);
+        v_w = vec3(0.0, 0.0, 1.0);
+        v_len = 0.0;
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
         return;
     }
     vec3 w = axis / len;
     vec3 helper = abs(w.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
-    vec3 u = normalize(cross(w, helper));
-    vec3 v = cross(w, u);
-    vec3 p = bar_a + axis * position.z + u_bar_radius * (position.x * u + position.y * v);
-    vec3 n = normal.x * u + normal.y * v + normal.z * w;
-    vec4 mv = modelViewMatrix * vec4(p, 1.0);
-    v_point = mv.xyz;
-    v_normal = normalMatrix * n;
-    gl_Position = projectionMatrix * mv;
+    float r = u_bar_radius;
+    vec3 u = r * normalize(cross(w, helper));
+    vec3 v = r * normalize(cross(w, u));
+    // the bar's box (end discs included), projected on the plane z = -1 and
+    // bounded by a rectangle aligned with the projected axis
+    vec2 d = b.xy / max(-b.z, 1.0e-4) - a.xy / max(-a.z, 1.0e-4);
+    vec2 e = dot(d, d) > 1.0e-12 ? normalize(d) : vec2(1.0, 0.0);
+    vec2 f = vec2(-e.y, e.x);
+    vec4 box = vec4(1.0e9, -1.0e9, 1.0e9, -1.0e9);
+    float near = 1.0e9;
+    widen(a + u + v, e, f, box, near);
+    widen(a + u - v, e, f, box, near);
+    widen(a - u + v, e, f, box, near);
+    widen(a - u - v, e, f, box, near);
+    widen(b + u + v, e, f, box, near);
+    widen(b + u - v, e, f, box, near);
+    widen(b - u + v, e, f, box, near);
+    widen(b - u - v, e, f, box, near);
+    vec2 pad = 0.01 * vec2(box.y - box.x, box.w - box.z);
+    float pe = position.x < 0.0 ? box.x - pad.x : box.y + pad.x;
+    float pf = position.y < 0.0 ? box.z - pad.y : box.w + pad.y;
+    vec3 p = near * vec3(pe * e + pf * f, -1.0);
+    v_point = p;
+    v_a = a;
+    v_w = w;
+    v_len = len;
+    gl_Position = projectionMatrix * vec4(p, 1.0);
 }
 """
 
 _BAR_FRAGMENT = (
     """
+uniform mat4 projectionMatrix;
 uniform vec3 u_bar_color;
-varying vec3 v_normal;
+uniform float u_bar_radius;
 varying vec3 v_point;
+varying vec3 v_a;
+varying vec3 v_w;
+varying float v_len;
 """
     + _LIGHTING
     + """
 void main() {
-    gl_FragColor = vec4(shade(u_bar_color, normalize(v_normal), v_point), 1.0);
+    // ray from the eye (the origin) through this pixel against the closed cylinder
+    vec3 ray = normalize(v_point);
+    vec3 w = normalize(v_w);
+    float r2 = u_bar_radius * u_bar_radius;
+    float rw = dot(ray, w);
+    float aw = dot(v_a, w);
+    vec3 rp = ray - rw * w;
+    vec3 ap = v_a - aw * w;
+    float qa = dot(rp, rp);
+    float qb = dot(rp, ap);
+    float disc = qb * qb - qa * (dot(ap, ap) - r2);
+    if (disc < 0.0 || qa < 1.0e-12) discard;
+    float t = (qb - sqrt(disc)) / qa;
+    vec3 hit = t * ray;
+    float s = dot(hit - v_a, w);
+    vec3 n;
+    if (s < 0.0 || s > v_len) {
+        // the front of the side lies past an end: the ray can only enter through that end's disc
+        float cap = s < 0.0 ? 0.0 : v_len;
+        vec3 c = v_a + cap * w;
+        if (abs(rw) < 1.0e-6) discard;
+        hit = (dot(c, w) / rw) * ray;
+        vec3 off = hit - c;
+        if (dot(off, off) > r2) discard;
+        n = s < 0.0 ? -w : w;
+    } else {
+        n = (hit - v_a - s * w) / u_bar_radius;
+    }
+#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300
+    vec4 clip = projectionMatrix * vec4(hit, 1.0);
+    gl_FragDepthEXT = 0.5 + 0.5 * clip.z / clip.w;
+#endif
+    gl_FragColor = vec4(shade(u_bar_color, n, hit), 1.0);
 }
 """
 )
@@ -430,13 +499,9 @@ class Scene:
             name: p3.InterleavedBufferAttribute(data=self._buffer, itemSize=size, offset=col)
             for name, (col, size) in bf.COLUMNS.items()
         }
-        cyl_pos, cyl_nrm = bf.cylinder_template(12)
         templates = {
             "ball": {"position": p3.BufferAttribute(array=bf.quad_template())},
-            "bar": {
-                "position": p3.BufferAttribute(array=cyl_pos),
-                "normal": p3.BufferAttribute(array=cyl_nrm),
-            },
+            "bar": {"position": p3.BufferAttribute(array=bf.quad_template())},
             "face": {"position": p3.BufferAttribute(array=bf.triangle_template())},
         }
         uses = {
@@ -470,6 +535,8 @@ class Scene:
             vertexShader=_BAR_VERTEX,
             fragmentShader=_BAR_FRAGMENT,
             uniforms=dict(light, u_bar_radius={"value": self.bar_radius}, u_bar_color={"value": list(self.bar_color)}),
+            extensions={"fragDepth": True},
+            side="DoubleSide",
         )
         face_mat = p3.ShaderMaterial(
             vertexShader=_FACE_VERTEX,
