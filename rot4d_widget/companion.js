@@ -1,13 +1,17 @@
 // rot4d_widget companion (anywidget ES module, no build step).
 //
-// Three jobs for one Scene, per displayed view of this invisible widget:
+// Four jobs for one Scene, per displayed view of this invisible widget:
 //  1. "drawn": after the pythreejs Scene has rendered a frame that contains
 //     the latest assignment to the shared row buffer, send
 //     {event: "drawn", seq} where seq is the buffer's `_rot4d_seq` (sent in
-//     the same message as the array).  The Scene model fires `afterRender`
-//     right after `renderer.render(...)`: the canvas then holds the new
-//     pixels; the ack leaves in the next animation frame, once that frame has
-//     been presented.  An arrival that is never rendered is never acknowledged.
+//     the same message as the array).  "Contains" is checked on the three.js
+//     object itself (`buffer.obj`, a THREE.InterleavedBuffer): at the Scene's
+//     `afterRender` (fired right after `renderer.render(...)`) its `array`
+//     must be the array that arrived, and its `version` must have moved past
+//     the one seen at the previous render (three.js uploads a buffer to the
+//     GPU when its version moves).  The ack then leaves in the next
+//     animation frame, once that frame has been presented.  An arrival that
+//     is never rendered is never acknowledged; an id is acknowledged once.
 //  2. focus loss: window blur or document hidden -> {event: "focus_lost", reason}.
 //  3. Notebook 7 shortcut guard: a capture-phase key listener on `window`
 //     calls preventDefault() while the pointer is over the canvas (the
@@ -15,7 +19,38 @@
 //     shortcuts (m, x, c, y, z, j, k, ...) skip the event; ipyevents, which
 //     listens on `document`, still receives and forwards it.  Ctrl/Meta/Alt
 //     chords are left alone (they are not the widget's keys).
+//  4. ipyevents leak guard: ipyevents adds a capture key listener on
+//     `document` on mouseenter and removes it on mouseleave.  A canvas view
+//     destroyed while hovered (cell re-run) never gets a mouseleave, and in
+//     JupyterLab that listener then swallows every key on the page.  So each
+//     canvas element, when first hovered, gets a hidden <rot4d-leave-guard>
+//     child whose disconnectedCallback (run as soon as the canvas leaves the
+//     document, before ipyevents drops its element listeners) dispatches a
+//     `mouseleave` on the canvas element: ipyevents' own handler then removes
+//     its document listener.  The guard needs no companion view: it stays
+//     with the canvas element and goes when the canvas goes.
 // All listeners are removed when the view is removed.
+
+const GUARD_TAG = "rot4d-leave-guard";
+
+// Defined once per page (this module may be evaluated several times).
+function defineLeaveGuard() {
+  if (typeof customElements === "undefined" || customElements.get(GUARD_TAG)) return;
+  customElements.define(
+    GUARD_TAG,
+    class extends HTMLElement {
+      connectedCallback() {
+        this.style.display = "none";
+        this._host = this.parentElement; // the canvas element (ipyevents' source view)
+      }
+      disconnectedCallback() {
+        const host = this._host;
+        // only when the canvas itself left the document (not if just this guard was removed)
+        if (host && !host.isConnected) host.dispatchEvent(new MouseEvent("mouseleave"));
+      }
+    }
+  );
+}
 
 function modelId(ref) {
   return typeof ref === "string" && ref.startsWith("IPY_MODEL_") ? ref.slice(10) : ref;
@@ -30,6 +65,24 @@ function canvasHovered(cls) {
   }
 }
 
+// The typed array three.js gets for a data-union value (an ndarray's `.data`).
+function dataOf(value) {
+  return value && value.data !== undefined ? value.data : value;
+}
+
+// widget_manager.get_model rejects while a model is not registered yet: retry
+// for a while (the canvas's models are normally there before this view).
+async function getModel(manager, id, isAlive) {
+  for (let i = 0; ; i++) {
+    try {
+      return await manager.get_model(id);
+    } catch (e) {
+      if (i >= 100 || !isAlive()) throw e;
+      await new Promise((resolve) => setTimeout(resolve, 100));
+    }
+  }
+}
+
 async function render({ model, el }) {
   el.style.display = "none";
   let alive = true;
@@ -37,26 +90,39 @@ async function render({ model, el }) {
   const send = (msg) => {
     if (alive) model.send(msg);
   };
+  const listen = (target, type, f, capture = false) => {
+    target.addEventListener(type, f, capture);
+    cleanups.push(() => target.removeEventListener(type, f, capture));
+  };
 
   // 3. shortcut guard
   const guard = (event) => {
     if (event.ctrlKey || event.metaKey || event.altKey) return;
     if (canvasHovered(model.get("canvas_class"))) event.preventDefault();
   };
-  for (const type of ["keydown", "keypress", "keyup"]) {
-    window.addEventListener(type, guard, true);
-    cleanups.push(() => window.removeEventListener(type, guard, true));
+  for (const type of ["keydown", "keypress", "keyup"]) listen(window, type, guard, true);
+
+  // 4. leak guard: put one guard into each canvas element of this scene as it is hovered
+  try {
+    defineLeaveGuard();
+  } catch (e) {
+    console.warn("rot4d_widget companion: leave guard unavailable", e);
   }
+  const onOver = (event) => {
+    const cls = model.get("canvas_class");
+    if (!cls || typeof customElements === "undefined" || !customElements.get(GUARD_TAG)) return;
+    const host = event.target && event.target.closest ? event.target.closest("." + CSS.escape(cls)) : null;
+    if (host && !Array.from(host.children).some((c) => c.localName === GUARD_TAG)) {
+      host.appendChild(document.createElement(GUARD_TAG));
+    }
+  };
+  listen(document, "mouseover", onOver, true);
 
   // 2. focus loss
-  const onBlur = () => send({ event: "focus_lost", reason: "blur" });
-  const onVisibility = () => {
+  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur" }));
+  listen(document, "visibilitychange", () => {
     if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden" });
-  };
-  window.addEventListener("blur", onBlur);
-  document.addEventListener("visibilitychange", onVisibility);
-  cleanups.push(() => window.removeEventListener("blur", onBlur));
-  cleanups.push(() => document.removeEventListener("visibilitychange", onVisibility));
+  });
 
   const cleanup = () => {
     alive = false;
@@ -72,22 +138,33 @@ async function render({ model, el }) {
   // 1. drawn acknowledgement
   try {
     const manager = model.widget_manager;
+    const isAlive = () => alive;
     const [buffer, scene] = await Promise.all([
-      manager.get_model(modelId(model.get("buffer_model_id"))),
-      manager.get_model(modelId(model.get("scene_model_id"))),
+      getModel(manager, modelId(model.get("buffer_model_id")), isAlive),
+      getModel(manager, modelId(model.get("scene_model_id")), isAlive),
     ]);
     if (alive) {
-      let pending = null;
+      const version = () => (buffer.obj ? buffer.obj.version : undefined);
+      let pending = null; // {seq, data, after}: the latest arrival not yet acknowledged
+      let lastSent = null;
+      let renderedVersion = version(); // three.js buffer version at the previous render
       const onArray = () => {
-        pending = buffer.get("_rot4d_seq");
+        // `after`: the version before this array can have been uploaded
+        pending = { seq: buffer.get("_rot4d_seq"), data: dataOf(buffer.get("array")), after: renderedVersion };
       };
       const onRendered = () => {
-        if (pending === null) return;
-        const seq = pending;
+        const obj = buffer.obj;
+        const p = pending;
+        renderedVersion = version();
+        if (p === null || !obj) return;
+        // not in this frame unless three.js holds the new array and re-uploaded it
+        if (obj.array !== p.data || (p.after !== undefined && !(obj.version > p.after))) return;
         pending = null;
+        if (p.seq === lastSent) return; // e.g. a growth step re-sending the shown picture
+        lastSent = p.seq;
         // The canvas holds the new pixels now; wait one more frame so that the
         // frame has been presented (and any rAF read-back has seen it).
-        requestAnimationFrame(() => send({ event: "drawn", seq: seq }));
+        requestAnimationFrame(() => send({ event: "drawn", seq: p.seq }));
       };
       buffer.on("change:array", onArray);
       scene.on("afterRender", onRendered);

@@ -139,7 +139,8 @@ function backbone(attrs) {
   return {
     L, attrs,
     get: (k) => attrs[k],
-    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); },
+    // like Backbone's set: attributes first, then change:<name> events, then "change"
+    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); },
     on(t, f) { (L[t] ||= []).push(f); },
     off(t, f) { L[t] = (L[t] || []).filter((g) => g !== f); },
     trigger(t) { (L[t] || []).slice().forEach((f) => f()); },
@@ -158,7 +159,14 @@ let raf = [];
 globalThis.requestAnimationFrame = (f) => raf.push(f);
 const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
 
-const buffer = backbone({ _rot4d_seq: 0, array: "a0" });
+// the pythreejs buffer model: its three.js object (`obj`) takes a new array on "change"
+// (set `applyLate` to hold it back, `bump = false` to skip the version bump)
+const wrap = (name) => ({ data: "data-" + name });
+const buffer = backbone({ _rot4d_seq: 0, array: wrap("a0") });
+buffer.obj = { array: "data-a0", version: 1 };
+let applyLate = false, bump = true;
+const apply = () => { buffer.obj.array = buffer.attrs.array.data; if (bump) buffer.obj.version++; };
+buffer.on("change", () => { if (!applyLate) apply(); });
 const scene = backbone({});
 const sent = [];
 const model = {
@@ -183,7 +191,8 @@ hovered = false;
 
 // 1. drawn acknowledgement
 const step = (label) => { out[label] = sent.splice(0); };
-buffer.setState({ _rot4d_seq: 5, array: "a1" });
+const set = (seq, name) => buffer.setState(seq === null ? { array: wrap(name) } : { _rot4d_seq: seq, array: wrap(name) });
+set(5, "a1");
 step("beforeRender");
 scene.trigger("afterRender");
 step("sameFrame");
@@ -191,18 +200,33 @@ frame();
 step("nextFrame");
 scene.trigger("afterRender"); frame();
 step("renderWithoutChange");
-buffer.setState({ _rot4d_seq: 6, array: "a2" });
-buffer.setState({ _rot4d_seq: 7, array: "a3" });
+set(6, "a2");
+set(7, "a3");
 scene.trigger("afterRender"); frame();
 step("coalesced");
-buffer.setState({ array: "a4" });  // growth step (a): same id
+set(null, "a4");  // growth step (a): same id, same picture
 scene.trigger("afterRender"); frame();
 step("sameId");
-buffer.setState({ _rot4d_seq: 8, array: "a5" });
+set(8, "a5");
 frame();
 step("noRenderNoAck");
 scene.trigger("afterRender"); frame();
 step("late");
+applyLate = true;  // the array arrived, three.js does not hold it yet
+set(9, "a6");
+scene.trigger("afterRender"); frame();
+step("notYetInThree");
+apply();
+scene.trigger("afterRender"); frame();
+step("nowInThree");
+applyLate = false; bump = false;  // three.js holds it but was not told to upload it
+set(10, "a7");
+scene.trigger("afterRender"); frame();
+step("notUploaded");
+bump = true;
+set(11, "a8");
+scene.trigger("afterRender"); frame();
+step("uploaded");
 
 // 2. focus loss
 window.fire("blur", {});
@@ -213,7 +237,7 @@ step("focus");
 // cleanup
 cleanup();
 out.left = { window: window.count(), document: document.count(), buffer: buffer.count(), scene: scene.count() };
-buffer.setState({ _rot4d_seq: 9, array: "a6" }); scene.trigger("afterRender"); frame();
+set(12, "a9"); scene.trigger("afterRender"); frame();
 window.fire("blur", {});
 hovered = true;
 out.afterCleanupPrevented = key("keydown");
@@ -252,9 +276,18 @@ def test_js_drawn_ack_waits_for_a_rendered_and_presented_frame(js_run):
     assert js_run["nextFrame"] == [{"event": "drawn", "seq": 5}]
     assert js_run["renderWithoutChange"] == []  # orbiting the camera acknowledges nothing
     assert js_run["coalesced"] == [{"event": "drawn", "seq": 7}]
-    assert js_run["sameId"] == [{"event": "drawn", "seq": 7}]  # re-sent picture keeps its id
+    assert js_run["sameId"] == []  # a re-sent picture keeps its id: acknowledged once already
     assert js_run["noRenderNoAck"] == []
     assert js_run["late"] == [{"event": "drawn", "seq": 8}]
+
+
+def test_js_drawn_ack_needs_the_array_in_the_three_js_buffer(js_run):
+    # rendered before three.js held the new array: that frame shows the old picture
+    assert js_run["notYetInThree"] == []
+    assert js_run["nowInThree"] == [{"event": "drawn", "seq": 9}]
+    # held but its version did not move: not uploaded, not drawn
+    assert js_run["notUploaded"] == []
+    assert js_run["uploaded"] == [{"event": "drawn", "seq": 11}]
 
 
 def test_js_focus_loss(js_run):
@@ -262,6 +295,7 @@ def test_js_focus_loss(js_run):
 
 
 def test_js_cleanup_removes_every_listener(js_run):
-    assert js_run["left"] == {"window": 0, "document": 0, "buffer": 0, "scene": 0}
+    # (the buffer's one "change" listener is the fake pythreejs model's own)
+    assert js_run["left"] == {"window": 0, "document": 0, "buffer": 1, "scene": 0}
     assert js_run["afterCleanupPrevented"] is False
     assert js_run["afterCleanup"] == []
