@@ -2,17 +2,21 @@
 
 An invisible widget (display it next to the scene's renderer, e.g. in the
 same box) whose module, ``companion.js``, ships in the package (no build
-step) and does three things in JupyterLab 4 and Notebook 7 alike:
+step) and does four things in JupyterLab 4 and Notebook 7 alike:
 
 1. **drawn acknowledgement** -- after the page has *rendered* a frame
-   containing the latest buffer assignment (the pythreejs Scene's
-   ``afterRender`` following the buffer's ``change:array``; not merely on
-   arrival) it sends ``{"event": "drawn", "seq": n}``, n being the scene's
-   ``update_id`` of that buffer.  Callbacks registered with `on_drawn` get
-   ``n``.  Acknowledgements coalesce: if two updates arrive before one
-   frame, only the later one is acknowledged.  Each displayed view of the
-   companion acknowledges (several views: several acks with the same n).
-   No view, a hidden tab or a frozen WebGL context: no acknowledgement.
+   containing the latest buffer assignment (not merely on arrival): at the
+   pythreejs Scene's ``afterRender`` the buffer's three.js object must hold
+   the array that arrived with ``change:array`` and its ``version`` must
+   have moved since the previous render (so three.js uploaded it); one
+   animation frame later it sends ``{"event": "drawn", "seq": n}``, n being
+   the scene's ``update_id`` of that buffer.  Callbacks registered with
+   `on_drawn` get ``n``.  Acknowledgements coalesce: if two updates arrive
+   before one frame, only the later one is acknowledged; an id is
+   acknowledged once per view (a growth step re-sending the shown picture
+   with the same id is not).  Each displayed view of the companion
+   acknowledges (several views: several acks with the same n).  No view, a
+   hidden tab or a frozen WebGL context: no acknowledgement.
 2. **focus loss** -- window ``blur`` or ``document.visibilityState ==
    "hidden"`` sends ``{"event": "focus_lost", "reason": "blur" | "hidden"}``;
    `on_focus_lost` callbacks get the reason.
@@ -22,6 +26,15 @@ step) and does three things in JupyterLab 4 and Notebook 7 alike:
    calls ``preventDefault()``, so Notebook 7's command shortcuts (m turns
    the cell to markdown, x cuts it, ...) skip the key, while ipyevents still
    receives it.  Ctrl/Meta/Alt chords pass untouched.
+4. **ipyevents leak guard** -- a canvas view destroyed while hovered (the
+   cell re-run) gets no mouseleave, so ipyevents' capture key listener on
+   ``document`` stayed behind and, in JupyterLab, swallowed every key on the
+   page.  Each canvas element, when first hovered, gets a hidden
+   ``<rot4d-leave-guard>`` child (custom element, defined once per page)
+   whose ``disconnectedCallback`` dispatches ``mouseleave`` on the canvas
+   element once it has left the document; ipyevents' own handler then
+   removes its listener.  The guard lives in the canvas element, so it works
+   whichever of the canvas and companion views goes first.
 
 Listeners are removed when the view is removed.
 """
