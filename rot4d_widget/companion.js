@@ -23,7 +23,7 @@
 //     `document` on mouseenter and removes it on mouseleave.  A canvas view
 //     destroyed while hovered (cell re-run) never gets a mouseleave, and in
 //     JupyterLab that listener then swallows every key on the page.  So each
-//     canvas element, when first hovered, gets a hidden <rot4d-leave-guard>
+//     canvas element of the scene gets a hidden <rot4d-leave-guard>
 //     child whose disconnectedCallback (run as soon as the canvas leaves the
 //     document, before ipyevents drops its element listeners) dispatches a
 //     `mouseleave` on the canvas element: ipyevents' own handler then removes
@@ -70,15 +70,16 @@ function dataOf(value) {
   return value && value.data !== undefined ? value.data : value;
 }
 
-// widget_manager.get_model rejects while a model is not registered yet: retry
-// for a while (the canvas's models are normally there before this view).
+// widget_manager.get_model rejects while a model is not registered yet (e.g.
+// while a reloaded page restores widgets from the kernel): retry, 50 ms first,
+// then up to 1 s apart, for about a minute, while this view lives.
 async function getModel(manager, id, isAlive) {
-  for (let i = 0; ; i++) {
+  for (let i = 0, wait = 50; ; i++, wait = Math.min(2 * wait, 1000)) {
     try {
       return await manager.get_model(id);
     } catch (e) {
-      if (i >= 100 || !isAlive()) throw e;
-      await new Promise((resolve) => setTimeout(resolve, 100));
+      if (i >= 65 || !isAlive()) throw e;
+      await new Promise((resolve) => setTimeout(resolve, wait));
     }
   }
 }
@@ -102,21 +103,30 @@ async function render({ model, el }) {
   };
   for (const type of ["keydown", "keypress", "keyup"]) listen(window, type, guard, true);
 
-  // 4. leak guard: put one guard into each canvas element of this scene as it is hovered
+  // 4. leak guard: one guard in each canvas element of this scene.  Placed on
+  // render (and a few times soon after, as the canvas view may come later),
+  // after each scene render, and on mouseover: a new canvas can appear under a
+  // pointer that does not move.
   try {
     defineLeaveGuard();
   } catch (e) {
     console.warn("rot4d_widget companion: leave guard unavailable", e);
   }
-  const onOver = (event) => {
+  const ensureGuards = () => {
     const cls = model.get("canvas_class");
-    if (!cls || typeof customElements === "undefined" || !customElements.get(GUARD_TAG)) return;
-    const host = event.target && event.target.closest ? event.target.closest("." + CSS.escape(cls)) : null;
-    if (host && !Array.from(host.children).some((c) => c.localName === GUARD_TAG)) {
-      host.appendChild(document.createElement(GUARD_TAG));
+    if (!alive || !cls || typeof customElements === "undefined" || !customElements.get(GUARD_TAG)) return;
+    // a live collection, cheap; a canvas element has only a few children
+    for (const host of document.getElementsByClassName(cls)) {
+      if (!Array.from(host.children).some((c) => c.localName === GUARD_TAG)) {
+        host.appendChild(document.createElement(GUARD_TAG));
+      }
     }
   };
-  listen(document, "mouseover", onOver, true);
+  listen(document, "mouseover", ensureGuards, true);
+  for (const ms of [0, 100, 500, 2000]) {
+    const t = setTimeout(ensureGuards, ms);
+    cleanups.push(() => clearTimeout(t));
+  }
 
   // 2. focus loss
   listen(window, "blur", () => send({ event: "focus_lost", reason: "blur" }));
@@ -153,6 +163,7 @@ async function render({ model, el }) {
         pending = { seq: buffer.get("_rot4d_seq"), data: dataOf(buffer.get("array")), after: renderedVersion };
       };
       const onRendered = () => {
+        ensureGuards();
         const obj = buffer.obj;
         const p = pending;
         renderedVersion = version();

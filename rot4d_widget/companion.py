@@ -29,7 +29,8 @@ step) and does four things in JupyterLab 4 and Notebook 7 alike:
 4. **ipyevents leak guard** -- a canvas view destroyed while hovered (the
    cell re-run) gets no mouseleave, so ipyevents' capture key listener on
    ``document`` stayed behind and, in JupyterLab, swallowed every key on the
-   page.  Each canvas element, when first hovered, gets a hidden
+   page.  Each canvas element of the scene (found on render, soon after,
+   after each scene render and on mouseover) gets a hidden
    ``<rot4d-leave-guard>`` child (custom element, defined once per page)
    whose ``disconnectedCallback`` dispatches ``mouseleave`` on the canvas
    element once it has left the document; ipyevents' own handler then

@@ -172,12 +172,20 @@ const sent = [];
 const model = {
   get: (k) => ({ buffer_model_id: "IPY_MODEL_buf", scene_model_id: "scn", canvas_class: CLS })[k],
   send: (m) => sent.push(m),
-  widget_manager: { get_model: async (id) => ({ buf: buffer, scn: scene })[id] },
+  // the buffer model is not registered at first: get_model rejects twice
+  widget_manager: {
+    misses: 0,
+    async get_model(id) {
+      if (id === "buf" && this.misses < 2) { this.misses++; throw new Error("widget model not found"); }
+      return ({ buf: buffer, scn: scene })[id];
+    },
+  },
 };
 const el = { style: {} };
 const mod = await import(pathToFileURL(process.argv[2]).href);
 const cleanup = await mod.default.render({ model, el });
 out.display = el.style.display;
+out.getModelMisses = model.widget_manager.misses;
 
 // 3. shortcut guard
 const key = (type, extra = {}) => { const ev = { type, prevented: false, ctrlKey: false, metaKey: false, altKey: false, ...extra, preventDefault() { this.prevented = true; } }; window.fire(type, ev); return ev.prevented; };
@@ -288,6 +296,10 @@ def test_js_drawn_ack_needs_the_array_in_the_three_js_buffer(js_run):
     # held but its version did not move: not uploaded, not drawn
     assert js_run["notUploaded"] == []
     assert js_run["uploaded"] == [{"event": "drawn", "seq": 11}]
+
+
+def test_js_retries_get_model_until_the_model_is_registered(js_run):
+    assert js_run["getModelMisses"] == 2  # and the acks above still came
 
 
 def test_js_focus_loss(js_run):

@@ -35,6 +35,17 @@ def _hover(page, sel):
     return box
 
 
+def _document_key_listeners(page):
+    """Capture-phase key listeners on ``document`` (ipyevents adds them while a canvas is hovered)."""
+    cdp = page.context.new_cdp_session(page)
+    try:
+        doc = cdp.send("Runtime.evaluate", {"expression": "document"})["result"]["objectId"]
+        found = cdp.send("DOMDebugger.getEventListeners", {"objectId": doc})["listeners"]
+    finally:
+        cdp.detach()
+    return sorted(x["type"] for x in found if x["type"].startswith("key") and x["useCapture"])
+
+
 def test_rerun_while_hovered_leaves_no_key_listener_behind(jupyter_server, page):
     name = "leak.ipynb"
     write_notebook(
@@ -74,5 +85,11 @@ def test_rerun_while_hovered_leaves_no_key_listener_behind(jupyter_server, page)
     page.keyboard.press("4")
     time.sleep(0.5)
     assert jp.kernel_json("[x.state.matrix.tolist() for x in ws]") == old
-    assert inserted, f"'b' was swallowed: commands {executed}, cells {jp.notebook_model()['cells']}"
+    diag = dict(
+        commands=executed,
+        cells=jp.notebook_model()["cells"],
+        capture_key_listeners=_document_key_listeners(page),
+        active=page.evaluate("() => [document.activeElement.tagName, document.activeElement.className]"),
+    )
+    assert inserted, f"'b' was swallowed: {diag}"
     assert "notebook:insert-cell-below" in executed
