@@ -29,8 +29,10 @@ every polytope the size of the pentachoron).  A 24-bit colour packed into a
 float32 is exact (float32 holds every integer below 2**24); the face shader
 unpacks it with ``floor``.
 
-Also here: the per-cell palette and the fixed template shapes (unit
-cylinder, billboard quad, barycentric triangle) that the scene builds once.
+Also here: the per-cell palette and the fixed template shapes (billboard
+quad for the ball and bar impostors, barycentric triangle) that the scene
+builds once; `cylinder_template` (a unit cylinder mesh) is no longer drawn by
+the scene, kept for meshes that need real geometry.
 """
 
 from __future__ import annotations

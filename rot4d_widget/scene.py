@@ -17,17 +17,29 @@ All three meshes read ONE `InstancedInterleavedBuffer` holding the row table
 of `rot4d_widget.buffers` (R rows x 20 float32: ball centre + flag, bar end
 points, triangle corners + packed colour).  Each mesh is an
 `InstancedBufferGeometry` whose own ``position`` attribute is a fixed
-template built once -- a billboard square (balls), a unit cylinder (bars), a
-barycentric triangle (faces) -- and whose per-instance attributes are
+template built once -- a billboard square (balls and bars), a barycentric
+triangle (faces) -- and whose per-instance attributes are
 `InterleavedBufferAttribute`s into the shared buffer.  `ShaderMaterial`s
 (GLSL ES 1.0 style; three r97 runs them on a WebGL2 context when it gets
 one, prefixing ``#version 300 es`` and compatibility defines) place each
 instance: the ball shader ray-casts a sphere impostor (exact perspective
 silhouette; the depth of the sphere's surface is written with
 ``gl_FragDepthEXT``, which is ``gl_FragDepth`` under WebGL2 and the
-EXT_frag_depth extension under WebGL1), the bar shader stretches the cylinder
-between the two end points, the face shader interpolates the three corners
-and unpacks the colour.  No sphere or cylinder mesh is ever sent.
+EXT_frag_depth extension under WebGL1), the bar shader ray-casts a closed
+cylinder impostor the same way (the square is stretched over a rectangle,
+aligned with the projected axis, that bounds the projection of the bar's
+box; the fragment shader intersects the pixel's ray with the cylinder's side,
+then with the end disc, discards misses, lights the hit like the balls and
+writes its depth), the face shader interpolates the three corners and unpacks
+the colour.  No sphere or cylinder mesh is ever sent.
+
+Why impostors for the bars too: on the software renderer (SwiftShader) the
+page's draw time is the update latency.  A 12-segment cylinder mesh is 144
+vertices per bar, drawn for every capacity row; measured per draw call
+(readPixels after each call, 600 x 500 canvas, median of 16 frames) the
+600-cell's bars took 48 ms as meshes and 25 ms as impostors (balls 12 ms,
+faces 17 ms), the 24-cell's 10.8 ms and 5.3 ms.  Needs a perspective camera
+(the rays start at the eye).
 
 Lighting is computed in those shaders, identically for balls, bars and
 faces: ambient + a hemisphere light (sky above, ground below, fixed in the

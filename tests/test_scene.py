@@ -141,17 +141,23 @@ def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
     assert arr.dtype == np.float32 and arr.shape == (sc.capacity, 20)
     # no sphere or cylinder per instance: the templates are small and fixed
     assert geos[0].attributes["position"].array.shape == (6, 3)
+    assert geos[1].attributes["position"].array.shape == (6, 3)  # bars are impostors too
+    assert "normal" not in geos[1].attributes
     assert geos[2].attributes["position"].array.shape == (3, 3)
 
 
-def test_ball_shader_writes_sphere_depth_under_webgl1_and_webgl2(scenes):
+@pytest.mark.parametrize("which", [0, 1], ids=["balls", "bars"])
+def test_impostor_shaders_write_depth_under_webgl1_and_webgl2(scenes, which):
     """three r97 in pythreejs runs on WebGL2 when it can (seen in Chromium): there the
     extension macro is undefined and gl_FragDepthEXT is #defined to gl_FragDepth."""
     sc = scenes("5-cell")
-    frag = sc._materials[0].fragmentShader
+    mat = sc._materials[which]
+    frag = mat.fragmentShader
     assert "#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300" in frag
     assert "gl_FragDepthEXT =" in frag
-    assert sc._materials[0].extensions == {"fragDepth": True}
+    assert "uniform mat4 projectionMatrix;" in frag  # not given to fragment shaders by r97
+    assert "discard" in frag
+    assert mat.extensions == {"fragDepth": True}
 
 
 def test_shader_attributes_match_the_columns(scenes):
