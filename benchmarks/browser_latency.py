@@ -7,7 +7,7 @@ ipyevents keydown handler assigns a new float32 position array -- and
 
     /work/venv/bin/python benchmarks/browser_latency.py [--presses 40] [--hold 2]
         [--tap 60-120] [--cases 5-cell,600-cell] [--seed 0] [--rev HEAD]
-        [--nodelay] [--json out.json]
+        [--nagle] [--json out.json]
 
 About 4 minutes for the default run (headless, runs as root).
 
@@ -20,10 +20,10 @@ machine is shared and its load drifts; the excess is taken against this
 
 ``--rev REV`` measures a clean ``git archive`` of that revision (first on the
 kernel's PYTHONPATH) instead of the working tree, so uncommitted edits
-elsewhere in the checkout do not leak into the numbers.  ``--nodelay``
-starts the server with TCP_NODELAY on the kernel WebSockets (through
-``ServerApp.kernel_websocket_connection_class``); jupyter_server does not set
-it, and Nagle's algorithm then holds every frame of a burst after the first
+elsewhere in the checkout do not leak into the numbers.  The package's
+server extension (rot4d_widget._server) sets TCP_NODELAY on the kernel
+WebSockets; ``--nagle`` switches it off to show what jupyter_server's default
+costs: Nagle's algorithm then holds every frame of a burst after the first
 (kernel status, comm updates) until the browser's delayed ACK, up to 40 ms.
 
 How each quantity is measured (clocks: the page's performance.now()):
@@ -332,20 +332,11 @@ def read_widget(w):
                           stamps={k: rec[k] for k in ("keys", "acks", "renders")})))
 '''
 
-#: ``--nodelay``: jupyter_server (tornado) never calls ``set_nodelay(True)`` on the kernel
-#: WebSocket, so Nagle's algorithm holds the 2nd and later frames of a burst (status busy,
-#: comm update, readout, status idle) until the browser's delayed ACK (40 ms on Linux).
-#: This sets it through a supported hook, ``ServerApp.kernel_websocket_connection_class``.
-NODELAY_MODULE = """
-from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
-
-
-class NoDelayConnection(ZMQChannelsWebsocketConnection):
-    def connect(self):
-        self.websocket_handler.set_nodelay(True)
-        return super().connect()
-"""
-NODELAY_CONFIG = 'c.ServerApp.kernel_websocket_connection_class = "rot4d_bench_nodelay.NoDelayConnection"\n'
+#: ``--nagle``: switch off the package's server extension (rot4d_widget._server), which
+#: sets TCP_NODELAY on kernel WebSockets; jupyter_server itself leaves Nagle's algorithm on,
+#: and it then holds the 2nd and later frames of a burst (status busy, comm update,
+#: readout, status idle) until the browser's delayed ACK (40 ms on Linux).
+NAGLE_CONFIG = {"ServerApp": {"jpserver_extensions": {"rot4d_widget._server": False}}}
 
 CELLS = [
     "import rot4d_bench_helpers as bench\nbench.renderer",
@@ -793,8 +784,8 @@ def main(argv=None) -> int:
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
                          "(default 60-120, a human tap; 0 = Playwright's instant press)")
-    ap.add_argument("--nodelay", action="store_true",
-                    help="start the server with TCP_NODELAY on kernel WebSockets (not jupyter_server's default)")
+    ap.add_argument("--nagle", action="store_true",
+                    help="disable the package's TCP_NODELAY server extension (jupyter_server's default)")
     ap.add_argument("--seed", type=int, default=None, help="random seed for keys, order and spacing")
     ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision (e.g. HEAD)")
     ap.add_argument("--json", default=None, help="also write the raw results here")
@@ -826,12 +817,9 @@ def main(argv=None) -> int:
     server = JupyterServer("lab", tmp / "server")
     (server.root / "rot4d_bench_helpers.py").write_text(HELPERS)
     pythonpath = [server.env.get("PYTHONPATH")]
-    if args.nodelay:
-        (tmp / "serverlib").mkdir()
-        (tmp / "serverlib" / "rot4d_bench_nodelay.py").write_text(NODELAY_MODULE)
-        (pathlib.Path(server.env["JUPYTER_CONFIG_DIR"]) / "jupyter_server_config.py").write_text(NODELAY_CONFIG)
-        pythonpath.insert(0, str(tmp / "serverlib"))
-    meta["server"] = "TCP_NODELAY on kernel WebSockets (--nodelay)" if args.nodelay else "jupyter_server defaults"
+    if args.nagle:
+        (pathlib.Path(server.env["JUPYTER_CONFIG_DIR"]) / "jupyter_server_config.json").write_text(
+            json.dumps(NAGLE_CONFIG))
     meta["tap"] = args.tap
     if args.rev:
         meta["code"] = export_revision(args.rev, tmp / "src")
@@ -842,6 +830,10 @@ def main(argv=None) -> int:
     failed: dict = {}
     try:
         server.start()
+        server.log.flush()
+        nodelay = "TCP_NODELAY" in pathlib.Path(server.log.name).read_text()
+        meta["server"] = ("rot4d_widget server extension: TCP_NODELAY on kernel WebSockets" if nodelay
+                          else "jupyter_server defaults (Nagle's algorithm on)")
         with sync_playwright() as p:
             context = p.chromium.launch_persistent_context(
                 str(tmp / "chromium-profile"), executable_path=chromium, headless=True,
