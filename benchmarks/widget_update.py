@@ -15,50 +15,21 @@ Targets (issue 3): <= 2 ms for the 120-cell and 600-cell, <= 64 KB per update.
 from __future__ import annotations
 
 import argparse
+import pathlib
 import statistics
 import sys
 import time
-import uuid
 
-import comm as comm_package
 import numpy as np
-from ipykernel.jsonutil import json_clean
-from jupyter_client.session import json_packer
 from scipy.stats import special_ortho_group
 
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.widget import Rot4DWidget
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+from recording_comm import RecordingComm, install  # noqa: E402  (serialises like ipykernel)
+
 KEYS = [("4", "Digit4"), ("2", "Digit2"), ("c", "KeyC"), ("z", "KeyZ"), ("w", "KeyW"), ("8", "Digit8")]
-
-
-class SerialisingComm:
-    """A comm that serialises each message as ipykernel's does, and records its size."""
-
-    kernel = "Truthy"
-    sent: list = []  # (comm_id, n_bytes)
-
-    def __init__(self, *args, comm_id=None, **kwargs):
-        self.comm_id = comm_id or uuid.uuid4().hex
-        self.handler = None
-
-    def open(self, *args, **kwargs):
-        pass
-
-    def on_msg(self, callback):
-        self.handler = callback
-
-    def on_close(self, callback):
-        pass
-
-    def close(self, *args, **kwargs):
-        pass
-
-    def send(self, data=None, metadata=None, buffers=None):
-        content = json_clean(dict(data=data, comm_id=self.comm_id))
-        packed = json_packer(content)
-        size = len(packed) + sum(memoryview(b).nbytes for b in (buffers or ()))
-        SerialisingComm.sent.append((self.comm_id, size))
 
 
 def key_msg(kind, key, code, t):
@@ -80,18 +51,18 @@ def bench(name, presses, rng):
             key, code = KEYS[i % len(KEYS)]
             w.state.matrix = m
             w._handle_drawn()  # the previous update was drawn: this one goes out at once
-            n0 = len(SerialisingComm.sent)
+            n0 = len(RecordingComm.log)
             t0 = time.perf_counter()
             handler(key_msg("keydown", key, code, float(i)))
             t1 = time.perf_counter()
-            update = SerialisingComm.sent[n0:]
+            update = RecordingComm.log[n0:]
             handler(key_msg("keyup", key, code, float(i)))
             if i < 20:  # warm-up
                 continue
             if not w.in_flight:
                 raise RuntimeError(f"{name}: a key press sent no scene update")
             times.append(t1 - t0)
-            sizes.append(sum(n for _, n in update))
+            sizes.append(sum(n for _, _, n, _ in update))
             counts.append(len(update))
         s = w.slice
         return {
@@ -112,7 +83,7 @@ def main(argv=None):
     parser.add_argument("--presses", type=int, default=300)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
-    comm_package.create_comm = lambda *a, **k: SerialisingComm(*a, **k)
+    install()
     rng = np.random.default_rng(args.seed)
     rows = [bench(name, args.presses, rng) for name in POLYTOPE_NAMES]
     print(f"Rot4DWidget: event dict -> update handed to the comm, {args.presses} presses at random orientations")

@@ -14,9 +14,7 @@ import json
 import pathlib
 import shutil
 import subprocess
-import uuid
 
-import comm as comm_package
 import pytest
 
 import rot4d_widget
@@ -25,32 +23,7 @@ from rot4d_widget.companion import Companion
 JS = pathlib.Path(rot4d_widget.__file__).with_name("companion.js")
 
 
-class Recorder:
-    kernel = "Truthy"
-
-    def __init__(self, *args, comm_id=None, **kwargs):
-        self.comm_id = comm_id or uuid.uuid4().hex
-        self.handler = None
-
-    def open(self, *args, **kwargs):
-        pass
-
-    def on_msg(self, callback):
-        self.handler = callback
-
-    def on_close(self, callback):
-        pass
-
-    def send(self, *args, **kwargs):
-        pass
-
-    def close(self, *args, **kwargs):
-        pass
-
-
-@pytest.fixture(autouse=True)
-def recording_comms(monkeypatch):
-    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: Recorder(*a, **k))
+pytestmark = pytest.mark.usefixtures("recording_comms")  # tests/conftest.py
 
 
 class FakeScene:

@@ -9,15 +9,11 @@ from __future__ import annotations
 
 import math
 import re
-import uuid
 
-import comm as comm_package
 import numpy as np
 import pytest
 import pythreejs as p3
-from ipykernel.jsonutil import json_clean
 from ipywidgets.widgets import widget as ipywidget_module
-from jupyter_client.session import json_packer
 
 from rot4d_widget import buffers as bf
 from rot4d_widget import polytope, slice_polytope
@@ -25,39 +21,10 @@ from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.scene import PENTACHORON_CIRCUMRADIUS, Scene
 
 
-class Recorder:
-    """A comm that records (comm_id, data, size in bytes) like ipykernel would send it."""
-
-    kernel = "Truthy"
-    log: list = []
-
-    def __init__(self, *args, comm_id=None, **kwargs):
-        self.comm_id = comm_id or uuid.uuid4().hex
-        self.handler = None
-
-    def open(self, *args, **kwargs):
-        pass
-
-    def on_msg(self, callback):
-        self.handler = callback
-
-    def on_close(self, callback):
-        pass
-
-    def send(self, data=None, metadata=None, buffers=None):
-        content = json_clean(dict(data=data, comm_id=self.comm_id))
-        n = len(json_packer(content)) + sum(memoryview(b).nbytes for b in (buffers or ()))
-        Recorder.log.append((self.comm_id, data, n, [np.frombuffer(b, dtype=np.uint8).copy() for b in buffers or ()]))
-
-    def close(self, *args, **kwargs):
-        pass
-
-
 @pytest.fixture(autouse=True)
-def log(monkeypatch):
-    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: Recorder(*a, **k))
-    Recorder.log = []
-    yield Recorder.log
+def log(recording_comms):
+    """Every message sent: (comm_id, data, n_bytes, buffers) -- tests/recording_comm.py."""
+    yield recording_comms
 
 
 def random_rotation(rng):

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from rot4d_widget import DEFAULT_KEYMAP, Keymap, RotationState, double_rotation, simple_rotation
+from rot4d_widget import DEFAULT_KEYMAP, RotationState, double_rotation, simple_rotation
 from rot4d_widget.state import ALPHA_STEP_FRACTION, DEFAULT_THETA0, PAPER_ALPHA_RATIO, THETA0_FACTOR
 
 SIMPLE_KEYS = {"2": "xy", "3": "xz", "4": "xw", "6": "yz", "8": "yw", "c": "zw"}

@@ -11,16 +11,12 @@ from __future__ import annotations
 
 import math
 import time
-import uuid
 
-import comm as comm_package
 import ipywidgets
 import numpy as np
 import pytest
 from ipywidgets import CallbackDispatcher
 from ipywidgets.widgets import widget as ipywidget_module
-from jupyter_client.session import json_packer
-from ipykernel.jsonutil import json_clean
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget import widget as wmod
@@ -28,41 +24,8 @@ from rot4d_widget.state import DEFAULT_THETA0
 from rot4d_widget.widget import Rot4DWidget
 
 
-# --------------------------------------------------------------------- comms
-class RecordingComm:
-    """Stands in for the kernel's comm: records what a widget sends, serialised like the real one."""
-
-    kernel = "Truthy"  # ipywidgets sends only when the comm has a kernel
-    log: list = []  # every message of every comm: (comm_id, data, n_bytes)
-
-    def __init__(self, *args, comm_id=None, **kwargs):
-        self.comm_id = comm_id or uuid.uuid4().hex
-        self.handler = None
-        self.closed = False
-
-    def open(self, *args, **kwargs):
-        pass
-
-    def on_msg(self, callback):
-        self.handler = callback
-
-    def on_close(self, callback):
-        pass
-
-    def send(self, data=None, metadata=None, buffers=None):
-        content = json_clean(dict(data=data, comm_id=self.comm_id))
-        n = len(json_packer(content)) + sum(memoryview(b).nbytes for b in (buffers or ()))
-        RecordingComm.log.append((self.comm_id, data, n))
-
-    def close(self, *args, **kwargs):
-        self.closed = True
-
-
-@pytest.fixture(autouse=True)
-def recording_comms(monkeypatch):
-    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: RecordingComm(*a, **k))
-    RecordingComm.log = []
-    yield RecordingComm.log
+# comms: tests/recording_comm.py, installed for every test of this module
+pytestmark = pytest.mark.usefixtures("recording_comms")
 
 
 # --------------------------------------------------------------------- fakes
@@ -120,33 +83,7 @@ def fake_rendering(monkeypatch):
     monkeypatch.setattr(wmod, "_scene_classes", lambda: (FakeScene, FakeCompanion))
 
 
-class FakeClock:
-    def __init__(self, t=100.0):
-        self.t = t
-
-    def __call__(self):
-        return self.t
-
-
-@pytest.fixture
-def clock():
-    return FakeClock()
-
-
-@pytest.fixture
-def make(clock):
-    made = []
-
-    def _make(*args, **kwargs):
-        kwargs.setdefault("clock", clock)
-        kwargs.setdefault("autotick", False)
-        w = Rot4DWidget(*args, **kwargs)
-        made.append(w)
-        return w
-
-    yield _make
-    for w in made:
-        w.close()
+# FakeClock, `clock` and `make`: tests/conftest.py
 
 
 # -------------------------------------------------------------------- events
@@ -490,7 +427,7 @@ def test_nothing_changed_sends_nothing(make, recording_comms):
     down(w, "k")  # alpha changes: the readout, not the geometry
     up(w, "k")
     assert len(w.scene.shown) == 1
-    assert [cid for cid, _, _ in recording_comms[n0:]] == [w.readout.comm.comm_id]
+    assert [cid for cid, *_ in recording_comms[n0:]] == [w.readout.comm.comm_id]
 
 
 def test_readout_shows_parameters_last_action_census_and_volume(make):

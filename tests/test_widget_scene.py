@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 from collections import Counter
 
-import comm as comm_package
 import numpy as np
 import pytest
 from ipywidgets.widgets import widget as ipywidget_module
@@ -19,35 +18,11 @@ from rot4d_widget import buffers as bf
 from rot4d_widget import slice_polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.widget import Rot4DWidget
-from test_widget import FakeClock, RecordingComm, down, run_ticker, up, xw_steps
+from test_widget import down, run_ticker, up, xw_steps
 
 
-@pytest.fixture(autouse=True)
-def recording_comms(monkeypatch):
-    monkeypatch.setattr(comm_package, "create_comm", lambda *a, **k: RecordingComm(*a, **k))
-    RecordingComm.log = []
-    yield RecordingComm.log
-
-
-@pytest.fixture
-def clock():
-    return FakeClock()
-
-
-@pytest.fixture
-def make(clock):
-    made = []
-
-    def _make(*args, **kwargs):
-        kwargs.setdefault("clock", clock)
-        kwargs.setdefault("autotick", False)
-        w = Rot4DWidget(*args, **kwargs)
-        made.append(w)
-        return w
-
-    yield _make
-    for w in made:
-        w.close()
+# comms, clock and `make`: tests/conftest.py
+pytestmark = pytest.mark.usefixtures("recording_comms")
 
 
 def companion_says(w, content):
@@ -61,7 +36,7 @@ def drawn(w, seq=None):
 
 def buffer_messages(w, log):
     bid = w.scene.buffer_model_id
-    return [(data, n) for cid, data, n in log if cid == bid]
+    return [(data, n) for cid, data, n, _ in log if cid == bid]
 
 
 # --------------------------------------------------------------------- tests
@@ -92,9 +67,9 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
         down(w, "w")
         up(w, "w")
         msgs = recording_comms[n0:]
-        by_widget = Counter(cid for cid, _, _ in msgs)
+        by_widget = Counter(cid for cid, *_ in msgs)
         assert by_widget == {w.scene.buffer_model_id: 1, w.readout.model_id: 1}, by_widget
-        total = sum(n for _, _, n in msgs)
+        total = sum(n for _, _, n, _ in msgs)
         assert total <= 64 * 1024
         (data, nbytes), = buffer_messages(w, msgs)
         assert set(data["state"]) == {"array", "_rot4d_seq"}
@@ -192,7 +167,7 @@ def test_parameter_keys_change_the_readout_only(make, recording_comms):
     n0 = len(recording_comms)
     down(w, "j")
     up(w, "j")
-    assert [cid for cid, _, _ in recording_comms[n0:]] == [w.readout.model_id]
+    assert [cid for cid, *_ in recording_comms[n0:]] == [w.readout.model_id]
     assert not w.in_flight  # no picture sent, so no acknowledgement to wait for
     down(w, "l")
     up(w, "l")
