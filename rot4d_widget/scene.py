@@ -162,6 +162,18 @@ vec3 shade(vec3 base, vec3 n, vec3 p) {
 }
 """
 
+#: Shared by the ray-cast impostors (balls, bars): write the depth of the surface point
+#: actually hit, so impostors occlude each other and the faces exactly.
+_IMPOSTOR_DEPTH = """
+uniform mat4 projectionMatrix;
+void write_depth(vec3 hit) {
+#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300
+    vec4 clip = projectionMatrix * vec4(hit, 1.0);
+    gl_FragDepthEXT = 0.5 + 0.5 * clip.z / clip.w;
+#endif
+}
+"""
+
 _BALL_VERTEX = """
 attribute vec4 ball;
 uniform float u_ball_radius;
@@ -191,13 +203,13 @@ void main() {
 
 _BALL_FRAGMENT = (
     """
-uniform mat4 projectionMatrix;
 uniform vec3 u_ball_color;
 uniform float u_ball_radius;
 varying vec3 v_centre;
 varying vec3 v_point;
 """
     + _LIGHTING
+    + _IMPOSTOR_DEPTH
     + """
 void main() {
     vec3 ray = normalize(v_point);
@@ -207,10 +219,7 @@ void main() {
     if (disc < 0.0) discard;
     vec3 hit = (b - sqrt(disc)) * ray;
     vec3 n = (hit - v_centre) / u_ball_radius;
-#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300
-    vec4 clip = projectionMatrix * vec4(hit, 1.0);
-    gl_FragDepthEXT = 0.5 + 0.5 * clip.z / clip.w;
-#endif
+    write_depth(hit);
     gl_FragColor = vec4(shade(u_ball_color, n, hit), 1.0);
 }
 """
@@ -279,7 +288,6 @@ void main() {
 
 _BAR_FRAGMENT = (
     """
-uniform mat4 projectionMatrix;
 uniform vec3 u_bar_color;
 uniform float u_bar_radius;
 varying vec3 v_point;
@@ -288,6 +296,7 @@ varying vec3 v_w;
 varying float v_len;
 """
     + _LIGHTING
+    + _IMPOSTOR_DEPTH
     + """
 void main() {
     // ray from the eye (the origin) through this pixel against the closed cylinder
@@ -318,10 +327,7 @@ void main() {
     } else {
         n = (hit - v_a - s * w) / u_bar_radius;
     }
-#if defined(GL_EXT_frag_depth) || __VERSION__ >= 300
-    vec4 clip = projectionMatrix * vec4(hit, 1.0);
-    gl_FragDepthEXT = 0.5 + 0.5 * clip.z / clip.w;
-#endif
+    write_depth(hit);
     gl_FragColor = vec4(shade(u_bar_color, n, hit), 1.0);
 }
 """
