@@ -30,8 +30,9 @@ cylinder impostor the same way (the square is stretched over a rectangle,
 aligned with the projected axis, that bounds the projection of the bar's
 box; the fragment shader intersects the pixel's ray with the cylinder's side,
 then with the end disc, discards misses, lights the hit like the balls and
-writes its depth), the face shader interpolates the three corners and unpacks
-the colour.  No sphere or cylinder mesh is ever sent.
+writes its depth), the face shader places the triangle's three corners,
+unpacks the colour and lights each corner.  No sphere or cylinder mesh is
+ever sent.
 
 Why impostors for the bars too: on the software renderer (SwiftShader) the
 page's draw time is the update latency.  A 12-segment cylinder mesh is 144
@@ -41,11 +42,17 @@ vertices per bar, drawn for every capacity row; measured per draw call
 faces 17 ms), the 24-cell's 10.8 ms and 5.3 ms.  Needs a perspective camera
 (the rays start at the eye).
 
-Lighting is computed in those shaders, identically for balls, bars and
-faces: ambient + a hemisphere light (sky above, ground below, fixed in the
+Lighting is computed in those shaders, with one GLSL function for balls,
+bars and faces: ambient + a hemisphere light (sky above, ground below, fixed in the
 world) + one point light riding with the camera (a head lamp, up and to the
 left).  There are no three.js light objects, in particular no
-DirectionalLight (pythreejs issues #388, #406).
+DirectionalLight (pythreejs issues #388, #406).  Balls and bars are lit per
+pixel (their normal varies across the pixel's hits); faces are flat, so they
+are lit at their corners and the colour is interpolated (Gouraud): the face
+pass is the largest (translucent, both sides drawn) and this halves it,
+4.9 -> 2.6 ms per frame for the 24-cell, with the picture unchanged to within
+2/255 per channel (``python benchmarks/browser_draw.py --cases 24-cell
+--variants default --screenshots DIR``, run on the two versions).
 
 One update = one message, never drawn half-applied
 --------------------------------------------------
@@ -333,44 +340,38 @@ void main() {
 """
 )
 
-_FACE_VERTEX = """
+_FACE_VERTEX = (
+    """
 attribute vec3 tri_a;
 attribute vec3 tri_b;
 attribute vec3 tri_c;
 attribute float tri_rgb;
-varying vec3 v_normal;
-varying vec3 v_point;
-varying vec3 v_color;
-void main() {
-    vec3 p = position.x * tri_a + position.y * tri_b + position.z * tri_c;
-    vec3 n = cross(tri_b - tri_a, tri_c - tri_a);
-    float r = floor(tri_rgb / 65536.0);
-    float g = floor((tri_rgb - r * 65536.0) / 256.0);
-    float b = tri_rgb - r * 65536.0 - g * 256.0;
-    v_color = vec3(r, g, b) / 255.0;
-    vec4 mv = modelViewMatrix * vec4(p, 1.0);
-    v_point = mv.xyz;
-    v_normal = normalMatrix * n;
-    gl_Position = projectionMatrix * mv;
-}
-"""
-
-_FACE_FRAGMENT = (
-    """
-uniform float u_opacity;
-varying vec3 v_normal;
-varying vec3 v_point;
 varying vec3 v_color;
 """
     + _LIGHTING
     + """
 void main() {
-    vec3 n = normalize(v_normal);
-    if (dot(n, v_point) > 0.0) n = -n;  // light the side facing the viewer
-    gl_FragColor = vec4(shade(v_color, n, v_point), u_opacity);
+    vec3 p = position.x * tri_a + position.y * tri_b + position.z * tri_c;
+    float r = floor(tri_rgb / 65536.0);
+    float g = floor((tri_rgb - r * 65536.0) / 256.0);
+    float b = tri_rgb - r * 65536.0 - g * 256.0;
+    vec4 mv = modelViewMatrix * vec4(p, 1.0);
+    vec3 n = normalize(normalMatrix * cross(tri_b - tri_a, tri_c - tri_a));
+    // a flat face: dot(n, point) has one sign over it, so each corner picks the same side
+    if (dot(n, mv.xyz) > 0.0) n = -n;  // light the side facing the viewer
+    v_color = shade(vec3(r, g, b) / 255.0, n, mv.xyz);
+    gl_Position = projectionMatrix * mv;
 }
 """
 )
+
+_FACE_FRAGMENT = """
+uniform float u_opacity;
+varying vec3 v_color;
+void main() {
+    gl_FragColor = vec4(v_color, u_opacity);
+}
+"""
 
 
 # -- option validation -------------------------------------------------------

@@ -1,0 +1,210 @@
+"""What each draw call of the widget costs on the page (headless Chromium, SwiftShader).
+
+    /work/venv/bin/python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
+        [--variants default,noaa] [--hold 2] [--rev HEAD]
+
+About 30 s per case and variant.  One JupyterLab 4 server, one headless
+Chromium; for each polychoron and variant a notebook shows
+``Rot4DWidget(name, **options)`` and "4" is held on its canvas for
+``--hold`` s, so every frame drawn is a different slice.
+
+A page init script wraps the WebGL2 context's ``clear`` and draw calls: each
+call is preceded and followed by a 1-pixel ``readPixels`` (which waits until
+the GPU -- here the CPU -- has finished), and the time between the two reads
+is charged to the call, by shader program: balls (the program with the
+``ball`` attribute), bars (``bar_a``), faces (``tri_a``).  Two back-to-back
+reads, timed the same way, give the overhead of a read (on a multisampled
+canvas it includes a resolve); it is subtracted from every call.  The
+forced synchronisation serialises what the GPU process might overlap, so
+the per-pass times add up to more than an unsynchronised frame costs: use
+them to compare passes and variants, and the latency benchmark
+(``browser_latency.py``) for the targets.
+
+``--screenshots DIR`` saves each canvas after the hold (the same held
+steps, so the same slice, for every variant: compare the pictures).
+
+Variants: ``default`` (the widget as shipped), ``noaa`` (``antialias=False``:
+no multisampling).  Prints a table of medians (ms) per pass and their sum.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "browser"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from browser_latency import (  # noqa: E402
+    POLYCHORA,
+    cpu_name,
+    export_revision,
+    find_chromium,
+    working_tree_description,
+)
+from conftest import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
+from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook  # noqa: E402
+
+VARIANTS = {"default": {}, "noaa": {"antialias": False}}
+PASSES = ["clear", "balls", "bars", "faces"]
+
+#: Installed before any page script: times clear and draw calls while __draw.on.
+DRAW_HOOK = r"""
+(() => {
+  const T = window.__draw = {on: false, rec: [], names: new Map()};
+  const px = new Uint8Array(4);
+  const sync = gl => gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  const pass = gl => {
+    const p = gl.getParameter(gl.CURRENT_PROGRAM);
+    if (!p) return 'other';
+    if (!T.names.has(p)) {
+      const has = a => gl.getAttribLocation(p, a) >= 0;
+      T.names.set(p, has('ball') ? 'balls' : has('bar_a') ? 'bars' : has('tri_a') ? 'faces' : 'other');
+    }
+    return T.names.get(p);
+  };
+  for (const Ctx of [window.WebGL2RenderingContext, window.WebGLRenderingContext]) {
+    if (!Ctx) continue;
+    for (const fn of ['clear', 'drawArrays', 'drawArraysInstanced', 'drawElements', 'drawElementsInstanced']) {
+      const orig = Ctx.prototype[fn];
+      if (!orig) continue;
+      Ctx.prototype[fn] = function (...args) {
+        if (!T.on || this.getParameter(this.FRAMEBUFFER_BINDING) !== null) return orig.apply(this, args);
+        sync(this);
+        const t0 = performance.now();
+        sync(this);
+        const t1 = performance.now();
+        orig.apply(this, args);
+        sync(this);
+        const t2 = performance.now();
+        T.rec.push([fn === 'clear' ? 'clear' : pass(this), t2 - t1, t1 - t0, t2]);
+      };
+    }
+  }
+})();
+"""
+
+CELLS = [
+    "from rot4d_widget import Rot4DWidget",
+    "w = Rot4DWidget({name!r}, **{options!r})\nw",
+]
+
+
+def run_one(context, server, case: str, variant: str, hold: float, shots: pathlib.Path | None) -> dict:
+    name = f"draw_{case.replace('-', '_')}_{variant}.ipynb"
+    write_notebook(server.root / name, [c.format(name=case, options=VARIANTS[variant]) for c in CELLS])
+    page = context.new_page()
+    try:
+        jp = JupyterPage(page, server, name).open(timeout=180)
+        jp.run_all(timeout=300)
+        sel = f".{jp.kernel('print(w.scene.canvas_class)').strip()} canvas"
+        page.wait_for_selector(sel, timeout=120_000)
+        if not jp.wait_for(lambda: (s := jp.canvas_stats(sel)) and s["count"] > 50, timeout=60):
+            raise RuntimeError(f"{case}: nothing drawn")
+        page.locator(sel).scroll_into_view_if_needed()
+        box = page.locator(sel).bounding_box()
+        page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+        time.sleep(0.5)
+        page.evaluate("() => { window.__draw.rec = []; window.__draw.on = true; }")
+        page.keyboard.down("4")
+        time.sleep(hold)
+        page.keyboard.up("4")
+        time.sleep(0.5)
+        rec = page.evaluate("() => { window.__draw.on = false; return window.__draw.rec; }")
+        if shots is not None:
+            page.mouse.move(0, 0)
+            time.sleep(0.3)
+            page.locator(sel).screenshot(path=str(shots / f"{case}-{variant}.png"))
+        capacity = int(jp.kernel("print(w.scene.capacity)"))
+        try:
+            page.evaluate("async () => { const f = " + _FIND_PANEL + "; await f().sessionContext.shutdown(); }")
+        except Exception:
+            pass
+    finally:
+        page.close()
+    per = {p: [] for p in PASSES}
+    frames = 0
+    for kind, ms, overhead, _ in rec:
+        if kind in per:
+            per[kind].append(max(ms - overhead, 0.0))
+        frames += kind == "clear"
+    return {"per": per, "frames": frames, "capacity": capacity,
+            "overhead": statistics.median([o for _, _, o, _ in rec]) if rec else float("nan")}
+
+
+def median(xs):
+    return statistics.median(xs) if xs else float("nan")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six)")
+    ap.add_argument("--variants", default="default,noaa", help=f"comma-separated, from {', '.join(VARIANTS)}")
+    ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' per case (default 2)")
+    ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision")
+    ap.add_argument("--screenshots", default=None, help="save each canvas after the hold in this folder")
+    args = ap.parse_args(argv)
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    variants = [v.strip() for v in args.variants.split(",") if v.strip()]
+    if not cases or any(c not in POLYCHORA for c in cases):
+        ap.error(f"choose cases from {', '.join(POLYCHORA)}")
+    if not variants or any(v not in VARIANTS for v in variants):
+        ap.error(f"choose variants from {', '.join(VARIANTS)}")
+
+    from playwright.sync_api import sync_playwright
+
+    chromium = find_chromium()
+    version = subprocess.run([chromium, "--version"], capture_output=True, text=True).stdout.strip()
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-draw-"))
+    code = working_tree_description()
+    server = JupyterServer("lab", tmp / "server")
+    if args.rev:
+        code = export_revision(args.rev, tmp / "src")
+        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp / "src"), server.env.get("PYTHONPATH")]))
+    shots = pathlib.Path(args.screenshots) if args.screenshots else None
+    if shots is not None:
+        shots.mkdir(parents=True, exist_ok=True)
+    load_before = os.getloadavg()
+    rows = []
+    try:
+        server.start()
+        with sync_playwright() as p:
+            context = p.chromium.launch_persistent_context(
+                str(tmp / "profile"), executable_path=chromium, headless=True, args=CHROMIUM_FLAGS,
+                viewport={"width": 1400, "height": 1200},
+            )
+            context.add_init_script(DRAW_HOOK)
+            try:
+                for case in cases:
+                    for variant in variants:
+                        r = run_one(context, server, case, variant, args.hold, shots)
+                        rows.append((case, variant, r))
+                        print(f"{case} {variant}: {r['frames']} frames", file=sys.stderr, flush=True)
+            finally:
+                context.close()
+    finally:
+        server.stop()
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("| case | variant | rows | frames | " + " | ".join(PASSES) + " | sum | read overhead |")
+    print("|---|---|---|---|" + "---|" * len(PASSES) + "---|---|")
+    for case, variant, r in rows:
+        meds = [median(r["per"][p]) for p in PASSES]
+        print(f"| {case} | {variant} | {r['capacity']} | {r['frames']} | "
+              + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | {r['overhead']:.1f} |")
+    print(f"\nMedians in ms per frame, per pass, synchronised by 1-pixel reads (overhead subtracted). "
+          f"{os.cpu_count()} CPUs ({cpu_name()}), load {' '.join(f'{x:.1f}' for x in load_before)} before, "
+          f"{' '.join(f'{x:.1f}' for x in os.getloadavg())} after; {version.split(' built')[0]}, headless, "
+          f"SwiftShader; canvas 600×500; code: {code}.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
