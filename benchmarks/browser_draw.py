@@ -20,8 +20,9 @@ the per-pass times add up to more than an unsynchronised frame costs: use
 them to compare passes and variants, and the latency benchmark
 (``browser_latency.py``) for the targets.
 
-``--screenshots DIR`` saves each canvas after the hold (the same held
-steps, so the same slice, for every variant: compare the pictures).
+``--screenshots DIR`` saves each canvas after the hold, in one fixed state
+(reset, then the keys `SHOT_KEYS`), so the pictures of two variants or two
+versions can be compared pixel by pixel.
 
 Variants: ``default`` (the widget as shipped), ``noaa`` (``antialias=False``:
 no multisampling).  Prints a table of medians (ms) per pass and their sum.
@@ -92,8 +93,11 @@ DRAW_HOOK = r"""
 })();
 """
 
+#: the state of the screenshots: 13 steps of R_xw, 5 of the double rotation R_xz,yw, 3 of R_yz
+SHOT_KEYS = "4" * 13 + "z" * 5 + "6" * 3
+
 CELLS = [
-    "from rot4d_widget import Rot4DWidget",
+    f"from rot4d_widget import Rot4DWidget\nSHOT_KEYS = {SHOT_KEYS!r}",
     "w = Rot4DWidget({name!r}, **{options!r})\nw",
 ]
 
@@ -119,9 +123,10 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
         page.keyboard.up("4")
         time.sleep(0.5)
         rec = page.evaluate("() => { window.__draw.on = false; return window.__draw.rec; }")
-        if shots is not None:
+        if shots is not None:  # one fixed state, so pictures of two versions can be compared
             page.mouse.move(0, 0)
-            time.sleep(0.3)
+            jp.kernel("w.press('r')\nfor k in SHOT_KEYS: w.press(k)")
+            time.sleep(1.0)
             page.locator(sel).screenshot(path=str(shots / f"{case}-{variant}.png"))
         capacity = int(jp.kernel("print(w.scene.capacity)"))
         try:

@@ -262,9 +262,16 @@ void main() {
         return;
     }
     vec3 w = axis / len;
+    // The box around the bar has sides u and v (both perpendicular to the axis).
+    // Any such pair bounds the cylinder; taking u across the line of sight (and
+    // v nearly along it) makes the box's projection hug the cylinder's, so the
+    // quad is about 2r wide instead of up to 2.8r for a fixed helper axis.
+    vec3 mid = 0.5 * (a + b);
+    vec3 across = cross(w, mid);
     vec3 helper = abs(w.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    if (dot(across, across) < 1.0e-8 * dot(mid, mid)) across = cross(w, helper);  // bar seen end-on
     float r = u_bar_radius;
-    vec3 u = r * normalize(cross(w, helper));
+    vec3 u = r * normalize(across);
     vec3 v = r * normalize(cross(w, u));
     // the bar's box (end discs included), projected on the plane z = -1 and
     // bounded by a rectangle aligned with the projected axis
