@@ -1,7 +1,7 @@
 """What each draw call of the widget costs on the page (headless Chromium, SwiftShader).
 
     /work/venv/bin/python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
-        [--variants default,noaa] [--hold 2] [--rev HEAD]
+        [--variants default,msaa] [--hold 2] [--rounds 1] [--screenshots DIR] [--rev HEAD]
 
 About 30 s per case and variant.  One JupyterLab 4 server, one headless
 Chromium; for each polychoron and variant a notebook shows
@@ -24,8 +24,8 @@ them to compare passes and variants, and the latency benchmark
 (reset, then the keys `SHOT_KEYS`), so the pictures of two variants or two
 versions can be compared pixel by pixel.
 
-Variants: ``default`` (the widget as shipped), ``noaa`` (``antialias=False``:
-no multisampling).  Prints a table of medians (ms) per pass and their sum.
+Variants: ``default`` (the widget as shipped: no multisampling), ``msaa``
+(``antialias=True``: WebGL's 4x multisampling).  Prints a table of medians (ms) per pass and their sum.
 """
 
 from __future__ import annotations
@@ -39,6 +39,8 @@ import subprocess
 import sys
 import tempfile
 import time
+
+import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
@@ -54,7 +56,7 @@ from browser_latency import (  # noqa: E402
 from conftest import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
 from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook  # noqa: E402
 
-VARIANTS = {"default": {}, "noaa": {"antialias": False}}
+VARIANTS = {"default": {}, "msaa": {"antialias": True}}
 PASSES = ["clear", "balls", "bars", "faces"]
 
 #: Installed before any page script: times clear and draw calls while __draw.on.
@@ -145,6 +147,12 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
             "overhead": statistics.median([o for _, _, o, _ in rec]) if rec else float("nan")}
 
 
+def _pixels(path):
+    import matplotlib.image
+
+    return np.asarray(matplotlib.image.imread(str(path)))[..., :3].astype(np.float64) * 255.0
+
+
 def median(xs):
     return statistics.median(xs) if xs else float("nan")
 
@@ -152,17 +160,21 @@ def median(xs):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six)")
-    ap.add_argument("--variants", default="default,noaa", help=f"comma-separated, from {', '.join(VARIANTS)}")
+    ap.add_argument("--variants", default="default,msaa", help=f"comma-separated, from {', '.join(VARIANTS)}")
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' per case (default 2)")
     ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision")
     ap.add_argument("--screenshots", default=None, help="save each canvas after the hold in this folder")
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="repeat every case and variant, interleaved; frames are pooled (default 1)")
     args = ap.parse_args(argv)
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     variants = [v.strip() for v in args.variants.split(",") if v.strip()]
     if not cases or any(c not in POLYCHORA for c in cases):
         ap.error(f"choose cases from {', '.join(POLYCHORA)}")
-    if not variants or any(v not in VARIANTS for v in variants):
-        ap.error(f"choose variants from {', '.join(VARIANTS)}")
+    if not variants or any(v not in VARIANTS for v in variants) or len(set(variants)) != len(variants):
+        ap.error(f"choose distinct variants from {', '.join(VARIANTS)}")
+    if args.rounds < 1:
+        ap.error("--rounds must be >= 1")
 
     from playwright.sync_api import sync_playwright
 
@@ -178,7 +190,7 @@ def main(argv=None) -> int:
     if shots is not None:
         shots.mkdir(parents=True, exist_ok=True)
     load_before = os.getloadavg()
-    rows = []
+    pooled: dict = {}
     try:
         server.start()
         with sync_playwright() as p:
@@ -188,11 +200,18 @@ def main(argv=None) -> int:
             )
             context.add_init_script(DRAW_HOOK)
             try:
-                for case in cases:
-                    for variant in variants:
-                        r = run_one(context, server, case, variant, args.hold, shots)
-                        rows.append((case, variant, r))
-                        print(f"{case} {variant}: {r['frames']} frames", file=sys.stderr, flush=True)
+                for _ in range(args.rounds):
+                    for case in cases:
+                        for variant in variants:
+                            r = run_one(context, server, case, variant, args.hold, shots)
+                            print(f"{case} {variant}: {r['frames']} frames", file=sys.stderr, flush=True)
+                            acc = pooled.setdefault((case, variant), {"per": {q: [] for q in PASSES},
+                                                                      "frames": 0, "overhead": []})
+                            for q in PASSES:
+                                acc["per"][q] += r["per"][q]
+                            acc["frames"] += r["frames"]
+                            acc["overhead"].append(r["overhead"])
+                            acc["capacity"] = r["capacity"]
             finally:
                 context.close()
     finally:
@@ -200,11 +219,20 @@ def main(argv=None) -> int:
         shutil.rmtree(tmp, ignore_errors=True)
     print("| case | variant | rows | frames | " + " | ".join(PASSES) + " | sum | read overhead |")
     print("|---|---|---|---|" + "---|" * len(PASSES) + "---|---|")
-    for case, variant, r in rows:
+    for (case, variant), r in pooled.items():
         meds = [median(r["per"][p]) for p in PASSES]
         print(f"| {case} | {variant} | {r['capacity']} | {r['frames']} | "
-              + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | {r['overhead']:.1f} |")
-    print(f"\nMedians in ms per frame, per pass, synchronised by 1-pixel reads (overhead subtracted). "
+              + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | {median(r['overhead']):.1f} |")
+    if shots is not None and len(variants) > 1:
+        print(f"\nScreenshots in {shots}; pixels that differ from the `{variants[0]}` picture by more "
+              "than 8/255 in some channel:")
+        for case in cases:
+            ref = _pixels(shots / f"{case}-{variants[0]}.png")
+            for v in variants[1:]:
+                d = np.abs(_pixels(shots / f"{case}-{v}.png") - ref).max(axis=-1)
+                print(f"- {case}, {v}: {100 * np.mean(d > 8):.2f} % (largest difference {d.max():.0f}/255)")
+    print(f"\n{args.rounds} round(s), {args.hold:g} s hold each; frames pooled. "
+          f"Medians in ms per frame, per pass, synchronised by 1-pixel reads (overhead subtracted). "
           f"{os.cpu_count()} CPUs ({cpu_name()}), load {' '.join(f'{x:.1f}' for x in load_before)} before, "
           f"{' '.join(f'{x:.1f}' for x in os.getloadavg())} after; {version.split(' built')[0]}, headless, "
           f"SwiftShader; canvas 600×500; code: {code}.")

@@ -2,7 +2,8 @@
 
 One run, one JupyterLab 4 server, one headless Chromium (SwiftShader WebGL):
 a baseline -- a bare pythreejs tetrahedron (Mesh + BufferGeometry) whose
-ipyevents keydown handler assigns a new float32 position array -- and
+ipyevents keydown handler assigns a new float32 position array, drawn by a
+Renderer with the widget's settings (600 x 500, no multisampling) -- and
 ``Rot4DWidget(name)`` for each of the six regular polychora.
 
     /work/venv/bin/python benchmarks/browser_latency.py [--presses 40] [--hold 2]
@@ -246,7 +247,7 @@ mesh = p3.Mesh(geometry, p3.MeshBasicMaterial(vertexColors="VertexColors", side=
                frustumCulled=False)
 camera = p3.PerspectiveCamera(position=[0, 0, 5], fov=40, aspect=600 / 500, near=0.1, far=100)
 renderer = p3.Renderer(camera=camera, scene=p3.Scene(children=[mesh, camera]), width=600, height=500,
-                       antialias=True, background="#ffffff", background_opacity=1.0, clearColor="#ffffff",
+                       antialias=False, background="#ffffff", background_opacity=1.0, clearColor="#ffffff",
                        controls=[p3.OrbitControls(controlling=camera, enableKeys=False)])
 renderer.add_class("bench-baseline")
 _lock = threading.Lock()

@@ -49,10 +49,19 @@ left).  There are no three.js light objects, in particular no
 DirectionalLight (pythreejs issues #388, #406).  Balls and bars are lit per
 pixel (their normal varies across the pixel's hits); faces are flat, so they
 are lit at their corners and the colour is interpolated (Gouraud): the face
-pass is the largest (translucent, both sides drawn) and this halves it,
-4.9 -> 2.6 ms per frame for the 24-cell, with the picture unchanged to within
-2/255 per channel (``python benchmarks/browser_draw.py --cases 24-cell
---variants default --screenshots DIR``, run on the two versions).
+pass was the largest (translucent, both sides drawn) and this halved it,
+4.9 -> 2.6 ms per 24-cell frame (with multisampling), with the picture
+unchanged to within 2/255 per channel (``python benchmarks/browser_draw.py
+--cases 24-cell --variants msaa --screenshots DIR``, on the two versions).
+
+Why no multisampling by default: MSAA smooths triangle edges only.  The
+balls' and bars' outlines are where their fragment shader discards, once per
+pixel, so they are not smoothed either way; the faces' edges lie under the
+bars.  With 4x MSAA and without, a 24-cell picture differs in 0.39 % of its
+pixels (single pixels along outlines), while every pass costs more: on the
+software renderer a 24-cell frame takes 8.5 ms with it, 5.4 ms without
+(``python benchmarks/browser_draw.py --cases 24-cell --rounds 3
+--screenshots DIR``).  ``antialias=True`` turns it on.
 
 One update = one message, never drawn half-applied
 --------------------------------------------------
@@ -454,7 +463,7 @@ class Scene:
     capacity : int >= 1, optional
         Initial row capacity (default: estimated from the polytope).
     antialias : bool
-        WebGL multisampling (default True).
+        WebGL multisampling (default False: see the module notes).
 
     Attributes
     ----------
@@ -480,7 +489,7 @@ class Scene:
         bar_color="#4a4a4a",
         cell_colors=None,
         capacity=None,
-        antialias=True,
+        antialias=False,
     ):
         try:
             radius = float(polytope.circumradius)

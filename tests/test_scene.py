@@ -60,6 +60,12 @@ def walk(obj):
 
 
 # ----------------------------------------------------------------- structure
+def test_multisampling_is_off_unless_asked_for(scenes):
+    # off by default: it smooths no impostor outline and costs every pass (see scene docs)
+    assert scenes("5-cell").renderer.antialias is False
+    assert scenes("5-cell", antialias=True).renderer.antialias is True
+
+
 def test_camera_controls_renderer_as_the_paper_and_the_issue_ask(scenes):
     sc = scenes("5-cell", width=420, height=300)
     cam = sc.renderer.camera
