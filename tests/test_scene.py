@@ -62,8 +62,8 @@ def walk(obj):
 # ----------------------------------------------------------------- structure
 def test_multisampling_is_off_unless_asked_for(scenes):
     # off by default: it smooths no impostor outline and costs every pass (see scene docs)
-    assert scenes("5-cell").renderer.antialias is False
-    assert scenes("5-cell", antialias=True).renderer.antialias is True
+    assert scenes("5-cell").renderer._antialias is False
+    assert scenes("5-cell", antialias=True).renderer._antialias is True
 
 
 def test_camera_controls_renderer_as_the_paper_and_the_issue_ask(scenes):
