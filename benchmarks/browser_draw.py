@@ -54,7 +54,7 @@ from browser_latency import (  # noqa: E402
     working_tree_description,
 )
 from conftest import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
-from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook  # noqa: E402
+from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
 VARIANTS = {"default": {}, "msaa": {"antialias": True}}
 PASSES = ["clear", "balls", "bars", "faces"]
@@ -131,10 +131,7 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
             time.sleep(1.0)
             page.locator(sel).screenshot(path=str(shots / f"{case}-{variant}.png"))
         capacity = int(jp.kernel("print(w.scene.capacity)"))
-        try:
-            page.evaluate("async () => { const f = " + _FIND_PANEL + "; await f().sessionContext.shutdown(); }")
-        except Exception:
-            pass
+        jp.shutdown_kernel()
     finally:
         page.close()
     per = {p: [] for p in PASSES}

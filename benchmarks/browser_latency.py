@@ -112,7 +112,7 @@ from conftest import (  # noqa: E402  (the browser tests' building blocks)
     _installed_chromium,
     _playwright_chromium,
 )
-from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook  # noqa: E402
+from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
 POLYCHORA = ["5-cell", "8-cell", "16-cell", "24-cell", "600-cell", "120-cell"]
 LARGE = {"600-cell", "120-cell"}
@@ -487,10 +487,7 @@ def run_case(context, server, case: str, args, rng: random.Random, hold_baseline
         rec = page.evaluate("() => { const B = window.__bench; B.stop();"
                             " return {t: B.t, h: B.h, g: B.g, cost: B.cost, keys: B.keys}; }")
         page.__dict__["closing"] = True  # "Cannot send" from views of a kernel being shut down
-        try:
-            page.evaluate("async () => { const f = " + _FIND_PANEL + "; await f().sessionContext.shutdown(); }")
-        except Exception:
-            pass
+        jp.shutdown_kernel()
     finally:
         page.close()
     return analyse(case, info, rec, order, ws_presses, holds, before, after_presses, args, errors)

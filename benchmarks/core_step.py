@@ -55,8 +55,8 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=3000)
     args = ap.parse_args()
     print(f"press + slice_polytope, random orientations, c0 = 0, {args.steps} steps each (medians)")
-    print(f"| polytope | median (ms) | p90 (ms) | target (ms) | slice V / E / F (median) |")
-    print(f"|---|---:|---:|---:|---|")
+    print("| polytope | median (ms) | p90 (ms) | target (ms) | slice V / E / F (median) |")
+    print("|---|---:|---:|---:|---|")
     for name in NAMES:
         r = measure(name, args.steps)
         target = TARGET_MS.get(name)

@@ -119,6 +119,13 @@ class JupyterPage:
     def kernel_json(self, expr: str):
         return json.loads(self.kernel(f"import json as _j; print(_j.dumps({expr}))"))
 
+    def shutdown_kernel(self) -> None:
+        """Shut the notebook's kernel down (best effort: the page may already be going)."""
+        try:
+            self.page.evaluate("async () => { const f = " + _FIND_PANEL + "; await f().sessionContext.shutdown(); }")
+        except Exception:
+            pass
+
     def executed_commands(self) -> list[str]:
         return self.page.evaluate("() => window.__executed.slice()")
 

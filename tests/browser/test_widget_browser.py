@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from jupyter_page import JupyterPage, write_notebook
-from rot4d_widget import RotationState, double_rotation, simple_rotation, slice_polytope
+from rot4d_widget import double_rotation, simple_rotation, slice_polytope
 
 HARMLESS_CONSOLE = (
     "Unsatisfied version",
