@@ -12,9 +12,11 @@ A page init script wraps the WebGL2 context's ``clear`` and draw calls: each
 call is preceded and followed by a 1-pixel ``readPixels`` (which waits until
 the GPU -- here the CPU -- has finished), and the time between the two reads
 is charged to the call, by shader program: balls (the program with the
-``ball`` attribute), bars (``bar_a``), faces (``tri_a``).  Two back-to-back
-reads, timed the same way, give the overhead of a read (on a multisampled
-canvas it includes a resolve); it is subtracted from every call.  The
+``ball`` attribute), bars (``bar_a``), faces (``tri_a``: two calls, back
+faces then front faces), summed per frame (a frame starts with its
+``clear``).  Two back-to-back reads, timed the same way, give the overhead
+of a read (on a multisampled canvas it includes a resolve); it is
+subtracted from every call.  The
 forced synchronisation serialises what the GPU process might overlap, so
 the per-pass times add up to more than an unsynchronised frame costs: use
 them to compare passes and variants, and the latency benchmark
@@ -134,12 +136,16 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
         jp.shutdown_kernel()
     finally:
         page.close()
+    # a frame starts with its clear; a pass may be several draw calls (faces: back, then front)
     per = {p: [] for p in PASSES}
     frames = 0
     for kind, ms, overhead, _ in rec:
-        if kind in per:
-            per[kind].append(max(ms - overhead, 0.0))
-        frames += kind == "clear"
+        if kind == "clear":
+            frames += 1
+            for p in PASSES:
+                per[p].append(0.0)
+        if kind in per and frames:
+            per[kind][-1] += max(ms - overhead, 0.0)
     return {"per": per, "frames": frames, "capacity": capacity,
             "overhead": statistics.median([o for _, _, o, _ in rec]) if rec else float("nan")}
 

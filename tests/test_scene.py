@@ -87,17 +87,28 @@ def test_no_directional_light_and_shaders_do_the_lighting(scenes):
     objects = list(walk(sc.three_scene))
     assert not any(isinstance(o, p3.DirectionalLight) for o in objects)
     meshes = [o for o in objects if isinstance(o, p3.Mesh)]
-    assert [m.name for m in meshes] == ["balls", "bars", "faces"]
+    assert [m.name for m in meshes] == ["balls", "bars", "faces (back)", "faces (front)"]
     for m in meshes:
         assert m.frustumCulled is False
         assert isinstance(m.material, p3.ShaderMaterial)
         # impostors are lit per pixel (their normal varies), flat faces per corner
-        lit_in = m.material.vertexShader if m.name == "faces" else m.material.fragmentShader
+        lit_in = m.material.vertexShader if m.name.startswith("faces") else m.material.fragmentShader
         assert "vec3 shade(" in lit_in and "shade(" in lit_in.split("void main()")[1]
         assert {"u_ambient", "u_sky", "u_ground", "u_light_position"} <= set(m.material.uniforms)
-    faces = meshes[2].material
-    assert faces.transparent and faces.depthWrite is False and faces.side == "DoubleSide"
-    assert faces.uniforms["u_opacity"]["value"] == pytest.approx(0.35)
+
+
+def test_translucent_faces_are_drawn_back_then_front(scenes):
+    """A convex slice: one back-facing and one front-facing layer per pixel, blended in that order."""
+    sc = scenes("24-cell")
+    balls, bars, back, front = [o for o in walk(sc.three_scene) if isinstance(o, p3.Mesh)]
+    assert back.geometry is front.geometry  # the same triangles, culled two ways
+    assert (back.material.side, front.material.side) == ("BackSide", "FrontSide")
+    # transparent meshes are drawn after the opaque ones, in renderOrder
+    assert not balls.material.transparent and not bars.material.transparent
+    assert back.renderOrder < front.renderOrder
+    for m in (back, front):
+        assert m.material.transparent and m.material.depthWrite is False
+        assert m.material.uniforms["u_opacity"]["value"] == pytest.approx(0.35)
 
 
 def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
