@@ -62,10 +62,12 @@ faces culled away first (``BackSide``), then the front faces
 layers back to front exactly; the triangles' winding is counter-clockwise
 seen from outside (`rot4d_widget.slicing`).  One double-sided pass blended
 them in buffer (cell) order instead: up to 30/255 off per channel over ~5 %
-of a 24- or 600-cell picture.  The second draw call costs ~0.5 ms per
-24-cell frame on the software renderer (``python benchmarks/browser_draw.py
---cases 24-cell --variants default --rounds 2``, with ``--rev`` for the
-version before).
+of a 24- or 600-cell picture.  The second draw call costs, on the
+software renderer, 0.3 to 1.1 ms per 24-cell frame and 2 to 7 ms per
+600-cell frame (SwiftShader pays per instance), over three runs of
+``python benchmarks/browser_draw.py --cases 600-cell,24-cell --variants
+default --rounds 2`` and of the same with ``--rev`` for the version before;
+both stay within their latency targets (``browser_latency.py``).
 
 Why no multisampling by default: MSAA smooths triangle edges only.  The
 balls' and bars' outlines are where their fragment shader discards, once per

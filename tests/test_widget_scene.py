@@ -85,6 +85,22 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
     assert set(ipywidget_module._instances) == before_ids  # updates never create widgets
 
 
+def test_the_faces_sent_are_wound_counter_clockwise_seen_from_outside(make):
+    # the scene's back-then-front face passes (BackSide, FrontSide) rely on it
+    w = make("600-cell")
+    for key in "4z8c":
+        down(w, key)
+        up(w, key)
+        drawn(w)
+    rows = w.scene.rows.astype(np.float64)
+    corners = rows[:, 10:19].reshape(-1, 3, 3)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    used = np.linalg.norm(normal, axis=1) > 1e-9
+    centre = w.slice.vertices.mean(axis=0) * w.scene.scale  # inside the convex slice
+    outward = np.einsum("ij,ij->i", normal[used], corners[used].mean(axis=1) - centre)
+    assert used.sum() == len(w.slice.triangles) and np.all(outward > 0)
+
+
 def test_the_faces_sent_form_a_closed_mesh(make):
     w = make("24-cell")
     for key in "4z8":
