@@ -1,7 +1,8 @@
 """What each draw call of the widget costs on the page (headless Chromium, SwiftShader).
 
     /work/venv/bin/python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
-        [--variants default,msaa] [--hold 2] [--rounds 1] [--screenshots DIR] [--rev HEAD]
+        [--variants default,msaa] [--hold 2] [--rounds 1] [--screenshots DIR [--compare OTHER]]
+        [--rev HEAD]
 
 About 30 s per case and variant.  One JupyterLab 4 server, one headless
 Chromium; for each polychoron and variant a notebook shows
@@ -24,7 +25,9 @@ them to compare passes and variants, and the latency benchmark
 
 ``--screenshots DIR`` saves each canvas after the hold, in one fixed state
 (reset, then the keys `SHOT_KEYS`), so the pictures of two variants or two
-versions can be compared pixel by pixel.
+versions can be compared pixel by pixel: the variants against the first
+one, and with ``--compare OTHER`` each picture against the one of the same
+name in OTHER (say, made with ``--rev`` of an earlier version).
 
 Variants: ``default`` (the widget as shipped: no multisampling), ``msaa``
 (``antialias=True``: WebGL's 4x multisampling).  Prints a table of medians (ms) per pass and their sum.
@@ -167,6 +170,9 @@ def main(argv=None) -> int:
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' per case (default 2)")
     ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision")
     ap.add_argument("--screenshots", default=None, help="save each canvas after the hold in this folder")
+    ap.add_argument("--compare", default=None,
+                    help="with --screenshots: compare each picture with the one of the same name in this "
+                         "folder (e.g. made with --rev of another version)")
     ap.add_argument("--rounds", type=int, default=1,
                     help="repeat every case and variant, interleaved; frames are pooled (default 1)")
     args = ap.parse_args(argv)
@@ -234,6 +240,18 @@ def main(argv=None) -> int:
             for v in variants[1:]:
                 d = np.abs(_pixels(shots / f"{case}-{v}.png") - ref).max(axis=-1)
                 print(f"- {case}, {v}: {100 * np.mean(d > 8):.2f} % (largest difference {d.max():.0f}/255)")
+    if shots is not None and args.compare:
+        other = pathlib.Path(args.compare)
+        print(f"\nPixels that differ from the picture of the same name in {other} by more than 8/255 in "
+              "some channel:")
+        for case in cases:
+            for v in variants:
+                name = f"{case}-{v}.png"
+                if not (other / name).exists():
+                    print(f"- {name}: not in {other}")
+                    continue
+                d = np.abs(_pixels(shots / name) - _pixels(other / name)).max(axis=-1)
+                print(f"- {name}: {100 * np.mean(d > 8):.2f} % (largest difference {d.max():.0f}/255)")
     print(f"\n{args.rounds} round(s), {args.hold:g} s hold each; frames pooled. "
           f"Medians in ms per frame, per pass, synchronised by 1-pixel reads (overhead subtracted). "
           f"{os.cpu_count()} CPUs ({cpu_name()}), load {' '.join(f'{x:.1f}' for x in load_before)} before, "

@@ -114,7 +114,9 @@ def estimate_capacity(polytope, samples: int = 6, seed: int = 0) -> int:
     return capacity_for(most)
 
 
-def slice_rows(slice_, *, scale: float = 1.0, cell_rgb=None, capacity: int | None = None) -> np.ndarray:
+def slice_rows(
+    slice_, *, scale: float = 1.0, cell_rgb=None, capacity: int | None = None, eye=None
+) -> np.ndarray:
     """The row table of a `Slice`: (capacity, 20) float32, C-contiguous.
 
     Parameters
@@ -128,6 +130,13 @@ def slice_rows(slice_, *, scale: float = 1.0, cell_rgb=None, capacity: int | Non
         Colour of each 4-D cell (default `cell_palette` of enough cells).
     capacity : int, optional
         Rows of the result (default ``rows_needed(slice_)``); must be at least that.
+    eye : 3 floats, optional
+        Where the scene is seen from (in the scaled coordinates).  If given,
+        the triangles facing away from it come first, then those facing it,
+        each group in the slice's order: drawn in row order, translucent
+        faces of a convex slice then blend back to front.  A triangle faces
+        the eye when the eye is on the outer side of its plane (corners
+        counter-clockwise seen from outside).
     """
     v = np.asarray(slice_.vertices, dtype=np.float64)
     e = np.asarray(slice_.edges, dtype=np.intp)
@@ -153,8 +162,21 @@ def slice_rows(slice_, *, scale: float = 1.0, cell_rgb=None, capacity: int | Non
     if nt and tc.max() >= len(packed):
         raise ValueError(f"Expected `cell_rgb` to have a colour for cell {int(tc.max())}, got {len(packed)} colours")
 
-    out = np.zeros((capacity, ROW_FLOATS), dtype=np.float32)
     p = v * float(scale)
+    if eye is not None and nt:
+        try:
+            o = np.asarray(eye, dtype=np.float64)
+        except (TypeError, ValueError):
+            o = None
+        if o is None or o.shape != (3,) or not np.all(np.isfinite(o)):
+            raise ValueError(f"Expected `eye` to be three finite numbers, got {eye!r}")
+        a = p[t[:, 0]]
+        normal = np.cross(p[t[:, 1]] - a, p[t[:, 2]] - a)
+        facing = np.einsum("ij,ij->i", normal, o - a) > 0.0
+        order = np.argsort(facing, kind="stable")  # away-facing (False) first
+        t, tc = t[order], tc[order]
+
+    out = np.zeros((capacity, ROW_FLOATS), dtype=np.float32)
     out[:nv, 0:3] = p
     out[:nv, 3] = 1.0
     out[:ne, 4:7] = p[e[:, 0]]

@@ -55,19 +55,21 @@ unchanged to within 2/255 per channel (``python benchmarks/browser_draw.py
 --cases 24-cell --variants msaa --screenshots DIR``, on the two versions).
 
 Translucent faces in the right order: a slice of a convex polytope is
-convex, so along any ray there is at most one face seen from behind and one
-seen from the front.  The faces are drawn twice from the same geometry, back
-faces culled away first (``BackSide``), then the front faces
-(``FrontSide``, a higher ``renderOrder``), which blends each pixel's two
-layers back to front exactly; the triangles' winding is counter-clockwise
-seen from outside (`rot4d_widget.slicing`).  One double-sided pass blended
-them in buffer (cell) order instead: up to 30/255 off per channel over ~5 %
-of a 24- or 600-cell picture.  The second draw call costs, on the
-software renderer, 0.3 to 1.1 ms per 24-cell frame and 2 to 7 ms per
-600-cell frame (SwiftShader pays per instance), over three runs of
-``python benchmarks/browser_draw.py --cases 600-cell,24-cell --variants
-default --rounds 2`` and of the same with ``--rev`` for the version before;
-both stay within their latency targets (``browser_latency.py``).
+convex, so along any ray from an eye outside it there is at most one face
+seen from behind and one seen from the front.  `buffers.slice_rows` puts the
+triangles that face away from the eye (the camera's position as the kernel
+knows it) before those that face it, and WebGL blends the triangles of one
+draw call in their order, so each pixel's two layers are composited back to
+front exactly, in one pass.  OrbitControls syncs the camera's position to the
+kernel when a drag ends; `Rot4DWidget` then re-sends the rows in the new
+order (during the drag the previous order stands).  Blending in cell order
+instead was off by up to 26/255 and 30/255 per channel over 5.2 % and 4.1 %
+of a 24- and a 600-cell picture; drawing back faces and front faces as two
+culled passes gives the same pixels as this order (0/255 difference) but
+costs the software renderer a second pass over every instance.  Checked
+with ``python benchmarks/browser_draw.py --cases 5-cell,24-cell,600-cell
+--variants default --screenshots DIR --compare OTHER`` against pictures made
+with ``--rev`` of each other version.
 
 Why no multisampling by default: MSAA smooths triangle edges only.  The
 balls' and bars' outlines are where their fragment shader discards, once per
@@ -588,29 +590,19 @@ class Scene:
             extensions={"fragDepth": True},
             side="DoubleSide",
         )
-        # The slice is convex, so a pixel sees at most one face from behind and one
-        # from the front: drawing the back-facing triangles first, then the
-        # front-facing ones, composites the translucent faces back to front exactly
-        # (one DoubleSide pass blends them in buffer order, i.e. by cell number).
-        face_mats = [
-            p3.ShaderMaterial(
-                vertexShader=_FACE_VERTEX,
-                fragmentShader=_FACE_FRAGMENT,
-                uniforms=dict(light, u_opacity={"value": self.face_opacity}),
-                side=side,
-                transparent=True,
-                depthWrite=False,
-            )
-            for side in ("BackSide", "FrontSide")
-        ]
-        self._materials = [ball_mat, bar_mat, *face_mats]
+        face_mat = p3.ShaderMaterial(
+            vertexShader=_FACE_VERTEX,
+            fragmentShader=_FACE_FRAGMENT,
+            uniforms=dict(light, u_opacity={"value": self.face_opacity}),
+            side="DoubleSide",
+            transparent=True,
+            depthWrite=False,
+        )
+        self._materials = [ball_mat, bar_mat, face_mat]
         self._meshes = [
             p3.Mesh(geometry=self._geometries["ball"], material=ball_mat, frustumCulled=False, name="balls"),
             p3.Mesh(geometry=self._geometries["bar"], material=bar_mat, frustumCulled=False, name="bars"),
-            p3.Mesh(geometry=self._geometries["face"], material=face_mats[0], frustumCulled=False,
-                    name="faces (back)", renderOrder=1),
-            p3.Mesh(geometry=self._geometries["face"], material=face_mats[1], frustumCulled=False,
-                    name="faces (front)", renderOrder=2),
+            p3.Mesh(geometry=self._geometries["face"], material=face_mat, frustumCulled=False, name="faces"),
         ]
         self.camera = p3.PerspectiveCamera(
             position=list(CAMERA_POSITION), fov=40, aspect=self.width / self.height, near=0.1, far=100.0
@@ -656,6 +648,11 @@ class Scene:
         return v
 
     @property
+    def eye(self) -> tuple:
+        """The camera's position as the kernel knows it (OrbitControls syncs it after a drag)."""
+        return tuple(float(x) for x in self.camera.position)
+
+    @property
     def messages_sent(self) -> int:
         return sum(w._rot4d_messages for w in self._counted)
 
@@ -678,7 +675,9 @@ class Scene:
         need = bf.rows_needed(slice_)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
-        rows = bf.slice_rows(slice_, scale=self.scale, cell_rgb=self._cell_rgb, capacity=self.capacity)
+        rows = bf.slice_rows(
+            slice_, scale=self.scale, cell_rgb=self._cell_rgb, capacity=self.capacity, eye=self.eye
+        )
         if force or not np.array_equal(rows, self._rows):
             self.update_id += 1
             self._assign(rows, self.update_id)

@@ -237,7 +237,7 @@ class Rot4DWidget(widgets.HBox):
         self._dirty = False
         self._in_flight = None  # scene.update_id of the update awaiting "drawn"
         self._sent_at = -math.inf
-        self._shown = None  # (matrix, c0) the scene shows
+        self._shown = None  # (matrix, c0, eye) the scene shows
         self._slice_cache = None  # (matrix, c0, Slice)
         self._last_label = None
         self._last_count = 0
@@ -304,6 +304,9 @@ class Rot4DWidget(widgets.HBox):
         renderer.observe(self._view_count_changed, names="_view_count")
         if renderer._view_count is None:
             renderer._view_count = 0
+        # The faces are ordered for the eye (back faces first): when a mouse orbit
+        # ends and the camera's new position reaches the kernel, re-send them.
+        self.scene.camera.observe(self._camera_moved, names="position")
 
         # The initial picture is part of the models' state: not "in flight".
         with self._lock:
@@ -397,6 +400,7 @@ class Rot4DWidget(widgets.HBox):
             scene = getattr(self, "scene", None)
             if scene is not None and "_was_displayed" in self.__dict__:
                 scene.renderer.unobserve(self._view_count_changed, names="_view_count")
+                scene.camera.unobserve(self._camera_moved, names="position")
         finally:
             # The Event first, so its document listeners go before the canvas does.
             for w in parts:
@@ -451,6 +455,17 @@ class Rot4DWidget(widgets.HBox):
     def _handle_focus_lost(self, *args, **kwargs) -> None:
         try:
             self.release_keys()
+        except Exception as exc:
+            self._report_error(exc)
+
+    def _camera_moved(self, change=None) -> None:
+        """The camera moved (OrbitControls): send the faces in the order for the new eye."""
+        try:
+            with self._lock:
+                if self._closed:
+                    return
+                self._dirty = True  # _render sees the new eye and re-sends; flow control as usual
+                self._flush(self._clock())
         except Exception as exc:
             self._report_error(exc)
 
@@ -563,12 +578,13 @@ class Rot4DWidget(widgets.HBox):
         self._dirty = False
         st = self.state
         m, c0 = st.matrix, st.c0
+        scene = self.scene
+        eye = scene.eye  # the faces' order depends on it
         shown = self._shown
-        if shown is None or not (c0 == shown[1] and np.array_equal(m, shown[0])):
+        if shown is None or not (c0 == shown[1] and eye == shown[2] and np.array_equal(m, shown[0])):
             s = self._current_slice()
-            scene = self.scene
             nbytes = scene.show(s)
-            self._shown = (m, c0)
+            self._shown = (m, c0, eye)
             if nbytes:  # 0: the picture did not change, nothing sent, no ack will come
                 self.last_update_bytes = nbytes
                 self.n_updates += 1

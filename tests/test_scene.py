@@ -87,28 +87,44 @@ def test_no_directional_light_and_shaders_do_the_lighting(scenes):
     objects = list(walk(sc.three_scene))
     assert not any(isinstance(o, p3.DirectionalLight) for o in objects)
     meshes = [o for o in objects if isinstance(o, p3.Mesh)]
-    assert [m.name for m in meshes] == ["balls", "bars", "faces (back)", "faces (front)"]
+    assert [m.name for m in meshes] == ["balls", "bars", "faces"]
     for m in meshes:
         assert m.frustumCulled is False
         assert isinstance(m.material, p3.ShaderMaterial)
         # impostors are lit per pixel (their normal varies), flat faces per corner
-        lit_in = m.material.vertexShader if m.name.startswith("faces") else m.material.fragmentShader
+        lit_in = m.material.vertexShader if m.name == "faces" else m.material.fragmentShader
         assert "vec3 shade(" in lit_in and "shade(" in lit_in.split("void main()")[1]
         assert {"u_ambient", "u_sky", "u_ground", "u_light_position"} <= set(m.material.uniforms)
+    faces = meshes[2].material
+    assert faces.transparent and faces.depthWrite is False and faces.side == "DoubleSide"
+    assert faces.uniforms["u_opacity"]["value"] == pytest.approx(0.35)
 
 
-def test_translucent_faces_are_drawn_back_then_front(scenes):
-    """A convex slice: one back-facing and one front-facing layer per pixel, blended in that order."""
-    sc = scenes("24-cell")
-    balls, bars, back, front = [o for o in walk(sc.three_scene) if isinstance(o, p3.Mesh)]
-    assert back.geometry is front.geometry  # the same triangles, culled two ways
-    assert (back.material.side, front.material.side) == ("BackSide", "FrontSide")
-    # transparent meshes are drawn after the opaque ones, in renderOrder
-    assert not balls.material.transparent and not bars.material.transparent
-    assert back.renderOrder < front.renderOrder
-    for m in (back, front):
-        assert m.material.transparent and m.material.depthWrite is False
-        assert m.material.uniforms["u_opacity"]["value"] == pytest.approx(0.35)
+def _facing(rows, eye):
+    corners = rows[:, 10:19].astype(np.float64).reshape(-1, 3, 3)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    used = np.linalg.norm(normal, axis=1) > 1e-12
+    return np.einsum("ij,ij->i", normal, np.asarray(eye) - corners[:, 0])[used] > 0
+
+
+@pytest.mark.parametrize("name", ["24-cell", "600-cell"])
+def test_faces_facing_away_from_the_camera_come_first(scenes, name):
+    """Drawn in row order, the translucent faces of the convex slice blend back to front."""
+    sc = scenes(name)
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q, _r = np.linalg.qr(rng.standard_normal((4, 4)))
+        if np.linalg.det(q) < 0:
+            q[:, 0] = -q[:, 0]  # a rotation
+        s = slice_polytope(sc.polytope, q, 0.0)
+        for eye in [(0.0, 0.0, 5.0), (3.0, -4.0, 1.0)]:
+            sc.camera.position = eye
+            sc.show(s)
+            facing = _facing(sc.rows, eye)
+            assert len(facing) == len(s.triangles)
+            assert 0 < facing.sum() < len(facing)  # both kinds seen from outside
+            k = int(np.argmax(facing))  # first front-facing triangle
+            assert not facing[:k].any() and facing[k:].all()
 
 
 def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
@@ -189,7 +205,7 @@ def test_one_show_is_one_message_to_the_buffer(scenes, log):
         assert tuple(data["state"]["array"]["shape"]) == (sc.capacity, 20)
         assert len(bufs) == 1 and bufs[0].nbytes == sc.capacity * 80
         rows = bufs[0].view(np.float32).reshape(sc.capacity, 20)
-        np.testing.assert_array_equal(rows, bf.slice_rows(s, scale=sc.scale, cell_rgb=sc._cell_rgb, capacity=sc.capacity))
+        np.testing.assert_array_equal(rows, bf.slice_rows(s, scale=sc.scale, cell_rgb=sc._cell_rgb, capacity=sc.capacity, eye=sc.eye))
         assert abs(sent - n) < 200  # show() reports the payload the comm sends
         assert n <= 40 * 1024
     assert live_widgets() == before  # show() never creates widgets

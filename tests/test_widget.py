@@ -15,6 +15,7 @@ import time
 import ipywidgets
 import numpy as np
 import pytest
+import traitlets
 from ipywidgets import CallbackDispatcher
 from ipywidgets.widgets import widget as ipywidget_module
 
@@ -29,6 +30,10 @@ pytestmark = pytest.mark.usefixtures("recording_comms")
 
 
 # --------------------------------------------------------------------- fakes
+class FakeCamera(traitlets.HasTraits):
+    position = traitlets.Tuple((0.0, 0.0, 5.0))
+
+
 class FakeScene:
     instances: list = []
 
@@ -36,12 +41,17 @@ class FakeScene:
         self.polytope = polytope
         self.options = options
         self.renderer = ipywidgets.Box()  # a DOMWidget, as ipyevents requires
+        self.camera = FakeCamera()
         self.scale = 1.0
         self.shown = []  # the Slices passed to show()
         self.closed = False
         FakeScene.instances.append(self)
 
     update_id = 0
+
+    @property
+    def eye(self):
+        return tuple(self.camera.position)
 
     def show(self, s):
         """Like Scene.show: bytes sent, 0 (and no new update_id) if the picture is unchanged."""

@@ -85,6 +85,36 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
     assert set(ipywidget_module._instances) == before_ids  # updates never create widgets
 
 
+def _front_facing(rows, eye):
+    corners = rows[:, 10:19].astype(np.float64).reshape(-1, 3, 3)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    used = np.linalg.norm(normal, axis=1) > 1e-9
+    return np.einsum("ij,ij->i", normal, np.asarray(eye) - corners[:, 0])[used] > 0
+
+
+def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_control(make, recording_comms):
+    w = make("24-cell")
+    down(w, "z")
+    up(w, "z")  # an update in flight
+    before = w.scene.rows
+    assert not np.diff(_front_facing(before, (0.0, 0.0, 5.0)).astype(int)).clip(max=0).any()  # back first
+    n_updates = w.n_updates
+    # OrbitControls syncs the camera position to the kernel when a drag ends
+    eye = (3.0, -4.0, 1.0)
+    w.scene.camera.position = eye
+    assert w.n_updates == n_updates  # one update in flight: this one waits for the ack
+    drawn(w)
+    assert w.n_updates == n_updates + 1 and w.scene.rows is not before
+    facing = _front_facing(w.scene.rows, eye)
+    assert 0 < facing.sum() < len(facing)
+    assert not np.diff(facing.astype(int)).clip(max=0).any()  # away-facing first, then facing
+    assert not np.array_equal(facing, _front_facing(before, eye))  # the old order was wrong for it
+    # the same picture for the eye it was made for: nothing more is sent
+    drawn(w)
+    w.scene.camera.position = eye
+    assert w.n_updates == n_updates + 1
+
+
 def test_the_faces_sent_are_wound_counter_clockwise_seen_from_outside(make):
     # the scene's back-then-front face passes (BackSide, FrontSide) rely on it
     w = make("600-cell")
