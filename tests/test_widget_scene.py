@@ -85,11 +85,25 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
     assert set(ipywidget_module._instances) == before_ids  # updates never create widgets
 
 
-def _front_facing(rows, eye):
+def _tap_and_draw(w, keys):
+    """Tap each key; the page acknowledges each update."""
+    for key in keys:
+        down(w, key)
+        up(w, key)
+        drawn(w)
+
+
+def _sent_triangles(rows):
+    """Corners (k, 3, 3) and normals (k, 3) of the triangles in a row table, in row order."""
     corners = rows[:, 10:19].astype(np.float64).reshape(-1, 3, 3)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    used = np.linalg.norm(normal, axis=1) > 1e-9
-    return np.einsum("ij,ij->i", normal, np.asarray(eye) - corners[:, 0])[used] > 0
+    used = np.linalg.norm(normal, axis=1) > 1e-9  # hidden rows have no area
+    return corners[used], normal[used]
+
+
+def _front_facing(rows, eye):
+    corners, normal = _sent_triangles(rows)
+    return np.einsum("ij,ij->i", normal, np.asarray(eye) - corners[:, 0]) > 0
 
 
 def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_control(make, recording_comms):
@@ -116,31 +130,19 @@ def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_contro
 
 
 def test_the_faces_sent_are_wound_counter_clockwise_seen_from_outside(make):
-    # the scene's back-then-front face passes (BackSide, FrontSide) rely on it
+    # ordering the faces for the eye (away-facing first) relies on it
     w = make("600-cell")
-    for key in "4z8c":
-        down(w, key)
-        up(w, key)
-        drawn(w)
-    rows = w.scene.rows.astype(np.float64)
-    corners = rows[:, 10:19].reshape(-1, 3, 3)
-    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    used = np.linalg.norm(normal, axis=1) > 1e-9
+    _tap_and_draw(w, "4z8c")
+    corners, normal = _sent_triangles(w.scene.rows)
     centre = w.slice.vertices.mean(axis=0) * w.scene.scale  # inside the convex slice
-    outward = np.einsum("ij,ij->i", normal[used], corners[used].mean(axis=1) - centre)
-    assert used.sum() == len(w.slice.triangles) and np.all(outward > 0)
+    outward = np.einsum("ij,ij->i", normal, corners.mean(axis=1) - centre)
+    assert len(corners) == len(w.slice.triangles) and np.all(outward > 0)
 
 
 def test_the_faces_sent_form_a_closed_mesh(make):
     w = make("24-cell")
-    for key in "4z8":
-        down(w, key)
-        up(w, key)
-        drawn(w)
-    rows = w.scene.rows.astype(np.float64)
-    corners = rows[:, 10:19].reshape(-1, 3, 3)
-    area = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
-    tris = corners[area > 1e-9]
+    _tap_and_draw(w, "4z8")
+    tris, _ = _sent_triangles(w.scene.rows)
     assert len(tris) == len(w.slice.triangles) > 0
     keys = {}
 
