@@ -144,6 +144,20 @@ class JupyterPage:
         """
         return self.page.evaluate(_CANVAS_STATS, [selector, list(background) if background else None])
 
+    def last_canvas_change(self, selector: str, since: float, watch: float, interval: float = 0.05) -> float:
+        """Watch a canvas until ``watch`` s after ``since`` (time.monotonic()).
+
+        Returns the monotonic time of the last change of its pixels seen, or
+        ``since`` if none: how long after ``since`` the view settled.
+        """
+        last, h = since, self.canvas_stats(selector)["hash"]
+        while time.monotonic() - since < watch:
+            s = self.canvas_stats(selector)["hash"]
+            if s != h:
+                last, h = time.monotonic(), s
+            time.sleep(interval)
+        return last
+
     def wait_for(self, predicate, timeout: float = 10.0, interval: float = 0.05):
         deadline = time.monotonic() + timeout
         while True:

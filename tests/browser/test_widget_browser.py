@@ -226,12 +226,7 @@ def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_ser
     assert held >= 0.99, held
     page.locator(sel).screenshot(path=str(artifacts / f"case4-held-{jupyter_server.kind}-{int(autorepeat)}.png"))
     # the canvas stops changing within 0.5 s of the release
-    last_change, h = released, jp.canvas_stats(sel)["hash"]
-    while time.monotonic() - released < 1.5:
-        s = jp.canvas_stats(sel)["hash"]
-        if s != h:
-            last_change, h = time.monotonic(), s
-        time.sleep(0.02)
+    last_change = jp.last_canvas_change(sel, since=released, watch=1.5, interval=0.02)
     assert last_change - released < 0.5
     after = _state(jp)
     time.sleep(0.5)
@@ -336,12 +331,7 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     time.sleep(2.0)
     page.keyboard.up("4")
     released = time.monotonic()
-    last_change, h = released, jp.canvas_stats(sel)["hash"]
-    while time.monotonic() - released < 2.5:
-        s = jp.canvas_stats(sel)["hash"]
-        if s != h:
-            last_change, h = time.monotonic(), s
-        time.sleep(0.05)
+    last_change = jp.last_canvas_change(sel, since=released, watch=2.5)
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 1})
     final = jp.canvas_stats(sel)["hash"]
     end = jp.kernel_json("dict(u=w.n_updates, a=w.n_acks, t=w.n_timeouts)")
@@ -417,12 +407,7 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
         page.keyboard.up("Shift")
     last_event = time.monotonic()
     # the view settles within 2 s of the last event
-    h, settled_at = jp.canvas_stats(sel)["hash"], time.monotonic()
-    while time.monotonic() - last_event < 3.0:
-        s = jp.canvas_stats(sel)["hash"]
-        if s != h:
-            h, settled_at = s, time.monotonic()
-        time.sleep(0.05)
+    settled_at = jp.last_canvas_change(sel, since=last_event, watch=3.0)
     assert settled_at - last_event < 2.0
     m = np.array(_state(jp)["m"])
     assert np.abs(m @ m.T - np.eye(4)).max() < 1e-12
