@@ -39,7 +39,6 @@ import argparse
 import os
 import pathlib
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -56,6 +55,7 @@ from browser_latency import (  # noqa: E402
     cpu_name,
     export_revision,
     find_chromium,
+    median,
     working_tree_description,
 )
 from conftest import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
@@ -150,17 +150,13 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
         if kind in per and frames:
             per[kind][-1] += max(ms - overhead, 0.0)
     return {"per": per, "frames": frames, "capacity": capacity,
-            "overhead": statistics.median([o for _, _, o, _ in rec]) if rec else float("nan")}
+            "overhead": median([o for _, _, o, _ in rec])}
 
 
 def _pixels(path):
     import matplotlib.image
 
     return np.asarray(matplotlib.image.imread(str(path)))[..., :3].astype(np.float64) * 255.0
-
-
-def median(xs):
-    return statistics.median(xs) if xs else float("nan")
 
 
 def main(argv=None) -> int:

@@ -162,14 +162,16 @@ def slice_rows(
     if nt and tc.max() >= len(packed):
         raise ValueError(f"Expected `cell_rgb` to have a colour for cell {int(tc.max())}, got {len(packed)} colours")
 
-    p = v * float(scale)
-    if eye is not None and nt:
+    if eye is not None:
         try:
             o = np.asarray(eye, dtype=np.float64)
         except (TypeError, ValueError):
             o = None
         if o is None or o.shape != (3,) or not np.all(np.isfinite(o)):
             raise ValueError(f"Expected `eye` to be three finite numbers, got {eye!r}")
+
+    p = v * float(scale)
+    if eye is not None and nt:
         a = p[t[:, 0]]
         normal = np.cross(p[t[:, 1]] - a, p[t[:, 2]] - a)
         facing = np.einsum("ij,ij->i", normal, o - a) > 0.0

@@ -130,6 +130,11 @@ def test_capacity_too_small_and_bad_shapes_raise():
         bf.slice_rows(bad)
     with pytest.raises(ValueError, match="colour for cell 2"):
         bf.slice_rows(fake_slice(n_cells=3, n_triangles=40), cell_rgb=bf.cell_palette(2))
+    empty = slice_polytope(polytope("5-cell"), np.eye(4), 10.0)  # no triangles: the eye is still checked
+    for eye in [(0.0, 5.0), (0.0, 0.0, float("nan")), "eye"]:
+        for s_ in (fake_slice(), empty):
+            with pytest.raises(ValueError, match="`eye` to be three finite numbers"):
+                bf.slice_rows(s_, capacity=16, eye=eye)
 
 
 def test_capacity_for_rounds_up_with_headroom():
