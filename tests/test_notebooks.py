@@ -5,9 +5,16 @@ nbval re-runs every notebook and, in lax mode, compares only the cells marked
 cell saved without an execution count, and a cell saved without outputs compares as "nothing to
 check".  So the stated facts are only tested if the committed copies carry what is checked here:
 execution counts, outputs, no errors, and rounded (platform-independent) numbers.
+
+The checks cover the project's own notebooks, listed by name in ``PROJECT_NOTEBOOKS``: a
+notebook a user drops into notebooks/ is not the project's and is not checked here (nbval still
+runs it, since pytest's testpaths include notebooks/).  A notebook committed to git but not
+listed fails ``test_every_committed_notebook_is_listed``.
 """
 
 import re
+import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -21,8 +28,13 @@ else:  # pragma: no cover
 
 ROOT = Path(__file__).resolve().parents[1]
 NB_DIR = ROOT / "notebooks"
-NOTEBOOKS = sorted(NB_DIR.glob("*.ipynb"))
-EXPECTED = ["01_pentachoron.ipynb", "02_regular_polychora.ipynb", "03_paper_figures.ipynb"]
+#: The project's notebooks, numbered 01, 02, ... without gaps; a new one is one line here.
+PROJECT_NOTEBOOKS = [
+    "01_pentachoron.ipynb",
+    "02_regular_polychora.ipynb",
+    "03_paper_figures.ipynb",
+]
+NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
 WIDGET_MIME = "application/vnd.jupyter.widget-view+json"
 
@@ -54,11 +66,19 @@ def notebook(request):
 
 
 def test_the_numbered_notebooks_are_there():
-    names = [p.name for p in NOTEBOOKS]
-    assert names[: len(EXPECTED)] == EXPECTED
-    for i, name in enumerate(names, start=1):
+    for i, name in enumerate(PROJECT_NOTEBOOKS, start=1):
         assert re.fullmatch(r"\d\d_[a-z0-9_]+\.ipynb", name), name
-        assert int(name[:2]) == i, f"notebooks are numbered 01, 02, ... without gaps: {names}"
+        assert int(name[:2]) == i, f"notebooks are numbered 01, 02, ... without gaps: {PROJECT_NOTEBOOKS}"
+        assert (NB_DIR / name).is_file(), f"notebooks/{name} is listed but missing"
+
+
+@pytest.mark.skipif(shutil.which("git") is None or not (ROOT / ".git").exists(), reason="not a git checkout")
+def test_every_committed_notebook_is_listed():
+    """A notebook the project commits is checked; one a user drops into notebooks/ is not (untracked)."""
+    out = subprocess.run(["git", "ls-files", "--", "notebooks/*.ipynb"], cwd=ROOT,
+                         capture_output=True, text=True, check=True).stdout
+    committed = sorted(Path(line).name for line in out.splitlines())
+    assert set(committed) <= set(PROJECT_NOTEBOOKS), f"add to PROJECT_NOTEBOOKS: {sorted(set(committed) - set(PROJECT_NOTEBOOKS))}"
 
 
 def test_every_notebook_states_checked_facts(notebook):
