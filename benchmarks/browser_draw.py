@@ -1,6 +1,6 @@
 """What each draw call of the widget costs on the page (headless Chromium, SwiftShader).
 
-    /work/venv/bin/python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
+    python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
         [--variants default,msaa] [--hold 2] [--rounds 1] [--screenshots DIR [--compare OTHER]]
         [--rev HEAD]
 
@@ -13,13 +13,14 @@ A page init script wraps the WebGL2 context's ``clear`` and draw calls: each
 call is preceded and followed by a 1-pixel ``readPixels`` (which waits until
 the GPU -- here the CPU -- has finished), and the time between the two reads
 is charged to the call, by shader program: balls (the program with the
-``ball`` attribute), bars (``bar_a``), faces (``tri_a``: two calls, back
-faces then front faces), summed per frame (a frame starts with its
-``clear``).  Two back-to-back reads, timed the same way, give the overhead
-of a read (on a multisampled canvas it includes a resolve); it is
-subtracted from every call.  The
-forced synchronisation serialises what the GPU process might overlap, so
-the per-pass times add up to more than an unsynchronised frame costs: use
+``ball`` attribute), bars (``bar_a``), faces (``tri_a``: one call since
+a0f17bf -- the kernel orders the triangles back to front for the eye; a
+``--rev`` before it drew back faces then front faces, two calls summed into
+the one pass), summed per frame (a frame starts with its ``clear``).  Two
+back-to-back reads, timed the same way, give the overhead of a read (on a
+multisampled canvas it includes a resolve); it is subtracted from every
+call.  The forced synchronisation serialises what the GPU process might
+overlap, so the per-pass times add up to more than an unsynchronised frame costs: use
 them to compare passes and variants, and the latency benchmark
 (``browser_latency.py``) for the targets.
 
@@ -31,6 +32,7 @@ name in OTHER (say, made with ``--rev`` of an earlier version).
 
 Variants: ``default`` (the widget as shipped: no multisampling), ``msaa``
 (``antialias=True``: WebGL's 4x multisampling).  Prints a table of medians (ms) per pass and their sum.
+The figures this benchmark produced, and the commands, are in docs/design.md.
 """
 
 from __future__ import annotations
@@ -139,7 +141,8 @@ def run_one(context, server, case: str, variant: str, hold: float, shots: pathli
         jp.shutdown_kernel()
     finally:
         page.close()
-    # a frame starts with its clear; a pass may be several draw calls (faces: back, then front)
+    # a frame starts with its clear; a pass may be several draw calls (one each today; faces were
+    # two, back then front, in a --rev before a0f17bf), summed
     per = {p: [] for p in PASSES}
     frames = 0
     for kind, ms, overhead, _ in rec:
