@@ -3,10 +3,13 @@
 jupyter_server does not set TCP_NODELAY on the kernel WebSockets.  Nagle's
 algorithm then holds every frame of a burst after the first (the kernel's
 "busy" status, then the widget's update) until the browser's delayed ACK, up
-to 40 ms -- measured by ``benchmarks/browser_latency.py --nodelay``: a held
-key's update took 39-42 ms to reach the page instead of 4-8 ms, halving the
-frames drawn per second.  With one update in flight by design, that stall is
-paid on every frame.
+to 40 ms.  With one update in flight by design, that stall is paid on every
+frame of a held key.  ``benchmarks/browser_latency.py --nagle`` switches this
+extension off to measure it; the figures are in docs/design.md.
+
+This module and the package's ``__init__`` import nothing heavy (no numpy,
+scipy or widget library): every Jupyter server in the environment loads it at
+start (tests/test_server_extension.py checks this in a fresh interpreter).
 
 This extension wraps whatever kernel WebSocket connection class the server
 is configured with (it does not replace it) so that the connection turns
