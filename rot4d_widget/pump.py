@@ -1,0 +1,208 @@
+"""The update pump: at most one scene update in flight, acknowledged by the page.
+
+After an update is sent the pump waits for the page's "drawn"
+acknowledgement of that update (its id) before it asks for the next one, which
+is computed from the latest state at that moment: nothing queues, so the view
+never falls behind and settles as soon as the state stops changing.  Without
+an answer (no view: scripting, nbval; a hidden tab) the latest state is sent
+anyway ``ack_timeout`` seconds after the previous update.  Acknowledgements
+name the update: with several views the first one counts, late, stale and
+unknown ones are ignored.
+
+Time advances through ``service(now)``: it runs the owner's ``tick(now)``
+(held keys), then sends if allowed, and returns when it wants to run next.
+A daemon thread calls it at those times while there is something to wait for
+(``autotick``); tests pass ``autotick=False`` and call ``service`` with their
+own clock.  Every entry point runs under one re-entrant lock, shared with the
+owner (``pump.lock``), so comm handlers and the ticker thread interleave
+safely.  Exceptions raised by ``tick``/``send`` go to ``on_error`` and never
+escape into the event loop.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT"]
+
+ACK_TIMEOUT = 0.5
+
+
+@dataclass
+class PumpStats:
+    """Counters of one pump: updates sent, acknowledged in time, sent after a timeout."""
+
+    updates: int = 0
+    acks: int = 0
+    timeouts: int = 0
+
+    def as_dict(self) -> dict:
+        return {"updates": self.updates, "acks": self.acks, "timeouts": self.timeouts}
+
+
+class UpdatePump:
+    """One update in flight.
+
+    Parameters
+    ----------
+    send : callable () -> int or None
+        Compute and send the latest state; return the update's id when an
+        update left (an acknowledgement is then awaited), None when nothing
+        changed on screen.
+    tick : callable (now) -> None, optional
+        Advance time-driven state (held keys) to ``now``.
+    deadline : callable () -> float or None, optional
+        When ``tick`` next wants to run.
+    clock : callable () -> seconds
+    ack_timeout : float
+    autotick : bool
+        Run the daemon thread when there is something to wait for.
+    on_error : callable (exception) -> None
+    """
+
+    def __init__(self, send, *, tick=None, deadline=None, clock=None, ack_timeout=ACK_TIMEOUT,
+                 autotick=True, on_error=None, name="rot4d-ticker"):
+        self._send = send
+        self._tick = tick
+        self._deadline = deadline
+        self.clock = clock if clock is not None else time.monotonic
+        self.ack_timeout = float(ack_timeout)
+        self.autotick = bool(autotick)
+        self._on_error = on_error
+        self._name = name
+        self.lock = threading.RLock()
+        self._wakeup = threading.Condition(self.lock)
+        self.stats = PumpStats()
+        self._dirty = False
+        self._in_flight = None
+        self._sent_at = -math.inf
+        self._thread = None
+        self._closed = False
+
+    # -- state ----------------------------------------------------------------
+    @property
+    def in_flight(self):
+        """Id of the update awaiting its acknowledgement, or None."""
+        return self._in_flight
+
+    @property
+    def dirty(self) -> bool:
+        """The state changed since the last update was computed."""
+        return self._dirty
+
+    def mark_dirty(self) -> None:
+        """The state changed: send it as soon as flow control allows (call ``flush``)."""
+        self._dirty = True
+
+    # -- entry points -----------------------------------------------------------
+    def flush(self, now=None) -> None:
+        """Send the latest state unless an update is in flight (and not timed out)."""
+        with self.lock:
+            if self._closed or not self._dirty:
+                return
+            now = self.clock() if now is None else now
+            if self._in_flight is not None:
+                if now - self._sent_at < self.ack_timeout:
+                    self.wake()
+                    return
+                self._in_flight = None
+                self.stats.timeouts += 1
+            self.send_now(now, expect_ack=True)
+            self.wake()
+
+    def send_now(self, now=None, *, expect_ack=True) -> None:
+        """Compute and send the latest state now, whatever is in flight (the initial picture)."""
+        with self.lock:
+            self._dirty = False
+            seq = self._send()
+            if seq is not None:
+                self.stats.updates += 1
+                if expect_ack:
+                    self._in_flight = seq
+                    self._sent_at = self.clock() if now is None else now
+
+    def acknowledge(self, seq) -> bool:
+        """The page drew update ``seq``; True if it was the one awaited."""
+        if isinstance(seq, bool) or not isinstance(seq, int):
+            return False
+        with self.lock:
+            if self._closed or self._in_flight is None or seq != self._in_flight:
+                return False  # late, duplicate (another view), unknown, or after a timeout
+            self._in_flight = None
+            self.stats.acks += 1
+            self.flush()
+            return True
+
+    def service(self, now=None):
+        """Run due ticks, honour the timeout, send if allowed; the clock time to run next (or None)."""
+        with self.lock:
+            if self._closed:
+                return None
+            now = self.clock() if now is None else now
+            try:
+                if self._tick is not None:
+                    self._tick(now)
+                self.flush(now)
+            except Exception as exc:
+                self._dirty = False
+                self._report(exc)
+            return self.next_deadline()
+
+    def next_deadline(self):
+        deadlines = []
+        if self._deadline is not None:
+            d = self._deadline()
+            if d is not None:
+                deadlines.append(d)
+        if self._dirty and self._in_flight is not None:
+            deadlines.append(self._sent_at + self.ack_timeout)
+        return min(deadlines) if deadlines else None
+
+    # -- the thread -------------------------------------------------------------
+    def wake(self) -> None:
+        """Start the ticker thread if there is something to wait for; let it recompute its deadline."""
+        with self.lock:
+            if not self.autotick or self._closed:
+                return
+            if self._thread is None:
+                if self.next_deadline() is None:
+                    return
+                self._thread = threading.Thread(target=self._run, name=self._name, daemon=True)
+                self._thread.start()
+            self._wakeup.notify_all()
+
+    def _run(self) -> None:
+        with self.lock:
+            while not self._closed:
+                deadline = self.service()
+                if self._closed:
+                    break
+                if deadline is None:
+                    self._wakeup.wait()
+                else:
+                    timeout = deadline - self.clock()
+                    if timeout > 0:
+                        self._wakeup.wait(timeout)
+
+    @property
+    def thread_alive(self) -> bool:
+        t = self._thread
+        return t is not None and t.is_alive()
+
+    def close(self) -> None:
+        """Stop the thread (joined unless called from it); idempotent."""
+        with self.lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._wakeup.notify_all()
+            thread, self._thread = self._thread, None
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=2.0)
+
+    def _report(self, exc) -> None:
+        if self._on_error is not None:
+            self._on_error(exc)

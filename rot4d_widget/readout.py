@@ -1,0 +1,102 @@
+"""The readout and help panel as HTML strings (pure functions, no widgets).
+
+The readout is sent with updates, so it stays small: rows of (label, text),
+a c0 gauge (where the hyperplane is between the object's lowest and highest
+w) and an orientation gizmo (where the object's own four axes point now: the
+x, y, z part of each as an arrow seen from the camera, the w part as a signed
+bar -- so a user sees how far w has been mixed in).  Styles go once, with the
+help panel.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+
+__all__ = ["readout_html", "help_html", "gizmo_svg", "gauge_html", "angle_text", "STYLE"]
+
+#: Compact tables (Jupyter's rendered-HTML CSS pads cells generously).  Sent
+#: once, with the help panel (a <style> applies while its container is hidden).
+STYLE = (
+    "<style>.rot4d-side table{border-collapse:collapse;margin:0}"
+    ".rot4d-side .rot4d-readout td,.rot4d-side .rot4d-help td"
+    "{padding:1px 0.5em 1px 0;line-height:1.3;text-align:left;vertical-align:top}"
+    ".rot4d-side .rot4d-readout table{font-family:monospace}"
+    ".rot4d-side .rot4d-help{font-size:90%}"
+    ".rot4d-gauge{display:inline-block;position:relative;width:8em;height:0.6em;"
+    "background:#ddd;vertical-align:middle;margin-left:0.4em}"
+    ".rot4d-gauge i{position:absolute;top:-0.2em;width:2px;height:1em;background:#c8102e}</style>"
+)
+
+#: The colours of the object's axes x, y, z, w in the gizmo.
+AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4", "#9467bd")
+
+
+def angle_text(rad: float) -> str:
+    """``0.04909 rad (2.81°)``."""
+    return f"{rad:.5f} rad ({math.degrees(rad):.2f}\u00b0)"
+
+
+def gauge_html(c0: float, lo: float, hi: float) -> str:
+    """c0 with a small bar: where w = c0 lies between ``lo`` and ``hi`` (clamped, marked outside)."""
+    span = hi - lo
+    frac = 0.5 if span <= 0 else (c0 - lo) / span
+    where = "below" if frac < 0 else "above" if frac > 1 else ""
+    pos = min(max(frac, 0.0), 1.0) * 100.0
+    note = f" ({where} the object)" if where else ""
+    return (
+        f"{c0:.4f}<span class='rot4d-gauge' title='w from {lo:.3g} to {hi:.3g}'>"
+        f"<i style='left:{pos:.0f}%'></i></span>{note}"
+    )
+
+
+def gizmo_svg(matrix) -> str:
+    """An inline SVG: the object's own axes now (columns of ``matrix``).
+
+    Left: the x, y part of each axis as an arrow from the centre as seen from
+    the camera (dashed when its z part points away); right: its w part as a
+    signed bar, labelled.  Colours `AXIS_COLORS`.  About 0.6 KB.
+    """
+    m = np.asarray(matrix, dtype=np.float64)
+    parts = []
+    for i, name in enumerate("xyzw"):
+        x, y, z, w = m[:, i]
+        col = AXIS_COLORS[i]
+        dash = "" if z >= 0 else " stroke-dasharray=3"
+        by = 9 + 14 * i
+        parts.append(
+            f"<line x2={30 + 26 * x:.0f} y2={30 - 26 * y:.0f} stroke={col}{dash} />"
+            f"<text x=66 y={by + 3} fill={col}>{name}</text>"
+            f"<rect x={100 + min(0.0, 28 * w):.0f} y={by - 3} width={abs(28 * w):.0f} height=6 fill={col} />"
+        )
+    return (
+        "<svg width=130 height=62 style='font:9px sans-serif'><title>the object's own axes now: "
+        "x, y parts as arrows, w parts as bars</title><g stroke-width=2>"
+        + "".join(parts).replace("<line ", "<line x1=30 y1=30 ")
+        + "</g><line x1=100 y1=0 x2=100 y2=60 stroke=#999 /></svg>"
+    )
+
+
+def readout_html(title: str, rows, *, gizmo: str = "", footer: str = "mouse over the view; ? for keys") -> str:
+    """The readout: a bold title, rows of (label, html text) and a footer."""
+    body = "".join(f"<tr><td>{html.escape(str(k))}</td><td>{v}</td></tr>" for k, v in rows)
+    return (
+        f"<div class='rot4d-readout'><b>{html.escape(title)}</b><table>{body}</table>"
+        f"{gizmo}<br><small>{html.escape(footer)}</small></div>"
+    )
+
+
+def help_html(groups, hold_delay: float, tick_rate: float) -> str:
+    """The key table: ``groups`` are (keys text, label, description) rows, one per action."""
+    rows = "".join(
+        f"<tr><td><kbd>{html.escape(keys)}</kbd></td><td>{html.escape(label)}</td><td>{html.escape(text)}</td></tr>"
+        for keys, label, text in groups
+    )
+    return (
+        STYLE + "<div class='rot4d-help'><table style='margin:0.5em 0'>" + rows + "</table>"
+        f"<small>Shift inverts a rotation. Hold a key: it repeats after {hold_delay * 1000:.0f} ms, "
+        f"{tick_rate:g} steps/s. Drag to turn the 3-D view (the slice itself does not change); "
+        "the wheel zooms.</small></div>"
+    )

@@ -1,0 +1,299 @@
+"""The source protocol: what `Rot4DWidget` shows, whatever it is.
+
+A *source* is anything that can be cut by the hyperplane w = c0 after a 4-D
+rotation.  The widget, the scene and the readout only ever see what a source
+returns, so a polytope, a 4-D scalar field or a user's own object are shown
+through the same keys.  A point q of the object is drawn at ``matrix @ q``
+(the rotation centre is the origin of the source's own coordinates).
+
+A source has
+
+``slice(matrix, c0)``
+    -> a slice object (see `SliceData`) for the (4, 4) rotation ``matrix`` and
+    the level ``c0``, in the source's own units.
+``size``
+    Circumradius about the rotation centre, in the source's units: the view
+    scales every source to the same displayed size, the default l/h step is
+    ``size / 64`` and the c0 gauge spans ``[-size, size]``.
+``n_groups``
+    How many colour groups triangles can have (cells, iso levels, ...).
+``describe()``
+    A JSON-able dict that rebuilds the source where that is possible
+    (``{"kind": "polytope", "name": "24-cell"}``), used by exports.
+``actions`` (optional)
+    A mapping ``key -> SourceAction``: extra keys the source brings (for
+    instance a level up/down).  The widget binds them and lists them in its help.
+``w_range(matrix)`` (optional)
+    ``(lowest, highest)`` w of the rotated object, for the c0 gauge (default
+    ``(-size, size)``).
+
+Rotations in the planes xy, xz and yz never change which part of a source
+the hyperplane cuts, only how the cut is turned in 3-D: the slice at
+``matrix`` equals the slice at ``R3 @ matrix`` turned by the 3-D rotation R3.
+That is geometry, not a promise a source has to make.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = [
+    "Source",
+    "SliceData",
+    "SourceAction",
+    "PolytopeSource",
+    "as_source",
+    "check_slice",
+]
+
+
+@runtime_checkable
+class Source(Protocol):
+    """What `Rot4DWidget` shows.  See the module docstring for each member."""
+
+    @property
+    def size(self) -> float: ...
+
+    @property
+    def n_groups(self) -> int: ...
+
+    def slice(self, matrix: np.ndarray, c0: float) -> Any: ...
+
+    def describe(self) -> dict: ...
+
+
+@dataclass(frozen=True)
+class SourceAction:
+    """An extra key action a source brings.
+
+    ``run(sign)`` changes the source (+1 for the key, -1 for Shift+key when
+    ``invertible``); the widget then re-slices.  ``repeat``: the action
+    repeats while the key is held, like a rotation.
+    """
+
+    name: str
+    description: str
+    run: Callable[[int], Any]
+    repeat: bool = True
+    invertible: bool = True
+
+
+def _readonly(a, dtype, shape_tail, name):
+    arr = np.array(a, dtype=dtype, copy=True)
+    if arr.ndim != 1 + len(shape_tail) or tuple(arr.shape[1:]) != shape_tail:
+        want = "(n" + "".join(f", {s}" for s in shape_tail) + ")"
+        raise ValueError(f"Expected `{name}` to have shape {want}, got {arr.shape}")
+    arr.flags.writeable = False
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class SliceData:
+    """One slice as the widget draws it; every array read-only, in the source's units.
+
+    points : (n, 3) float64 -- balls (and the corners that triangles and segments index)
+    segments : (m, 2) intp -- bars, as pairs of indices into ``points``
+    triangles : (k, 3) intp -- faces, indices into ``points``, counter-clockwise
+        seen from outside
+    groups : (k,) intp -- colour group of each triangle, in ``[0, n_groups)``
+    normals : (n, 3) float64 or None -- unit normals at ``points`` (smooth shading)
+    volume : float or None -- 3-volume enclosed, None if it has no meaning
+    readout : tuple of (label, text) -- rows for the widget's readout
+    convex : bool -- the triangles bound one convex solid: back-facing then
+        front-facing order blends exactly; otherwise triangles are sorted by depth
+    show_points : bool -- draw balls at ``points`` (False: points only carry corners)
+    """
+
+    points: np.ndarray
+    segments: np.ndarray
+    triangles: np.ndarray
+    groups: np.ndarray
+    normals: np.ndarray | None = None
+    volume: float | None = None
+    readout: tuple = ()
+    convex: bool = False
+    show_points: bool = True
+    extra: Mapping = field(default_factory=dict)
+
+    @classmethod
+    def build(cls, points, segments=None, triangles=None, groups=None, **kwargs) -> "SliceData":
+        """Validate and copy: shapes, index ranges, finiteness; arrays made read-only."""
+        p = _readonly(np.zeros((0, 3)) if points is None else points, np.float64, (3,), "points")
+        s = _readonly(np.zeros((0, 2)) if segments is None else segments, np.intp, (2,), "segments")
+        t = _readonly(np.zeros((0, 3)) if triangles is None else triangles, np.intp, (3,), "triangles")
+        g = np.zeros(len(t), dtype=np.intp) if groups is None else np.array(groups, dtype=np.intp, copy=True)
+        if g.shape != (len(t),):
+            raise ValueError(f"Expected `groups` to have shape ({len(t)},), one per triangle, got {g.shape}")
+        g.flags.writeable = False
+        normals = kwargs.pop("normals", None)
+        if normals is not None:
+            normals = _readonly(normals, np.float64, (3,), "normals")
+            if len(normals) != len(p):
+                raise ValueError(f"Expected `normals` to have one row per point ({len(p)}), got {len(normals)}")
+        data = cls(p, s, t, g, normals, **kwargs)
+        check_slice(data)
+        return data
+
+
+def check_slice(data, n_groups: int | None = None) -> None:
+    """Raise ValueError (naming the member) if a slice object breaks the protocol."""
+    try:
+        p = np.asarray(data.points)
+        s = np.asarray(data.segments)
+        t = np.asarray(data.triangles)
+        g = np.asarray(data.groups)
+    except AttributeError as exc:
+        raise TypeError(
+            "Expected a slice with `points` (n, 3), `segments` (m, 2), `triangles` (k, 3) and `groups` (k,); "
+            f"{exc}"
+        ) from None
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"Expected `points` to have shape (n, 3), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("Expected `points` to be finite")
+    for name, a, k in (("segments", s, 2), ("triangles", t, 3)):
+        if a.ndim != 2 or a.shape[1] != k:
+            raise ValueError(f"Expected `{name}` to have shape (m, {k}), got {a.shape}")
+        if a.size and (not np.issubdtype(a.dtype, np.integer) or a.min() < 0 or a.max() >= len(p)):
+            raise ValueError(f"Expected `{name}` to be integer indices into the {len(p)} points")
+    if g.shape != (len(t),):
+        raise ValueError(f"Expected `groups` to have shape ({len(t)},), one per triangle, got {g.shape}")
+    if g.size and (not np.issubdtype(g.dtype, np.integer) or g.min() < 0):
+        raise ValueError("Expected `groups` to be integers >= 0")
+    if n_groups is not None and g.size and g.max() >= n_groups:
+        raise ValueError(f"Expected `groups` < n_groups = {n_groups}, got {int(g.max())}")
+    vol = getattr(data, "volume", None)
+    if vol is not None and not (isinstance(vol, (int, float, np.floating, np.integer)) and math.isfinite(vol)):
+        raise ValueError(f"Expected `volume` to be a finite number or None, got {vol!r}")
+
+
+# ----------------------------------------------------------------- polytopes
+_POLYGON_NAMES = {
+    3: "triangle", 4: "quadrilateral", 5: "pentagon", 6: "hexagon",
+    7: "heptagon", 8: "octagon", 9: "nonagon", 10: "decagon",
+}
+
+
+def census_text(s) -> str:
+    """A polytope slice's faces in words: ``"8 triangles, 6 quadrilaterals"``."""
+    if s.dim < 0:
+        return "empty (w = c0 misses it)"
+    census = s.face_census()
+    if not census:
+        return f"touches it ({'vertex' if s.dim == 0 else 'edge' if s.dim == 1 else 'face'})"
+    parts = []
+    for n, count in sorted(census.items()):
+        name = _POLYGON_NAMES.get(n, f"{n}-gon")
+        parts.append(f"{count} {name}{'' if count == 1 else 's'}")
+    return ", ".join(parts)
+
+
+class PolytopeSlice(SliceData):
+    """`SliceData` of a polytope, keeping the full `Slice` as ``.slice``.
+
+    Attribute access falls through to the `Slice` (``face_census()``,
+    ``vertices``, ``cell_ids``, ``dim`` ...), so code written for `Slice`
+    keeps working on what the widget shows.
+    """
+
+    def __getattr__(self, name):
+        if name.startswith("__") or name == "slice":
+            raise AttributeError(name)
+        return getattr(self.extra["slice"], name)
+
+    @property
+    def slice(self):
+        return self.extra["slice"]
+
+    def __repr__(self) -> str:
+        return f"PolytopeSlice({self.slice!r})"
+
+
+class PolytopeSource:
+    """A convex 4-polytope as a source: groups are its cells, the slice is exact."""
+
+    def __init__(self, polytope):
+        from .polytopes import polytope as get_polytope
+
+        self.polytope = get_polytope(polytope)
+
+    @property
+    def size(self) -> float:
+        return float(self.polytope.circumradius)
+
+    @property
+    def n_groups(self) -> int:
+        return max(1, len(self.polytope.cells))
+
+    @property
+    def name(self) -> str:
+        return self.polytope.name
+
+    @property
+    def edge_length(self) -> float:
+        """Length of the polytope's first edge (sets the default ball radius)."""
+        v, e = self.polytope.vertices, self.polytope.edges
+        return float(np.linalg.norm(v[e[0, 0]] - v[e[0, 1]])) if len(e) else self.size
+
+    def w_range(self, matrix) -> tuple:
+        w = self.polytope.vertices @ np.asarray(matrix)[3]
+        return float(w.min()), float(w.max())
+
+    def slice(self, matrix, c0) -> PolytopeSlice:
+        from .slicing import slice_polytope
+
+        s = slice_polytope(self.polytope, matrix, c0)
+        return PolytopeSlice(
+            points=s.vertices,
+            segments=s.edges,
+            triangles=s.triangles,
+            groups=s.triangle_cells,
+            normals=None,
+            volume=float(s.volume),
+            readout=(("slice", census_text(s)),),
+            convex=True,
+            extra={"slice": s},
+        )
+
+    def describe(self) -> dict:
+        from .polytopes import POLYTOPE_NAMES
+
+        d = {"kind": "polytope", "name": self.polytope.name}
+        if self.polytope.name not in POLYTOPE_NAMES:
+            d["vertices"] = np.asarray(self.polytope.vertices).tolist()
+        return d
+
+    def __repr__(self) -> str:
+        return f"PolytopeSource({self.polytope.name!r})"
+
+
+def as_source(obj):
+    """A polytope name, a `Polytope` or any `Source` -> a source.
+
+    Raises TypeError naming what is allowed.
+    """
+    from .polytopes import Polytope
+
+    if isinstance(obj, (str, Polytope)):
+        return PolytopeSource(obj)
+    missing = [m for m in ("slice", "size", "n_groups", "describe") if not hasattr(obj, m)]
+    if missing:
+        raise TypeError(
+            "Expected a polytope name (e.g. '24-cell'), a rot4d_widget.Polytope or a source with "
+            f"slice(matrix, c0), size, n_groups and describe(); {type(obj).__name__} lacks {', '.join(missing)}"
+        )
+    if not callable(obj.slice) or not callable(obj.describe):
+        raise TypeError("Expected `source.slice` and `source.describe` to be methods")
+    size = obj.size
+    if isinstance(size, bool) or not isinstance(size, (int, float, np.integer, np.floating)) or not (
+        math.isfinite(size) and size > 0
+    ):
+        raise ValueError(f"Expected `source.size` to be a finite number > 0, got {size!r}")
+    n = obj.n_groups
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"Expected `source.n_groups` to be an int >= 1, got {n!r}")
+    return obj
