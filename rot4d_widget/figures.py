@@ -6,13 +6,19 @@ view from the paper's viewpoint, the point (x, y, z) = (0, 0, ``distance``) look
 
     x' = x d / (d - z),    y' = y d / (d - z),
 
-and every radius at that point is multiplied by the same factor ``d / (d - z)``.  Artists are
+and every radius at that point is multiplied by the same factor ``d / (d - z)``.  The frame is the
+live view's camera (:mod:`rot4d_widget.look`): a vertical field of view of ``fov`` = 40 degrees, so
+the axes span ``|y'| <= d tan(fov / 2)`` and ``|x'| <=`` that times the panel's aspect, and a point
+sits in the panel where a three.js ``PerspectiveCamera`` at (0, 0, 5) with that fov and aspect puts
+it.  Palette, scale, default radii and colours come from :mod:`rot4d_widget.look` too, so a 4-D
+cell has the same colour here and in the widget.  Artists are
 painted back to front (painter's algorithm, by the depth of a ball's centre, a bar's midpoint, a
 face's centroid), so nearer things cover farther ones.
 
 * balls at slice vertices (circles, with a small highlight),
 * bars along slice edges (trapezoids whose width follows the perspective of each end),
-* translucent faces (slice polygons), coloured by the 4-D cell they are cut from.
+* translucent faces (slice polygons), coloured by the 4-D cell they are cut from
+  (``look.group_palette``, the live view's palette).
 
 ``render_key_sequence(key, n_panels)`` shows what holding a key does: panel k is drawn after k
 presses; :func:`paper_figure_3` and :func:`paper_figure_4` reproduce the paper's figures.
@@ -36,6 +42,8 @@ from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
+from . import look
+from .look import REFERENCE_RADIUS
 from .polytopes import Polytope, pentachoron
 from .polytopes import polytope as _named_polytope
 from .slicing import Slice, slice_polytope
@@ -43,6 +51,7 @@ from .state import PAPER_ALPHA_RATIO, RotationState
 
 __all__ = [
     "CAMERA_DISTANCE",
+    "CAMERA_FOV",
     "REFERENCE_RADIUS",
     "FIG3_THETA0",
     "FIG4_THETA0",
@@ -57,11 +66,15 @@ __all__ = [
     "paper_figure_4",
 ]
 
-#: The paper's viewpoint: the eye at (0, 0, 5) looking down -z.
-CAMERA_DISTANCE = 5.0
-#: Circumradius of the paper's pentachoron (edge a = 2): sqrt(2/5) * a.  Other polytopes are
-#: scaled to this circumradius by default so that they appear the same size.
-REFERENCE_RADIUS = 2.0 * math.sqrt(2.0 / 5.0)
+#: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
+CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
+#: Vertical field of view of the frame, degrees (``look.CAMERA_FOV``, the live camera's).
+CAMERA_FOV = float(look.CAMERA_FOV)
+# REFERENCE_RADIUS (from look): the paper's pentachoron's circumradius (edge a = 2), sqrt(2/5) * a.
+# Other polytopes are scaled to it by default so that they appear the same size.
+#: Edge of the pentachoron of circumradius REFERENCE_RADIUS: the default ball and bar radii of
+#: :func:`draw_slice` are this edge's (``look.default_ball_radius(2.0)`` = 0.07).
+_REFERENCE_EDGE = REFERENCE_RADIUS / math.sqrt(2.0 / 5.0)
 #: Fig. 3: key "4" (R_xw) with theta0 = pi/16.
 FIG3_THETA0 = math.pi / 16
 #: Fig. 4: key "z" (R_xz,yw) with alpha = pi sqrt2 / (8 sqrt3) and "beta = 1 - alpha",
@@ -129,9 +142,15 @@ def _as_colormap(cmap) -> Colormap:
     raise TypeError(f"Expected `cmap` to be a colormap name or a matplotlib Colormap, got {type(cmap).__name__}")
 
 
-def _cell_colors(cell_ids: np.ndarray, cmap: Colormap) -> np.ndarray:
-    """(P, 4) RGBA per polygon: the same 4-D cell always gets the same colour."""
+def _cell_colors(cell_ids: np.ndarray, cmap: Colormap | None) -> np.ndarray:
+    """(P, 4) RGBA per polygon: the same 4-D cell always gets the same colour.
+
+    ``cmap`` None: ``look.group_palette`` (the live view's colour of each cell, unrounded).
+    """
     ids = np.asarray(cell_ids, dtype=np.int64)
+    if cmap is None:
+        rgb = look.group_palette(int(ids.max()) + 1 if len(ids) else 0)[ids].astype(np.float64)
+        return np.concatenate([rgb, np.ones((len(ids), 1))], axis=1)
     if isinstance(cmap, ListedColormap):  # qualitative maps: cycle through the list
         return np.asarray(cmap(ids % cmap.N))
     # continuous maps: spread consecutive ids with the golden ratio
@@ -176,6 +195,13 @@ def _view_limit(radius: float, distance: float, margin: float) -> float:
     return distance * radius / math.sqrt(distance**2 - radius**2) + margin
 
 
+def _axes_aspect(ax) -> float:
+    """Width / height of ``ax``'s box on its figure (1 if it has no area)."""
+    fig = ax.figure
+    box = ax.get_position(original=True).transformed(getattr(fig, "transSubfigure", fig.transFigure))
+    return box.width / box.height if box.width > 0 and box.height > 0 else 1.0
+
+
 # --------------------------------------------------------------------------- one panel
 @dataclass
 class SliceDrawing:
@@ -183,7 +209,8 @@ class SliceDrawing:
 
     ``centers`` (n, 2) and ``factors`` (n,) are the projected slice vertices and their perspective
     factors; ``balls[i]`` is the circle of slice vertex ``i``; ``bars[j]`` the patch of edge ``j``;
-    ``faces[k]`` the polygon of ``slice.polygons[k]``.
+    ``faces[k]`` the polygon of ``slice.polygons[k]``.  ``limit`` is the half-height of the view
+    (the x limits are ``limit`` times the panel's aspect with a camera, ``limit`` without one).
     """
 
     centers: np.ndarray
@@ -201,22 +228,28 @@ def draw_slice(
     *,
     scale: float = 1.0,
     distance: float = CAMERA_DISTANCE,
+    fov: float | None = CAMERA_FOV,
     radius: float | None = None,
-    ball_radius: float = 0.07,
-    bar_radius: float = 0.025,
-    face_alpha: float = 0.35,
-    ball_color="#c8102e",
-    bar_color="#4a4a4a",
-    cmap="tab10",
+    ball_radius: float | None = None,
+    bar_radius: float | None = None,
+    face_alpha: float = look.FACE_OPACITY,
+    ball_color=look.BALL_COLOR,
+    bar_color=look.BAR_COLOR,
+    cmap=None,
     label: str | None = None,
 ) -> SliceDrawing:
     """Draw one slice on a matplotlib ``ax`` in the paper's perspective view.
 
     ``slice`` is a :class:`rot4d_widget.Slice`; its vertices are multiplied by ``scale`` first.
     ``ball_radius`` and ``bar_radius`` are 3-D sizes (after scaling), shrunk with distance like
-    everything else.  ``radius`` fixes the axis limits to a sphere of that radius (after scaling)
-    so that panels of one sequence share a frame; by default the limits fit this slice.
-    Faces are coloured by ``slice.cell_ids`` through ``cmap`` (a name or a Colormap).
+    everything else; by default ``look.default_ball_radius`` of the reference pentachoron's edge
+    (0.07) and ``look.default_bar_radius(ball_radius)``, as in the live view.
+    The frame is the camera's: vertical field of view ``fov`` degrees and the aspect of ``ax``,
+    so every panel of a sequence shares it and a point sits where the live view puts it.  With
+    ``fov=None`` the frame fits a sphere of ``radius`` (after scaling) if given, else this slice;
+    with a camera, ``radius`` only checks that the eye is outside that sphere.
+    Faces are coloured by ``slice.cell_ids`` with ``look.group_palette`` (the live view's colours),
+    or through ``cmap`` (a matplotlib colormap name or Colormap) if given.
 
     Returns a :class:`SliceDrawing` listing the artists; they also carry the gids "ball", "bar",
     "face" and "highlight" (kept in SVG output).
@@ -227,14 +260,26 @@ def draw_slice(
         raise TypeError(f"Expected `slice` to be a rot4d_widget.Slice, got {type(slice).__name__}")
     scale = _real("scale", scale, minimum=0.0, inclusive=False)
     d = _real("distance", distance, minimum=0.0, inclusive=False)
+    if fov is not None:
+        fov = _real("fov", fov, minimum=0.0, inclusive=False)
+        if fov >= 180.0:
+            raise ValueError(f"Expected `fov` < 180 degrees, got {fov:g}")
+    if ball_radius is None:
+        ball_radius = look.default_ball_radius(_REFERENCE_EDGE)
     ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+    if bar_radius is None:
+        bar_radius = look.default_bar_radius(ball_radius)
     bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
     face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
     if radius is not None:
         radius = _real("radius", radius, minimum=0.0, inclusive=False)
+        if radius >= d:
+            raise ValueError(
+                f"Expected `radius` < `distance` ({d:g}) so the eye is outside the scene, got {radius:g}"
+            )
     if label is not None and not isinstance(label, str):
         raise TypeError(f"Expected `label` to be a string or None, got {type(label).__name__}")
-    colormap = _as_colormap(cmap)
+    colormap = None if cmap is None else _as_colormap(cmap)
     ball_rgba = to_rgba(ball_color)
     bar_rgba = to_rgba(bar_color)
 
@@ -295,16 +340,22 @@ def draw_slice(
             drawing.balls.append(ball)
             drawing.highlights.append(shine)
 
-    # frame: a fixed sphere if given, else this slice
+    # frame: the camera's (as the live view), else a fixed sphere if given, else this slice.
+    # The picture plane is z = 0 (x' = x d / (d - z)); there the camera's frustum is
+    # |y'| <= d tan(fov/2), |x'| <= aspect d tan(fov/2): axes fractions are three.js NDC.
     margin = max(ball_radius, bar_radius)
-    if radius is not None:
+    aspect = 1.0
+    if fov is not None:
+        limit = d * math.tan(math.radians(fov) / 2.0)
+        aspect = _axes_aspect(ax)
+    elif radius is not None:
         limit = _view_limit(radius, d, margin * d / (d - radius))
     elif len(pts):
         limit = float(np.max(np.abs(xy) + (margin * fac)[:, None]))
         limit = max(limit * 1.05, 1e-3)
     else:
         limit = 1.0
-    ax.set_xlim(-limit, limit)
+    ax.set_xlim(-limit * aspect, limit * aspect)
     ax.set_ylim(-limit, limit)
     ax.set_aspect("equal")
     ax.set_axis_off()
@@ -325,7 +376,7 @@ def _grid_figure(n_panels: int, ncols: int, panel_size: float, dpi: float, title
     nrows = -(-n_panels // ncols)
     top = TITLE_HEIGHT if title else 0.0
     width, height = ncols * panel_size, nrows * panel_size + top
-    fig = Figure(figsize=(width, height), dpi=dpi)
+    fig = Figure(figsize=(width, height), dpi=dpi, facecolor=look.BACKGROUND)
     axes = []
     for k in range(nrows * ncols):
         r, c = divmod(k, ncols)
@@ -359,17 +410,18 @@ def panel_style(polytope, scale: float | None = None) -> dict:
     """Keywords for :func:`draw_slice` that suit ``polytope``: ``scale``, ``radius``, ball and bar sizes.
 
     ``scale`` defaults to ``REFERENCE_RADIUS / circumradius`` (every polytope the size of the paper's
-    pentachoron); the frame ``radius`` is the scaled circumradius; balls and bars follow the scaled
-    edge length (the pentachoron's 0.07 and 0.025 at most, so that the 600 vertices of the 120-cell
-    do not merge).  Use as ``draw_slice(ax, s, **panel_style(p))``.
+    pentachoron); the ``radius`` is the scaled circumradius; balls and bars follow the scaled
+    edge length as in the live view (``look.default_ball_radius`` and ``look.default_bar_radius``:
+    the pentachoron's 0.07 and 0.028 at most, so that the 600 vertices of the 120-cell do not
+    merge).  Use as ``draw_slice(ax, s, **panel_style(p))``.
     """
     poly = _as_polytope(polytope)
     s = _default_scale(poly, scale)
     e = np.asarray(poly.edges, dtype=np.int64).reshape(-1, 2)
     edge = float(np.linalg.norm(poly.vertices[e[:, 0]] - poly.vertices[e[:, 1]], axis=1).mean()) if len(e) else 1.0
-    ball = min(0.07, max(0.02, 0.035 * edge * s))
+    ball = look.default_ball_radius(edge * s)
     return {"scale": s, "radius": s * float(poly.circumradius), "ball_radius": ball,
-            "bar_radius": ball * 0.025 / 0.07}
+            "bar_radius": look.default_bar_radius(ball)}
 
 
 def render_slice(
@@ -456,7 +508,7 @@ def _save(fig: Figure, path) -> None:
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in _SAVE_FORMATS:
         raise ValueError(f"Expected `path` to end in one of {', '.join(_SAVE_FORMATS)}, got {os.fspath(path)!r}")
-    fig.savefig(path, dpi=fig.dpi, facecolor="white")
+    fig.savefig(path, dpi=fig.dpi, facecolor=look.BACKGROUND)
 
 
 def paper_figure_3(path=None, *, panel_size: float = 2.0, dpi: float = 100, title: bool = True) -> Figure:

@@ -260,7 +260,7 @@ def test_parameter_key_sequence_moves_the_hyperplane():
 
 
 def test_default_scale_makes_every_polytope_the_pentachoron_size():
-    fig = render_slice("24-cell", ball_radius=0.07, bar_radius=0.025)  # the pentachoron's sizes
+    fig = render_slice("24-cell", ball_radius=0.07, bar_radius=0.028)  # the pentachoron's sizes
     ax = fig.axes[0]
     fig5 = render_slice(pentachoron(A))
     assert ax.get_xlim() == pytest.approx(fig5.axes[0].get_xlim())
@@ -311,6 +311,31 @@ def test_draw_slice_bad_input(tetra_slice):
         draw_slice(ax, tetra_slice, radius=6.0)
     with pytest.raises(TypeError, match="label"):
         draw_slice(ax, tetra_slice, label=1)
+    with pytest.raises(ValueError, match="fov"):
+        draw_slice(ax, tetra_slice, fov=180.0)
+    with pytest.raises(TypeError, match="fov"):
+        draw_slice(ax, tetra_slice, fov="40")
+
+
+def test_without_a_camera_the_frame_fits_the_sphere_or_the_slice(tetra_slice):
+    """fov=None keeps the tighter frames: a sphere of `radius` plus the balls, or the slice itself."""
+    ax = Figure().add_subplot()
+    d = draw_slice(ax, tetra_slice, fov=None, radius=1.0, ball_radius=0.1, bar_radius=0.0)
+    r = 5.0 * 1.0 / math.sqrt(25.0 - 1.0) + 0.1 * 5.0 / 4.0  # the sphere's outline + a ball at its front
+    assert ax.get_xlim() == pytest.approx((-r, r)) and ax.get_ylim() == pytest.approx((-r, r))
+    ax = Figure().add_subplot()
+    d = draw_slice(ax, tetra_slice, fov=None)
+    reach = np.abs(d.centers).max() + max(b.radius for b in d.balls)
+    assert reach < d.limit < 1.2 * reach
+
+
+def test_cmap_still_colours_by_a_matplotlib_colormap(tetra_slice):
+    from matplotlib import colormaps
+
+    d = draw_slice(Figure().add_subplot(), tetra_slice, cmap="tab10")
+    tab10 = colormaps["tab10"]
+    got = {tuple(f.get_facecolor()[:3]) for f in d.faces}
+    assert got == {tuple(tab10(int(c) % 10)[:3]) for c in tetra_slice.cell_ids}
 
 
 @pytest.mark.parametrize("path, exc", [("fig.jpg", ValueError), (3, TypeError)])
@@ -346,7 +371,9 @@ def test_module_exports():
 def test_panel_style_keeps_dense_polytopes_readable():
     five, dense = figures.panel_style(pentachoron(A)), figures.panel_style("120-cell")
     assert five == pytest.approx({"scale": 1.0, "radius": figures.REFERENCE_RADIUS, "ball_radius": 0.07,
-                                  "bar_radius": 0.025})
+                                  "bar_radius": 0.028})
     assert dense["radius"] == pytest.approx(figures.REFERENCE_RADIUS)
-    assert 0.02 <= dense["ball_radius"] < five["ball_radius"]
-    assert dense["bar_radius"] < dense["ball_radius"]
+    # the live view's rule: 0.1 x the displayed edge (the 120-cell's is 2 x scale), bars 0.4 x balls
+    assert dense["ball_radius"] == pytest.approx(0.1 * 2.0 * dense["scale"])
+    assert dense["ball_radius"] < five["ball_radius"]
+    assert dense["bar_radius"] == pytest.approx(0.4 * dense["ball_radius"])

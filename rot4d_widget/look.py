@@ -1,0 +1,152 @@
+"""How things look: the one place for the palette, reference scale, camera, default radii and colours.
+
+The static figures (`rot4d_widget.figures`, matplotlib) and the live view (`rot4d_widget.scene` and
+`rot4d_widget.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
+same in both.  numpy only: no widget library, no matplotlib.
+
+Scale
+    Every polytope is shown scaled by ``REFERENCE_RADIUS / circumradius``: its displayed
+    circumradius is that of the paper's pentachoron (edge a = 2), ``a sqrt(2/5)``.
+Camera
+    The paper's viewpoint: the eye at ``CAMERA_POSITION`` = (0, 0, 5) looking down -z, a perspective
+    camera with vertical field of view ``CAMERA_FOV`` degrees (a three.js ``PerspectiveCamera``; a
+    figure uses the same fov and its own aspect).  A point (x, y, z) in displayed units lands at
+    ``(x, y) / ((d - z) tan(fov / 2))`` in normalised device coordinates (y; x is further divided by
+    the aspect width / height), d = 5.
+Radii
+    ``default_ball_radius(displayed_edge)`` and ``default_bar_radius(ball_radius)``, in displayed
+    units.
+Colours
+    ``BACKGROUND``, ``BALL_COLOR``, ``BAR_COLOR`` ('#rrggbb'); faces are ``FACE_OPACITY`` opaque and
+    coloured by group (the 4-D cell a face is cut from) with ``group_palette``, or all
+    ``SINGLE_FACE_COLOR`` when one colour is chosen for every face.  ``as_rgb`` reads any of
+    these colour forms.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "REFERENCE_RADIUS",
+    "CAMERA_POSITION",
+    "CAMERA_FOV",
+    "CAMERA_NEAR",
+    "CAMERA_FAR",
+    "BACKGROUND",
+    "BALL_COLOR",
+    "BAR_COLOR",
+    "FACE_OPACITY",
+    "SINGLE_FACE_COLOR",
+    "default_ball_radius",
+    "default_bar_radius",
+    "as_rgb",
+    "group_palette",
+    "cell_palette",
+]
+
+# -- scale and camera ----------------------------------------------------------
+
+#: Displayed circumradius of every object: the paper's pentachoron (edge a = 2), a sqrt(2/5).
+REFERENCE_RADIUS = 2.0 * math.sqrt(2.0 / 5.0)
+
+#: Where the eye is (displayed units); it looks down -z at the origin.
+CAMERA_POSITION = (0.0, 0.0, 5.0)
+#: Vertical field of view in degrees (three.js ``PerspectiveCamera.fov``).
+CAMERA_FOV = 40.0
+#: Near and far clipping distances of the live camera.
+CAMERA_NEAR = 0.1
+CAMERA_FAR = 100.0
+
+# -- colours -------------------------------------------------------------------
+
+BACKGROUND = "#ffffff"
+BALL_COLOR = "#c8102e"
+BAR_COLOR = "#4a4a4a"
+#: Opacity of the faces (0 transparent ... 1 opaque).
+FACE_OPACITY = 0.35
+#: Every face's colour when faces are not coloured by group: a light steel blue.
+SINGLE_FACE_COLOR = "#9fb6cd"
+
+
+# -- radii -----------------------------------------------------------------------
+
+
+def default_ball_radius(displayed_edge: float) -> float:
+    """Ball radius for an object whose edges are ``displayed_edge`` long (displayed units).
+
+    ``min(0.07, 0.1 * displayed_edge)``: the pentachoron's 0.07 at most, smaller for dense
+    polytopes so that neighbouring balls do not merge.
+    """
+    return min(0.07, 0.1 * float(displayed_edge))
+
+
+def default_bar_radius(ball_radius: float) -> float:
+    """Bar radius that goes with balls of ``ball_radius``: ``0.4 * ball_radius``."""
+    return 0.4 * float(ball_radius)
+
+
+# -- colour conversion and the group palette -----------------------------------
+
+_HEX = "0123456789abcdefABCDEF"
+
+
+def as_rgb(color, name: str = "color") -> tuple:
+    """``'#rgb'``, ``'#rrggbb'`` or (r, g, b) floats in [0, 1] -> (r, g, b) floats."""
+    if isinstance(color, str):
+        s = color.strip()
+        if s.startswith("#") and len(s) in (4, 7) and all(ch in _HEX for ch in s[1:]):
+            h = s[1:] if len(s) == 7 else "".join(ch * 2 for ch in s[1:])
+            return tuple(int(h[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
+    else:
+        try:
+            rgb = tuple(float(x) for x in color)
+        except (TypeError, ValueError):
+            rgb = None
+        if rgb is not None and len(rgb) == 3 and all(0.0 <= x <= 1.0 for x in rgb):
+            return rgb
+    raise ValueError(
+        f"Expected `{name}` to be '#rgb', '#rrggbb' or three floats in [0, 1], got {color!r}"
+    )
+
+
+def group_palette(n_cells: int) -> np.ndarray:
+    """Deterministic, distinct colours for ``n_cells`` cells: (n_cells, 3) float32 in [0, 1].
+
+    Hue and lightness follow the R2 low-discrepancy sequence (golden-ratio
+    generalisation), so any few consecutive cells differ clearly and up to
+    several thousand cells get distinct 8-bit colours.  Prefix-stable: row k
+    depends on k only, so group k has one colour whatever ``n_cells`` is.
+    """
+    n = int(n_cells)
+    if n < 0:
+        raise ValueError(f"Expected `n_cells` >= 0, got {n}")
+    g = 1.32471795724474602596  # plastic number: R2 sequence
+    k = np.arange(n, dtype=np.float64)
+    hue = np.mod(0.5 + k / g, 1.0)
+    light = 0.42 + 0.30 * np.mod(0.5 + k / (g * g), 1.0)
+    sat = 0.72
+    # HSL -> RGB, vectorised
+    c = (1.0 - np.abs(2.0 * light - 1.0)) * sat
+    h6 = hue * 6.0
+    x = c * (1.0 - np.abs(np.mod(h6, 2.0) - 1.0))
+    sector = np.floor(h6).astype(np.intp) % 6
+    zeros = np.zeros(n)
+    table = np.stack(
+        [
+            np.stack([c, x, zeros], 1),
+            np.stack([x, c, zeros], 1),
+            np.stack([zeros, c, x], 1),
+            np.stack([zeros, x, c], 1),
+            np.stack([x, zeros, c], 1),
+            np.stack([c, zeros, x], 1),
+        ]
+    )  # (6, n, 3)
+    rgb = table[sector, np.arange(n)] + (light - c / 2.0)[:, None]
+    return np.clip(rgb, 0.0, 1.0).astype(np.float32)
+
+
+#: The name the live view has used (``rot4d_widget.buffers.cell_palette``).
+cell_palette = group_palette
