@@ -6,7 +6,7 @@ ipyevents keydown handler assigns a new float32 position array, drawn by a
 Renderer with the widget's settings (600 x 500, no multisampling) -- and
 ``Rot4DWidget(name)`` for each of the six regular polychora.
 
-    /work/venv/bin/python benchmarks/browser_latency.py [--presses 40] [--hold 2]
+    python benchmarks/browser_latency.py [--presses 40] [--hold 2]
         [--tap 60-120] [--cases 5-cell,600-cell] [--seed 0] [--rev HEAD]
         [--nagle] [--runs 1] [--json out.json]
 
@@ -51,7 +51,8 @@ key -> msg, msg -> px, kernel
     is the first ``comm_msg`` with binary buffers after the key.  key -> msg =
     page -> kernel -> page; msg -> px = deserialise + wait for a frame + draw
     + read-back.  kernel = time per update in the kernel (the widget's
-    ``_render``: slice + scene.show + readout; the baseline's handler), timed
+    ``_send``, the update pump's callback: slice + scene.show + readout; the
+    baseline's handler), timed
     by wrapping it from the notebook (benchmark side only).  The widget's
     probe also stamps, with time.time() (the page's timeOrigin + now() is the
     same wall clock, checked to < 1 ms), when the key and each "drawn" ack
@@ -299,15 +300,16 @@ def probe(w):
     # "drawn" acks as they reach the widget, and every update's computation (start, end, thread)
     rec = {"kernel": [], "up": None, "keys": [], "acks": [], "renders": []}
     main = threading.main_thread()
-    render = w._render
-    def timed_render(*a, **k):  # slice + scene.show + readout, once per update
+    pump = w._pump
+    render = pump._send  # the widget's _send: slice + scene.show + readout, once per update
+    def timed_render(*a, **k):
         e0, t0 = time.time(), time.perf_counter()
         try:
             return render(*a, **k)
         finally:
             rec["kernel"].append(time.perf_counter() - t0)
             rec["renders"].append((e0, time.time(), threading.current_thread() is main))
-    w._render = timed_render
+    pump._send = timed_render
     handle_event, handle_drawn = w._handle_event, w._handle_drawn
     def stamped_event(ev):
         if isinstance(ev, dict) and ev.get("type") == "keydown" and not ev.get("repeat"):
@@ -322,15 +324,15 @@ def probe(w):
     w.companion.on_drawn(stamped_drawn)
     def on_keyup(ev):  # registered after the widget's own handler: runs after it
         if isinstance(ev, dict) and ev.get("type") == "keyup":
-            rec["up"] = {"n": w.n_updates, "in_flight": w.in_flight, "R": w.state.matrix.tolist()}
+            rec["up"] = {"n": w.stats.updates, "in_flight": w.in_flight, "R": w.state.matrix.tolist()}
     w.events.on_dom_event(on_keyup)
     w._bench_probe = rec
     return w
 
 def read_widget(w):
     rec = w._bench_probe
-    print(json.dumps(dict(n_updates=w.n_updates, kernel_ms=[1000 * x for x in rec["kernel"]], up=rec["up"],
-                          final=w.state.matrix.tolist(), acks=w.n_acks, timeouts=w.n_timeouts,
+    print(json.dumps(dict(n_updates=w.stats.updates, kernel_ms=[1000 * x for x in rec["kernel"]], up=rec["up"],
+                          final=w.state.matrix.tolist(), acks=w.stats.acks, timeouts=w.stats.timeouts,
                           capacity=w.scene.capacity, canvas_class=w.scene.canvas_class,
                           stamps={k: rec[k] for k in ("keys", "acks", "renders")})))
 '''

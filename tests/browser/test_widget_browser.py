@@ -111,8 +111,8 @@ def test_notebook_01_draws_the_w0_tetrahedron(jupyter_server, page, artifacts):
     )
     assert webgl and webgl["ok"], webgl
     info = jp.kernel_json(
-        "dict(m=widget.state.matrix.tolist(), c0=widget.state.c0, fov=widget.scene.camera.fov,"
-        " pos=list(widget.scene.camera.position), scale=widget.scene.scale, r=widget.scene.ball_radius,"
+        "dict(m=widget.state.matrix.tolist(), c0=widget.state.c0, fov=widget.scene.canvas.camera.fov,"
+        " pos=list(widget.scene.canvas.camera.position), scale=widget.scene.scale, r=widget.ball_radius,"
         " w=widget.scene.width, h=widget.scene.height)"
     )
     np.testing.assert_allclose(info["m"], np.eye(4), atol=1e-9)  # the notebook ends on a full turn
@@ -326,7 +326,7 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     _hover(jp, sel)
     cdp = page.context.new_cdp_session(page)
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 6})
-    start = jp.kernel_json("dict(u=w.n_updates, a=w.n_acks, t=w.n_timeouts)")
+    start = jp.kernel_json("w.stats.as_dict()")
     page.keyboard.down("4")
     time.sleep(2.0)
     page.keyboard.up("4")
@@ -334,12 +334,12 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     last_change = jp.last_canvas_change(sel, since=released, watch=2.5)
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 1})
     final = jp.canvas_stats(sel)["hash"]
-    end = jp.kernel_json("dict(u=w.n_updates, a=w.n_acks, t=w.n_timeouts)")
+    end = jp.kernel_json("w.stats.as_dict()")
     acks = page.evaluate("() => window.__acks")
-    updates = end["u"] - start["u"]
+    updates = end["updates"] - start["updates"]
     assert updates >= 3
     # at most one update in flight: every update but the last was answered (or timed out) first
-    assert updates <= (end["a"] - start["a"]) + (end["t"] - start["t"]) + 1, (start, end)
+    assert updates <= (end["acks"] - start["acks"]) + (end["timeouts"] - start["timeouts"]) + 1, (start, end)
     # after release the view settles at once (the update in flight, nothing queued)
     assert last_change - released < 1.5
     # an acknowledgement leaves only once the canvas shows its update: no ack while the
