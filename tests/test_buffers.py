@@ -1,4 +1,10 @@
-"""rot4d_widget.buffers: the row table every update sends, the palette, the template shapes."""
+"""rot4d_widget.buffers: the row table every update sends, the palette, the template shapes.
+
+Slices come from the source protocol (`rot4d_widget.source`): a polytope's
+through `PolytopeSource`, made-up ones as plain objects with ``points``,
+``segments``, ``triangles``, ``groups`` (and optionally ``convex``,
+``show_points``).
+"""
 
 from __future__ import annotations
 
@@ -8,8 +14,9 @@ import numpy as np
 import pytest
 
 from rot4d_widget import buffers as bf
-from rot4d_widget import polytope, slice_polytope
+from rot4d_widget import polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
+from rot4d_widget.source import PolytopeSource, SliceData
 
 
 def random_rotation(rng):
@@ -20,14 +27,19 @@ def random_rotation(rng):
     return q
 
 
-def fake_slice(n_vertices=5, n_edges=7, n_triangles=4, n_cells=3, seed=0):
+def fake_slice(n_points=5, n_segments=7, n_triangles=4, n_groups=3, seed=0):
+    """A slice object with only the protocol's four required members (no convex / show_points)."""
     rng = np.random.default_rng(seed)
     return SimpleNamespace(
-        vertices=rng.standard_normal((n_vertices, 3)),
-        edges=rng.integers(0, max(n_vertices, 1), (n_edges, 2)).astype(np.intp),
-        triangles=rng.integers(0, max(n_vertices, 1), (n_triangles, 3)).astype(np.intp),
-        triangle_cells=rng.integers(0, n_cells, n_triangles).astype(np.intp),
+        points=rng.standard_normal((n_points, 3)),
+        segments=rng.integers(0, max(n_points, 1), (n_segments, 2)).astype(np.intp),
+        triangles=rng.integers(0, max(n_points, 1), (n_triangles, 3)).astype(np.intp),
+        groups=rng.integers(0, n_groups, n_triangles).astype(np.intp),
     )
+
+
+def polytope_slice(p, matrix, c0):
+    return PolytopeSource(p).slice(matrix, c0)
 
 
 def real_slices():
@@ -36,7 +48,7 @@ def real_slices():
     for name in POLYTOPE_NAMES:
         p = polytope(name)
         for c in (0.0, 0.5 * p.circumradius):
-            out.append((name, p, slice_polytope(p, random_rotation(rng), c)))
+            out.append((name, p, polytope_slice(p, random_rotation(rng), c)))
     return out
 
 
@@ -47,20 +59,20 @@ SLICES = real_slices()
 @pytest.mark.parametrize("name,p,s", SLICES, ids=[f"{n}-{i % 2}" for i, (n, _, _) in enumerate(SLICES)])
 def test_every_ball_bar_and_triangle_is_in_its_row_scaled(name, p, s):
     scale = 1.2649 / p.circumradius
-    palette = bf.cell_palette(len(p.cells))
-    rows = bf.slice_rows(s, scale=scale, cell_rgb=palette, capacity=bf.rows_needed(s) + 5)
-    v = s.vertices * scale
-    nv, ne, nt = len(s.vertices), len(s.edges), len(s.triangles)
+    palette = bf.group_palette(len(p.cells))
+    rows = bf.slice_rows(s, scale=scale, group_rgb=palette, capacity=bf.rows_needed(s) + 5)
+    v = s.points * scale
+    nv, ne, nt = len(s.points), len(s.segments), len(s.triangles)
     assert nv and ne and nt  # these slices are solid
     c = {k: slice(col, col + size) for k, (col, size) in bf.COLUMNS.items()}
     np.testing.assert_allclose(rows[:nv, c["ball"]][:, :3], v, rtol=1e-6, atol=1e-6)
     assert np.all(rows[:nv, 3] == 1.0)
-    np.testing.assert_allclose(rows[:ne, c["bar_a"]], v[s.edges[:, 0]], rtol=1e-6, atol=1e-6)
-    np.testing.assert_allclose(rows[:ne, c["bar_b"]], v[s.edges[:, 1]], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(rows[:ne, c["bar_a"]], v[s.segments[:, 0]], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(rows[:ne, c["bar_b"]], v[s.segments[:, 1]], rtol=1e-6, atol=1e-6)
     for key, k in (("tri_a", 0), ("tri_b", 1), ("tri_c", 2)):
         np.testing.assert_allclose(rows[:nt, c[key]], v[s.triangles[:, k]], rtol=1e-6, atol=1e-6)
     rgb = bf.unpack_rgb(rows[:nt, 19])
-    expected = np.rint(palette[s.triangle_cells].astype(np.float64) * 255).astype(np.uint8)
+    expected = np.rint(palette[s.groups].astype(np.float64) * 255).astype(np.uint8)
     np.testing.assert_array_equal(rgb, expected)
 
 
@@ -83,11 +95,11 @@ def test_columns_tile_the_row_without_overlap():
 
 
 def test_rows_past_each_count_are_hidden():
-    s = fake_slice(n_vertices=3, n_edges=9, n_triangles=5)
+    s = fake_slice(n_points=3, n_segments=9, n_triangles=5)
     rows = bf.slice_rows(s, capacity=16)
-    # balls: flag 0 past the vertex count
+    # balls: flag 0 past the point count
     assert np.all(rows[3:, 3] == 0.0) and np.all(rows[:3, 3] == 1.0)
-    # bars: zero length past the edge count
+    # bars: zero length past the segment count
     assert np.all(np.linalg.norm(rows[9:, 4:7] - rows[9:, 7:10], axis=1) == 0.0)
     # triangles: zero area past the triangle count
     a, b, c = rows[5:, 10:13], rows[5:, 13:16], rows[5:, 16:19]
@@ -99,42 +111,113 @@ def test_rows_past_each_count_are_hidden():
 def test_hidden_rows_of_real_slices():
     name, p, s = SLICES[-1]  # 600-cell off-centre
     rows = bf.slice_rows(s, capacity=bf.capacity_for(bf.rows_needed(s)))
-    nv, ne, nt = len(s.vertices), len(s.edges), len(s.triangles)
+    nv, ne, nt = len(s.points), len(s.segments), len(s.triangles)
     assert not rows[nv:, 0:4].any() and not rows[ne:, 4:10].any() and not rows[nt:, 10:20].any()
 
 
 def test_empty_slice_is_all_hidden():
-    s = SimpleNamespace(
-        vertices=np.zeros((0, 3)), edges=np.zeros((0, 2), np.intp),
-        triangles=np.zeros((0, 3), np.intp), triangle_cells=np.zeros(0, np.intp),
-    )
+    s = SliceData.build(np.zeros((0, 3)))
     assert bf.rows_needed(s) == 0
     rows = bf.slice_rows(s, capacity=16)
     assert rows.shape == (16, 20) and not rows.any()
     p = polytope("5-cell")
-    far = slice_polytope(p, np.eye(4), 2.0 * p.circumradius)
+    far = polytope_slice(p, np.eye(4), 2.0 * p.circumradius)
     assert not bf.slice_rows(far, capacity=16).any()
 
 
 def test_capacity_too_small_and_bad_shapes_raise():
-    s = fake_slice(n_edges=9)
+    s = fake_slice(n_segments=9)
     with pytest.raises(ValueError, match=r"`capacity` >= 9"):
         bf.slice_rows(s, capacity=8)
     bad = fake_slice()
-    bad.vertices = np.zeros((5, 4))
-    with pytest.raises(ValueError, match=r"`vertices` to have shape \(n, 3\), got \(5, 4\)"):
+    bad.points = np.zeros((5, 4))
+    with pytest.raises(ValueError, match=r"`points` to have shape \(n, 3\), got \(5, 4\)"):
         bf.slice_rows(bad)
     bad = fake_slice()
-    bad.triangle_cells = bad.triangle_cells[:-1]
-    with pytest.raises(ValueError, match="`triangle_cells`"):
+    bad.segments = np.zeros((7, 3), np.intp)
+    with pytest.raises(ValueError, match=r"`segments` to have shape \(m, 2\), got \(7, 3\)"):
         bf.slice_rows(bad)
-    with pytest.raises(ValueError, match="colour for cell 2"):
-        bf.slice_rows(fake_slice(n_cells=3, n_triangles=40), cell_rgb=bf.cell_palette(2))
-    empty = slice_polytope(polytope("5-cell"), np.eye(4), 10.0)  # no triangles: the eye is still checked
+    bad = fake_slice()
+    bad.groups = bad.groups[:-1]
+    with pytest.raises(ValueError, match="`groups`"):
+        bf.slice_rows(bad)
+    with pytest.raises(ValueError, match="colour for group 2"):
+        bf.slice_rows(fake_slice(n_groups=3, n_triangles=40), group_rgb=bf.group_palette(2))
+    empty = polytope_slice(polytope("5-cell"), np.eye(4), 10.0)  # no triangles: the eye is still checked
     for eye in [(0.0, 5.0), (0.0, 0.0, float("nan")), "eye"]:
         for s_ in (fake_slice(), empty):
             with pytest.raises(ValueError, match="`eye` to be three finite numbers"):
                 bf.slice_rows(s_, capacity=16, eye=eye)
+
+
+def _row_triangles(rows, n):
+    """Corners (n, 3, 3) and packed colours (n,) of the first ``n`` triangle rows, float64."""
+    return rows[:n, 10:19].astype(np.float64).reshape(n, 3, 3), rows[:n, 19]
+
+
+def test_non_convex_slice_sorts_triangles_farthest_first_from_the_eye():
+    """No back/front rule holds for a non-convex surface: blend in depth order (centroids)."""
+    rng = np.random.default_rng(3)
+    n = 40
+    centres = rng.uniform(-2.0, 2.0, (n, 3))
+    points = (centres[:, None, :] + 0.1 * rng.standard_normal((n, 3, 3))).reshape(-1, 3)
+    triangles = np.arange(3 * n).reshape(n, 3)
+    groups = rng.integers(0, 6, n)
+    data = SliceData.build(points, None, triangles, groups, convex=False)
+    palette = bf.group_palette(6)
+    for eye in [(0.0, 0.0, 5.0), (4.0, -3.0, 1.0), (0.5, 0.2, -0.3)]:  # the last one among the triangles
+        rows = bf.slice_rows(data, scale=1.5, group_rgb=palette, eye=eye)
+        corners, rgb = _row_triangles(rows, n)
+        depth = np.linalg.norm(corners.mean(axis=1) - eye, axis=1)
+        assert np.all(np.diff(depth) <= 1e-9), "triangles must come farthest first"
+        # each triangle kept its corners and the colour of its group
+        want = {tuple(np.round((points[t] * 1.5).astype(np.float32), 4).ravel()): bf.pack_rgb(palette[g : g + 1])[0]
+                for t, g in zip(triangles, groups)}
+        got = {tuple(np.round(c.astype(np.float32), 4).ravel()): col for c, col in zip(corners, rgb)}
+        assert got == want
+    # without an eye the slice's own order is kept
+    corners, _ = _row_triangles(bf.slice_rows(data), n)
+    np.testing.assert_allclose(corners, points[triangles], atol=1e-6)
+
+
+def test_convex_and_non_convex_orders_differ_for_the_same_triangles():
+    p = polytope("24-cell")
+    s = polytope_slice(p, random_rotation(np.random.default_rng(9)), 0.0)
+    assert s.convex
+    loose = SliceData.build(s.points, s.segments, s.triangles, s.groups, convex=False)
+    eye = (3.0, -4.0, 1.0)
+    nt = len(s.triangles)
+    convex_rows, depth_rows = bf.slice_rows(s, eye=eye), bf.slice_rows(loose, eye=eye)
+    (a, _), (b, _) = _row_triangles(convex_rows, nt), _row_triangles(depth_rows, nt)
+    assert not np.array_equal(a, b)
+    assert np.all(np.diff(np.linalg.norm(b.mean(axis=1) - eye, axis=1)) <= 1e-9)
+    normal = np.cross(a[:, 1] - a[:, 0], a[:, 2] - a[:, 0])
+    facing = np.einsum("ij,ij->i", normal, np.asarray(eye) - a[:, 0]) > 0
+    assert 0 < facing.sum() < nt and not np.diff(facing.astype(int)).clip(max=0).any()  # away-facing first
+
+
+@pytest.mark.parametrize("single", [(1.0, 0.0, 0.0), (0.623, 0.714, 0.804)])
+def test_single_rgb_paints_every_triangle_that_colour(single):
+    s = fake_slice(n_points=9, n_segments=4, n_triangles=12, n_groups=5)
+    # the group palette is ignored, even one too short for the groups
+    rows = bf.slice_rows(s, capacity=16, single_rgb=single, group_rgb=bf.group_palette(1))
+    packed = bf.pack_rgb([single])[0]
+    assert np.all(rows[:12, 19] == packed) and not rows[12:, 19].any()
+    np.testing.assert_array_equal(bf.unpack_rgb(rows[:12, 19])[0], np.rint(np.asarray(single) * 255))
+    # everything else is as with group colours
+    np.testing.assert_array_equal(rows[:, :19], bf.slice_rows(s, capacity=16)[:, :19])
+
+
+def test_show_points_false_sends_no_ball_rows():
+    """Points that only carry corners (an isosurface's vertices) are not drawn as balls."""
+    s = fake_slice(n_points=30, n_segments=4, n_triangles=6)
+    hidden = SliceData.build(s.points, s.segments, s.triangles, s.groups, show_points=False)
+    assert bf.rows_needed(hidden) == 6 and bf.rows_needed(s) == 30
+    rows = bf.slice_rows(hidden, capacity=16)
+    assert not rows[:, 0:4].any()  # every ball flag 0: no ball drawn
+    shown = bf.slice_rows(s, capacity=32)
+    np.testing.assert_array_equal(rows[:, 4:], shown[:16, 4:])  # bars and triangles unchanged
+    assert np.all(shown[:30, 3] == 1.0)
 
 
 def test_capacity_for_rounds_up_with_headroom():
@@ -152,9 +235,9 @@ def test_estimate_capacity_covers_central_slices():
     rng = np.random.default_rng(5)
     for name in ("24-cell", "120-cell"):
         p = polytope(name)
-        cap = bf.estimate_capacity(p)
+        cap = bf.estimate_capacity(PolytopeSource(p))
         assert cap % 16 == 0
-        most = max(bf.rows_needed(slice_polytope(p, random_rotation(rng), 0.0)) for _ in range(20))
+        most = max(bf.rows_needed(polytope_slice(p, random_rotation(rng), 0.0)) for _ in range(20))
         assert most <= cap <= 2 * most
 
 
@@ -164,7 +247,7 @@ def test_bytes_per_update_within_budget_for_every_polychoron():
     rng = np.random.default_rng(2)
     for name in POLYTOPE_NAMES:
         p = polytope(name)
-        most = max(bf.rows_needed(slice_polytope(p, random_rotation(rng), 0.0)) for _ in range(30))
+        most = max(bf.rows_needed(polytope_slice(p, random_rotation(rng), 0.0)) for _ in range(30))
         nbytes = bf.capacity_for(most) * bf.ROW_BYTES
         assert nbytes <= 64 * 1024, (name, nbytes)
         if name == "120-cell":
@@ -215,28 +298,6 @@ def test_as_rgb_rejects_naming_the_allowed_forms(value):
 
 
 # ------------------------------------------------------------------ templates
-def test_cylinder_template_is_closed_and_wound_outwards():
-    pos, nrm = bf.cylinder_template(12)
-    assert pos.dtype == nrm.dtype == np.float32 and pos.shape == nrm.shape == (12 * 12, 3)
-    assert pos.flags["C_CONTIGUOUS"] and nrm.flags["C_CONTIGUOUS"]
-    np.testing.assert_allclose(np.linalg.norm(nrm, axis=1), 1.0, atol=1e-6)
-    assert set(np.unique(pos[:, 2])) == {0.0, 1.0}
-    tri = pos.reshape(-1, 3, 3).astype(np.float64)
-    face_n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    centroid = tri.mean(axis=1) - [0.0, 0.0, 0.5]
-    assert np.all((face_n * centroid).sum(axis=1) > 0)  # CCW seen from outside
-    # every edge of the closed surface is shared by exactly two triangles
-    key = lambda p: tuple(np.round(p, 5))  # noqa: E731
-    edges = {}
-    for t in tri:
-        for i in range(3):
-            e = tuple(sorted([key(t[i]), key(t[(i + 1) % 3])]))
-            edges[e] = edges.get(e, 0) + 1
-    assert set(edges.values()) == {2}
-    with pytest.raises(ValueError, match="`segments` >= 3"):
-        bf.cylinder_template(2)
-
-
 def test_quad_and_triangle_templates():
     q = bf.quad_template()
     assert q.shape == (6, 3) and q.dtype == np.float32
