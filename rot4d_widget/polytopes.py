@@ -53,6 +53,15 @@ for _canon, _aliases in _ALIASES.items():
         _NAME_OF[_alias] = _canon
 
 
+def _sealed(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only, behind a read-only view: nothing can write, resize or
+    re-enable writing through what is handed out (``a`` must be fresh, owned here)."""
+    a.flags.writeable = False
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def _normalise_name(name: str) -> str:
     return "".join(name.lower().split()).replace("_", "-")
 
@@ -161,11 +170,16 @@ class Polytope:
     ----------
     vertices : (V, 4) float64
     edges : (E, 2) intp, each row sorted
-    faces : list of F int arrays, each an ordered cycle of vertex indices
-    cells : list of C lists of face indices
+    faces : tuple of F intp arrays, each an ordered cycle of vertex indices
+    cells : tuple of C tuples of face indices
+    face_cells : (F, 2) intp, the two cells of each face, ascending
     circumradius : float, max distance of a vertex from the origin
     cell_normals : (C, 4) float64 outward unit normals; ``cell_offsets`` (C,)
         so that cell c lies in ``vertices @ cell_normals[c] == cell_offsets[c]``
+
+    Every array is read-only and the sequences are tuples: a polytope is
+    shared (``polytope(name)`` is cached, slicing tables are built from it
+    once), so an edit anywhere would corrupt every later slice.
     """
 
     def __init__(self, vertices, name: str = "polytope"):
@@ -178,8 +192,7 @@ class Polytope:
         if not np.all(np.isfinite(v)):
             raise ValueError("Expected `vertices` to be finite")
         self.name = str(name)
-        self.vertices = v
-        self.vertices.flags.writeable = False
+        self.vertices = _sealed(v)
         self.circumradius = float(np.sqrt((v * v).sum(axis=1)).max())
         self._build()
 
@@ -215,13 +228,13 @@ class Polytope:
         for cyc in faces:
             for a, b in zip(cyc, np.roll(cyc, -1)):
                 edges.add((min(a, b), max(a, b)))
-        self.edges = np.array(sorted(edges), dtype=np.intp).reshape(-1, 2)
-        self.faces = faces
-        self.cells = cells
-        self.cell_normals = normals
-        self.cell_offsets = offsets
-        self.face_cells = np.stack([ci, cj], axis=1).astype(np.intp)  # (F, 2), ascending
-        self._cell_vertex_mask = cell_vertices
+        self.edges = _sealed(np.array(sorted(edges), dtype=np.intp).reshape(-1, 2))
+        self.faces = tuple(_sealed(f) for f in faces)
+        self.cells = tuple(tuple(int(f) for f in c) for c in cells)
+        self.cell_normals = _sealed(np.ascontiguousarray(normals))
+        self.cell_offsets = _sealed(np.ascontiguousarray(offsets))
+        self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
+        self._cell_vertex_mask = _sealed(cell_vertices)
 
     def _order_cycle(self, idx: np.ndarray) -> np.ndarray:
         """Order the vertices of a planar convex polygon in 4-D as a cycle."""

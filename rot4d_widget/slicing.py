@@ -48,6 +48,15 @@ TOLERANCE = 1e-9
 _TWO_PI_PLUS = 8.0  # > 2*pi: spacing of per-polygon sort keys
 
 
+def _sealed(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only, behind a read-only view: nothing can write, resize or
+    re-enable writing through what is handed out (``a`` must be fresh, owned here)."""
+    a.flags.writeable = False
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 class _Tables:
     """Incidence arrays for vectorised slicing, built once per polytope."""
 
@@ -94,6 +103,10 @@ class _Tables:
         self.empty_i3 = np.zeros((0, 3), dtype=np.intp)
         self.empty_i = np.zeros(0, dtype=np.intp)
         self.offsets0 = np.zeros(1, dtype=np.intp)
+        # shared by every slice of this polytope (the empty ones go into Slices): sealed
+        for name, a in vars(self).items():
+            if isinstance(a, np.ndarray) and a.flags.writeable:
+                setattr(self, name, _sealed(a))
 
 
 _TABLES: "weakref.WeakKeyDictionary[Polytope, _Tables]" = weakref.WeakKeyDictionary()
@@ -122,6 +135,9 @@ class Slice:
     triangle_cells : (k,) intp -- the 4-D cell of each triangle
     volume : float -- the 3-volume (0 unless the slice is solid)
     dim : int -- 3 solid, 2/1/0 when H only touches a face/edge/vertex, -1 empty
+
+    Every array is read-only (a missed slice shares its empty arrays with
+    every other missed slice of the polytope); copy one to edit it.
     """
 
     vertices: np.ndarray
@@ -134,14 +150,22 @@ class Slice:
     volume: float
     dim: int
 
+    def __post_init__(self):
+        for a in (self.vertices, self.edges, self.polygon_indices, self.polygon_offsets,
+                  self.cell_ids, self.triangles, self.triangle_cells):
+            a.flags.writeable = False
+
     @property
     def polygons(self) -> list:
-        """The polygons as a list of vertex-index arrays (for iteration; not on the hot path)."""
+        """The polygons as a list of (read-only) vertex-index arrays (for iteration; not on the hot path)."""
         return np.split(self.polygon_indices, self.polygon_offsets[1:-1]) if len(self.cell_ids) else []
 
     @property
     def polygon_sizes(self) -> np.ndarray:
-        return np.diff(self.polygon_offsets)
+        """(P,) intp, read-only: the number of corners of each polygon."""
+        sizes = np.diff(self.polygon_offsets)
+        sizes.flags.writeable = False
+        return sizes
 
     def face_census(self) -> dict:
         """``{number of sides: number of polygons}``, e.g. ``{3: 8, 4: 6}``."""

@@ -174,3 +174,66 @@ def test_bad_pentachoron_edge():
         pentachoron(-1.0)
     with pytest.raises(TypeError, match="positive number"):
         pentachoron("2")
+
+
+# -- arrays that cannot be corrupted (issue 7) ---------------------------------
+
+
+def exposed_arrays(p):
+    """Every array a Polytope hands out, by name."""
+    arrays = {
+        "vertices": p.vertices,
+        "edges": p.edges,
+        "cell_normals": p.cell_normals,
+        "cell_offsets": p.cell_offsets,
+        "face_cells": p.face_cells,
+    }
+    arrays.update({f"faces[{i}]": f for i, f in enumerate(p.faces)})
+    arrays.update({f"cells[{i}]": np.asarray(c) for i, c in enumerate(p.cells) if isinstance(c, np.ndarray)})
+    # every public ndarray attribute is in the list above
+    public = {k for k, v in vars(p).items() if not k.startswith("_") and isinstance(v, np.ndarray)}
+    assert public <= set(arrays), public - set(arrays)
+    return arrays
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_array_of_a_cached_polytope_is_read_only(name):
+    p = polytope(name)
+    assert polytope(name) is p  # cached: an edit would reach every later user
+    for attr, a in exposed_arrays(p).items():
+        assert not a.flags.writeable, f"{name}: {attr} is writable"
+        with pytest.raises(ValueError, match="read-only"):
+            a[...] = 0
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_faces_and_cells_cannot_be_replaced_or_extended(name):
+    p = polytope(name)
+    for seq in (p.faces, p.cells):
+        assert isinstance(seq, tuple)
+        with pytest.raises(TypeError):
+            seq[0] = seq[1]
+    for cell in p.cells:
+        assert isinstance(cell, tuple)
+
+
+def test_editing_edges_cannot_corrupt_later_slices():
+    p = polytope("5-cell")
+    before = slice_polytope(p, np.eye(4), 0.0)
+    with pytest.raises(ValueError):
+        p.edges[0] = (3, 4)
+    with pytest.raises(ValueError):
+        p.faces[0][0] = 4
+    after = slice_polytope(p, np.eye(4), 0.0)
+    np.testing.assert_array_equal(after.edges, before.edges)
+    assert p.counts == COUNTS["5-cell"]
+
+
+def test_a_built_polytope_copies_its_input_and_is_read_only():
+    v = polytope("8-cell").vertices.copy()
+    p = Polytope(v, name="box")
+    v[0] = 100.0
+    assert np.abs(p.vertices).max() == 1.0
+    for attr, a in exposed_arrays(p).items():
+        assert not a.flags.writeable, attr
+    assert p.cell_vertices(0).flags.writeable  # a fresh array, the caller's to keep

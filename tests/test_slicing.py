@@ -13,7 +13,7 @@ from scipy.spatial import ConvexHull
 
 from reference_geometry import merged_hull_faces, random_rotation, rotation_with_w_row, slice_volume_by_halfspaces
 from rot4d_widget import polytope, slice_polytope
-from rot4d_widget.slicing import TOLERANCE
+from rot4d_widget.slicing import TOLERANCE, Slice
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 SMALL = ["5-cell", "8-cell", "16-cell", "24-cell"]
@@ -234,3 +234,76 @@ def test_triangle_cells_follow_polygons():
 def test_bad_slice_input(args, exc, match):
     with pytest.raises(exc, match=match):
         slice_polytope(*args)
+
+
+# -- arrays that cannot be corrupted (issue 7) ---------------------------------
+
+SLICE_ARRAYS = ("vertices", "edges", "polygon_indices", "polygon_offsets", "cell_ids", "triangles", "triangle_cells")
+
+
+def exposed_arrays(s):
+    """Every array a Slice hands out: its fields, its properties, and the polygons."""
+    arrays = {name: getattr(s, name) for name in SLICE_ARRAYS}
+    arrays["polygon_sizes"] = s.polygon_sizes
+    for i, poly in enumerate(s.polygons):
+        arrays[f"polygons[{i}]"] = poly
+    # no array field left unchecked
+    fields = {f for f in Slice.__dataclass_fields__ if isinstance(getattr(s, f), np.ndarray)}
+    assert fields == set(SLICE_ARRAYS)
+    return arrays
+
+
+def slices_of_every_kind(name):
+    """A solid slice, a missed one, the touching cases and an on-H cell (8-cell)."""
+    p = polytope(name)
+    h = heights(name, np.eye(4))
+    out = {
+        "solid": slice_polytope(p, random_rotation(5), 0.1 * p.circumradius),
+        "missed above": slice_polytope(p, np.eye(4), 2 * p.circumradius),
+        "missed below": slice_polytope(p, np.eye(4), -2 * p.circumradius),
+        "touching top": slice_polytope(p, np.eye(4), float(h.max())),
+        "touching bottom": slice_polytope(p, np.eye(4), float(h.min())),
+    }
+    if name == "8-cell":
+        out["whole cell"] = slice_polytope(p, np.eye(4), 1.0)
+        out["vertex"] = slice_polytope(p, rotation_with_w_row((1, 1, 1, 1)), 2.0)
+    return out
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_array_of_every_slice_is_read_only(name):
+    for kind, s in slices_of_every_kind(name).items():
+        for attr, a in exposed_arrays(s).items():
+            assert not a.flags.writeable, f"{name} {kind}: {attr} is writable"
+            with pytest.raises(ValueError, match="read-only"):
+                a[...] = 0
+
+
+@pytest.mark.parametrize("name", ["5-cell", "8-cell", "600-cell"])
+def test_editing_one_missed_slice_cannot_corrupt_the_next(name):
+    p = polytope(name)
+    s = slice_polytope(p, np.eye(4), 3 * p.circumradius)
+    for attr in SLICE_ARRAYS:
+        a = getattr(s, attr)
+        with pytest.raises(ValueError):
+            a[...] = 5
+        # a shared array can be neither unlocked nor resized in place; this slice's
+        # own arrays may be (deliberately), which touches no other slice
+        for edit in (lambda: setattr(a.flags, "writeable", True), lambda: a.resize(7, refcheck=False)):
+            try:
+                edit()
+            except ValueError:
+                pass
+        if a.flags.writeable:
+            a[...] = 5
+    later = slice_polytope(p, random_rotation(2), -3 * p.circumradius)
+    assert later.polygon_offsets.tolist() == [0] and later.polygons == [] and later.face_census() == {}
+    assert later.edges.shape == (0, 2) and later.triangles.shape == (0, 3) and later.vertices.shape == (0, 3)
+
+
+def test_slicing_does_not_touch_the_callers_matrix():
+    m = random_rotation(4)
+    before = m.copy()
+    s = slice_polytope("24-cell", m, 0.2)
+    m[:] = np.eye(4)
+    np.testing.assert_array_equal(slice_polytope("24-cell", before, 0.2).vertices, s.vertices)
