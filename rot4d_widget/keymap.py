@@ -12,6 +12,11 @@ A :class:`Keymap` maps *key names* to :class:`Action` s.  A key name is
 Shift inverts rotations (the paper's Table 1) and does nothing to other
 actions.  From a browser event Shift means the ``shiftKey`` flag only, so Caps
 Lock does not invert.
+
+Besides the paper's keys the default table reserves keys for the next
+features (iso level ``o``/``i``, parallel slices ``n``/``b``, slice spacing
+``g``/``f``, screenshot ``p``); the core gives them no meaning.  A data source
+brings its own keys as ``Action("custom", ...)`` through `Keymap.extended`.
 """
 
 from __future__ import annotations
@@ -20,20 +25,62 @@ import re
 from dataclasses import dataclass
 from typing import Mapping
 
+import numpy as np
+
 from .rotation import DOUBLE_PLANES, PLANES
 
-__all__ = ["Action", "Keymap", "DEFAULT_KEYMAP", "ACTION_NAMES"]
+__all__ = ["Action", "Keymap", "DEFAULT_KEYMAP", "ACTION_NAMES", "RESERVED_KINDS", "REPEATING_KINDS"]
 
 #: Parameter and control actions by name; rotations are named by their plane(s).
 ACTION_NAMES = (
     "alpha+", "alpha-", "c0+", "c0-", "theta0+", "theta0-", "reset", "help",
+    "level+", "level-", "slices+", "slices-", "spacing+", "spacing-", "screenshot",
 )
 _ACTION_KINDS = {
     "alpha+": ("alpha", +1), "alpha-": ("alpha", -1),
     "c0+": ("c0", +1), "c0-": ("c0", -1),
     "theta0+": ("theta0", +1), "theta0-": ("theta0", -1),
     "reset": ("reset", 0), "help": ("help", 0),
+    "level+": ("level", +1), "level-": ("level", -1),
+    "slices+": ("slices", +1), "slices-": ("slices", -1),
+    "spacing+": ("spacing", +1), "spacing-": ("spacing", -1),
+    "screenshot": ("screenshot", 0),
 }
+
+#: Kinds bound in `DEFAULT_KEYMAP` for features still to come; `RotationState`
+#: ignores them, and `Keymap.extended` may rebind their keys.
+RESERVED_KINDS = frozenset({"level", "slices", "spacing", "screenshot"})
+
+#: Kinds that repeat while their key is held (at the widget's tick rate):
+#: rotations, alpha (k/j), c0 (l/h), the iso level (o/i) and the slice
+#: spacing (g/f) -- continuous changes.  The others act once per press:
+#: theta0 (+/-) would run away, reset/help/screenshot are one-shot, and
+#: adding or removing a parallel slice (n/b) is counted by the user.
+REPEATING_KINDS = frozenset({"rotate", "alpha", "c0", "level", "spacing"})
+
+_SIGNED_LABELS = {
+    "alpha": "\u03b1", "c0": "c0", "theta0": "\u03b80", "level": "level", "slices": "slices", "spacing": "spacing",
+}
+_DESCRIPTIONS = {
+    ("alpha", +1): "raise \u03b1 (\u03b2 = \u03b80 \u2212 \u03b1 falls)",
+    ("alpha", -1): "lower \u03b1 (\u03b2 = \u03b80 \u2212 \u03b1 rises)",
+    ("c0", +1): "raise the slicing hyperplane w = c0",
+    ("c0", -1): "lower the slicing hyperplane w = c0",
+    ("theta0", +1): "larger step angle \u03b80",
+    ("theta0", -1): "smaller step angle \u03b80",
+    ("reset", 0): "reset orientation and parameters",
+    ("help", 0): "show / hide this help",
+    ("level", +1): "raise the iso level (fields)",
+    ("level", -1): "lower the iso level (fields)",
+    ("slices", +1): "add a parallel slice (multi-slice view)",
+    ("slices", -1): "remove a parallel slice (multi-slice view)",
+    ("spacing", +1): "widen the slice spacing (multi-slice view)",
+    ("spacing", -1): "narrow the slice spacing (multi-slice view)",
+    ("screenshot", 0): "save a picture of the view (PNG)",
+}
+#: In help, a character typed on the same physical key as another one bound
+#: to the same action is not shown ("=" next to "+", "_" next to "-").
+_HELP_TWINS = {"=": "+", "_": "-"}
 _CODE_RE = re.compile(r"^[A-Z][A-Za-z0-9]+$")
 _DIGIT_CODE_RE = re.compile(r"^(?:Digit|Numpad)([0-9])$")
 
@@ -46,12 +93,27 @@ class Action:
 
     ``kind`` is ``"rotate"`` (``planes`` is one of ``"xy" ... "zw"`` or
     ``"xy,zw" "xz,yw" "xw,yz"``), ``"alpha"``, ``"c0"``, ``"theta0"`` (``sign``
-    +1 or -1), ``"reset"`` or ``"help"``.
+    +1 or -1), ``"reset"`` or ``"help"``; the reserved ``"level"``,
+    ``"slices"``, ``"spacing"`` (``sign`` +1 or -1) and ``"screenshot"``; or
+    ``"custom"``, an action a data source brings, shown as ``name`` and
+    described by ``text`` (``Action("custom", name="phase+", sign=1,
+    text="advance the phase")``).
     """
 
     kind: str
     planes: str = ""
     sign: int = 0
+    name: str = ""
+    text: str = ""
+
+    def __post_init__(self):
+        if self.kind == "custom":
+            if not (isinstance(self.name, str) and self.name):
+                raise ValueError(
+                    f"A custom action needs a `name` (a non-empty string shown in help), got {self.name!r}"
+                )
+            if not isinstance(self.text, str):
+                raise TypeError(f"A custom action's `text` must be a string, got {type(self.text).__name__}")
 
     @classmethod
     def parse(cls, spec) -> "Action":
@@ -79,10 +141,11 @@ class Action:
         """Short human name: ``"R_xw"``, ``"R_xz,yw⁻¹"``, ``"α+"``, ``"c0−"``..."""
         if self.kind == "rotate":
             return f"R_{self.planes}" + (_SUPERSCRIPT_MINUS_ONE if inverted else "")
-        sign = "+" if self.sign > 0 else "\u2212"
-        return {"alpha": f"\u03b1{sign}", "c0": f"c0{sign}", "theta0": f"\u03b80{sign}"}.get(
-            self.kind, self.kind
-        )
+        if self.kind == "custom":
+            return self.name
+        if self.kind in _SIGNED_LABELS:
+            return _SIGNED_LABELS[self.kind] + ("+" if self.sign > 0 else "\u2212")
+        return self.kind
 
     def describe(self) -> str:
         """A sentence for help tables."""
@@ -91,15 +154,10 @@ class Action:
                 p1, p2 = self.planes.split(",")
                 return f"double rotation R_{self.planes}: {p1} by \u03b1 and {p2} by \u03b2"
             return f"simple rotation R_{self.planes} by \u03b80"
-        return {
-            "alpha": "raise \u03b1 (\u03b2 = \u03b80 \u2212 \u03b1 falls)" if self.sign > 0
-            else "lower \u03b1 (\u03b2 = \u03b80 \u2212 \u03b1 rises)",
-            "c0": "raise the slicing hyperplane w = c0" if self.sign > 0
-            else "lower the slicing hyperplane w = c0",
-            "theta0": "larger step angle \u03b80" if self.sign > 0 else "smaller step angle \u03b80",
-            "reset": "reset orientation and parameters",
-            "help": "show / hide this help",
-        }[self.kind]
+        if self.kind == "custom":
+            return self.text or self.name
+        sign = 0 if self.kind in ("reset", "help", "screenshot") else (1 if self.sign > 0 else -1)
+        return _DESCRIPTIONS.get((self.kind, sign), self.kind)
 
 
 def _check_key_name(name) -> str:
@@ -161,14 +219,46 @@ class Keymap(Mapping):
                 new[k] = v
         return Keymap(new)
 
+    def extended(self, bindings: Mapping) -> "Keymap":
+        """A copy with extra bindings, e.g. a data source's ``Action("custom", ...)`` s.
+
+        ``bindings`` maps key names (as in the constructor) to actions.  A key
+        may be new, or one bound to a reserved kind (``"level"``, ``"slices"``,
+        ``"spacing"``, ``"screenshot"``: features still to come).  Any other
+        bound key -- the paper's keys, reset, help, theta0 -- raises
+        ``ValueError`` naming the key and its action, and so does a code
+        ``"KeyX"`` while the letter ``x`` is bound to such an action (the code
+        would take precedence over the letter on most layouts).
+        """
+        extra = Keymap(bindings)._bindings  # checks names and actions like the constructor
+        for key in extra:
+            current = self._bindings.get(key)
+            if current is not None and current.kind not in RESERVED_KINDS:
+                raise ValueError(
+                    f"Key {key!r} is already bound to {current.label()} ({current.describe()}); "
+                    f"only keys of the reserved kinds {', '.join(sorted(RESERVED_KINDS))} or unbound keys "
+                    "can be extended -- use Keymap.replace to rebind it on purpose"
+                )
+            if len(key) == 4 and key.startswith("Key"):
+                shadowed = self._bindings.get(key[3].lower())
+                if shadowed is not None and shadowed.kind not in RESERVED_KINDS:
+                    raise ValueError(
+                        f"Key {key!r} would shadow {key[3].lower()!r}, bound to {shadowed.label()} "
+                        f"({shadowed.describe()}); bind the character instead"
+                    )
+        return Keymap({**self._bindings, **extra})
+
     def resolve(self, key: str, shift: bool = False):
         """Scripting lookup: ``("C")`` or ``("c", shift=True)`` -> ``(action, inverted)`` or None.
 
         An upper-case letter counts as shifted.  A ``code`` name such as
-        ``"Digit2"`` or ``"NumpadAdd"`` is accepted too.
+        ``"Digit2"`` or ``"NumpadAdd"`` is accepted too.  ``shift`` must be a
+        bool (or numpy bool): ``TypeError`` otherwise.
         """
         if not isinstance(key, str):
             raise TypeError(f"Expected `key` to be a string such as '4' or 'z', got {type(key).__name__}")
+        if not isinstance(shift, (bool, np.bool_)):
+            raise TypeError(f"Expected `shift` to be a bool (True or False), got {type(shift).__name__} {shift!r}")
         if len(key) == 1:
             lower = key.lower()
             if lower != key:
@@ -211,11 +301,31 @@ class Keymap(Mapping):
         return action, shift and action.is_rotation
 
     def help_rows(self):
-        """``[(key, label, description), ...]`` in binding order, for help panels."""
+        """``[(key, label, description), ...]`` in binding order, one row per binding."""
         return [(k, a.label(), a.describe()) for k, a in self._bindings.items()]
 
+    def help_groups(self):
+        """``[(keys_text, label, description), ...]``: one row per distinct action, in table order.
 
-#: The paper's Tables 1 and 2, plus reset "r", step angle "+"/"-" and help "?".
+        The keys of one action are collapsed to what a reader types: a digit
+        once (it covers Digit and Numpad), ``"+"`` without its twin ``"="``
+        and ``"-"`` without ``"_"``, and codes such as ``"NumpadAdd"`` only
+        when no single character is bound to the action (``"F1"`` alone is
+        kept).  Several distinct characters are joined by spaces (``"a q"``).
+        """
+        keys_of: dict = {}
+        for key, action in self._bindings.items():
+            keys_of.setdefault(action, []).append(key)
+        rows = []
+        for action, keys in keys_of.items():
+            chars = [k for k in keys if len(k) == 1]
+            shown = [k for k in chars if _HELP_TWINS.get(k) not in chars] if chars else keys
+            rows.append((" ".join(shown), action.label(), action.describe()))
+        return rows
+
+
+#: The paper's Tables 1 and 2, plus reset "r", step angle "+"/"-", help "?", and
+#: the keys reserved for the next features (letters by the character typed).
 DEFAULT_KEYMAP = Keymap(
     {
         # Table 1: simple rotations, key = product of the axis numbers (hex)
@@ -229,5 +339,10 @@ DEFAULT_KEYMAP = Keymap(
         "+": "theta0+", "=": "theta0+", "NumpadAdd": "theta0+",
         "-": "theta0-", "_": "theta0-", "NumpadSubtract": "theta0-",
         "?": "help",
+        # reserved for the next features; the core ignores them
+        "o": "level+", "i": "level-",  # a field's iso level
+        "n": "slices+", "b": "slices-",  # parallel slices
+        "g": "spacing+", "f": "spacing-",  # their spacing
+        "p": "screenshot",  # a PNG of the view
     }
 )
