@@ -104,11 +104,13 @@ def double_rotation(planes: str, alpha: float, beta: float) -> np.ndarray:
 def as_rotation_matrix(matrix, name: str = "matrix") -> np.ndarray:
     """Validate a 4-D rotation: (4, 4), finite, orthogonal with det +1.
 
-    Returns it as a C-contiguous float64 array.  Raises ``TypeError`` for
-    non-numeric input and ``ValueError`` naming what is expected otherwise.
+    Returns a **fresh** C-contiguous float64 array, never the caller's own
+    (so neither side can later edit what the other holds).  Raises
+    ``TypeError`` for non-numeric input and ``ValueError`` naming what is
+    expected otherwise.
     """
     try:
-        m = np.asarray(matrix, dtype=np.float64)
+        m = np.array(matrix, dtype=np.float64, order="C", copy=True)
     except (TypeError, ValueError):
         raise TypeError(f"Expected `{name}` to be a (4, 4) array of real numbers") from None
     if m.shape != (4, 4):
@@ -123,7 +125,7 @@ def as_rotation_matrix(matrix, name: str = "matrix") -> np.ndarray:
         )
     if np.linalg.det(m) < 0:
         raise ValueError(f"Expected `{name}` to be a rotation (det +1), got a reflection (det -1)")
-    return np.ascontiguousarray(m)
+    return m
 
 
 def reorthonormalize(matrix: np.ndarray) -> np.ndarray:

@@ -51,6 +51,15 @@ def _finite(name: str, value) -> float:
     return value
 
 
+def _read_only(m: np.ndarray) -> np.ndarray:
+    """A freshly made array, read-only behind a read-only view (no copy): what is
+    handed out can be neither written, nor resized, nor made writable again."""
+    m.flags.writeable = False
+    v = m.view()
+    v.flags.writeable = False
+    return v
+
+
 def _theta0(value) -> float:
     value = _finite("theta0", value)
     if not 0.0 < value <= THETA0_MAX:
@@ -64,6 +73,11 @@ class RotationState:
     ``press(key, shift=False)`` applies one step of the key's action;
     rotations compose extrinsically (``matrix = step @ matrix``) and the
     matrix is re-orthonormalised after every step.
+
+    ``matrix`` is a read-only array that every step *replaces* (never edits),
+    so an array read earlier keeps its values, reading it twice without a
+    step in between gives the same object (callers may cache on ``is``), and
+    assigning ``state.matrix = m`` copies ``m`` after validating it.
     """
 
     def __init__(
@@ -83,19 +97,22 @@ class RotationState:
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else _finite("alpha", alpha)
         self._c0 = _finite("c0", c0)
         self.c0_step = c0_step
-        self._matrix = np.eye(4) if matrix is None else as_rotation_matrix(matrix)
-        self._initial = (self._theta0, self._alpha, self._c0, self._matrix.copy())
+        self._matrix = _read_only(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
+        self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
         self._steps: dict = {}
 
     # -- parameters ---------------------------------------------------------
     @property
     def matrix(self) -> np.ndarray:
-        """(4, 4) float64 orientation; points rotate as ``vertices @ matrix.T``."""
+        """(4, 4) float64 orientation, read-only; points rotate as ``vertices @ matrix.T``.
+
+        The same object until the next step or assignment replaces it.
+        """
         return self._matrix
 
     @matrix.setter
     def matrix(self, value) -> None:
-        self._matrix = as_rotation_matrix(value)
+        self._matrix = _read_only(as_rotation_matrix(value))  # validated copy
 
     @property
     def theta0(self) -> float:
@@ -148,7 +165,7 @@ class RotationState:
 
     # -- actions ------------------------------------------------------------
     def step_matrix(self, action: Action, inverted: bool = False) -> np.ndarray:
-        """The (4, 4) matrix one press of a rotation ``action`` applies."""
+        """The (4, 4) matrix (read-only, cached) one press of a rotation ``action`` applies."""
         cache_key = (action.planes, inverted)
         m = self._steps.get(cache_key)
         if m is None:
@@ -157,14 +174,15 @@ class RotationState:
                 m = double_rotation(action.planes, sign * self._alpha, sign * self.beta)
             else:
                 m = simple_rotation(action.planes, sign * self._theta0)
-            self._steps[cache_key] = m
+            self._steps[cache_key] = _read_only(m)
         return m
 
     def apply(self, action: Action, inverted: bool = False) -> bool:
         """Apply one step of ``action``; True if the state changed."""
         kind = action.kind
         if kind == "rotate":
-            self._matrix = reorthonormalize(self.step_matrix(action, inverted) @ self._matrix)
+            # a new array each step: arrays handed out before are never edited
+            self._matrix = _read_only(reorthonormalize(self.step_matrix(action, inverted) @ self._matrix))
         elif kind == "alpha":
             self.alpha = self._alpha + action.sign * self.alpha_step
         elif kind == "c0":
@@ -177,8 +195,8 @@ class RotationState:
             self.theta0 = new
         elif kind == "reset":
             self.reset()
-        else:  # "help" and anything the core has no meaning for
-            return False
+        else:  # "help", the reserved "level" "slices" "spacing" "screenshot", "custom":
+            return False  # the widget or a data source acts on them, the core has no meaning for them
         return True
 
     def press(self, key: str, shift: bool = False) -> bool:
@@ -186,6 +204,8 @@ class RotationState:
 
         An upper-case letter counts as shifted (``press("C")`` is R_zw
         inverted).  Shift inverts rotations and is ignored by parameter keys.
+        ``shift`` must be a bool (``True``/``False`` or a numpy bool): a
+        ``TypeError`` otherwise.
         """
         found = self.keymap.resolve(key, shift)
         if found is None:
@@ -195,7 +215,7 @@ class RotationState:
     def reset(self) -> None:
         """Back to the state as constructed (orientation, theta0, alpha, c0)."""
         self._theta0, self._alpha, self._c0, m = self._initial
-        self._matrix = m.copy()
+        self._matrix = _read_only(m.copy())  # a new object, like every step
         self._steps.clear()
 
     def __repr__(self) -> str:

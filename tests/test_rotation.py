@@ -120,3 +120,30 @@ def test_all_pairs_of_planes_do_not_commute_when_they_share_an_axis():
         r1, r2 = simple_rotation(p, 0.5), simple_rotation(q, 0.7)
         commute = np.allclose(r1 @ r2, r2 @ r1)
         assert commute == set(p).isdisjoint(q)
+
+
+@pytest.mark.parametrize(
+    "given",
+    [
+        np.eye(4),
+        np.asfortranarray(np.eye(4)),
+        simple_rotation("xw", 0.3),
+        np.eye(4, dtype=np.float32),
+        [[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+    ],
+)
+def test_as_rotation_matrix_never_hands_back_the_callers_array(given):
+    out = as_rotation_matrix(given)
+    assert out is not given and out.dtype == np.float64 and out.flags.c_contiguous
+    if isinstance(given, np.ndarray):
+        assert not np.shares_memory(out, given)
+    before = np.array(given, dtype=np.float64)
+    out[0, 0] = 7.0  # the result is the caller's to edit ...
+    np.testing.assert_array_equal(np.asarray(given, dtype=np.float64), before)  # ... and the input is untouched
+
+
+def test_as_rotation_matrix_of_a_read_only_input_is_a_writable_copy():
+    m = np.eye(4)
+    m.flags.writeable = False
+    out = as_rotation_matrix(m)
+    assert out.flags.writeable and not np.shares_memory(out, m)

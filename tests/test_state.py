@@ -175,3 +175,113 @@ def test_bad_assignments():
         st.c0 = float("inf")
     with pytest.raises(TypeError, match="string"):
         st.press(4)
+
+
+# -- state that cannot be corrupted (issue 7) ---------------------------------
+
+
+def test_setting_matrix_copies_the_callers_array():
+    st = RotationState()
+    m = np.eye(4)
+    st.matrix = m
+    m[0, 0] = 7.0
+    np.testing.assert_array_equal(st.matrix, np.eye(4))
+
+
+def test_constructor_matrix_is_copied():
+    m = simple_rotation("xy", 0.3)
+    st = RotationState(matrix=m)
+    m[:] = 0.0
+    np.testing.assert_allclose(st.matrix, simple_rotation("xy", 0.3))
+    st.press("4")
+    st.reset()
+    np.testing.assert_allclose(st.matrix, simple_rotation("xy", 0.3))
+
+
+def test_matrix_is_read_only():
+    st = RotationState()
+    with pytest.raises(ValueError, match="read-only"):
+        st.matrix[0, 0] = 5.0
+    st.press("4")
+    with pytest.raises(ValueError, match="read-only"):
+        st.matrix[0, 0] = 5.0
+    st.matrix = simple_rotation("yz", 0.2)
+    with pytest.raises(ValueError, match="read-only"):
+        st.matrix[0, 0] = 5.0
+    st.reset()
+    with pytest.raises(ValueError, match="read-only"):
+        st.matrix[0, 0] = 5.0
+    np.testing.assert_array_equal(st.matrix, np.eye(4))
+
+
+def test_reset_cannot_be_corrupted_through_matrix():
+    st = RotationState(matrix=simple_rotation("xw", 0.4))
+    for write in (lambda m: m.__setitem__((0, 0), 9.0), lambda m: m.fill(0.0)):
+        with pytest.raises(ValueError):
+            write(st.matrix)
+    st.press("r")
+    np.testing.assert_allclose(st.matrix, simple_rotation("xw", 0.4))
+
+
+def test_matrix_is_the_same_object_until_a_step_replaces_it():
+    """The widget caches its slice on ``state.matrix is m``: reading is free and stable,
+    every step hands out a new object, and no step edits an array handed out before."""
+    st = RotationState(theta0=0.1)
+    first = st.matrix
+    assert st.matrix is first
+    seen = [(first, first.copy())]
+    for key in ["4", "Z", "c", "k", "y", "l", "+", "r", "8"]:
+        st.press(key)
+        seen.append((st.matrix, st.matrix.copy()))
+    st.matrix = simple_rotation("xz", 0.2)
+    seen.append((st.matrix, st.matrix.copy()))
+    for old, snapshot in seen:
+        np.testing.assert_array_equal(old, snapshot)
+    before = st.matrix
+    st.press("2")
+    assert st.matrix is not before
+
+
+def test_step_matrix_cache_cannot_be_corrupted():
+    st = RotationState(theta0=0.1)
+    step = st.step_matrix(DEFAULT_KEYMAP["4"])
+    with pytest.raises(ValueError, match="read-only"):
+        step[0, 0] = 0.0
+    st.press("4")
+    np.testing.assert_allclose(st.matrix, simple_rotation("xw", 0.1), atol=1e-15)
+
+
+@pytest.mark.parametrize("shift", ["yes", 1, 0, None, 1.0, [True]])
+def test_shift_must_be_a_bool(shift):
+    st = RotationState()
+    with pytest.raises(TypeError, match="`shift` to be a bool.*True or False"):
+        st.press("4", shift=shift)
+    with pytest.raises(TypeError, match="`shift` to be a bool"):
+        DEFAULT_KEYMAP.resolve("4", shift)
+    np.testing.assert_array_equal(st.matrix, np.eye(4))
+
+
+def test_numpy_bool_shift_is_accepted():
+    st = RotationState(theta0=0.1)
+    assert st.press("4", shift=np.bool_(True))
+    np.testing.assert_allclose(st.matrix, simple_rotation("xw", -0.1), atol=1e-15)
+    assert DEFAULT_KEYMAP.resolve("4", np.False_) == (DEFAULT_KEYMAP["4"], False)
+
+
+@pytest.mark.parametrize("key", ["o", "i", "n", "b", "g", "f", "p"])
+def test_reserved_keys_change_nothing_in_the_core(key):
+    st = RotationState(theta0=0.1)
+    st.press("4")
+    before = (st.matrix, st.theta0, st.alpha, st.c0)
+    assert key in DEFAULT_KEYMAP
+    assert st.press(key) is False and st.press(key, shift=True) is False
+    assert st.matrix is before[0] and (st.theta0, st.alpha, st.c0) == before[1:]
+
+
+def test_custom_actions_change_nothing_in_the_core():
+    from rot4d_widget import Action
+
+    st = RotationState()
+    before = st.matrix
+    assert st.apply(Action("custom", name="phase+", sign=1, text="advance the phase")) is False
+    assert st.matrix is before
