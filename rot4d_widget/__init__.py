@@ -32,13 +32,16 @@ _LAZY = {
     "RotationState": "state",
     "Source": "source",
     "SliceData": "source",
+    "SourceAction": "source",
+    "PolytopeSource": "source",
     "Rot4DWidget": "widget",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
 #: statement, as they were when this ``__init__`` imported the core eagerly.
 _SUBMODULES = ("buffers", "companion", "figures", "keymap", "polytopes", "rotation",
-               "scene", "slicing", "source", "state", "widget")
+               "scene", "slicing", "source", "state", "widget",
+               "look", "readout", "keyhold", "pump")
 
 
 def _exists(module: str) -> bool:

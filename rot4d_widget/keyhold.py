@@ -69,6 +69,11 @@ class KeyRepeater:
     def __len__(self) -> int:
         return len(self._held)
 
+    @property
+    def held_keys(self) -> tuple:
+        """Ids of the keys held now, in the order pressed."""
+        return tuple(k for k, _ in sorted(self._held.items(), key=lambda kv: kv[1].order))
+
     def press(self, key_id, action, inverted: bool, now: float) -> None:
         """Key ``key_id`` went down at ``now`` (its first step is the caller's); repeats start later."""
         self._held.pop(key_id, None)

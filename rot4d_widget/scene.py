@@ -394,7 +394,8 @@ class Scene:
         """The display options in force (a copy)."""
         return dict(self._display)
 
-    def check_display(self, options) -> dict:
+    @staticmethod
+    def check_display(options) -> dict:
         """Validated display options (TypeError/ValueError naming what is allowed)."""
         out = {}
         for name, value in options.items():

@@ -64,6 +64,12 @@ _DISPLAY_TRAITS = ("ball_radius", "bar_radius", "face_opacity", "background", "s
 _STATE_TRAITS = ("theta0", "alpha", "c0")
 
 
+class _Value(traitlets.Any):
+    """A trait whose value the widget validates itself (None included), with errors naming what is allowed."""
+
+    allow_none = False
+
+
 def _scene_classes():
     """Import the rendering path lazily (pythreejs is heavy), once."""
     from .companion import Companion
@@ -122,18 +128,18 @@ class Rot4DWidget(widgets.HBox):
     errors : ipywidgets.Output -- exceptions raised by key handling
     """
 
-    theta0 = traitlets.Any(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
-    alpha = traitlets.Any(0.0, help="double-rotation angle alpha (beta = theta0 - alpha), radians")
-    c0 = traitlets.Any(0.0, help="level of the slicing hyperplane w = c0, in the source's units")
+    theta0 = _Value(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
+    alpha = _Value(0.0, help="double-rotation angle alpha (beta = theta0 - alpha), radians")
+    c0 = _Value(0.0, help="level of the slicing hyperplane w = c0, in the source's units")
     orientation = traitlets.Any(read_only=True, help="(4, 4) rotation matrix, read-only")
-    ball_radius = traitlets.Any(0.07)
-    bar_radius = traitlets.Any(0.028)
-    face_opacity = traitlets.Any(look.FACE_OPACITY)
-    background = traitlets.Any(look.BACKGROUND)
-    show_balls = traitlets.Any(True)
-    show_bars = traitlets.Any(True)
-    show_faces = traitlets.Any(True)
-    color_by = traitlets.Any("group", help='"group" or one colour for every face')
+    ball_radius = _Value(0.07)
+    bar_radius = _Value(0.028)
+    face_opacity = _Value(look.FACE_OPACITY)
+    background = _Value(look.BACKGROUND)
+    show_balls = _Value(True)
+    show_bars = _Value(True)
+    show_faces = _Value(True)
+    color_by = _Value("group", help='"group" or one colour for every face')
 
     def __init__(
         self,
@@ -205,6 +211,11 @@ class Rot4DWidget(widgets.HBox):
         # -- widgets ------------------------------------------------------------
         Scene, Companion = _scene_classes()
         from .buffers import estimate_capacity
+
+        Scene.check_display(dict(
+            ball_radius=ball_radius, bar_radius=bar_radius, face_opacity=face_opacity, background=background,
+            show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
+        ))
 
         built = []
         try:
@@ -280,6 +291,23 @@ class Rot4DWidget(widgets.HBox):
     def stats(self):
         """Counters of the update pump: ``updates`` sent, ``acks`` received in time, ``timeouts``."""
         return self._pump.stats
+
+    @property
+    def held_keys(self) -> tuple:
+        """The keys (browser ``code``s) held now, in the order pressed."""
+        return self._repeater.held_keys
+
+    @property
+    def hold_delay(self) -> float:
+        return self._repeater.hold_delay
+
+    @property
+    def tick_rate(self) -> float:
+        return self._repeater.tick_rate
+
+    @property
+    def ack_timeout(self) -> float:
+        return self._pump.ack_timeout
 
     @property
     def in_flight(self) -> bool:

@@ -1,4 +1,8 @@
-"""Shared fixtures: a recording comm, a fake clock, widgets made with them."""
+"""Shared fixtures: a recording comm, a fake clock, widgets made with them.
+
+`service(w, now)` does what the widget's ticker thread does once (the update
+pump's ``service``): the one place tests reach into a widget for time.
+"""
 
 import pytest
 
@@ -32,8 +36,8 @@ def make(clock):
     made = []
 
     def _make(*args, **kwargs):
-        kwargs.setdefault("clock", clock)
-        kwargs.setdefault("autotick", False)
+        kwargs.setdefault("_clock", clock)
+        kwargs.setdefault("_autotick", False)
         w = Rot4DWidget(*args, **kwargs)
         made.append(w)
         return w
@@ -41,3 +45,8 @@ def make(clock):
     yield _make
     for w in made:
         w.close()
+
+
+def service(w, now=None):
+    """Run the widget's due ticks and flow control once (what its ticker thread does)."""
+    return w._pump.service(now)

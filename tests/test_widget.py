@@ -9,6 +9,7 @@ tests/test_widget_scene.py runs the real Scene and Companion.
 
 from __future__ import annotations
 
+import html
 import math
 import time
 
@@ -18,9 +19,11 @@ import pytest
 import traitlets
 from ipywidgets import CallbackDispatcher
 from ipywidgets.widgets import widget as ipywidget_module
+from conftest import service
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget import widget as wmod
+from rot4d_widget.look import REFERENCE_RADIUS
 from rot4d_widget.state import DEFAULT_THETA0
 from rot4d_widget.widget import Rot4DWidget
 
@@ -34,17 +37,32 @@ class FakeCamera(traitlets.HasTraits):
     position = traitlets.Tuple((0.0, 0.0, 5.0))
 
 
+def _register(cbs, cb, remove):
+    if remove:
+        if cb in cbs:
+            cbs.remove(cb)
+    elif cb not in cbs:
+        cbs.append(cb)
+
+
 class FakeScene:
+    """The Scene's interface to the widget, recording what it is asked to show."""
+
     instances: list = []
 
-    def __init__(self, polytope, **options):
-        self.polytope = polytope
+    def __init__(self, **options):
         self.options = options
-        self.renderer = ipywidgets.Box()  # a DOMWidget, as ipyevents requires
+        self.canvas = ipywidgets.Box()  # a DOMWidget, as ipyevents requires
+        self.canvas._view_count = 0
         self.camera = FakeCamera()
-        self.scale = 1.0
-        self.shown = []  # the Slices passed to show()
+        self.shown = []  # the slices passed to show()
+        self.single = []  # their single_rgb
         self.closed = False
+        self.display = {k: options[k] for k in ("ball_radius", "bar_radius", "face_opacity", "background",
+                                                 "show_balls", "show_bars", "show_faces")}
+        self._view_cbs, self._eye_cbs = [], []
+        self.canvas.observe(lambda ch: [cb(ch["new"] or 0) for cb in list(self._view_cbs)], names="_view_count")
+        self.camera.observe(lambda ch: [cb(self.eye) for cb in list(self._eye_cbs)], names="position")
         FakeScene.instances.append(self)
 
     update_id = 0
@@ -53,17 +71,37 @@ class FakeScene:
     def eye(self):
         return tuple(self.camera.position)
 
-    def show(self, s):
-        """Like Scene.show: bytes sent, 0 (and no new update_id) if the picture is unchanged."""
-        if self.shown and np.array_equal(self.shown[-1].vertices, s.vertices):
-            return 0
+    @property
+    def view_count(self):
+        return self.canvas._view_count or 0
+
+    def on_view_count(self, cb, remove=False):
+        _register(self._view_cbs, cb, remove)
+
+    def on_eye_moved(self, cb, remove=False):
+        _register(self._eye_cbs, cb, remove)
+
+    @staticmethod
+    def check_display(options):
+        from rot4d_widget.scene import Scene
+
+        return Scene.check_display(options)
+
+    def set_display(self, **options):
+        self.display.update(self.check_display(options))
+
+    def show(self, s, single_rgb=None):
+        """Like Scene.show: True if sent, False (and no new update_id) if the picture is unchanged."""
+        if self.shown and np.array_equal(self.shown[-1].points, s.points) and self.single[-1] == single_rgb:
+            return False
         self.shown.append(s)
+        self.single.append(single_rgb)
         self.update_id += 1
-        return 1000
+        return True
 
     def close(self):
         self.closed = True
-        self.renderer.close()
+        self.canvas.close()
 
 
 class FakeCompanion(ipywidgets.DOMWidget):
@@ -130,10 +168,10 @@ def up(w, key, **kw):
 def run_ticker(w, clock, until):
     """Do what the ticker thread does, with the fake clock: wake at each deadline up to ``until``."""
     while True:
-        deadline = w._service()
+        deadline = service(w)
         if deadline is None or deadline > until:
             clock.t = until
-            w._service()
+            service(w)
             return
         clock.t = max(clock.t, deadline)
 
@@ -156,9 +194,9 @@ def test_builds_a_displayable_hbox_with_canvas_readout_help(make):
     assert w.state.theta0 == DEFAULT_THETA0 and w.state.c0 == 0.0
     assert w.state.c0_step == pytest.approx(polytope("5-cell").circumradius / 64)
     canvas, side = w.children
-    assert canvas.children == (w.scene.renderer, w.companion)
+    assert canvas.children == (w.scene.canvas, w.companion)
     assert side.children == (w.readout, w.help_panel, w.errors)
-    assert w.events.source is w.scene.renderer
+    assert w.events.source is w.scene.canvas
     assert set(w.events.watched_events) >= {"keydown", "keyup", "mouseleave"}
     assert w.events.prevent_default_action
     # the initial slice is the regular tetrahedron of the paper's Fig. 3(a)
@@ -171,9 +209,11 @@ def test_builds_a_displayable_hbox_with_canvas_readout_help(make):
 
 def test_accepts_a_name_alias_or_polytope_and_options(make):
     p = polytope("24-cell")
-    w = make(p, theta0=0.1, alpha=0.03, c0=0.5, width=320, height=240, background="white", foo=1)
+    w = make(p, theta0=0.1, alpha=0.03, c0=0.5, width=320, height=240, background="#fff", face_opacity=0.5)
     assert w.polytope is p and w.state.theta0 == 0.1 and w.state.alpha == 0.03 and w.state.c0 == 0.5
-    assert w.scene.options == {"width": 320, "height": 240, "background": "white", "foo": 1}
+    o = w.scene.options
+    assert (o["width"], o["height"], o["background"], o["face_opacity"]) == (320, 240, "#fff", 0.5)
+    assert w.background == "#fff" and w.face_opacity == 0.5
     assert w.state.c0_step == pytest.approx(p.circumradius / 64)
     assert make("tesseract").polytope is polytope("8-cell")
     assert make(c0_step=0.25).state.c0_step == 0.25
@@ -182,8 +222,13 @@ def test_accepts_a_name_alias_or_polytope_and_options(make):
 @pytest.mark.parametrize(
     "kwargs, exc, match",
     [
-        ({"polytope": "7-cell"}, ValueError, "5-cell.*120-cell"),
-        ({"polytope": 5}, TypeError, "polytope name"),
+        ({"source": "7-cell"}, ValueError, "5-cell.*120-cell"),
+        ({"source": 5}, TypeError, "polytope name"),
+        ({"source": object()}, TypeError, "slice.*size.*n_groups.*describe"),
+        ({"colour": "red"}, TypeError, "colour"),
+        ({"color_by": "purple"}, ValueError, "color_by.*group"),
+        ({"face_opacity": 2}, ValueError, "face_opacity"),
+        ({"show_faces": "no"}, TypeError, "show_faces"),
         ({"theta0": float("nan")}, ValueError, "theta0"),
         ({"theta0": float("inf")}, ValueError, "theta0"),
         ({"theta0": -0.1}, ValueError, r"theta0.*\(0, pi\]"),
@@ -195,14 +240,14 @@ def test_accepts_a_name_alias_or_polytope_and_options(make):
         ({"tick_rate": float("inf")}, ValueError, "tick_rate"),
         ({"tick_rate": 10_000}, ValueError, "tick_rate"),
         ({"ack_timeout": -1}, ValueError, "ack_timeout"),
-        ({"clock": 3}, TypeError, "clock"),
+        ({"_clock": 3}, TypeError, "clock"),
         ({"keymap": {"4": "xw"}}, TypeError, "Keymap"),
     ],
 )
 def test_bad_options_raise_naming_what_is_allowed(kwargs, exc, match):
     before = len(ipywidget_module._instances)
     with pytest.raises(exc, match=match):
-        Rot4DWidget(autotick=False, **kwargs)
+        Rot4DWidget(_autotick=False, **kwargs)
     assert len(ipywidget_module._instances) == before  # nothing half-built left open
 
 
@@ -251,10 +296,10 @@ def test_browser_auto_repeat_adds_nothing(make, clock):
     down(w, "4")
     for i in range(1, 30):  # repeats at 30 Hz, like a real keyboard
         clock.t = t0 + i / 30
-        w._service()
+        service(w)
         down(w, "4", repeat=True)
     clock.t = t0 + 1.0
-    w._service()
+    service(w)
     up(w, "4")
     assert xw_steps(w) == 24  # the same as without repeats
 
@@ -388,12 +433,12 @@ def test_without_acknowledgements_the_latest_state_is_sent_after_the_timeout(mak
     run_ticker(w, clock, t0 + w.ack_timeout - 0.01)
     assert len(w.scene.shown) == 2
     run_ticker(w, clock, t0 + w.ack_timeout + 0.001)
-    assert len(w.scene.shown) == 3 and w.n_timeouts == 1
+    assert len(w.scene.shown) == 3 and w.stats.timeouts == 1
     run_ticker(w, clock, t0 + 0.7)
     up(w, "4")
     run_ticker(w, clock, t0 + 10.0)
     # the steps taken after the first timeout go out one timeout later; then nothing
-    assert w.n_timeouts == 2 and len(w.scene.shown) == 4
+    assert w.stats.timeouts == 2 and len(w.scene.shown) == 4
     assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
 
 
@@ -408,7 +453,7 @@ def test_scripting_press_redraws_and_respects_flow_control(make, clock):
     assert np.allclose(w.slice.vertices, slice_polytope(w.polytope, expected, 0.0).vertices)
     assert len(w.scene.shown) == 2
     clock.t += w.ack_timeout  # no view (nbval): the timeout sends the latest
-    w._service()
+    service(w)
     assert len(w.scene.shown) == 3 and w.scene.shown[-1] is w.slice
     assert w.press("q") is False
     with pytest.raises(TypeError, match="key"):
@@ -451,7 +496,8 @@ def test_readout_shows_parameters_last_action_census_and_volume(make):
     for label in ("\u03b80", "\u03b1", "\u03b2", "c0", "volume"):
         assert label in text
     assert f"{w.state.theta0:.5f}" in text and f"{w.state.beta:.5f}" in text
-    assert f"{w.slice.volume:.4f}" in text
+    scale = REFERENCE_RADIUS / w.polytope.circumradius
+    assert f"{w.slice.volume * scale ** 3:.4f} as drawn" in text
     census = w.slice.face_census()
     assert str(sum(census.values())) in text or any(f"{c} " in text for c in census.values())
     down(w, "2", code="Digit2", shift=True)
@@ -473,9 +519,10 @@ def test_help_key_toggles_the_key_table(make):
     down(w, "?", code="Slash", shift=True)
     up(w, "?", code="Slash", shift=True)
     assert w.help_visible
-    for key, label, _ in w.state.keymap.help_rows():
-        assert f"<kbd>{key}</kbd>" in w.help_panel.value
-        assert label in w.help_panel.value
+    for keys, label, _ in w.state.keymap.help_groups():
+        assert f"<kbd>{html.escape(keys)}</kbd>" in w.help_panel.value
+        assert html.escape(label) in w.help_panel.value
+    assert "Numpad" not in w.help_panel.value and "Drag" in w.help_panel.value
     w.press("?")
     assert not w.help_visible
 
@@ -506,7 +553,7 @@ def test_malformed_events_are_ignored(make, event):
 def test_errors_in_key_handling_are_shown_not_lost(make, clock):
     w = make()
 
-    def broken(s):
+    def broken(s, single_rgb=None):
         raise RuntimeError("scene exploded")
 
     w.scene.show = broken
@@ -524,7 +571,7 @@ def test_errors_in_the_ticker_are_shown_and_stop_the_hold(make, clock):
     w = make()
     down(w, "4")
     w.companion.drawn()
-    w.scene.show = lambda s: 1 / 0
+    w.scene.show = lambda s, single_rgb=None: 1 / 0
     run_ticker(w, clock, clock.t + 1.0)
     assert any("ZeroDivisionError" in o["text"] for o in w.errors.outputs)
     assert w.held_keys == ()
@@ -533,7 +580,7 @@ def test_errors_in_the_ticker_are_shown_and_stop_the_hold(make, clock):
 def test_rerunning_the_cell_makes_independent_widgets(make):
     w1 = make()
     w2 = make()
-    assert w1.scene.renderer is not w2.scene.renderer and w1.events is not w2.events
+    assert w1.scene.canvas is not w2.scene.canvas and w1.events is not w2.events
     down(w2, "4")
     up(w2, "4")
     assert xw_steps(w2) == 1 and xw_steps(w1) == 0
@@ -545,9 +592,9 @@ def test_rerunning_the_cell_makes_independent_widgets(make):
 
 def test_close_stops_the_thread_and_closes_every_child(recording_comms):
     w = Rot4DWidget(hold_delay=0.01, tick_rate=200)
-    children = [w.events, w.companion, w.scene.renderer, w.readout, w.help_panel, w.errors, *w.children]
+    children = [w.events, w.companion, w.scene.canvas, w.readout, w.help_panel, w.errors, *w.children]
     down(w, "4")
-    thread = w._thread
+    thread = w._pump._thread
     assert thread is not None and thread.is_alive()
     time.sleep(0.05)
     w.close()
@@ -577,7 +624,7 @@ def test_the_ticker_thread_rotates_in_real_time_and_stops_on_keyup():
         assert xw_steps(w) == n
         assert w.errors.outputs == ()
         # with no acknowledgement (no view), the timeout still delivered the latest state
-        assert w.n_timeouts >= 1
+        assert w.stats.timeouts >= 1
         assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
     finally:
         w.close()
@@ -586,9 +633,9 @@ def test_the_ticker_thread_rotates_in_real_time_and_stops_on_keyup():
 def test_no_thread_until_needed_and_none_for_a_scripting_widget_at_rest():
     w = Rot4DWidget()
     try:
-        assert w._thread is None
+        assert not w._pump.thread_alive
         w.press("k")  # readout only: nothing in flight, nothing to wait for
-        assert w._thread is None
+        assert not w._pump.thread_alive
     finally:
         w.close()
 
@@ -617,12 +664,12 @@ def test_events_from_the_thread_and_the_kernel_interleave_safely():
 def front_end_view_count(w, n):
     """The front end reports the canvas's number of views (ipywidgets' _view_count)."""
     msg = {"content": {"data": {"method": "update", "state": {"_view_count": n}, "buffer_paths": []}}, "buffers": []}
-    w.scene.renderer.comm.handler(msg)
+    w.scene.canvas.comm.handler(msg)
 
 
 def test_a_widget_whose_views_are_all_gone_acts_on_nothing(make, clock):
     w = make()
-    assert w.scene.renderer._view_count == 0  # counting requested from the front end
+    assert w.scene.canvas._view_count == 0  # counting requested from the front end
     front_end_view_count(w, 1)  # displayed
     down(w, "4")
     assert xw_steps(w) == 1 and w.held_keys == ("Digit4",)
@@ -640,6 +687,6 @@ def test_a_widget_whose_views_are_all_gone_acts_on_nothing(make, clock):
 
 def test_a_front_end_that_does_not_count_views_still_gets_keys(make):
     w = make()
-    assert w.scene.renderer._view_count == 0 and not w._was_displayed
+    assert w.scene.view_count == 0 and not w._was_displayed
     down(w, "4")
     assert xw_steps(w) == 1

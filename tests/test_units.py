@@ -1,0 +1,175 @@
+"""The widget's small units on their own: key repeat, update pump, readout HTML."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+from rot4d_widget.keyhold import KeyRepeater
+from rot4d_widget.pump import UpdatePump
+from rot4d_widget import readout as ro
+from rot4d_widget.rotation import simple_rotation
+
+
+# ------------------------------------------------------------------ key repeat
+def test_a_held_key_repeats_after_the_hold_delay_at_the_tick_rate():
+    r = KeyRepeater(hold_delay=0.25, tick_rate=30)
+    r.press("Digit4", "xw", False, now=10.0)
+    assert r.due(10.2) == [] and r.next_deadline() == pytest.approx(10.25)
+    steps = [s for t in np.arange(10.2, 11.0, 0.01) for s in r.due(t)] + r.due(11.0)  # called often
+    assert len(steps) == 1 + math.floor((11.0 - 10.25) * 30) == 23
+    assert steps[0] == ("xw", False)
+    r.release("Digit4")
+    assert r.due(20.0) == [] and r.next_deadline() is None and r.held_keys == ()
+
+
+def test_two_keys_step_in_time_order_then_press_order():
+    r = KeyRepeater(hold_delay=0.1, tick_rate=10)
+    r.press("a", "A", False, now=0.0)
+    r.press("b", "B", True, now=0.0)
+    assert r.held_keys == ("a", "b")
+    assert r.due(0.25) == [("A", False), ("B", True), ("A", False), ("B", True)]
+
+
+def test_a_stall_replays_at_most_max_lag_of_ticks():
+    r = KeyRepeater(hold_delay=0.1, tick_rate=20, max_lag=0.25)
+    r.press("k", "K", False, now=0.0)
+    assert len(r.due(100.0)) == math.ceil(0.25 * 20)  # not 2000
+    assert r.next_deadline() == pytest.approx(100.05)  # and it goes on from now
+
+
+@pytest.mark.parametrize("kw, match", [({"hold_delay": 0}, "hold_delay"), ({"tick_rate": 1e6}, "tick_rate"),
+                                        ({"tick_rate": "fast"}, "tick_rate"), ({"max_lag": -1}, "max_lag")])
+def test_bad_repeat_settings_are_refused(kw, match):
+    with pytest.raises((TypeError, ValueError), match=match):
+        KeyRepeater(**kw)
+
+
+# ----------------------------------------------------------------- update pump
+class Page:
+    """What the pump drives: a counter of sends; each send gets a new id."""
+
+    def __init__(self):
+        self.sent = []
+        self.changes = 0
+
+    def send(self):
+        if self.sent and self.sent[-1][1] == self.changes:
+            return None  # nothing new on screen
+        self.sent.append((len(self.sent) + 1, self.changes))
+        return len(self.sent)
+
+
+def make_pump(page, clock, **kw):
+    return UpdatePump(page.send, clock=clock, autotick=False, **kw)
+
+
+def test_one_update_in_flight_and_the_next_is_the_latest():
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5)
+    for i in range(5):  # five changes while the first update is on its way
+        page.changes += 1
+        pump.mark_dirty()
+        pump.flush()
+    assert [s[1] for s in page.sent] == [1] and pump.in_flight == 1
+    assert pump.acknowledge(1) is True
+    assert [s[1] for s in page.sent] == [1, 5]  # the latest, not the backlog
+    assert pump.acknowledge(1) is False  # late duplicate (another view)
+    assert pump.acknowledge(7) is False and pump.acknowledge(True) is False  # unknown / not an id
+    assert pump.acknowledge(2) is True and pump.in_flight is None
+    assert pump.stats.as_dict() == {"updates": 2, "acks": 2, "timeouts": 0}
+
+
+def test_without_an_ack_the_latest_goes_out_after_the_timeout():
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5)
+    page.changes += 1
+    pump.mark_dirty()
+    pump.flush()
+    page.changes += 1
+    pump.mark_dirty()
+    assert pump.service(0.4) == pytest.approx(0.5)  # it wants to run at the timeout
+    assert len(page.sent) == 1
+    pump.service(0.5)
+    assert len(page.sent) == 2 and pump.stats.timeouts == 1
+    assert pump.service(2.0) is None  # nothing dirty: nothing to wait for
+
+
+def test_errors_go_to_on_error_and_the_pump_goes_on():
+    seen = []
+    boom = {"on": True}
+
+    def send():
+        if boom["on"]:
+            raise RuntimeError("boom")
+        return 1
+
+    pump = UpdatePump(send, clock=lambda: 0.0, autotick=False, on_error=seen.append)
+    pump.mark_dirty()
+    pump.service(0.0)
+    assert [type(e) for e in seen] == [RuntimeError] and not pump.dirty
+    boom["on"] = False
+    pump.mark_dirty()
+    pump.service(0.0)
+    assert pump.stats.updates == 1
+
+
+def test_the_thread_runs_ticks_in_real_time_and_stops_on_close():
+    import threading
+    import time
+
+    ticks = []
+    deadline = {"t": time.monotonic()}
+
+    def tick(now):
+        while deadline["t"] is not None and deadline["t"] <= now:
+            ticks.append(now)
+            deadline["t"] += 0.01
+            if len(ticks) >= 20:
+                deadline["t"] = None
+
+    pump = UpdatePump(lambda: None, tick=tick, deadline=lambda: deadline["t"])
+    pump.wake()
+    for _ in range(200):
+        if len(ticks) >= 20:
+            break
+        time.sleep(0.01)
+    assert len(ticks) == 20 and pump.thread_alive
+    pump.close()
+    assert not pump.thread_alive
+    assert not any(t.name.startswith("rot4d-ticker") and t.is_alive() for t in threading.enumerate()
+                   if t is pump._thread)
+
+
+# --------------------------------------------------------------------- readout
+def test_the_gizmo_shows_each_axis_xy_as_an_arrow_and_w_as_a_bar():
+    m = simple_rotation("xw", math.pi / 6)  # x tilts into w: its w part is sin(30°)
+    svg = ro.gizmo_svg(m)
+    assert len(svg.encode()) < 1000  # sent with the readout
+    bars = [float(w) for w in re.findall(r"<rect x=[-\d.]+ y=[-\d.]+ width=([\d.]+)", svg)]
+    assert bars == pytest.approx([28 * abs(m[3, i]) for i in range(4)], abs=0.51)
+    ends = [(float(x), float(y)) for x, y in re.findall(r"x2=([-\d.]+) y2=([-\d.]+)", svg)]
+    assert ends[0] == pytest.approx((30 + 26 * m[0, 0], 30 - 26 * m[1, 0]), abs=0.51)
+    assert len(ends) == 5  # four axes and the separator
+
+
+def test_the_gauge_places_c0_between_the_extremes_and_says_when_outside():
+    assert "left:50%" in ro.gauge_html(0.0, -1.0, 1.0)
+    assert "left:75%" in ro.gauge_html(0.5, -1.0, 1.0)
+    out = ro.gauge_html(3.0, -1.0, 1.0)
+    assert "left:100%" in out and "above the object" in out
+    assert "below the object" in ro.gauge_html(-3.0, -1.0, 1.0)
+
+
+def test_angles_read_in_radians_and_degrees():
+    assert ro.angle_text(math.pi / 64) == "0.04909 rad (2.81\u00b0)"
+
+
+def test_readout_escapes_its_title_and_labels():
+    html = ro.readout_html("<b>x</b>", [("<i>", "1")])
+    assert "&lt;b&gt;x&lt;/b&gt;" in html and "&lt;i&gt;" in html
