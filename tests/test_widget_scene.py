@@ -2,7 +2,13 @@
 
 What goes over the comms per update (count, size, dtype, shape), what the
 companion's front-end messages do, bad scene options, close().  Messages are
-recorded by a comm that serialises like ipykernel's (tests/test_widget.py).
+recorded by a comm that serialises like ipykernel's (tests/recording_comm.py).
+The widget is read through public behaviour: the recorded messages,
+``scene.rows`` / ``scene.update_id``, ``w.stats``, ``w.in_flight``; what the
+page sends (acknowledgements, OrbitControls' camera position) arrives on the
+comms as the front end sends it.  Time is the fake clock of tests/conftest.py,
+advanced by `run_ticker` through `service`, the one place here that reaches
+into the widget (its update pump).
 """
 
 from __future__ import annotations
@@ -15,10 +21,10 @@ import pytest
 from ipywidgets.widgets import widget as ipywidget_module
 
 from rot4d_widget import buffers as bf
-from rot4d_widget import slice_polytope
+from rot4d_widget import look, polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.widget import Rot4DWidget
-from test_widget import down, run_ticker, up, xw_steps
+from test_widget import down, up, xw_steps
 
 
 # comms, clock and `make`: tests/conftest.py
@@ -39,17 +45,53 @@ def buffer_messages(w, log):
     return [(data, n) for cid, data, n, _ in log if cid == bid]
 
 
+def orbit_ends_at(w, eye):
+    """OrbitControls syncs the camera's position to the kernel when a drag ends."""
+    camera = w.scene.canvas.camera
+    camera.comm.handler(
+        {"content": {"data": {"method": "update", "state": {"position": list(eye)}, "buffer_paths": []}}, "buffers": []}
+    )
+
+
+def service(w, now):
+    """What the widget's ticker thread does once at clock time ``now``: due key repeats, the
+    acknowledgement timeout, a send if flow control allows.  Returns when it wants to run next.
+
+    The only use of the widget's private update pump in this file (the fake clock stands in
+    for the thread, which `make` does not start).
+    """
+    return w._pump.service(now)
+
+
+def run_ticker(w, clock, until):
+    """Wake at each deadline the widget asks for, up to ``until``, moving the fake clock."""
+    while True:
+        deadline = service(w, clock.t)
+        if deadline is None or deadline > until:
+            clock.t = until
+            service(w, clock.t)
+            return
+        clock.t = max(clock.t, deadline)
+
+
+def scaled_points(w, data=None):
+    """The points of a slice as the view shows them: every source the pentachoron's size."""
+    data = w.slice if data is None else data
+    return np.asarray(data.points) * (look.REFERENCE_RADIUS / w.source.size)
+
+
 # --------------------------------------------------------------------- tests
 def test_layout_holds_canvas_companion_readout_help_and_errors(make):
     w = make()
     canvas, side = w.children
-    assert canvas.children == (w.scene.renderer, w.companion)
+    assert canvas.children == (w.scene.canvas, w.companion)
     assert side.children == (w.readout, w.help_panel, w.errors)
-    assert w.events.source is w.scene.renderer
+    assert w.events.source is w.scene.canvas
     assert w.companion.canvas_class == w.scene.canvas_class
-    assert w.scene.canvas_class in w.scene.renderer._dom_classes
+    assert w.scene.canvas_class in w.scene.canvas._dom_classes
     assert w.companion.layout.display == "none"  # invisible, but displayed with the canvas
     assert w.companion.buffer_model_id == w.scene.buffer_model_id
+    assert w.companion.scene_model_id == w.scene.scene_model_id
 
 
 @pytest.mark.parametrize("name", POLYTOPE_NAMES)
@@ -63,9 +105,11 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
         w.state.matrix = q
         drawn(w)  # the previous update was drawn
         old = w.scene.rows
+        updates = w.stats.updates
         n0 = len(recording_comms)
         down(w, "w")
         up(w, "w")
+        assert w.stats.updates == updates + 1
         msgs = recording_comms[n0:]
         by_widget = Counter(cid for cid, *_ in msgs)
         assert by_widget == {w.scene.buffer_model_id: 1, w.readout.model_id: 1}, by_widget
@@ -73,15 +117,16 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
         assert total <= 64 * 1024
         (data, nbytes), = buffer_messages(w, msgs)
         assert set(data["state"]) == {"array", "_rot4d_seq"}
-        assert data["state"]["_rot4d_seq"] == w.scene.update_id == w._in_flight
+        assert data["state"]["_rot4d_seq"] == w.scene.update_id
+        assert w.in_flight  # awaiting the page's acknowledgement of this update
         rows = w.scene.rows
-        assert rows is not old and rows.base is not old
+        assert rows is not old and not np.shares_memory(rows, old)
         assert rows.dtype == np.float32 and rows.flags.c_contiguous
         assert rows.shape == (w.scene.capacity, bf.ROW_FLOATS)
-        assert nbytes >= rows.nbytes
+        assert rows.nbytes <= nbytes <= rows.nbytes + 256  # the array and a little JSON
         s = w.slice
-        assert np.allclose(rows[: len(s.vertices), 0:3], s.vertices * w.scene.scale, atol=1e-5)
-        assert np.all(rows[: len(s.vertices), 3] == 1.0) and np.all(rows[len(s.vertices):, 3] == 0.0)
+        assert np.allclose(rows[: len(s.points), 0:3], scaled_points(w, s), atol=1e-5)
+        assert np.all(rows[: len(s.points), 3] == 1.0) and np.all(rows[len(s.points):, 3] == 0.0)
     assert set(ipywidget_module._instances) == before_ids  # updates never create widgets
 
 
@@ -112,21 +157,21 @@ def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_contro
     up(w, "z")  # an update in flight
     before = w.scene.rows
     assert not np.diff(_front_facing(before, (0.0, 0.0, 5.0)).astype(int)).clip(max=0).any()  # back first
-    n_updates = w.n_updates
-    # OrbitControls syncs the camera position to the kernel when a drag ends
+    n_updates = w.stats.updates
     eye = (3.0, -4.0, 1.0)
-    w.scene.camera.position = eye
-    assert w.n_updates == n_updates  # one update in flight: this one waits for the ack
+    orbit_ends_at(w, eye)
+    assert w.scene.eye == eye
+    assert w.stats.updates == n_updates  # one update in flight: this one waits for the ack
     drawn(w)
-    assert w.n_updates == n_updates + 1 and w.scene.rows is not before
+    assert w.stats.updates == n_updates + 1 and w.scene.rows is not before
     facing = _front_facing(w.scene.rows, eye)
     assert 0 < facing.sum() < len(facing)
     assert not np.diff(facing.astype(int)).clip(max=0).any()  # away-facing first, then facing
     assert not np.array_equal(facing, _front_facing(before, eye))  # the old order was wrong for it
     # the same picture for the eye it was made for: nothing more is sent
     drawn(w)
-    w.scene.camera.position = eye
-    assert w.n_updates == n_updates + 1
+    orbit_ends_at(w, eye)
+    assert w.stats.updates == n_updates + 1 and not w.in_flight
 
 
 def test_the_faces_sent_are_wound_counter_clockwise_seen_from_outside(make):
@@ -134,7 +179,7 @@ def test_the_faces_sent_are_wound_counter_clockwise_seen_from_outside(make):
     w = make("600-cell")
     _tap_and_draw(w, "4z8c")
     corners, normal = _sent_triangles(w.scene.rows)
-    centre = w.slice.vertices.mean(axis=0) * w.scene.scale  # inside the convex slice
+    centre = scaled_points(w).mean(axis=0)  # inside the convex slice
     outward = np.einsum("ij,ij->i", normal, corners.mean(axis=1) - centre)
     assert len(corners) == len(w.slice.triangles) and np.all(outward > 0)
 
@@ -155,7 +200,7 @@ def test_the_faces_sent_form_a_closed_mesh(make):
         for e in ((a, b), (b, c), (c, a)):
             edges[tuple(sorted(e))] += 1
     assert set(edges.values()) == {2}  # every edge shared by exactly two triangles
-    assert len(keys) == len(w.slice.vertices)
+    assert len(keys) == len(w.slice.points)
 
 
 def test_the_companion_acknowledgement_releases_the_next_update(make, clock, recording_comms):
@@ -165,20 +210,22 @@ def test_the_companion_acknowledgement_releases_the_next_update(make, clock, rec
     first = w.scene.update_id
     run_ticker(w, clock, t0 + 0.45)
     assert len(buffer_messages(w, recording_comms)) == 2  # the initial picture + the first step
+    acks = w.stats.acks
     drawn(w, first - 1)  # an acknowledgement of an older update: ignored
-    assert w.scene.update_id == first
+    assert w.scene.update_id == first and w.stats.acks == acks
     drawn(w, first)
-    assert w.scene.update_id == first + 1 and w.in_flight
+    assert w.scene.update_id == first + 1 and w.in_flight and w.stats.acks == acks + 1
     assert np.allclose(
-        w.scene.rows[: len(w.slice.vertices), 0:3],
-        slice_polytope(w.polytope, w.state.matrix, 0.0).vertices * w.scene.scale,
+        w.scene.rows[: len(w.slice.points), 0:3],
+        scaled_points(w, w.source.slice(w.state.matrix, 0.0)),
         atol=1e-5,
     )
     drawn(w, first)  # a second view's late acknowledgement: the first one counted
-    assert w.in_flight
+    assert w.in_flight and w.stats.acks == acks + 1
     companion_says(w, {"event": "drawn", "seq": "soon"})  # malformed: ignored
     companion_says(w, {"event": "drawn"})
-    assert w.in_flight and w.errors.outputs == ()
+    assert w.in_flight and w.errors.outputs == () and w.stats.acks == acks + 1
+    assert w.stats.timeouts == 0
     up(w, "4")
 
 
@@ -204,10 +251,10 @@ def test_a_held_key_without_acknowledgements_sends_one_update_per_timeout(make, 
     n = len(buffer_messages(w, recording_comms))
     # initial + keydown + one per ack_timeout while held (at 0.5, 1.0, 1.5, 2.0 s) + the rest
     assert n <= 2 + math.ceil(2.0 / w.ack_timeout) + 1
+    assert w.stats.updates == n  # every buffer message is a counted update (the initial one too)
+    assert w.stats.acks == 0 and 1 <= w.stats.timeouts <= math.ceil(3.0 / w.ack_timeout)
     assert xw_steps(w) == 0 and w.state.matrix[1, 3] != 0  # R_yw turned, many steps
-    assert np.allclose(
-        w.scene.rows[: len(w.slice.vertices), 0:3], w.slice.vertices * w.scene.scale, atol=1e-5
-    )
+    assert np.allclose(w.scene.rows[: len(w.slice.points), 0:3], scaled_points(w), atol=1e-5)
 
 
 def test_parameter_keys_change_the_readout_only(make, recording_comms):
@@ -243,20 +290,62 @@ def test_refresh_after_a_direct_state_change(make, recording_comms):
         ({"bar_radius": float("nan")}, ValueError, "bar_radius"),
         ({"face_opacity": 1.5}, ValueError, r"face_opacity.*\[0, 1\]"),
         ({"background": "sky"}, ValueError, "background.*#rrggbb"),
-        ({"cell_colors": ["#fff"]}, ValueError, "cell_colors.*one per cell"),
+        ({"group_colors": ["#fff"]}, ValueError, r"group_colors.*at least 5 colours \(one per group\)"),
+        ({"show_faces": "yes"}, TypeError, "show_faces.*True or False"),
         ({"not_an_option": 1}, TypeError, "not_an_option"),
     ],
 )
 def test_bad_scene_options_raise_and_leave_nothing_open(kwargs, exc, match):
     before = len(ipywidget_module._instances)
     with pytest.raises(exc, match=match):
-        Rot4DWidget(autotick=False, **kwargs)
+        Rot4DWidget(_autotick=False, **kwargs)
     assert len(ipywidget_module._instances) == before
+
+
+def test_default_radii_follow_the_displayed_edge(make):
+    assert make("5-cell").scene.display["ball_radius"] == pytest.approx(0.07)
+    w = make("120-cell")
+    edge = 2.0 * look.REFERENCE_RADIUS / polytope("120-cell").circumradius  # edge 2, shown scaled
+    d = w.scene.display
+    assert d["ball_radius"] == pytest.approx(0.1 * edge) == pytest.approx(w.ball_radius)
+    assert d["bar_radius"] == pytest.approx(0.4 * d["ball_radius"]) == pytest.approx(w.bar_radius)
+
+
+def test_display_traits_reach_the_page_as_one_synced_trait_each(make, recording_comms):
+    w = make("24-cell")
+    parts = {m.name: m for m in w.scene.canvas.scene.children if getattr(m, "name", "")}
+    shown = w.scene.update_id
+    n0 = len(recording_comms)
+    w.face_opacity = 0.8
+    w.show_balls = False
+    w.background = "#000000"
+    sent = [(cid, data["state"]) for cid, data, *_ in recording_comms[n0:]]
+    assert [cid for cid, _ in sent] == [parts["faces"].material.model_id, parts["balls"].model_id, w.scene.canvas.model_id]
+    assert sent[0][1]["uniforms"]["u_opacity"]["value"] == pytest.approx(0.8)
+    assert sent[1][1] == {"visible": False}
+    assert sent[2][1] == {"background": "#000000", "clearColor": "#000000"}
+    assert w.scene.display["face_opacity"] == 0.8 and w.scene.update_id == shown  # no rows re-sent
+    n0 = len(recording_comms)
+    with pytest.raises(ValueError, match=r"`face_opacity` to be a number in \[0, 1\]"):
+        w.face_opacity = 3
+    with pytest.raises(TypeError, match="`show_bars` to be True or False"):
+        w.show_bars = "no"
+    assert w.face_opacity == 0.8 and w.show_bars is True and recording_comms[n0:] == []
+
+
+def test_color_by_one_colour_re_sends_every_face_in_it(make, recording_comms):
+    w = make("24-cell")
+    nt = len(w.slice.triangles)
+    assert len(np.unique(w.scene.rows[:nt, 19])) > 1  # by group (4-D cell)
+    n0 = len(recording_comms)
+    w.color_by = "#9fb6cd"
+    assert len(buffer_messages(w, recording_comms[n0:])) == 1
+    assert np.all(bf.unpack_rgb(w.scene.rows[:nt, 19]) == [0x9F, 0xB6, 0xCD])
 
 
 def test_rerun_makes_an_independent_widget(make):
     w1, w2 = make(), make()
-    assert w1.scene.renderer is not w2.scene.renderer and w1.events.source is not w2.events.source
+    assert w1.scene.canvas is not w2.scene.canvas and w1.events.source is not w2.events.source
     down(w2, "4")
     up(w2, "4")
     assert xw_steps(w2) == 1 and xw_steps(w1) == 0
@@ -264,10 +353,10 @@ def test_rerun_makes_an_independent_widget(make):
 
 def test_close_releases_every_widget(recording_comms):
     before = set(ipywidget_module._instances)
-    w = Rot4DWidget("16-cell", autotick=False)
+    w = Rot4DWidget("16-cell", _autotick=False)
     assert len(set(ipywidget_module._instances) - before) > 10
     # the renderer's own sub-widgets are the Scene's to close (Scene.close)
-    renderer_parts = {w.scene.renderer.layout.model_id, w.scene.renderer.shadowMap.model_id}
+    renderer_parts = {w.scene.canvas.layout.model_id, w.scene.canvas.shadowMap.model_id}
     w.close()
     left = set(ipywidget_module._instances) - before
     assert left <= renderer_parts, [type(ipywidget_module._instances[k]).__name__ for k in left]
