@@ -46,6 +46,23 @@ def test_reads_the_scene_and_is_invisible():
         Companion(object())
 
 
+def test_reads_a_real_scene_s_interface():
+    """What the companion needs from the Scene: the buffer's and the three.js scene's model ids
+    and the canvas's CSS class -- all public on the new Scene."""
+    from rot4d_widget.scene import Scene
+
+    sc = Scene(scale=1.0, n_groups=5, capacity=16)
+    c = Companion(sc)
+    try:
+        assert (c.buffer_model_id, c.scene_model_id, c.canvas_class) == (
+            sc.buffer_model_id, sc.scene_model_id, sc.canvas_class,
+        )
+        assert sc.scene_model_id == sc.canvas.scene.model_id and sc.canvas_class in sc.canvas._dom_classes
+    finally:
+        c.close()
+        sc.close()
+
+
 def test_on_drawn_and_on_focus_lost_dispatch_and_can_be_removed():
     c = Companion(FakeScene())
     drawn, lost = [], []
