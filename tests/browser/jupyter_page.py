@@ -66,6 +66,49 @@ _CANVAS_STATS = """
 """
 
 
+#: In the page: after every frame's rendering step, hash a (downscaled) copy of the canvas and
+#: stamp (performance.now()) each frame whose picture changed; stamp key events on ``window``
+#: (capture phase: before ipyevents).  Times measured here are the page's own, free of the
+#: few hundred ms a Playwright call can take on a loaded machine.
+_PIXEL_WATCH = r"""
+(sel) => {
+  if (window.__pw) window.__pw.stop();
+  const c = document.querySelector(sel);
+  if (!c) return false;
+  const k = Math.min(1, 300 / c.width);
+  const W = Math.max(1, Math.round(c.width * k)), H = Math.max(1, Math.round(c.height * k));
+  const tmp = document.createElement('canvas'); tmp.width = W; tmp.height = H;
+  const ctx = tmp.getContext('2d', {willReadFrequently: true});
+  const P = window.__pw = {changes: [], keys: [], frames: 0, run: true};
+  let prev = null;
+  const ch = new MessageChannel();
+  ch.port1.onmessage = () => {
+    if (!P.run) return;
+    ctx.clearRect(0, 0, W, H);
+    ctx.drawImage(c, 0, 0, W, H);
+    const d = new Int32Array(ctx.getImageData(0, 0, W, H).data.buffer);
+    let h = -2128831035;
+    for (let i = 0; i < d.length; i++) h = Math.imul(h ^ d[i], 16777619);
+    const t = performance.now();
+    P.frames++;
+    if (prev !== null && h !== prev) P.changes.push(t);
+    prev = h;
+  };
+  const loop = () => { if (!P.run) return; requestAnimationFrame(loop); ch.port2.postMessage(0); };
+  requestAnimationFrame(loop);
+  const onKey = (e) => P.keys.push([e.type, e.code, e.repeat, performance.now()]);
+  window.addEventListener('keydown', onKey, true);
+  window.addEventListener('keyup', onKey, true);
+  P.stop = () => {
+    P.run = false;
+    window.removeEventListener('keydown', onKey, true);
+    window.removeEventListener('keyup', onKey, true);
+  };
+  return true;
+}
+"""
+
+
 def write_notebook(path, cells: list[str]) -> None:
     nb = nbformat.v4.new_notebook()
     nb.cells = [nbformat.v4.new_code_cell(c) for c in cells]
@@ -144,19 +187,62 @@ class JupyterPage:
         """
         return self.page.evaluate(_CANVAS_STATS, [selector, list(background) if background else None])
 
-    def last_canvas_change(self, selector: str, since: float, watch: float, interval: float = 0.05) -> float:
-        """Watch a canvas until ``watch`` s after ``since`` (time.monotonic()).
+    # -- timing measured in the page (see _PIXEL_WATCH) ------------------------
+    def watch_pixels(self, selector: str) -> None:
+        """Start stamping, in the page, every frame of this canvas whose pixels changed, and every key."""
+        assert self.page.evaluate(_PIXEL_WATCH, selector), f"no canvas {selector!r}"
 
-        Returns the monotonic time of the last change of its pixels seen, or
-        ``since`` if none: how long after ``since`` the view settled.
+    def page_now(self) -> float:
+        """The page's clock (performance.now()), in ms."""
+        return self.page.evaluate("() => performance.now()")
+
+    def pixel_changes(self, after_ms: float = -1.0) -> list[float]:
+        """Page times (ms) of the frames whose pixels changed, after ``after_ms``."""
+        return self.page.evaluate("(t) => window.__pw.changes.filter(x => x > t)", after_ms)
+
+    def key_stamps(self, kind: str, code: str | None = None) -> list[float]:
+        """Page times (ms) of ``kind`` ('keydown'/'keyup') events, not repeats, optionally of one ``code``."""
+        return [t for k, c, rep, t in self.page.evaluate("() => window.__pw.keys")
+                if k == kind and not rep and (code is None or c == code)]
+
+    def wait_quiet(self, quiet: float, timeout: float = 30.0) -> bool:
+        """Wait until the watched canvas has not changed for ``quiet`` s (page time)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            now = self.page_now()
+            changes = self.pixel_changes()
+            if not changes or now - changes[-1] >= 1000 * quiet:
+                return True
+            time.sleep(0.05)
+        return False
+
+    def tap_round_trips(self, keys, timeout: float = 20.0) -> list[float]:
+        """Press each key once (isolated taps); the round trip of each, keydown -> pixels changed, in s.
+
+        Measured in the page (watch_pixels first).  Between taps the view is
+        left to settle (quiet for twice the last round trip, at least 0.3 s).
         """
-        last, h = since, self.canvas_stats(selector)["hash"]
-        while time.monotonic() - since < watch:
-            s = self.canvas_stats(selector)["hash"]
-            if s != h:
-                last, h = time.monotonic(), s
-            time.sleep(interval)
-        return last
+        out = []
+        for key in keys:
+            self.wait_quiet(max(0.3, 2 * out[-1]) if out else 0.3)
+            n = len(self.key_stamps("keydown"))
+            self.page.keyboard.press(key)
+            got = self.wait_for(lambda: len(self.key_stamps("keydown")) > n, timeout=5)
+            assert got, f"tap {key!r}: the page saw no keydown"
+            down = self.key_stamps("keydown")[n]
+            first = self.wait_for(lambda: self.pixel_changes(down), timeout=timeout)
+            assert first, f"tap {key!r}: the canvas did not change within {timeout} s"
+            out.append((first[0] - down) / 1000)
+        self.wait_quiet(max(0.3, 2 * out[-1]))
+        return out
+
+    def settle_after(self, t_ms: float, watch: float) -> float:
+        """Watch the canvas until ``watch`` s (page time) after ``t_ms``; seconds from ``t_ms`` to its
+        last change (0 if none)."""
+        while self.page_now() < t_ms + 1000 * watch:
+            time.sleep(0.05)
+        changes = self.pixel_changes(t_ms)
+        return (changes[-1] - t_ms) / 1000 if changes else 0.0
 
     def wait_for(self, predicate, timeout: float = 10.0, interval: float = 0.05):
         deadline = time.monotonic() + timeout

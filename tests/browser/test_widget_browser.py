@@ -1,13 +1,19 @@
 """What a user sees and does, in JupyterLab 4 and Notebook 7 (each case runs in both).
 
 Bounds here are behaviours with generous margins, not speed targets: speed
-lives in benchmarks/browser_latency.py.
+lives in benchmarks/browser_latency.py.  Every timing bound is derived from
+what the page measured in the same run, before the behaviour under test:
+the round trip of a few isolated taps (keydown -> pixels changed, page
+clock), times a generous multiple, never below a floor.  A loaded machine
+slows the taps and the behaviour alike; a broken flow control inflates the
+behaviour only (issue 7).
 """
 
 from __future__ import annotations
 
 import math
 import random
+import statistics
 import time
 
 import numpy as np
@@ -90,6 +96,14 @@ def _wait_kernel_change(jp, before, var="w", timeout=5.0):
 
 def _wait_pixels_change(jp, sel, old_hash, timeout=5.0):
     return jp.wait_for(lambda: (s := jp.canvas_stats(sel))["hash"] != old_hash and s, timeout=timeout)
+
+
+TAP_KEYS = ["2", "Shift+2", "2"]  # isolated taps measuring this run's round trip
+
+
+def _timing_bound(round_trips, multiple, floor):
+    """``multiple`` x the median tap round trip (s) of this run, at least ``floor`` s."""
+    return max(floor, multiple * statistics.median(round_trips))
 
 
 def _bad_console(page):
@@ -195,6 +209,11 @@ def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_ser
     jp = _open_case(page, jupyter_server, f"hold-{int(autorepeat)}.ipynb")
     sel = _canvas(jp)
     _hover(jp, sel)
+    jp.watch_pixels(sel)
+    taps = jp.tap_round_trips(TAP_KEYS)
+    # settles after release: the update in flight, then the latest state (~2 round trips; the page
+    # draws continuously while a key is held, which slows each trip on a loaded machine)
+    bound = _timing_bound(taps, 6, 0.75)
     timing = jp.kernel_json("dict(delay=w.hold_delay, rate=w.tick_rate)")
     # The hold is timed where the widget's listener sees it, in the page: on a
     # loaded machine each Playwright call can take a few hundred ms, so the
@@ -207,27 +226,30 @@ def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_ser
     before = _state(jp)
     t0 = time.monotonic()
     page.keyboard.down("4")
+    repeats_sent = 0
     if autorepeat:
         while time.monotonic() - t0 < 1.0:
             time.sleep(1 / 30)
             page.keyboard.down("4")  # Playwright sends these with repeat=true
+            repeats_sent += 1
     else:
         time.sleep(1.0)
     page.keyboard.up("4")
-    released = time.monotonic()
     seen = page.evaluate("() => window.__hold")
     firsts = [t for kind, rep, t in seen if kind == "keydown" and not rep]
     ups = [t for kind, rep, t in seen if kind == "keyup"]
     assert len(firsts) == 1 and len(ups) == 1, seen
     if autorepeat:
-        # repeats really reached the page (fewer than 30 when each Playwright call is slow)
-        assert sum(1 for kind, rep, _ in seen if kind == "keydown" and rep) >= 5, seen
+        # every repeat sent reached the page (fewer than 30 in 1 s when each Playwright call is
+        # slow: a loaded machine managed 3), and there were some
+        repeats_seen = sum(1 for kind, rep, _ in seen if kind == "keydown" and rep)
+        assert repeats_seen == repeats_sent >= 2, (repeats_sent, seen)
     held = (ups[0] - firsts[0]) / 1000
     assert held >= 0.99, held
+    settle = jp.settle_after(ups[0], watch=bound + 1.0)
+    # (the screenshot only now: taking one stalls the page's frames, which would count as settling late)
     page.locator(sel).screenshot(path=str(artifacts / f"case4-held-{jupyter_server.kind}-{int(autorepeat)}.png"))
-    # the canvas stops changing within 0.5 s of the release
-    last_change = jp.last_canvas_change(sel, since=released, watch=1.5, interval=0.02)
-    assert last_change - released < 0.5
+    assert settle < bound, f"view kept changing {settle:.2f} s after release (bound {bound:.2f} s, taps {taps})"
     after = _state(jp)
     time.sleep(0.5)
     assert _state(jp)["m"] == after["m"]  # no further step in the kernel
@@ -242,23 +264,29 @@ def test_rotation_stops_when_the_pointer_leaves_or_the_page_blurs(jupyter_server
     jp = _open_case(page, jupyter_server, f"stop-{how}.ipynb")
     sel = _canvas(jp)
     box = _hover(jp, sel)
+    jp.watch_pixels(sel)
+    taps = jp.tap_round_trips(TAP_KEYS)
+    # the leave/blur reaches the kernel (one way), the update in flight lands, then at most the
+    # latest state: ~2 round trips; generous, as events may queue on a loaded machine
+    bound = _timing_bound(taps, 6, 1.0)
+    page.evaluate(
+        "(sel) => { window.__left = null; document.querySelector(sel).addEventListener("
+        "'mouseleave', () => { window.__left = performance.now(); }, {once: true}); }",
+        sel,
+    )
     page.keyboard.down("8")
     time.sleep(0.6)
     if how == "mouseleave":
         page.mouse.move(box["x"] + box["width"] + 200, box["y"] - 50)
+        left = jp.wait_for(lambda: page.evaluate("() => window.__left"), timeout=5)
+        assert left, "the canvas saw no mouseleave"
     else:
-        page.evaluate("() => { window.dispatchEvent(new FocusEvent('blur')); }")
-    # it stops within a generous bound (events may queue on a loaded machine) ...
-    left = time.monotonic()
+        left = page.evaluate("() => { window.dispatchEvent(new FocusEvent('blur')); return performance.now(); }")
+    # it stops within the bound (page time) ...
+    settle = jp.settle_after(left, watch=bound + 1.0)
+    assert settle < bound, f"still rotating {settle:.2f} s after {how} (bound {bound:.2f} s, taps {taps})"
+    # ... and stays stopped while the key is still down, in the kernel too
     a = _state(jp)["m"]
-    while time.monotonic() - left < 3.0:
-        time.sleep(0.25)
-        b = _state(jp)["m"]
-        if b == a:
-            break
-        a = b
-    assert b == a, "still rotating 3 s after the pointer left / the page blurred"
-    # ... and stays stopped while the key is still down
     time.sleep(0.6)
     c = _state(jp)["m"]
     page.keyboard.up("8")
@@ -321,27 +349,34 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     """
     jp = _open_case(page, jupyter_server, "flow.ipynb", polytope_name="600-cell")
     sel = _canvas(jp)
-    page.evaluate(_WATCH_ACKS, sel)
-    initial = jp.canvas_stats(sel)["hash"]
     _hover(jp, sel)
+    jp.watch_pixels(sel)
     cdp = page.context.new_cdp_session(page)
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 6})
+    # this run's round trip on the throttled page, from isolated taps (no flow control at work)
+    taps = jp.tap_round_trips(TAP_KEYS)
+    bound = _timing_bound(taps, 4, 1.0)
+    page.evaluate(_WATCH_ACKS, sel)
+    initial = jp.canvas_stats(sel)["hash"]
     start = jp.kernel_json("w.stats.as_dict()")
     page.keyboard.down("4")
     time.sleep(2.0)
     page.keyboard.up("4")
-    released = time.monotonic()
-    last_change = jp.last_canvas_change(sel, since=released, watch=2.5)
+    released = jp.wait_for(lambda: jp.key_stamps("keyup", "Digit4"), timeout=5)[-1]
+    settle = jp.settle_after(released, watch=bound + 1.5)
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 1})
     final = jp.canvas_stats(sel)["hash"]
     end = jp.kernel_json("w.stats.as_dict()")
     acks = page.evaluate("() => window.__acks")
     updates = end["updates"] - start["updates"]
-    assert updates >= 3
+    answered = (end["acks"] - start["acks"]) + (end["timeouts"] - start["timeouts"])
+    diag = f"taps {[round(t, 3) for t in taps]} s, stats before {start}, after {end}"
+    print(f"flow control: settled {settle:.2f} s after release, bound {bound:.2f} s; {diag}")
+    # after release the view settles at once (the update in flight, then the latest state; nothing queued)
+    assert settle < bound, f"view kept changing {settle:.2f} s after release (bound {bound:.2f} s); {diag}"
+    assert updates >= 3, diag
     # at most one update in flight: every update but the last was answered (or timed out) first
-    assert updates <= (end["acks"] - start["acks"]) + (end["timeouts"] - start["timeouts"]) + 1, (start, end)
-    # after release the view settles at once (the update in flight, nothing queued)
-    assert last_change - released < 1.5
+    assert updates <= answered + 1, f"{updates} updates sent, {answered} answered; {diag}"
     # an acknowledgement leaves only once the canvas shows its update: no ack while the
     # first picture is still up, each ack on a new picture, the last one on the final picture
     assert len(acks) >= 3
@@ -371,6 +406,9 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     )
     sel = _canvas(jp)
     _hover(jp, sel)
+    jp.watch_pixels(sel)
+    taps = jp.tap_round_trips(TAP_KEYS)
+    bound = _timing_bound(taps, 6, 1.0)
     cdp = page.context.new_cdp_session(page)
     models_before = jp.kernel_json("live_models()")
 
@@ -405,10 +443,11 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
         page.keyboard.up(k)
     if shift:
         page.keyboard.up("Shift")
-    last_event = time.monotonic()
-    # the view settles within 2 s of the last event
-    settled_at = jp.last_canvas_change(sel, since=last_event, watch=3.0)
-    assert settled_at - last_event < 2.0
+    time.sleep(0.2)
+    last_event = max(t for _, _, _, t in page.evaluate("() => window.__pw.keys"))
+    # the view settles soon after the last event (nothing queued)
+    settle = jp.settle_after(last_event, watch=bound + 1.0)
+    assert settle < bound, f"view kept changing {settle:.2f} s after the last key (bound {bound:.2f} s, taps {taps})"
     m = np.array(_state(jp)["m"])
     assert np.abs(m @ m.T - np.eye(4)).max() < 1e-12
     assert jp.kernel_json("len(w.errors.outputs)") == 0
