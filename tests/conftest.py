@@ -1,8 +1,4 @@
-"""Shared fixtures: a recording comm, a fake clock, widgets made with them.
-
-`service(w, now)` does what the widget's ticker thread does once (the update
-pump's ``service``): the one place tests reach into a widget for time.
-"""
+"""Shared fixtures: a recording comm, a fake clock, widgets made with them."""
 
 import pytest
 
@@ -45,8 +41,3 @@ def make(clock):
     yield _make
     for w in made:
         w.close()
-
-
-def service(w, now=None):
-    """Run the widget's due ticks and flow control once (what its ticker thread does)."""
-    return w._pump.service(now)

@@ -20,7 +20,7 @@ from rot4d_widget import PolytopeSource, SourceAction
 from rot4d_widget.source import as_source
 from rot4d_widget.widget import Rot4DWidget
 
-from conftest import service
+from widget_time import service
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

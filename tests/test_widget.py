@@ -19,7 +19,7 @@ import pytest
 import traitlets
 from ipywidgets import CallbackDispatcher
 from ipywidgets.widgets import widget as ipywidget_module
-from conftest import service
+from widget_time import service
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget import widget as wmod

@@ -25,6 +25,7 @@ from rot4d_widget import look, polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.widget import Rot4DWidget
 from test_widget import down, up, xw_steps
+from widget_time import service
 
 
 # comms, clock and `make`: tests/conftest.py
@@ -51,16 +52,6 @@ def orbit_ends_at(w, eye):
     camera.comm.handler(
         {"content": {"data": {"method": "update", "state": {"position": list(eye)}, "buffer_paths": []}}, "buffers": []}
     )
-
-
-def service(w, now):
-    """What the widget's ticker thread does once at clock time ``now``: due key repeats, the
-    acknowledgement timeout, a send if flow control allows.  Returns when it wants to run next.
-
-    The only use of the widget's private update pump in this file (the fake clock stands in
-    for the thread, which `make` does not start).
-    """
-    return w._pump.service(now)
 
 
 def run_ticker(w, clock, until):
