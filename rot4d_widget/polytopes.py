@@ -55,7 +55,9 @@ for _canon, _aliases in _ALIASES.items():
 
 def _sealed(a: np.ndarray) -> np.ndarray:
     """``a`` made read-only, behind a read-only view: nothing can write, resize or
-    re-enable writing through what is handed out (``a`` must be fresh, owned here)."""
+    re-enable writing through what is handed out."""
+    if a.base is not None:  # a view: its base could be unlocked and written
+        a = a.copy()
     a.flags.writeable = False
     v = a.view()
     v.flags.writeable = False

@@ -54,6 +54,8 @@ def _finite(name: str, value) -> float:
 def _read_only(m: np.ndarray) -> np.ndarray:
     """A freshly made array, read-only behind a read-only view (no copy): what is
     handed out can be neither written, nor resized, nor made writable again."""
+    if m.base is not None:  # a view (not made here): its base could be unlocked
+        m = m.copy()
     m.flags.writeable = False
     v = m.view()
     v.flags.writeable = False
@@ -174,7 +176,7 @@ class RotationState:
                 m = double_rotation(action.planes, sign * self._alpha, sign * self.beta)
             else:
                 m = simple_rotation(action.planes, sign * self._theta0)
-            self._steps[cache_key] = _read_only(m)
+            m = self._steps[cache_key] = _read_only(m)
         return m
 
     def apply(self, action: Action, inverted: bool = False) -> bool:

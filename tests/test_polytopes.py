@@ -224,6 +224,11 @@ def test_editing_edges_cannot_corrupt_later_slices():
         p.edges[0] = (3, 4)
     with pytest.raises(ValueError):
         p.faces[0][0] = 4
+    for a in (p.edges, p.vertices, p.faces[0], p.face_cells, p.cell_normals):
+        with pytest.raises(ValueError):
+            a.flags.writeable = True
+        with pytest.raises(ValueError):
+            a.resize(a.size + 5, refcheck=False)
     after = slice_polytope(p, np.eye(4), 0.0)
     np.testing.assert_array_equal(after.edges, before.edges)
     assert p.counts == COUNTS["5-cell"]

@@ -211,6 +211,10 @@ def test_matrix_is_read_only():
     st.reset()
     with pytest.raises(ValueError, match="read-only"):
         st.matrix[0, 0] = 5.0
+    with pytest.raises(ValueError):
+        st.matrix.flags.writeable = True  # cannot be unlocked ...
+    with pytest.raises(ValueError):
+        st.matrix.resize((2, 2), refcheck=False)  # ... nor resized in place
     np.testing.assert_array_equal(st.matrix, np.eye(4))
 
 
@@ -244,9 +248,12 @@ def test_matrix_is_the_same_object_until_a_step_replaces_it():
 
 def test_step_matrix_cache_cannot_be_corrupted():
     st = RotationState(theta0=0.1)
-    step = st.step_matrix(DEFAULT_KEYMAP["4"])
-    with pytest.raises(ValueError, match="read-only"):
-        step[0, 0] = 0.0
+    for _ in range(2):  # the first call (which fills the cache) and a cached one
+        step = st.step_matrix(DEFAULT_KEYMAP["4"])
+        with pytest.raises(ValueError, match="read-only"):
+            step[0, 0] = 0.0
+        with pytest.raises(ValueError):
+            step.flags.writeable = True
     st.press("4")
     np.testing.assert_allclose(st.matrix, simple_rotation("xw", 0.1), atol=1e-15)
 
