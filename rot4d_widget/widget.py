@@ -45,7 +45,7 @@ from ipyevents import Event
 from . import look
 from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
-from .keymap import DEFAULT_KEYMAP, REPEATING_KINDS, Action, Keymap
+from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, UpdatePump
 from .source import as_source
 from .state import DEFAULT_THETA0, RotationState, _finite, _theta0
@@ -667,13 +667,17 @@ def _source_actions(source) -> dict:
 
 
 def _help_groups(keymap: Keymap) -> list:
-    groups = getattr(keymap, "help_groups", None)
-    if groups is not None:
-        return groups()
-    merged: dict = {}
-    for key, label, description in keymap.help_rows():
-        merged.setdefault((label, description), []).append(key)
-    return [(" ".join(keys), label, text) for (label, text), keys in merged.items()]
+    """The key table, one row per action; reserved keys that do nothing here yet in one honest row."""
+    rows, reserved = [], []
+    for keys, label, text in keymap.help_groups():
+        kinds = {keymap[k].kind for k in keys.split() if k in keymap}
+        if kinds and kinds <= RESERVED_KINDS:
+            reserved.append(keys)
+        else:
+            rows.append((keys, label, text))
+    if reserved:
+        rows.append((" ".join(reserved), "reserved", "iso levels, parallel slices, pictures: not active in this view yet"))
+    return rows
 
 
 def _close_quietly(w) -> None:

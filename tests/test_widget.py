@@ -23,6 +23,7 @@ from widget_time import service
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget import widget as wmod
+from rot4d_widget.keymap import RESERVED_KINDS
 from rot4d_widget.look import REFERENCE_RADIUS
 from rot4d_widget.state import DEFAULT_THETA0
 from rot4d_widget.widget import Rot4DWidget
@@ -520,8 +521,12 @@ def test_help_key_toggles_the_key_table(make):
     up(w, "?", code="Slash", shift=True)
     assert w.help_visible
     for keys, label, _ in w.state.keymap.help_groups():
+        if w.state.keymap[keys.split()[0]].kind in RESERVED_KINDS:
+            assert keys in w.help_panel.value  # listed once, as reserved: they do nothing here yet
+            continue
         assert f"<kbd>{html.escape(keys)}</kbd>" in w.help_panel.value
         assert html.escape(label) in w.help_panel.value
+    assert "<kbd>o i n b g f p</kbd><td>reserved" in w.help_panel.value.replace("</td>", "")
     assert "Numpad" not in w.help_panel.value and "Drag" in w.help_panel.value
     w.press("?")
     assert not w.help_visible
