@@ -54,12 +54,12 @@ def _state(jp, var="w"):
     )
 
 
-def _open_case(page, server, name, polytope_name="5-cell", extra_cells=()):
+def _open_case(page, server, name, polytope_name="5-cell", extra_cells=(), widget_args=""):
     write_notebook(
         server.root / name,
         [
             "from rot4d_widget import Rot4DWidget\nimport numpy as np\nws = []",
-            f"w = Rot4DWidget({polytope_name!r})\nws.append(w)\nw",
+            f"w = Rot4DWidget({polytope_name!r}{widget_args})\nws.append(w)\nw",
             *extra_cells,
         ],
     )
@@ -131,7 +131,8 @@ def test_notebook_01_draws_the_w0_tetrahedron(jupyter_server, page, artifacts):
     )
     np.testing.assert_allclose(info["m"], np.eye(4), atol=1e-9)  # the notebook ends on a full turn
     stats = jp.canvas_stats(sel)
-    page.locator(sel).screenshot(path=str(artifacts / f"case1-tetrahedron-{jupyter_server.kind}.png"))
+    # (the notebook shows the widget twice, the second time under its c0 slider)
+    page.locator(sel).first.screenshot(path=str(artifacts / f"case1-tetrahedron-{jupyter_server.kind}.png"))
     # the silhouette of the balls, projected by an independent pinhole camera at (0, 0, 5)
     verts = slice_polytope("5-cell", np.eye(4), 0.0).vertices * info["scale"]
     W, H = stats["width"], stats["height"]
@@ -204,6 +205,12 @@ def _steps_of_xw(m_before, m_after, theta0):
     return math.atan2(r[3, 0], r[0, 0]) / theta0
 
 
+def _step_difference(steps, expected, theta0):
+    """steps - expected, up to whole turns (a long hold on a loaded machine can pass half a turn)."""
+    turn = 2 * math.pi / theta0
+    return (steps - expected + turn / 2) % turn - turn / 2
+
+
 @pytest.mark.parametrize("autorepeat", [False, True])
 def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_server, page, artifacts, autorepeat):
     jp = _open_case(page, jupyter_server, f"hold-{int(autorepeat)}.ipynb")
@@ -255,7 +262,7 @@ def test_holding_a_key_rotates_at_the_tick_rate_and_stops_on_release(jupyter_ser
     assert _state(jp)["m"] == after["m"]  # no further step in the kernel
     steps = _steps_of_xw(before["m"], after["m"], before["theta0"])
     expected = 1 + timing["rate"] * (held - timing["delay"])
-    assert abs(steps - expected) <= 5, (steps, expected, held)
+    assert abs(_step_difference(steps, expected, before["theta0"])) <= 5, (steps, expected, held)
 
 
 # 5 -------------------------------------------------------------------------
@@ -347,7 +354,10 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     The page draws slower than the tick rate: without one-update-in-flight the
     kernel would queue updates and the view would keep moving after release.
     """
-    jp = _open_case(page, jupyter_server, "flow.ipynb", polytope_name="600-cell")
+    # ack_timeout far above this page's round trip: the acknowledgement path is what is tested.
+    # (With the default 0.5 s a 6x-throttled page on a loaded machine answers later than that:
+    # the pump then sends on timeouts, unacknowledged, and the view falls behind.)
+    jp = _open_case(page, jupyter_server, "flow.ipynb", polytope_name="600-cell", widget_args=", ack_timeout=10.0")
     sel = _canvas(jp)
     _hover(jp, sel)
     jp.watch_pixels(sel)
@@ -377,6 +387,7 @@ def test_drawn_acks_follow_the_pixels_and_one_update_is_in_flight(jupyter_server
     assert updates >= 3, diag
     # at most one update in flight: every update but the last was answered (or timed out) first
     assert updates <= answered + 1, f"{updates} updates sent, {answered} answered; {diag}"
+    assert end["timeouts"] == start["timeouts"], f"an acknowledgement took over 10 s; {diag}"
     # an acknowledgement leaves only once the canvas shows its update: no ack while the
     # first picture is still up, each ack on a new picture, the last one on the final picture
     assert len(acks) >= 3
@@ -408,7 +419,7 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     _hover(jp, sel)
     jp.watch_pixels(sel)
     taps = jp.tap_round_trips(TAP_KEYS)
-    bound = _timing_bound(taps, 6, 1.0)
+    settle_bound = _timing_bound(taps, 6, 1.0)
     cdp = page.context.new_cdp_session(page)
     models_before = jp.kernel_json("live_models()")
 
@@ -446,8 +457,10 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     time.sleep(0.2)
     last_event = max(t for _, _, _, t in page.evaluate("() => window.__pw.keys"))
     # the view settles soon after the last event (nothing queued)
-    settle = jp.settle_after(last_event, watch=bound + 1.0)
-    assert settle < bound, f"view kept changing {settle:.2f} s after the last key (bound {bound:.2f} s, taps {taps})"
+    settle = jp.settle_after(last_event, watch=settle_bound + 1.0)
+    assert settle < settle_bound, (
+        f"view kept changing {settle:.2f} s after the last key (bound {settle_bound:.2f} s, taps {taps})"
+    )
     m = np.array(_state(jp)["m"])
     assert np.abs(m @ m.T - np.eye(4)).max() < 1e-12
     assert jp.kernel_json("len(w.errors.outputs)") == 0
