@@ -348,6 +348,8 @@ CELLS = [
     "from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({name!r}))\nw",
 ]
 READ = {BASE: "bench.read_baseline()", WIDGET: "bench.read_widget(w)"}
+#: ``--in-flight N``: set the widget's bound on updates in flight (None: the package's default).
+IN_FLIGHT = None
 
 
 # -- helpers ------------------------------------------------------------------
@@ -418,7 +420,10 @@ def ws_on(page):
 
 def run_case(context, server, case: str, args, rng: random.Random, hold_baseline: bool) -> dict:
     name = f"bench_{case.replace('-', '_')}.ipynb"
-    write_notebook(server.root / name, [c.format(name=case) for c in CELLS])
+    cells = [c.format(name=case) for c in CELLS]
+    if IN_FLIGHT is not None:  # --in-flight: the widget's bound on updates in flight, for comparisons
+        cells[1] = cells[1].replace("\nw", f"\nw._pump.max_in_flight = {IN_FLIGHT}\nw", 1)
+    write_notebook(server.root / name, cells)
     page = context.new_page()
     errors: list[str] = []
     page.on("pageerror", lambda e: None if page.__dict__.get("closing") else errors.append(str(e)))
@@ -904,7 +909,13 @@ def main(argv=None) -> int:
     ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision (e.g. HEAD)")
     ap.add_argument("--json", default=None, help="also write the raw results here")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory (server log)")
+    ap.add_argument("--in-flight", type=int, default=None,
+                    help="updates the widget may have in flight (default: the package's; 1 = the old protocol)")
     args = ap.parse_args(argv)
+    global IN_FLIGHT
+    if args.in_flight is not None and args.in_flight < 1:
+        ap.error("--in-flight must be >= 1")
+    IN_FLIGHT = args.in_flight
     if args.presses < 1 or args.hold <= FPS_SKIP or args.runs < 1:
         ap.error(f"need --presses >= 1, --hold > {FPS_SKIP} and --runs >= 1")
     try:

@@ -1,6 +1,8 @@
 // rot4d_widget companion (anywidget ES module, no build step).
 //
-// Four jobs for one Scene, per displayed view of this invisible widget:
+// Four jobs for one Scene, per displayed view of this invisible widget (job 1 also
+// applies, as it arrives, what travels with each update: the rows each layer draws,
+// `_rot4d_counts`, and a 3-D turn of the whole view, `_rot4d_turn`):
 //  1. "drawn": after the pythreejs Scene has rendered a frame that contains
 //     the latest assignment to the shared row buffer, send
 //     {event: "drawn", seq} where seq is the buffer's `_rot4d_seq` (sent in
@@ -145,22 +147,61 @@ async function render({ model, el }) {
     }
   };
 
-  // 1. drawn acknowledgement
+  // 1. drawn acknowledgement, drawn counts, 3-D turn
   try {
     const manager = model.widget_manager;
     const isAlive = () => alive;
-    const [buffer, scene] = await Promise.all([
+    const ids = (name) => (model.get(name) || []).map(modelId);
+    const [buffer, scene, geometries, meshes] = await Promise.all([
       getModel(manager, modelId(model.get("buffer_model_id")), isAlive),
       getModel(manager, modelId(model.get("scene_model_id")), isAlive),
+      Promise.all(ids("geometry_model_ids").map((id) => getModel(manager, id, isAlive))),
+      Promise.all(ids("mesh_model_ids").map((id) => getModel(manager, id, isAlive))),
     ]);
     if (alive) {
       const version = () => (buffer.obj ? buffer.obj.version : undefined);
-      let pending = null; // {seq, data, after}: the latest arrival not yet acknowledged
+      // Draw only the rows in use: set in the same event that applied the array, so a
+      // frame never draws a count with another update's rows.  Never more than the rows held.
+      const applyCounts = () => {
+        const counts = buffer.get("_rot4d_counts") || [];
+        const obj = buffer.obj;
+        const rows = obj && obj.array ? obj.array.length / obj.stride : 0;
+        geometries.forEach((g, i) => {
+          if (g.obj && Number.isInteger(counts[i])) g.obj.maxInstancedCount = Math.max(0, Math.min(counts[i], rows));
+        });
+      };
+      // The whole view turned in 3-D (keys that leave w alone): one rotation for every mesh.
+      const applyTurn = () => {
+        const m = buffer.get("_rot4d_turn");
+        if (!Array.isArray(m) || m.length !== 16) return;
+        for (const mesh of meshes) {
+          const obj = mesh.obj;
+          if (!obj) continue;
+          const e = obj.matrix.elements;
+          for (let i = 0; i < 16; i++) e[i] = m[i];
+          obj.quaternion.setFromRotationMatrix(obj.matrix);
+        }
+      };
+      if (geometries.length) applyCounts();
+      if (meshes.length) applyTurn();
+      let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
-      const onArray = () => {
-        // `after`: the version before this array can have been uploaded
-        pending = { seq: buffer.get("_rot4d_seq"), data: dataOf(buffer.get("array")), after: renderedVersion };
+      const onChange = () => {
+        const arrayChanged = buffer.hasChanged("array");
+        if (buffer.hasChanged("_rot4d_counts") || arrayChanged) applyCounts();
+        if (buffer.hasChanged("_rot4d_turn")) {
+          applyTurn();
+          scene.trigger("rerender", scene, {}); // a turn alone changes no three.js buffer
+        }
+        const data = arrayChanged ? dataOf(buffer.get("array")) : null;
+        if (buffer.hasChanged("_rot4d_seq")) {
+          // `after`: the version before this array can have been uploaded; a turn alone
+          // (data null) is in the next frame drawn.
+          pending = { seq: buffer.get("_rot4d_seq"), data, after: renderedVersion };
+        } else if (arrayChanged && pending !== null && pending.data !== null) {
+          pending = { seq: pending.seq, data, after: renderedVersion }; // a growth step re-sent the rows
+        }
       };
       const onRendered = () => {
         ensureGuards();
@@ -169,17 +210,17 @@ async function render({ model, el }) {
         renderedVersion = version();
         if (p === null || !obj) return;
         // not in this frame unless three.js holds the new array and re-uploaded it
-        if (obj.array !== p.data || (p.after !== undefined && !(obj.version > p.after))) return;
+        if (p.data !== null && (obj.array !== p.data || (p.after !== undefined && !(obj.version > p.after)))) return;
         pending = null;
-        if (p.seq === lastSent) return; // e.g. a growth step re-sending the shown picture
+        if (p.seq === lastSent) return;
         lastSent = p.seq;
         // The canvas holds the new pixels now; wait one more frame so that the
         // frame has been presented (and any rAF read-back has seen it).
         requestAnimationFrame(() => send({ event: "drawn", seq: p.seq }));
       };
-      buffer.on("change:array", onArray);
+      buffer.on("change", onChange);
       scene.on("afterRender", onRendered);
-      cleanups.push(() => buffer.off("change:array", onArray));
+      cleanups.push(() => buffer.off("change", onChange));
       cleanups.push(() => scene.off("afterRender", onRendered));
     }
   } catch (e) {

@@ -17,6 +17,13 @@ step) and does four things in JupyterLab 4 and Notebook 7 alike:
    with the same id is not).  Each displayed view of the companion
    acknowledges (several views: several acks with the same n).  No view, a
    hidden tab or a frozen WebGL context: no acknowledgement.
+   As each update arrives it also applies what travels in the same message:
+   ``_rot4d_counts`` (the rows each layer draws: it sets the geometries'
+   ``maxInstancedCount``, never above the rows held, in the event that
+   applied the array, so no frame draws one update's count with another's
+   rows) and ``_rot4d_turn`` (a 3-D turn of the whole view, set on every
+   mesh; a turn alone changes no buffer, so it asks the scene to render and
+   is acknowledged at the next frame drawn).
 2. **focus loss** -- window ``blur`` or ``document.visibilityState ==
    "hidden"`` sends ``{"event": "focus_lost", "reason": "blur" | "hidden"}``;
    `on_focus_lost` callbacks get the reason.
@@ -46,7 +53,7 @@ import pathlib
 
 import anywidget
 from ipywidgets import CallbackDispatcher, Layout
-from traitlets import Unicode
+from traitlets import List, Unicode
 
 __all__ = ["Companion"]
 
@@ -55,8 +62,8 @@ class Companion(anywidget.AnyWidget):
     """Invisible front-end helper for one `Scene`.
 
     ``Companion(scene)`` reads ``scene.buffer_model_id``,
-    ``scene.scene_model_id`` and ``scene.canvas_class``; they can also be given
-    as keyword arguments.
+    ``scene.scene_model_id``, ``scene.canvas_class``, ``scene.geometry_model_ids``
+    and ``scene.mesh_model_ids``; they can also be given as keyword arguments.
     """
 
     _esm = pathlib.Path(__file__).with_name("companion.js")
@@ -64,6 +71,8 @@ class Companion(anywidget.AnyWidget):
     buffer_model_id = Unicode("").tag(sync=True)
     scene_model_id = Unicode("").tag(sync=True)
     canvas_class = Unicode("").tag(sync=True)
+    geometry_model_ids = List(Unicode()).tag(sync=True)
+    mesh_model_ids = List(Unicode()).tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -71,6 +80,8 @@ class Companion(anywidget.AnyWidget):
                 kwargs.setdefault("buffer_model_id", scene.buffer_model_id)
                 kwargs.setdefault("scene_model_id", scene.scene_model_id)
                 kwargs.setdefault("canvas_class", scene.canvas_class)
+                kwargs.setdefault("geometry_model_ids", list(scene.geometry_model_ids))
+                kwargs.setdefault("mesh_model_ids", list(scene.mesh_model_ids))
             except AttributeError:
                 raise TypeError(f"Expected `scene` to be a rot4d_widget Scene, got {type(scene).__name__}") from None
         kwargs.setdefault("layout", Layout(display="none", width="0px", height="0px"))

@@ -1,13 +1,22 @@
-"""The update pump: at most one scene update in flight, acknowledged by the page.
+"""The update pump: at most ``max_in_flight`` scene updates in flight, acknowledged by the page.
 
-After an update is sent the pump waits for the page's "drawn"
-acknowledgement of that update (its id) before it asks for the next one, which
-is computed from the latest state at that moment: nothing queues, so the view
-never falls behind and settles as soon as the state stops changing.  Without
-an answer (no view: scripting, nbval; a hidden tab) the latest state is sent
-anyway ``ack_timeout`` seconds after the previous update.  Acknowledgements
-name the update: with several views the first one counts, late, stale and
-unknown ones are ignored.
+After an update is sent the pump may send the next one, computed from the
+latest state at that moment, while fewer than ``max_in_flight`` updates await
+the page's "drawn" acknowledgement.  With two in flight the kernel computes
+and sends the next picture while the page draws the previous one, so the
+round trip to the kernel is no longer in series with the page's frames; the
+page always draws the newest picture it holds.  Nothing queues beyond that
+bound, so the view never falls behind and settles as soon as the state stops
+changing.  An acknowledgement names an update and retires it and every older
+one (the page acknowledges only the newest of several arriving before a frame).
+With several views the first acknowledgement counts; stale and unknown ones
+are ignored.
+
+Without an answer (no view: scripting, nbval; a hidden tab) the latest state
+is sent anyway once the oldest update in flight is ``timeout`` old, where
+``timeout`` is ``ack_timeout`` or, when the page has been slower than that,
+four times the median of its recent acknowledgement times (a slow page must
+not be flooded by timeouts).
 
 Time advances through ``service(now)``: it runs the owner's ``tick(now)``
 (held keys), then sends if allowed, and returns when it wants to run next.
@@ -26,21 +35,33 @@ import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT"]
+__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_IN_FLIGHT"]
 
 ACK_TIMEOUT = 0.5
+#: Updates allowed in flight at once (1: strictly one at a time).
+MAX_IN_FLIGHT = 2
+#: Recent acknowledgement times the adaptive timeout looks at.
+_ACK_WINDOW = 8
 
 
 @dataclass
 class PumpStats:
-    """Counters of one pump: updates sent, acknowledged in time, sent after a timeout."""
+    """Counters of one pump.
+
+    updates: sent; acks: acknowledgements that retired updates; acknowledged:
+    updates they retired (an acknowledgement retires every older update too);
+    timeouts: updates given up unanswered.  At any time
+    ``updates - acknowledged - timeouts`` (the initial picture aside) is what is in flight.
+    """
 
     updates: int = 0
     acks: int = 0
+    acknowledged: int = 0
     timeouts: int = 0
 
     def as_dict(self) -> dict:
-        return {"updates": self.updates, "acks": self.acks, "timeouts": self.timeouts}
+        return {"updates": self.updates, "acks": self.acks, "acknowledged": self.acknowledged,
+                "timeouts": self.timeouts}
 
 
 class UpdatePump:
@@ -58,18 +79,23 @@ class UpdatePump:
         When ``tick`` next wants to run.
     clock : callable () -> seconds
     ack_timeout : float
+        Seconds to wait for an acknowledgement at least (see the module docs).
+    max_in_flight : int >= 1
     autotick : bool
         Run the daemon thread when there is something to wait for.
     on_error : callable (exception) -> None
     """
 
     def __init__(self, send, *, tick=None, deadline=None, clock=None, ack_timeout=ACK_TIMEOUT,
-                 autotick=True, on_error=None, name="rot4d-ticker"):
+                 max_in_flight=MAX_IN_FLIGHT, autotick=True, on_error=None, name="rot4d-ticker"):
         self._send = send
         self._tick = tick
         self._deadline = deadline
         self.clock = clock if clock is not None else time.monotonic
         self.ack_timeout = float(ack_timeout)
+        if isinstance(max_in_flight, bool) or not isinstance(max_in_flight, int) or max_in_flight < 1:
+            raise ValueError(f"Expected `max_in_flight` to be an int >= 1, got {max_in_flight!r}")
+        self.max_in_flight = max_in_flight
         self.autotick = bool(autotick)
         self._on_error = on_error
         self._name = name
@@ -77,16 +103,27 @@ class UpdatePump:
         self._wakeup = threading.Condition(self.lock)
         self.stats = PumpStats()
         self._dirty = False
-        self._in_flight = None
-        self._sent_at = -math.inf
+        self._flight = {}  # update id -> clock time sent, oldest first
+        self._ack_times = []  # recent send -> acknowledgement durations
         self._thread = None
         self._closed = False
 
     # -- state ----------------------------------------------------------------
     @property
     def in_flight(self):
-        """Id of the update awaiting its acknowledgement, or None."""
-        return self._in_flight
+        """Id of the newest update awaiting its acknowledgement, or None."""
+        return next(reversed(self._flight), None)
+
+    @property
+    def n_in_flight(self) -> int:
+        return len(self._flight)
+
+    @property
+    def timeout(self) -> float:
+        """The acknowledgement timeout in force: ``ack_timeout``, or 4 x the recent median if larger."""
+        times = sorted(self._ack_times)
+        recent = 4.0 * times[len(times) // 2] if times else 0.0
+        return max(self.ack_timeout, recent)
 
     @property
     def dirty(self) -> bool:
@@ -99,16 +136,17 @@ class UpdatePump:
 
     # -- entry points -----------------------------------------------------------
     def flush(self, now=None) -> None:
-        """Send the latest state unless an update is in flight (and not timed out)."""
+        """Send the latest state unless ``max_in_flight`` updates are in flight (and none timed out)."""
         with self.lock:
             if self._closed or not self._dirty:
                 return
             now = self.clock() if now is None else now
-            if self._in_flight is not None:
-                if now - self._sent_at < self.ack_timeout:
+            if len(self._flight) >= self.max_in_flight:
+                oldest, sent = next(iter(self._flight.items()))
+                if now - sent < self.timeout:
                     self.wake()
                     return
-                self._in_flight = None
+                del self._flight[oldest]  # the page does not answer: stop waiting for the oldest
                 self.stats.timeouts += 1
             self.send_now(now, expect_ack=True)
             self.wake()
@@ -121,17 +159,20 @@ class UpdatePump:
             if seq is not None:
                 self.stats.updates += 1
                 if expect_ack:
-                    self._in_flight = seq
-                    self._sent_at = self.clock() if now is None else now
+                    self._flight[seq] = self.clock() if now is None else now
 
     def acknowledge(self, seq) -> bool:
-        """The page drew update ``seq``; True if it was the one awaited."""
+        """The page drew update ``seq`` (and so every older one); True if it was awaited."""
         if isinstance(seq, bool) or not isinstance(seq, int):
             return False
         with self.lock:
-            if self._closed or self._in_flight is None or seq != self._in_flight:
+            if self._closed or seq not in self._flight:
                 return False  # late, duplicate (another view), unknown, or after a timeout
-            self._in_flight = None
+            sent = self._flight[seq]
+            for k in [k for k in self._flight if k <= seq]:
+                del self._flight[k]
+                self.stats.acknowledged += 1
+            self._ack_times = (self._ack_times + [max(0.0, self.clock() - sent)])[-_ACK_WINDOW:]
             self.stats.acks += 1
             self.flush()
             return True
@@ -157,8 +198,8 @@ class UpdatePump:
             d = self._deadline()
             if d is not None:
                 deadlines.append(d)
-        if self._dirty and self._in_flight is not None:
-            deadlines.append(self._sent_at + self.ack_timeout)
+        if self._dirty and len(self._flight) >= self.max_in_flight:
+            deadlines.append(next(iter(self._flight.values())) + self.timeout)
         return min(deadlines) if deadlines else None
 
     # -- the thread -------------------------------------------------------------

@@ -67,7 +67,7 @@ import uuid
 
 import numpy as np
 import pythreejs as p3
-from traitlets import CInt
+from traitlets import CFloat, CInt, List
 
 from . import buffers as bf
 from . import look
@@ -85,10 +85,21 @@ def shader_source(name: str) -> str:
     return _INCLUDE.sub(lambda m: shader_source(m.group(1)), text)
 
 
+_IDENTITY4 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+
+
 class _RowBuffer(p3.InstancedInterleavedBuffer):
-    """The shared buffer; ``_rot4d_seq`` travels in the same message as the array."""
+    """The shared buffer.  What travels in the same message as the array (or alone, for a turn):
+
+    ``_rot4d_seq`` the update's id; ``_rot4d_counts`` the rows each layer draws
+    (balls, bars, faces: the companion sets the geometries' drawn count as it
+    applies the message); ``_rot4d_turn`` a 3-D turn of the whole view as a
+    column-major 4x4 (the companion sets it on the meshes).
+    """
 
     _rot4d_seq = CInt(0).tag(sync=True)
+    _rot4d_counts = List(CInt(), default_value=[0, 0, 0]).tag(sync=True)
+    _rot4d_turn = List(CFloat(), default_value=_IDENTITY4).tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
@@ -349,6 +360,16 @@ class Scene:
         return self._buffer.model_id
 
     @property
+    def geometry_model_ids(self) -> list:
+        """Model ids of the ball, bar and face geometries (the companion sets their drawn counts)."""
+        return [self._geometries[k].model_id for k in ("ball", "bar", "face")]
+
+    @property
+    def mesh_model_ids(self) -> list:
+        """Model ids of the ball, bar and face meshes (the companion turns them)."""
+        return [self._meshes[k].model_id for k in ("ball", "bar", "face")]
+
+    @property
     def scene_model_id(self) -> str:
         """Model id of the pythreejs Scene (it fires ``afterRender`` on the page)."""
         return self._three_scene.model_id
@@ -450,24 +471,62 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb, capacity=self.capacity, eye=self.eye,
             single_rgb=single_rgb,
         )
-        if not force and np.array_equal(rows, self._rows):
+        if not force and np.array_equal(rows, self._rows) and self._buffer._rot4d_turn == _IDENTITY4:
             return False
         self.update_id += 1
-        self._assign(rows, self.update_id)
+        counts = [len(data.points) if getattr(data, "show_points", True) else 0, len(data.segments), len(data.triangles)]
+        self._assign(rows, self.update_id, counts)
         return True
 
-    def _assign(self, rows, seq):
+    def turn(self, rotation) -> bool:
+        """Turn the whole view by the 3-D ``rotation`` (3, 3) relative to the rows shown; True if sent.
+
+        One small message (no rows): the page turns the meshes as it applies
+        it.  The next `show` resets the turn (its rows are in the new frame), in
+        the same message.  The faces' back-to-front order stays that of the rows.
+        """
+        if self._closed:
+            raise RuntimeError("this Scene is closed")
+        r = np.asarray(rotation, dtype=np.float64)
+        if r.shape != (3, 3) or not np.all(np.isfinite(r)) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9):
+            raise ValueError(f"Expected `rotation` to be a (3, 3) rotation matrix, got shape {r.shape}")
+        m4 = np.eye(4)
+        m4[:3, :3] = r
+        turn = [float(x) for x in m4.flatten(order="F")]
+        if turn == self._buffer._rot4d_turn:
+            return False
+        self.update_id += 1
+        with self._buffer.hold_sync():
+            self._buffer._rot4d_turn = turn
+            self._buffer._rot4d_seq = self.update_id
+        return True
+
+    @property
+    def counts(self) -> list:
+        """Rows each layer draws now: [balls, bars, faces] (the rest of the capacity is skipped)."""
+        return list(self._buffer._rot4d_counts)
+
+    @property
+    def turned(self) -> bool:
+        """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
+        return self._buffer._rot4d_turn != _IDENTITY4
+
+    def _assign(self, rows, seq, counts=None):
         buf = self._buffer
         with buf.hold_sync():
             buf.array = rows
             buf._rot4d_seq = seq
+            if counts is not None:
+                buf._rot4d_counts = [int(c) for c in counts]
+            if buf._rot4d_turn != _IDENTITY4:
+                buf._rot4d_turn = list(_IDENTITY4)
         self._rows = rows
 
     def _grow(self, capacity):
         """Grow the row capacity; every intermediate frame shows one whole picture."""
         padded = np.zeros((capacity, bf.ROW_FLOATS), dtype=np.float32)
         padded[: self.capacity] = self._rows
-        self._assign(padded, self.update_id)  # (a) same picture, more (hidden) rows
+        self._assign(padded, self.update_id, self._buffer._rot4d_counts)  # (a) same picture, more (hidden) rows
         for g in self._geometries.values():  # (b) draw them
             g.maxInstancedCount = capacity
         self.capacity = capacity  # (c) is the caller's normal update

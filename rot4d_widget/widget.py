@@ -46,16 +46,19 @@ from . import look
 from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
-from .pump import ACK_TIMEOUT, UpdatePump
+from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .source import as_source
 from .state import DEFAULT_THETA0, RotationState, _finite, _theta0
 
-__all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "C0_STEP_FRACTION"]
+__all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
 
 log = logging.getLogger(__name__)
 
 #: The l/h step as a fraction of the source's size (circumradius).
 C0_STEP_FRACTION = 1.0 / 64.0
+#: While keys repeat, the readout (an HTML relayout on the page) changes at most this often (s);
+#: it is exact again as soon as no key is held.
+READOUT_PERIOD = 0.25
 #: How many error reports the ``errors`` area keeps.
 MAX_ERRORS_SHOWN = 5
 
@@ -197,8 +200,12 @@ class Rot4DWidget(widgets.HBox):
         self._slice_cache = None  # (matrix, c0, version, data)
         self._source_version = 0
         self._shown = None  # what the scene shows: (matrix, c0, eye, version, color_by)
+        self._rows_key = None  # the state its rows were computed for (the view may be turned from it)
+        self._rows_data = None  # the slice those rows show
         self._last_label = None
         self._last_count = 0
+        self._readout_at = -math.inf  # when the readout was last computed
+        self._readout_stale = False  # the readout lags the state (keys were repeating)
         self._closed = False
         self._was_displayed = False
         self._syncing = False
@@ -352,6 +359,14 @@ class Rot4DWidget(widgets.HBox):
         """Forget every held key (what mouseleave and focus loss do)."""
         with self._pump.lock:
             self._repeater.clear()
+            self._settle()
+
+    def _settle(self) -> None:
+        """At rest (no key held): bring the readout up to date and the rows into the turned frame."""
+        turned = self._shown is not None and self._shown is not self._rows_key
+        if (self._readout_stale or turned) and not len(self._repeater) and not self._closed:
+            self._pump.mark_dirty()
+            self._pump.flush()
 
     def close(self) -> None:
         """Stop the ticker thread, drop the listeners, close every child widget."""
@@ -459,6 +474,7 @@ class Rot4DWidget(widgets.HBox):
                 if key_id is not None:
                     with self._pump.lock:
                         self._repeater.release(key_id)
+                        self._settle()
             elif etype == "mouseleave":
                 self.release_keys()
         except Exception as exc:  # shown, never lost, never raised into the kernel
@@ -564,26 +580,44 @@ class Rot4DWidget(widgets.HBox):
         return data
 
     def _send(self):
-        """Pump callback: show the latest state; the update's id, or None if nothing was sent."""
+        """Pump callback: show the latest state; the update's id, or None if nothing was sent.
+
+        While keys are held, a change that only turns the slice in 3-D (the
+        rotation since the rows shown leaves w alone, nothing else changed) is
+        sent as a turn, a few bytes, without slicing; at rest the rows are
+        re-sent in the new frame (the faces' order is exact again).
+        """
         st = self.state
         scene = self.scene
         key = (st.matrix, st.c0, scene.eye, self._source_version, self.color_by)
-        shown = self._shown
+        held = bool(len(self._repeater))
+        shown, rows = self._shown, self._rows_key
         sent = None
-        if shown is None or not (
-            key[1:] == shown[1:] and (key[0] is shown[0] or np.array_equal(key[0], shown[0]))
-        ):
-            single = None if self.color_by == "group" else look.as_rgb(self.color_by, "color_by")
-            if scene.show(self._current_slice(), single_rgb=single):
+        if shown is not None and _same(key, shown) and (shown is rows or held):
+            pass  # the view shows this state (turned rows only while keys are held)
+        elif held and rows is not None and key[1:] == rows[1:] and _leaves_w_alone(key[0], rows[0]):
+            if scene.turn(np.asarray(key[0])[:3, :3] @ np.asarray(rows[0])[:3, :3].T):
                 sent = scene.update_id
             self._shown = key
-        self.readout.value = self._readout_html()
+        else:
+            single = None if self.color_by == "group" else look.as_rgb(self.color_by, "color_by")
+            self._rows_data = self._current_slice()
+            if scene.show(self._rows_data, single_rgb=single):
+                sent = scene.update_id
+            self._shown = self._rows_key = key
+        now = self._pump.clock()
+        if not len(self._repeater) or now - self._readout_at >= READOUT_PERIOD:
+            self.readout.value = self._readout_html()
+            self._readout_at, self._readout_stale = now, False
+        else:
+            self._readout_stale = True
         return sent
 
     # -------------------------------------------------------------- display
     def _readout_html(self) -> str:
         st = self.state
-        data = self._current_slice()
+        # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
+        data = self._rows_data if self._shown is not self._rows_key else self._current_slice()
         if self._last_label is None:
             last = "\u2014"
         else:
@@ -616,6 +650,17 @@ class Rot4DWidget(widgets.HBox):
 
 
 # ------------------------------------------------------------------ helpers
+def _same(a, b) -> bool:
+    """Two (matrix, c0, eye, version, color_by) keys describe the same state."""
+    return a[1:] == b[1:] and (a[0] is b[0] or np.array_equal(a[0], b[0]))
+
+
+def _leaves_w_alone(m, m_rows) -> bool:
+    """True if ``m = R3 @ m_rows`` for a rotation R3 of x, y, z only (w untouched)."""
+    t = np.asarray(m) @ np.asarray(m_rows).T
+    return abs(t[3, 3] - 1.0) < 1e-12
+
+
 def _title(source) -> str:
     name = getattr(source, "name", None)
     return str(name) if name else type(source).__name__

@@ -30,6 +30,8 @@ class FakeScene:
     buffer_model_id = "buf123"
     scene_model_id = "scn456"
     canvas_class = "rot4d-canvas-abc"
+    geometry_model_ids = ["g1", "g2", "g3"]
+    mesh_model_ids = ["m1", "m2", "m3"]
 
 
 def from_page(w, content):
@@ -130,7 +132,9 @@ function backbone(attrs) {
     L, attrs,
     get: (k) => attrs[k],
     // like Backbone's set: attributes first, then change:<name> events, then "change"
-    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); },
+    changed: {},
+    hasChanged(k) { return k in this.changed; },
+    setState(state) { this.changed = state; Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); this.changed = {}; },
     on(t, f) { (L[t] ||= []).push(f); },
     off(t, f) { L[t] = (L[t] || []).filter((g) => g !== f); },
     trigger(t) { (L[t] || []).slice().forEach((f) => f()); },
@@ -153,21 +157,28 @@ const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
 // (set `applyLate` to hold it back, `bump = false` to skip the version bump)
 const wrap = (name) => ({ data: "data-" + name });
 const buffer = backbone({ _rot4d_seq: 0, array: wrap("a0") });
-buffer.obj = { array: "data-a0", version: 1 };
+buffer.obj = { array: "data-a0", version: 1, stride: 1 };  // rows = the fake array's length (7)
 let applyLate = false, bump = true;
 const apply = () => { buffer.obj.array = buffer.attrs.array.data; if (bump) buffer.obj.version++; };
 buffer.on("change", () => { if (!applyLate) apply(); });
 const scene = backbone({});
+let rerenders = 0;
+scene.on("rerender", () => rerenders++);
+const geometries = [0, 1, 2].map(() => ({ obj: { maxInstancedCount: 16 } }));
+const meshes = [0, 1, 2].map(() => ({ obj: { matrix: { elements: new Array(16).fill(0) },
+  quaternion: { setFromRotationMatrix(m) { this.from = m.elements.slice(); } } } }));
 const sent = [];
 const model = {
-  get: (k) => ({ buffer_model_id: "IPY_MODEL_buf", scene_model_id: "scn", canvas_class: CLS })[k],
+  get: (k) => ({ buffer_model_id: "IPY_MODEL_buf", scene_model_id: "scn", canvas_class: CLS,
+                 geometry_model_ids: ["IPY_MODEL_g0", "g1", "g2"], mesh_model_ids: ["m0", "m1", "m2"] })[k],
   send: (m) => sent.push(m),
   // the buffer model is not registered at first: get_model rejects twice
   widget_manager: {
     misses: 0,
     async get_model(id) {
       if (id === "buf" && this.misses < 2) { this.misses++; throw new Error("widget model not found"); }
-      return ({ buf: buffer, scn: scene })[id];
+      return ({ buf: buffer, scn: scene, g0: geometries[0], g1: geometries[1], g2: geometries[2],
+                m0: meshes[0], m1: meshes[1], m2: meshes[2] })[id];
     },
   },
 };
@@ -226,6 +237,21 @@ set(11, "a8");
 scene.trigger("afterRender"); frame();
 step("uploaded");
 
+// drawn counts travel with the rows and are applied with them (never above the rows held)
+buffer.setState({ _rot4d_seq: 12, array: wrap("b1"), _rot4d_counts: [3, 5, 9] });
+out.counts = geometries.map((g) => g.obj.maxInstancedCount);
+scene.trigger("afterRender"); frame();
+step("countsAck");
+// a 3-D turn alone: applied to every mesh, a render requested, acknowledged at the next frame drawn
+const turn = [0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+const before = rerenders;
+buffer.setState({ _rot4d_seq: 13, _rot4d_turn: turn });
+out.turned = meshes.map((m) => JSON.stringify(m.obj.quaternion.from) === JSON.stringify(turn));
+out.rerendered = rerenders - before;
+step("turnBeforeRender");
+scene.trigger("afterRender"); frame();
+step("turnAck");
+
 // 2. focus loss
 window.fire("blur", {});
 document.visibilityState = "hidden"; document.fire("visibilitychange", {});
@@ -235,7 +261,7 @@ step("focus");
 // cleanup
 cleanup();
 out.left = { window: window.count(), document: document.count(), buffer: buffer.count(), scene: scene.count() };
-set(12, "a9"); scene.trigger("afterRender"); frame();
+set(14, "a9"); scene.trigger("afterRender"); frame();
 window.fire("blur", {});
 hovered = true;
 out.afterCleanupPrevented = key("keydown");
@@ -288,6 +314,19 @@ def test_js_drawn_ack_needs_the_array_in_the_three_js_buffer(js_run):
     assert js_run["uploaded"] == [{"event": "drawn", "seq": 11}]
 
 
+def test_js_draws_only_the_rows_in_use_set_with_the_rows(js_run):
+    # counts arrive in the buffer's message; never more than the rows the array holds (7 here)
+    assert js_run["counts"] == [3, 5, 7]
+    assert js_run["countsAck"] == [{"event": "drawn", "seq": 12}]
+
+
+def test_js_a_turn_alone_turns_every_mesh_and_is_acknowledged_when_drawn(js_run):
+    assert js_run["turned"] == [True, True, True]
+    assert js_run["rerendered"] == 1  # no buffer changed: the scene is asked to render
+    assert js_run["turnBeforeRender"] == []
+    assert js_run["turnAck"] == [{"event": "drawn", "seq": 13}]
+
+
 def test_js_retries_get_model_until_the_model_is_registered(js_run):
     assert js_run["getModelMisses"] == 2  # and the acks above still came
 
@@ -297,7 +336,8 @@ def test_js_focus_loss(js_run):
 
 
 def test_js_cleanup_removes_every_listener(js_run):
-    # (the buffer's one "change" listener is the fake pythreejs model's own)
-    assert js_run["left"] == {"window": 0, "document": 0, "buffer": 1, "scene": 0}
+    # (the buffer's one "change" listener is the fake pythreejs model's own, the scene's
+    # one "rerender" listener the driver's counter)
+    assert js_run["left"] == {"window": 0, "document": 0, "buffer": 1, "scene": 1}
     assert js_run["afterCleanupPrevented"] is False
     assert js_run["afterCleanup"] == []

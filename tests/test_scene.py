@@ -273,7 +273,7 @@ def test_one_show_is_one_message_to_the_buffer(scenes, log):
         cid, data, n, bufs = log[0]
         assert cid == sc.buffer_model_id
         assert data["method"] == "update"
-        assert set(data["state"]) == {"array", "_rot4d_seq"}
+        assert {"array", "_rot4d_seq"} <= set(data["state"]) <= {"array", "_rot4d_seq", "_rot4d_counts", "_rot4d_turn"}
         assert data["state"]["_rot4d_seq"] == sc.update_id == k
         assert data["state"]["array"]["dtype"] == "float32"
         assert tuple(data["state"]["array"]["shape"]) == (sc.capacity, 20)

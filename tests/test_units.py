@@ -67,37 +67,60 @@ def make_pump(page, clock, **kw):
     return UpdatePump(page.send, clock=clock, autotick=False, **kw)
 
 
-def test_one_update_in_flight_and_the_next_is_the_latest():
+@pytest.mark.parametrize("max_in_flight", [1, 2, 3])
+def test_at_most_max_in_flight_updates_and_the_next_is_the_latest(max_in_flight):
     t = [0.0]
     page = Page()
-    pump = make_pump(page, lambda: t[0], ack_timeout=0.5)
-    for i in range(5):  # five changes while the first update is on its way
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5, max_in_flight=max_in_flight)
+    for i in range(6):  # six changes, none acknowledged yet
         page.changes += 1
         pump.mark_dirty()
         pump.flush()
-    assert [s[1] for s in page.sent] == [1] and pump.in_flight == 1
-    assert pump.acknowledge(1) is True
-    assert [s[1] for s in page.sent] == [1, 5]  # the latest, not the backlog
+    assert [s[1] for s in page.sent] == list(range(1, max_in_flight + 1)) and pump.n_in_flight == max_in_flight
+    assert pump.acknowledge(1) is True  # the oldest drawn: the latest state (not the backlog) goes out
+    assert page.sent[-1][1] == 6 and pump.n_in_flight == max_in_flight
     assert pump.acknowledge(1) is False  # late duplicate (another view)
-    assert pump.acknowledge(7) is False and pump.acknowledge(True) is False  # unknown / not an id
-    assert pump.acknowledge(2) is True and pump.in_flight is None
-    assert pump.stats.as_dict() == {"updates": 2, "acks": 2, "timeouts": 0}
+    assert pump.acknowledge(99) is False and pump.acknowledge(True) is False  # unknown / not an id
+    assert pump.acknowledge(page.sent[-1][0]) is True  # the newest retires every older one
+    assert pump.in_flight is None and pump.stats.acks == 2
 
 
-def test_without_an_ack_the_latest_goes_out_after_the_timeout():
+def test_without_an_ack_the_oldest_is_given_up_after_the_timeout():
     t = [0.0]
     page = Page()
-    pump = make_pump(page, lambda: t[0], ack_timeout=0.5)
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5, max_in_flight=2)
+    for now in (0.0, 0.1, 0.2):
+        t[0] = now
+        page.changes += 1
+        pump.mark_dirty()
+        pump.flush()
+    assert len(page.sent) == 2
+    assert pump.service(0.4) == pytest.approx(0.5)  # it wants to run when the oldest times out
+    pump.service(0.5)
+    assert len(page.sent) == 3 and pump.stats.timeouts == 1
+    assert pump.service(2.0) is None  # nothing dirty: nothing to wait for
+
+
+def test_a_slow_page_stretches_the_timeout_to_four_times_its_median_ack():
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5, max_in_flight=1)
+    for i in range(8):  # the page takes 0.3 s per picture
+        page.changes += 1
+        pump.mark_dirty()
+        pump.flush()
+        t[0] += 0.3
+        assert pump.acknowledge(page.sent[-1][0])
+    assert pump.timeout == pytest.approx(1.2)
     page.changes += 1
     pump.mark_dirty()
     pump.flush()
     page.changes += 1
     pump.mark_dirty()
-    assert pump.service(0.4) == pytest.approx(0.5)  # it wants to run at the timeout
-    assert len(page.sent) == 1
-    pump.service(0.5)
-    assert len(page.sent) == 2 and pump.stats.timeouts == 1
-    assert pump.service(2.0) is None  # nothing dirty: nothing to wait for
+    pump.service(t[0] + 0.6)  # past ack_timeout but not past 4 x 0.3 s: still waiting
+    assert pump.stats.timeouts == 0
+    pump.service(t[0] + 1.21)
+    assert pump.stats.timeouts == 1
 
 
 def test_errors_go_to_on_error_and_the_pump_goes_on():

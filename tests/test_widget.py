@@ -58,6 +58,7 @@ class FakeScene:
         self.camera = FakeCamera()
         self.shown = []  # the slices passed to show()
         self.single = []  # their single_rgb
+        self.turns = []  # the 3-D turns passed to turn()
         self.closed = False
         self.display = {k: options[k] for k in ("ball_radius", "bar_radius", "face_opacity", "background",
                                                  "show_balls", "show_bars", "show_faces")}
@@ -97,6 +98,12 @@ class FakeScene:
             return False
         self.shown.append(s)
         self.single.append(single_rgb)
+        self.update_id += 1
+        return True
+
+    def turn(self, r3):
+        """Like Scene.turn: the whole view turned in 3-D (no new rows)."""
+        self.turns.append(np.array(r3))
         self.update_id += 1
         return True
 
@@ -369,43 +376,55 @@ def test_parameter_keys_repeat_but_step_angle_keys_do_not(make, clock):
     assert w.state.theta0 == pytest.approx(theta0 * math.sqrt(2))
 
 
-def test_at_most_one_update_in_flight_and_the_next_is_the_latest_state(make, clock):
+def test_at_most_two_updates_in_flight_and_the_next_is_the_latest_state(make, clock):
     w = make()
     t0 = clock.t
     down(w, "4")
+    first = w.scene.update_id
     assert len(w.scene.shown) == 2 and w.in_flight
-    run_ticker(w, clock, t0 + 0.45)  # state moves on, but nothing is sent without an ack
+    run_ticker(w, clock, t0 + 0.45)  # the second goes out with the first tick, then nothing without an ack
     assert xw_steps(w) > 3
-    assert len(w.scene.shown) == 2
-    w.companion.drawn()
-    assert len(w.scene.shown) == 3 and w.in_flight
+    assert len(w.scene.shown) == 3 and wmod.MAX_IN_FLIGHT == 2
+    w.companion.drawn(first)  # the oldest drawn: the latest state goes out
+    assert len(w.scene.shown) == 4 and w.in_flight
     latest = slice_polytope(w.polytope, w.state.matrix, w.state.c0)
     assert np.allclose(w.scene.shown[-1].vertices, latest.vertices)
-    w.companion.drawn()  # acknowledges update 3: nothing changed since, so nothing is sent
+    w.companion.drawn()  # the newest drawn (and so every older one): nothing changed since
     w.companion.drawn()
-    assert len(w.scene.shown) == 3 and not w.in_flight
+    assert len(w.scene.shown) == 4 and not w.in_flight
+
+
+def test_an_acknowledgement_retires_every_older_update(make, clock):
+    w = make()
+    w.press("4")
+    w.press("4")
+    assert len(w.scene.shown) == 3 and w.stats.updates == 3
+    w.press("4")  # two in flight: pending
+    assert len(w.scene.shown) == 3
+    w.companion.drawn()  # the page drew the newest (it skipped the older one): both retired
+    assert len(w.scene.shown) == 4 and w.stats.acks == 1
+    w.companion.drawn()
+    assert not w.in_flight
 
 
 def test_duplicate_acknowledgements_release_nothing_extra(make, clock):
     w = make()
-    down(w, "4")
-    up(w, "4")
-    assert w.in_flight and len(w.scene.shown) == 2
-    down(w, "4")
-    up(w, "4")  # a second step while the first is in flight: pending
-    assert len(w.scene.shown) == 2
-    first = w.scene.update_id
-    w.companion.drawn(first)  # view A acknowledges the first update -> the second goes out
-    assert len(w.scene.shown) == 3 and w.scene.update_id == first + 1
-    w.companion.drawn(first)  # view B's late acknowledgement of the first: ignored
-    assert w.in_flight
-    down(w, "4")
-    up(w, "4")
-    assert len(w.scene.shown) == 3  # still waiting for the second update's acknowledgement
-    w.companion.drawn(first + 1)
-    assert len(w.scene.shown) == 4
+    w.press("4")
+    w.press("4")
+    assert w.in_flight and len(w.scene.shown) == 3
+    w.press("4")  # a third step while two are in flight: pending
+    assert len(w.scene.shown) == 3
+    first = w.scene.update_id - 1
+    w.companion.drawn(first)  # view A acknowledges the older update -> the third goes out
+    assert len(w.scene.shown) == 4 and w.scene.update_id == first + 2
+    w.companion.drawn(first)  # view B's late acknowledgement of it: ignored
+    w.press("4")
+    assert len(w.scene.shown) == 4  # still two in flight
+    assert w.stats.acks == 1
     w.companion.drawn(first + 7)  # an update that was never sent: ignored
-    assert w.in_flight
+    assert w.in_flight and w.stats.acks == 1
+    w.companion.drawn(first + 1)
+    assert len(w.scene.shown) == 5
 
 
 def test_after_release_the_view_settles_at_once(make, clock):
@@ -432,30 +451,33 @@ def test_without_acknowledgements_the_latest_state_is_sent_after_the_timeout(mak
     t0 = clock.t
     down(w, "4")
     run_ticker(w, clock, t0 + w.ack_timeout - 0.01)
-    assert len(w.scene.shown) == 2
-    run_ticker(w, clock, t0 + w.ack_timeout + 0.001)
-    assert len(w.scene.shown) == 3 and w.stats.timeouts == 1
+    assert len(w.scene.shown) == 1 + wmod.MAX_IN_FLIGHT and w.stats.timeouts == 0
+    run_ticker(w, clock, t0 + w.ack_timeout + 0.001)  # the oldest is given up: the latest goes out
+    assert len(w.scene.shown) == 2 + wmod.MAX_IN_FLIGHT and w.stats.timeouts == 1
     run_ticker(w, clock, t0 + 0.7)
     up(w, "4")
     run_ticker(w, clock, t0 + 10.0)
-    # the steps taken after the first timeout go out one timeout later; then nothing
-    assert w.stats.timeouts == 2 and len(w.scene.shown) == 4
+    # one update per timeout while the state changes; the final state is shown; then nothing
+    assert len(w.scene.shown) == 1 + wmod.MAX_IN_FLIGHT + w.stats.timeouts
     assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
+    n = len(w.scene.shown)
+    run_ticker(w, clock, t0 + 20.0)
+    assert len(w.scene.shown) == n
 
 
 def test_scripting_press_redraws_and_respects_flow_control(make, clock):
     w = make()
     assert w.press("4") is True
-    assert len(w.scene.shown) == 2
-    assert w.press("C") is True  # R_zw inverted; pending while update 1 is in flight
-    assert w.press("c", shift=True) is True
+    assert w.press("C") is True  # R_zw inverted: the second update in flight
+    assert len(w.scene.shown) == 3
+    assert w.press("c", shift=True) is True  # pending while two are in flight
     expected = simple_rotation("zw", -2 * w.state.theta0) @ simple_rotation("xw", w.state.theta0)
     assert np.allclose(w.state.matrix, expected)
     assert np.allclose(w.slice.vertices, slice_polytope(w.polytope, expected, 0.0).vertices)
-    assert len(w.scene.shown) == 2
+    assert len(w.scene.shown) == 3
     clock.t += w.ack_timeout  # no view (nbval): the timeout sends the latest
     service(w)
-    assert len(w.scene.shown) == 3 and w.scene.shown[-1] is w.slice
+    assert len(w.scene.shown) == 4 and w.scene.shown[-1] is w.slice
     assert w.press("q") is False
     with pytest.raises(TypeError, match="key"):
         w.press(4)
@@ -502,11 +524,31 @@ def test_readout_shows_parameters_last_action_census_and_volume(make):
     census = w.slice.face_census()
     assert str(sum(census.values())) in text or any(f"{c} " in text for c in census.values())
     down(w, "2", code="Digit2", shift=True)
+    up(w, "2", code="Digit2", shift=True)  # at rest: the readout is exact
     w.companion.drawn()
     assert "R_xy\u207b\u00b9" in w.readout.value and "\u00d7" not in w.readout.value
     down(w, "l")
+    up(w, "l")
     w.companion.drawn()
     assert f"{w.state.c0:.4f}" in w.readout.value and "c0+" in w.readout.value
+
+
+def test_while_keys_repeat_the_readout_changes_a_few_times_a_second_and_exactly_at_rest(make, clock):
+    w = make()
+    t0 = clock.t
+    values = []
+    w.readout.observe(lambda ch: values.append((clock.t, ch["new"])), names="value")
+    down(w, "4")
+    for i in range(60):  # the page keeps up: every update acknowledged as it is drawn
+        run_ticker(w, clock, t0 + 0.25 + i / 30)
+        w.companion.drawn()
+    assert w.stats.updates > 30  # the picture follows the held key ...
+    times = [t for t, _ in values]
+    assert len(values) <= 2 + (times[-1] - t0) / wmod.READOUT_PERIOD  # ... the readout at <= 4 Hz
+    assert all(b - a >= wmod.READOUT_PERIOD - 1e-9 for a, b in zip(times[1:], times[2:]))
+    up(w, "4")
+    w.companion.drawn()
+    assert f"R_xw \u00d7{xw_steps(w)}" in w.readout.value  # exact at rest
 
 
 def test_readout_names_an_empty_slice(make):

@@ -107,7 +107,7 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
         total = sum(n for _, _, n, _ in msgs)
         assert total <= 64 * 1024
         (data, nbytes), = buffer_messages(w, msgs)
-        assert set(data["state"]) == {"array", "_rot4d_seq"}
+        assert {"array", "_rot4d_seq"} <= set(data["state"]) <= {"array", "_rot4d_seq", "_rot4d_counts", "_rot4d_turn"}
         assert data["state"]["_rot4d_seq"] == w.scene.update_id
         assert w.in_flight  # awaiting the page's acknowledgement of this update
         rows = w.scene.rows
@@ -144,15 +144,16 @@ def _front_facing(rows, eye):
 
 def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_control(make, recording_comms):
     w = make("24-cell")
-    down(w, "z")
-    up(w, "z")  # an update in flight
+    for _ in range(2):  # two updates in flight (the most allowed)
+        down(w, "z")
+        up(w, "z")
     before = w.scene.rows
     assert not np.diff(_front_facing(before, (0.0, 0.0, 5.0)).astype(int)).clip(max=0).any()  # back first
     n_updates = w.stats.updates
     eye = (3.0, -4.0, 1.0)
     orbit_ends_at(w, eye)
     assert w.scene.eye == eye
-    assert w.stats.updates == n_updates  # one update in flight: this one waits for the ack
+    assert w.stats.updates == n_updates  # two updates in flight: this one waits for an ack
     drawn(w)
     assert w.stats.updates == n_updates + 1 and w.scene.rows is not before
     facing = _front_facing(w.scene.rows, eye)
@@ -200,12 +201,13 @@ def test_the_companion_acknowledgement_releases_the_next_update(make, clock, rec
     down(w, "4")
     first = w.scene.update_id
     run_ticker(w, clock, t0 + 0.45)
-    assert len(buffer_messages(w, recording_comms)) == 2  # the initial picture + the first step
+    # the initial picture, the first step, the first repeat; then two are in flight
+    assert len(buffer_messages(w, recording_comms)) == 3
     acks = w.stats.acks
     drawn(w, first - 1)  # an acknowledgement of an older update: ignored
-    assert w.scene.update_id == first and w.stats.acks == acks
+    assert w.scene.update_id == first + 1 and w.stats.acks == acks
     drawn(w, first)
-    assert w.scene.update_id == first + 1 and w.in_flight and w.stats.acks == acks + 1
+    assert w.scene.update_id == first + 2 and w.in_flight and w.stats.acks == acks + 1
     assert np.allclose(
         w.scene.rows[: len(w.slice.points), 0:3],
         scaled_points(w, w.source.slice(w.state.matrix, 0.0)),
@@ -240,10 +242,11 @@ def test_a_held_key_without_acknowledgements_sends_one_update_per_timeout(make, 
     up(w, "8")
     run_ticker(w, clock, t0 + 3.0)
     n = len(buffer_messages(w, recording_comms))
-    # initial + keydown + one per ack_timeout while held (at 0.5, 1.0, 1.5, 2.0 s) + the rest
-    assert n <= 2 + math.ceil(2.0 / w.ack_timeout) + 1
+    # initial + keydown + first repeat + one per ack_timeout while held (at 0.5, 0.75, 1.0, ... s:
+    # each timeout gives up the oldest of the two in flight) + the rest
+    assert n <= 3 + w.stats.timeouts + 1
     assert w.stats.updates == n  # every buffer message is a counted update (the initial one too)
-    assert w.stats.acks == 0 and 1 <= w.stats.timeouts <= math.ceil(3.0 / w.ack_timeout)
+    assert w.stats.acks == 0 and 1 <= w.stats.timeouts <= 2 * math.ceil(3.0 / w.ack_timeout)
     assert xw_steps(w) == 0 and w.state.matrix[1, 3] != 0  # R_yw turned, many steps
     assert np.allclose(w.scene.rows[: len(w.slice.points), 0:3], scaled_points(w), atol=1e-5)
 
@@ -352,3 +355,76 @@ def test_close_releases_every_widget(recording_comms):
     left = set(ipywidget_module._instances) - before
     assert left <= renderer_parts, [type(ipywidget_module._instances[k]).__name__ for k in left]
     w.close()
+
+
+# ------------------------------------------------------- less work per update
+def test_each_layer_draws_only_its_rows_in_use_set_in_the_same_message(make, recording_comms):
+    w = make("24-cell")
+    n0 = len(recording_comms)
+    _tap_and_draw(w, "4z")
+    data, _ = buffer_messages(w, recording_comms[n0:])[-1]
+    s = w.slice
+    counts = w.scene.counts
+    assert counts == [len(s.points), len(s.segments), len(s.triangles)]
+    assert max(counts) <= w.scene.capacity
+    # sent with the rows whenever they change (the companion applies both as one)
+    sent = [d["state"]["_rot4d_counts"] for d, _ in buffer_messages(w, recording_comms[n0:]) if "_rot4d_counts" in d["state"]]
+    assert sent and sent[-1] == counts
+    assert all("array" in d["state"] for d, _ in buffer_messages(w, recording_comms[n0:]) if "_rot4d_counts" in d["state"])
+
+
+class CountingSource:
+    """A polytope source that counts its slices (the resampling a field would do)."""
+
+    def __init__(self, name):
+        from rot4d_widget import PolytopeSource
+
+        self.inner = PolytopeSource(name)
+        self.size, self.n_groups, self.calls = self.inner.size, self.inner.n_groups, 0
+
+    def slice(self, m, c0):
+        self.calls += 1
+        return self.inner.slice(m, c0)
+
+    def describe(self):
+        return self.inner.describe()
+
+
+@pytest.mark.parametrize("key", ["2", "3", "6"])
+def test_held_keys_that_leave_w_alone_turn_the_view_without_slicing(make, clock, recording_comms, key):
+    src = CountingSource("24-cell")
+    w = make(src)
+    t0 = clock.t
+    rows0 = w.scene.rows
+    n0, calls0 = len(recording_comms), src.calls
+    down(w, key)
+    for i in range(20):
+        run_ticker(w, clock, t0 + 0.25 + i / 30)
+        drawn(w)
+    assert src.calls == calls0  # no new slice while the key turns the view ...
+    msgs = buffer_messages(w, recording_comms[n0:])
+    assert len(msgs) >= 10 and all(set(d["state"]) == {"_rot4d_turn", "_rot4d_seq"} for d, _ in msgs)
+    assert max(n for _, n in msgs) < 600  # a few hundred bytes, not the rows
+    turn = np.array(msgs[-1][0]["state"]["_rot4d_turn"]).reshape(4, 4, order="F")
+    m = w.state.matrix
+    assert np.allclose(turn[:3, :3], m[:3, :3], atol=1e-12)  # the rows were made at the identity
+    assert np.array_equal(w.scene.rows, rows0) and w.scene.turned
+    up(w, key)  # at rest: the rows in the new frame, faces ordered for the eye, turn reset
+    drawn(w)
+    last = buffer_messages(w, recording_comms[n0:])[-1][0]["state"]
+    assert "array" in last and last["_rot4d_turn"] == list(np.eye(4).flatten())
+    assert not w.scene.turned and src.calls == calls0 + 1
+    assert np.allclose(w.scene.rows[: len(w.slice.points), 0:3], scaled_points(w), atol=1e-5)
+
+
+def test_held_keys_that_move_w_send_new_rows(make, clock, recording_comms):
+    w = make("24-cell")
+    t0 = clock.t
+    n0 = len(recording_comms)
+    down(w, "4")
+    for i in range(10):
+        run_ticker(w, clock, t0 + 0.25 + i / 30)
+        drawn(w)
+    msgs = buffer_messages(w, recording_comms[n0:])
+    assert msgs and all("array" in d["state"] and "_rot4d_turn" not in d["state"] for d, _ in msgs)
+    assert not w.scene.turned
