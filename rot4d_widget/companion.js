@@ -187,23 +187,38 @@ async function render({ model, el }) {
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
-      const onChange = () => {
-        const arrayChanged = buffer.hasChanged("array");
-        if (buffer.hasChanged("_rot4d_counts") || arrayChanged) applyCounts();
-        if (buffer.hasChanged("_rot4d_turn")) {
+      // The attributes of one message arrive as one synchronous burst of change:<name>
+      // events (pythreejs applies the array in its own); collect them and act once,
+      // in a microtask, or at the next render if that comes first.
+      let batch = null;
+      const settle = () => {
+        const b = batch;
+        batch = null;
+        if (b === null) return;
+        if (b.counts || b.array) applyCounts();
+        if (b.turn) {
           applyTurn();
           scene.trigger("rerender", scene, {}); // a turn alone changes no three.js buffer
         }
-        const data = arrayChanged ? dataOf(buffer.get("array")) : null;
-        if (buffer.hasChanged("_rot4d_seq")) {
+        const data = b.array ? dataOf(buffer.get("array")) : null;
+        if (b.seq) {
           // `after`: the version before this array can have been uploaded; a turn alone
           // (data null) is in the next frame drawn.
           pending = { seq: buffer.get("_rot4d_seq"), data, after: renderedVersion };
-        } else if (arrayChanged && pending !== null && pending.data !== null) {
+        } else if (b.array && pending !== null && pending.data !== null) {
           pending = { seq: pending.seq, data, after: renderedVersion }; // a growth step re-sent the rows
         }
       };
+      const note = (what) => () => {
+        if (batch === null) {
+          batch = {};
+          queueMicrotask(settle);
+        }
+        batch[what] = true;
+      };
+      const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn") };
       const onRendered = () => {
+        settle();
         ensureGuards();
         const obj = buffer.obj;
         const p = pending;
@@ -218,9 +233,11 @@ async function render({ model, el }) {
         // frame has been presented (and any rAF read-back has seen it).
         requestAnimationFrame(() => send({ event: "drawn", seq: p.seq }));
       };
-      buffer.on("change", onChange);
+      for (const [name, f] of Object.entries(watched)) {
+        buffer.on("change:" + name, f);
+        cleanups.push(() => buffer.off("change:" + name, f));
+      }
       scene.on("afterRender", onRendered);
-      cleanups.push(() => buffer.off("change", onChange));
       cleanups.push(() => scene.off("afterRender", onRendered));
     }
   } catch (e) {

@@ -132,9 +132,7 @@ function backbone(attrs) {
     L, attrs,
     get: (k) => attrs[k],
     // like Backbone's set: attributes first, then change:<name> events, then "change"
-    changed: {},
-    hasChanged(k) { return k in this.changed; },
-    setState(state) { this.changed = state; Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); this.changed = {}; },
+    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); },
     on(t, f) { (L[t] ||= []).push(f); },
     off(t, f) { L[t] = (L[t] || []).filter((g) => g !== f); },
     trigger(t) { (L[t] || []).slice().forEach((f) => f()); },
@@ -239,6 +237,7 @@ step("uploaded");
 
 // drawn counts travel with the rows and are applied with them (never above the rows held)
 buffer.setState({ _rot4d_seq: 12, array: wrap("b1"), _rot4d_counts: [3, 5, 9] });
+await null;  // applied in a microtask after the message's burst of change events
 out.counts = geometries.map((g) => g.obj.maxInstancedCount);
 scene.trigger("afterRender"); frame();
 step("countsAck");
@@ -246,6 +245,7 @@ step("countsAck");
 const turn = [0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
 const before = rerenders;
 buffer.setState({ _rot4d_seq: 13, _rot4d_turn: turn });
+await null;
 out.turned = meshes.map((m) => JSON.stringify(m.obj.quaternion.from) === JSON.stringify(turn));
 out.rerendered = rerenders - before;
 step("turnBeforeRender");
