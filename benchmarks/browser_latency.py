@@ -348,6 +348,9 @@ CELLS = [
     "from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({name!r}))\nw",
 ]
 READ = {BASE: "bench.read_baseline()", WIDGET: "bench.read_widget(w)"}
+#: Frames drawn after a key's release that still count as settling at once: the two updates
+#: the widget may have in flight at keyup, plus the latest state (rows re-sent at rest).
+AFTER_FRAMES = 3
 #: ``--in-flight N``: set the widget's bound on updates in flight (None: the package's default).
 IN_FLIGHT = None
 
@@ -713,7 +716,7 @@ def report(results: dict, meta: dict) -> str:
         h = w["hold"]
         lat_ok = excess <= lat_target and not w["misses"]
         fps_ok = h["fps"] >= fps_target
-        rel_ok = (not h["moved_after_up"]) and h["after_frames"] <= 2 and h["settle_ms"] <= 500
+        rel_ok = (not h["moved_after_up"]) and h["after_frames"] <= AFTER_FRAMES and h["settle_ms"] <= 500
         after = f"{h['after_frames']}, {fmt(h['settle_ms'])} ms" + (", state moved after keyup" if h["moved_after_up"] else "")
         std = statistics.stdev(lat) if len(lat) > 1 else math.nan
         lines.append(
@@ -791,7 +794,7 @@ def verdicts(case: str, r: dict) -> dict:
         "excess": mean(w["latency_ms"]) - mean(b["latency_ms"]),
         "misses": w["misses"],
         "fps": h["fps"],
-        "release_ok": (not h["moved_after_up"]) and h["after_frames"] <= 2 and h["settle_ms"] <= 500,
+        "release_ok": (not h["moved_after_up"]) and h["after_frames"] <= AFTER_FRAMES and h["settle_ms"] <= 500,
     }
 
 

@@ -596,7 +596,7 @@ class Rot4DWidget(widgets.HBox):
         if shown is not None and _same(key, shown) and (shown is rows or held):
             pass  # the view shows this state (turned rows only while keys are held)
         elif held and rows is not None and key[1:] == rows[1:] and _leaves_w_alone(key[0], rows[0]):
-            if scene.turn(np.asarray(key[0])[:3, :3] @ np.asarray(rows[0])[:3, :3].T):
+            if scene.turn((np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]):
                 sent = scene.update_id
             self._shown = key
         else:

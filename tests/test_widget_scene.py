@@ -373,6 +373,14 @@ def test_each_layer_draws_only_its_rows_in_use_set_in_the_same_message(make, rec
     assert all("array" in d["state"] for d, _ in buffer_messages(w, recording_comms[n0:]) if "_rot4d_counts" in d["state"])
 
 
+def random_rotation(rng):
+    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
 class CountingSource:
     """A polytope source that counts its slices (the resampling a field would do)."""
 
@@ -394,6 +402,9 @@ class CountingSource:
 def test_held_keys_that_leave_w_alone_turn_the_view_without_slicing(make, clock, recording_comms, key):
     src = CountingSource("24-cell")
     w = make(src)
+    w.state.matrix = m0 = random_rotation(np.random.default_rng(5))  # w already mixed in
+    w.refresh()
+    drawn(w)
     t0 = clock.t
     rows0 = w.scene.rows
     n0, calls0 = len(recording_comms), src.calls
@@ -407,13 +418,18 @@ def test_held_keys_that_leave_w_alone_turn_the_view_without_slicing(make, clock,
     assert max(n for _, n in msgs) < 600  # a few hundred bytes, not the rows
     turn = np.array(msgs[-1][0]["state"]["_rot4d_turn"]).reshape(4, 4, order="F")
     m = w.state.matrix
-    assert np.allclose(turn[:3, :3], m[:3, :3], atol=1e-12)  # the rows were made at the identity
+    r3 = (m @ m0.T)[:3, :3]  # m = R3 @ m0: a turn of x, y, z only
+    assert np.allclose(turn[:3, :3], r3, atol=1e-12) and np.allclose(turn[:3, :3] @ turn[:3, :3].T, np.eye(3))
+    # the rows made at m0, turned, are the slice at m
+    turned = rows0[: len(w.slice.points), 0:3].astype(float) @ r3.T
+    d = np.linalg.norm(turned[:, None] - scaled_points(w)[None], axis=2)
+    assert d.min(axis=1).max() < 1e-5
     assert np.array_equal(w.scene.rows, rows0) and w.scene.turned
     up(w, key)  # at rest: the rows in the new frame, faces ordered for the eye, turn reset
     drawn(w)
     last = buffer_messages(w, recording_comms[n0:])[-1][0]["state"]
     assert "array" in last and last["_rot4d_turn"] == list(np.eye(4).flatten())
-    assert not w.scene.turned and src.calls == calls0 + 1
+    assert not w.scene.turned and src.calls == calls0 + 1 and w.errors.outputs == ()
     assert np.allclose(w.scene.rows[: len(w.slice.points), 0:3], scaled_points(w), atol=1e-5)
 
 
