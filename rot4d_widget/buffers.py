@@ -102,14 +102,12 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
     It is a starting size, not a bound: the scene grows the table safely if a
     larger slice ever comes.
     """
+    from .rotation import random_rotation
+
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):
-        q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-        q = q * np.sign(np.diag(r))
-        if np.linalg.det(q) < 0:
-            q[:, 0] = -q[:, 0]
-        most = max(most, rows_needed(source.slice(q, 0.0)))
+        most = max(most, rows_needed(source.slice(random_rotation(rng), 0.0)))
     return capacity_for(most)
 
 

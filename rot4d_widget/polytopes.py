@@ -30,6 +30,8 @@ import itertools
 import math
 
 import numpy as np
+
+from ._arrays import sealed as _sealed
 from scipy.spatial import ConvexHull
 
 __all__ = ["Polytope", "polytope", "pentachoron", "POLYTOPE_NAMES"]
@@ -51,17 +53,6 @@ _NAME_OF = {}
 for _canon, _aliases in _ALIASES.items():
     for _alias in (_canon, *_aliases):
         _NAME_OF[_alias] = _canon
-
-
-def _sealed(a: np.ndarray) -> np.ndarray:
-    """``a`` made read-only, behind a read-only view: nothing can write, resize or
-    re-enable writing through what is handed out."""
-    if a.base is not None:  # a view: its base could be unlocked and written
-        a = a.copy()
-    a.flags.writeable = False
-    v = a.view()
-    v.flags.writeable = False
-    return v
 
 
 def _normalise_name(name: str) -> str:

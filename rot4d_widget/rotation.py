@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "random_rotation",
     "AXES",
     "PLANES",
     "DOUBLE_PLANES",
@@ -136,3 +137,14 @@ def reorthonormalize(matrix: np.ndarray) -> np.ndarray:
     however many steps are taken (without it the error grows like sqrt(steps)).
     """
     return 1.5 * matrix - 0.5 * (matrix @ (matrix.T @ matrix))
+
+
+def random_rotation(rng=None) -> np.ndarray:
+    """A uniformly random (4, 4) rotation (Haar measure, det +1) from ``rng``
+    (a numpy Generator or a seed)."""
+    rng = np.random.default_rng(rng)
+    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q

@@ -37,6 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import sealed as _sealed
+
 from .polytopes import Polytope, polytope as _get_polytope
 from .rotation import as_rotation_matrix
 
@@ -46,17 +48,6 @@ __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
 TOLERANCE = 1e-9
 
 _TWO_PI_PLUS = 8.0  # > 2*pi: spacing of per-polygon sort keys
-
-
-def _sealed(a: np.ndarray) -> np.ndarray:
-    """``a`` made read-only, behind a read-only view: nothing can write, resize or
-    re-enable writing through what is handed out."""
-    if a.base is not None:  # a view: its base could be unlocked and written
-        a = a.copy()
-    a.flags.writeable = False
-    v = a.view()
-    v.flags.writeable = False
-    return v
 
 
 class _Tables:

@@ -11,20 +11,14 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+
+from rot4d_widget.rotation import random_rotation
 import pytest
 
 from rot4d_widget import buffers as bf
 from rot4d_widget import polytope
 from rot4d_widget.polytopes import POLYTOPE_NAMES
 from rot4d_widget.source import PolytopeSource, SliceData
-
-
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 def fake_slice(n_points=5, n_segments=7, n_triangles=4, n_groups=3, seed=0):

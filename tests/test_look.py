@@ -5,20 +5,14 @@ import subprocess
 import sys
 
 import numpy as np
+
+from rot4d_widget.rotation import random_rotation
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from rot4d_widget import buffers, figures, look, pentachoron, polytope, slice_polytope
 from rot4d_widget.figures import draw_slice, panel_style, render_slice
-
-
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 def _projected_corners(slice_, k, scale):

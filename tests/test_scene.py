@@ -17,6 +17,8 @@ import pathlib
 import re
 
 import numpy as np
+
+from rot4d_widget.rotation import random_rotation
 import pytest
 import pythreejs as p3
 from ipywidgets.widgets import widget as ipywidget_module
@@ -50,14 +52,6 @@ def before_capacity(name):
 def log(recording_comms):
     """Every message sent: (comm_id, data, n_bytes, buffers) -- tests/recording_comm.py."""
     yield recording_comms
-
-
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 def scene_options(src, **kw):

@@ -12,6 +12,8 @@ import re
 
 import ipywidgets
 import numpy as np
+
+from rot4d_widget.rotation import random_rotation
 import pytest
 
 from rot4d_widget import SliceData, polytope, simple_rotation, slice_polytope
@@ -25,14 +27,6 @@ from widget_time import service
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
 README = pathlib.Path(__file__).resolve().parents[1] / "README.md"
-
-
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 def readme_source():

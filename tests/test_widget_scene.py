@@ -17,6 +17,8 @@ import math
 from collections import Counter
 
 import numpy as np
+
+from rot4d_widget.rotation import random_rotation
 import pytest
 from ipywidgets.widgets import widget as ipywidget_module
 
@@ -371,14 +373,6 @@ def test_each_layer_draws_only_its_rows_in_use_set_in_the_same_message(make, rec
     sent = [d["state"]["_rot4d_counts"] for d, _ in buffer_messages(w, recording_comms[n0:]) if "_rot4d_counts" in d["state"]]
     assert sent and sent[-1] == counts
     assert all("array" in d["state"] for d, _ in buffer_messages(w, recording_comms[n0:]) if "_rot4d_counts" in d["state"])
-
-
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.standard_normal((4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 class CountingSource:
