@@ -425,7 +425,8 @@ def run_case(context, server, case: str, args, rng: random.Random, hold_baseline
     name = f"bench_{case.replace('-', '_')}.ipynb"
     cells = [c.format(name=case) for c in CELLS]
     if IN_FLIGHT is not None:  # --in-flight: the widget's bound on updates in flight, for comparisons
-        cells[1] = cells[1].replace("\nw", f"\nw._pump.max_in_flight = {IN_FLIGHT}\nw", 1)
+        head, _, last = cells[1].rpartition("\n")  # ... w = bench.probe(...) / w
+        cells[1] = f"{head}\nw._pump.max_in_flight = {IN_FLIGHT}\n{last}"
     write_notebook(server.root / name, cells)
     page = context.new_page()
     errors: list[str] = []
