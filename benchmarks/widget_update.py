@@ -9,6 +9,9 @@ total bytes (JSON + binary buffers) one update sends, as recorded by the comm
 of tests/recording_comm.py (it serialises like ipykernel; the widget itself
 counts nothing).  Each update is acknowledged the way the page does it, by a
 "drawn" message from the companion, so the next press goes out at once.
+The update is what the keydown sends: while a key is down the readout changes
+at most every 0.25 s (rot4d_widget.widget.READOUT_PERIOD), so presses this
+close together send the buffer alone, and the readout follows at rest.
 
     python benchmarks/widget_update.py [--presses 300] [--seed 0]
 

@@ -32,6 +32,7 @@ them short.  The traits live in the kernel only (use ``link``, not
 
 from __future__ import annotations
 
+import html
 import logging
 import math
 import traceback
@@ -296,7 +297,8 @@ class Rot4DWidget(widgets.HBox):
 
     @property
     def stats(self):
-        """Counters of the update pump: ``updates`` sent, ``acks`` received in time, ``timeouts``."""
+        """Counters of the update pump (`rot4d_widget.pump.PumpStats`): ``updates`` sent, ``acks``
+        and the updates they ``acknowledged``, ``timeouts``."""
         return self._pump.stats
 
     @property
@@ -621,7 +623,7 @@ class Rot4DWidget(widgets.HBox):
         if self._last_label is None:
             last = "\u2014"
         else:
-            last = ro.html.escape(self._last_label) + (f" \u00d7{self._last_count}" if self._last_count > 1 else "")
+            last = html.escape(self._last_label) + (f" \u00d7{self._last_count}" if self._last_count > 1 else "")
         w_range = getattr(self.source, "w_range", None)
         lo, hi = w_range(st.matrix) if w_range is not None else (-self.source.size, self.source.size)
         rows = [
@@ -631,7 +633,7 @@ class Rot4DWidget(widgets.HBox):
             ("c0", ro.gauge_html(st.c0, lo, hi)),
             ("last", last),
         ]
-        rows += [(k, ro.html.escape(str(v))) for k, v in getattr(data, "readout", ())]
+        rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
         volume = getattr(data, "volume", None)
         if volume is not None:
             rows.append(("volume", f"{volume * self._scale ** 3:.4f} as drawn"))

@@ -19,7 +19,7 @@ import pytest
 from rot4d_widget import SliceData, polytope, simple_rotation, slice_polytope
 from rot4d_widget.look import REFERENCE_RADIUS
 from rot4d_widget import PolytopeSource, SourceAction
-from rot4d_widget.source import as_source
+from rot4d_widget.source import as_source, census_text
 from rot4d_widget.widget import Rot4DWidget
 
 from widget_time import service
@@ -54,7 +54,11 @@ def test_a_polytope_is_a_source_whose_slice_is_the_exact_slice():
     assert np.array_equal(data.points, s.vertices) and np.array_equal(data.triangles, s.triangles)
     assert np.array_equal(data.groups, s.triangle_cells) and data.volume == s.volume and data.convex
     assert data.face_census() == s.face_census()  # the full Slice stays reachable
-    assert dict(data.readout)["slice"].startswith(str(sum(s.face_census().values()))) or "slice" in dict(data.readout)
+    assert dict(data.readout) == {"slice": census_text(s)}
+    assert census_text(s) == ", ".join(
+        f"{c} {({3: 'triangle', 4: 'quadrilateral', 5: 'pentagon', 6: 'hexagon'})[n]}{'' if c == 1 else 's'}"
+        for n, c in sorted(s.face_census().items())
+    )
 
 
 @pytest.mark.parametrize(
@@ -150,12 +154,11 @@ class Tube:
 def test_a_source_brings_its_own_keys_to_the_keymap_and_help(make):
     w = make(Tube())
     assert w.state.keymap["o"].kind == "custom" and "make the box thicker" in w.help_panel.value
-    vol0 = w.slice.volume
     w._handle_event({"type": "keydown", "key": "o", "code": "KeyO"})
-    assert w.source.half == pytest.approx(0.6) and w.slice.volume > vol0
-    assert "thicker" in w.readout.value or w.in_flight
+    assert w.source.half == pytest.approx(0.6) and w.slice.volume == pytest.approx(1.2**3)
     assert w.held_keys == ("KeyO",)  # repeats while held
     w._handle_event({"type": "keyup", "key": "o", "code": "KeyO"})
+    assert "half</td><td>0.60" in w.readout.value and "thicker" in w.readout.value  # at rest: exact
     w._handle_event({"type": "keydown", "key": "i", "code": "KeyI"})
     assert w.source.half == pytest.approx(0.5) and w.held_keys == ()  # repeat=False
 
