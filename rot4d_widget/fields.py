@@ -1,0 +1,1090 @@
+"""4-D scalar fields as sources: resample on the rotated hyperplane, then isosurfaces.
+
+A `Field4D` holds samples f[x, y, z, w] on the nodes of a regular (or, from
+xarray, unevenly spaced) 4-D grid -- a numpy array or memmap, a dask array, a
+zarr array -- or a vectorised function f(x, y, z, w).  Each step
+(`slice_field`):
+
+1. the data's 4-D box is cut by w = c0 after the rotation (the exact polytope
+   slicer on the box, an 8-cell scaled to the extent);
+2. a 3-D grid of ``resolution`` samples along the longest side of that cut's
+   bounding box (same spacing on all three axes, one sample of padding) is
+   pulled back into the data, ``q = matrix.T @ (x, y, z, c0) + centre``, and
+   the array is interpolated there, multilinearly (order 1, no prefilter),
+   by a numba kernel that walks the affine grid (base + i a + j b + k c in
+   index space) -- a function is evaluated exactly at those points instead;
+3. ``v = min(f - level, K * g)`` with g the signed distance to the box
+   (positive inside, piecewise linear along grid lines, so the zero of its
+   linear interpolation lies ON the box face) and K a typical |grad f|;
+   NaN counts as below every level;
+4. scikit-image's marching cubes (Lewiner) at v = 0 for each level, vertices
+   mapped from index space to slice coordinates, wound counter-clockwise seen
+   from where f < level.
+
+Coordinates.  *Data coordinates* are the field's own (``extent`` or xarray
+coordinates).  *Slice coordinates* (what the widget draws) are data
+coordinates about the box's centre, with w divided by ``w_per_unit`` (how
+much data-w one unit of space is): a data point q is drawn at
+``matrix @ (q - centre)`` with its w so scaled.
+
+Chunked data (dask, zarr, anything with ``chunks``): a full-resolution step
+reads only the chunks the hyperplane comes within one sample of (the whole
+4-D bounding block is never read), into a zero-filled buffer whose untouched
+pages are never committed; recently read chunks are kept up to
+``chunk_cache_bytes``.  ``field.coarse()`` is an in-memory copy with at most
+`COARSE_SAMPLES` nodes per axis over the same box (built once, the only time
+every chunk is read) for the held-key steps and for the data range.
+
+Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
+float64; everything returned is read-only.
+"""
+
+from __future__ import annotations
+
+import collections
+import itertools
+import math
+import numbers
+import sys
+import threading
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._arrays import sealed as _sealed
+from .rotation import as_rotation_matrix
+
+__all__ = ["Field4D", "FieldSlice", "slice_field", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+
+#: Nodes per axis, at most, of the in-memory coarse copy (`Field4D.coarse`).
+COARSE_SAMPLES = 48
+#: A step may hold at most this many bytes of samples (about `BYTES_PER_SAMPLE` per grid point).
+MAX_SAMPLE_BYTES = 2 * 1024**3
+#: Working bytes per grid point: f and g (float64), v (float32), marching cubes' own.
+BYTES_PER_SAMPLE = 24
+#: Nodes per axis of the grid a function field is sampled on for its range.
+_FUNCTION_PROBE = 21
+_AXES = "xyzw"
+
+
+# ----------------------------------------------------------------------------- kernels
+try:
+    import numba as _numba
+    from numba import prange as _prange
+except ImportError:  # pragma: no cover - numba is a dependency; scipy stands in without it
+    _numba = None
+    _prange = range
+
+_kernels = None
+_kernel_lock = threading.Lock()
+
+
+def _get_kernels():
+    """The numba kernels, compiled (or loaded from numba's cache) on first call; None without numba."""
+    global _kernels
+    if _kernels is None:
+        with _kernel_lock:
+            if _kernels is None:
+                _kernels = () if _numba is None else (
+                    _numba.njit(parallel=True, cache=True, nogil=True)(_affine_kernel),
+                    _numba.njit(parallel=True, cache=True, nogil=True)(_points_kernel),
+                )
+    return _kernels or None
+
+
+def _lerp4(a, x0, x1, x2, x3):  # pragma: no cover - compiled by numba
+    """Quadrilinear interpolation of the 4-D array ``a`` at index (x0, x1, x2, x3), clamped into it."""
+    n0, n1, n2, n3 = a.shape
+    x0 = min(max(x0, 0.0), n0 - 1.0)
+    x1 = min(max(x1, 0.0), n1 - 1.0)
+    x2 = min(max(x2, 0.0), n2 - 1.0)
+    x3 = min(max(x3, 0.0), n3 - 1.0)
+    i0 = min(int(x0), n0 - 2)
+    i1 = min(int(x1), n1 - 2)
+    i2 = min(int(x2), n2 - 2)
+    i3 = min(int(x3), n3 - 2)
+    t0 = x0 - i0
+    t1 = x1 - i1
+    t2 = x2 - i2
+    t3 = x3 - i3
+    acc = 0.0
+    for d0 in range(2):
+        w0 = t0 if d0 else 1.0 - t0
+        for d1 in range(2):
+            w01 = w0 * (t1 if d1 else 1.0 - t1)
+            for d2 in range(2):
+                w012 = w01 * (t2 if d2 else 1.0 - t2)
+                acc += w012 * (1.0 - t3) * a[i0 + d0, i1 + d1, i2 + d2, i3]
+                acc += w012 * t3 * a[i0 + d0, i1 + d1, i2 + d2, i3 + 1]
+    return acc
+
+
+def _affine_kernel(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pragma: no cover - numba
+    """f and the box distance g on the affine grid ``base + i step[0] + j step[1] + k step[2]``.
+
+    a : 4-D array (a block of the data, native axis order); base (4,), step (3, 4):
+    index coordinates in ``a``; centre, halfn (4,): the data box's centre and half
+    size in the same index coordinates; inv_s (4,): slice units per index step.
+    g = min_d (halfn_d - |x_d - centre_d|) inv_s_d (slice units, > 0 inside).
+    Points outside the box are not interpolated (f = 0 there).
+    """
+    n0, n1, n2 = n[0], n[1], n[2]
+    for i in _prange(n0):
+        for j in range(n1):
+            b0 = base[0] + i * step[0, 0] + j * step[1, 0]
+            b1 = base[1] + i * step[0, 1] + j * step[1, 1]
+            b2 = base[2] + i * step[0, 2] + j * step[1, 2]
+            b3 = base[3] + i * step[0, 3] + j * step[1, 3]
+            for k in range(n2):
+                x0 = b0 + k * step[2, 0]
+                x1 = b1 + k * step[2, 1]
+                x2 = b2 + k * step[2, 2]
+                x3 = b3 + k * step[2, 3]
+                g = (halfn[0] - abs(x0 - centre[0])) * inv_s[0]
+                g = min(g, (halfn[1] - abs(x1 - centre[1])) * inv_s[1])
+                g = min(g, (halfn[2] - abs(x2 - centre[2])) * inv_s[2])
+                g = min(g, (halfn[3] - abs(x3 - centre[3])) * inv_s[3])
+                g_out[i, j, k] = g
+                if g < 0.0:
+                    f_out[i, j, k] = 0.0
+                else:
+                    f_out[i, j, k] = _lerp4_jit(a, x0, x1, x2, x3)
+
+
+def _points_kernel(a, idx, inside, out):  # pragma: no cover - numba
+    """Quadrilinear values of ``a`` at the rows of ``idx`` (N, 4) where ``inside``; 0 elsewhere."""
+    for p in _prange(idx.shape[0]):
+        if inside[p]:
+            out[p] = _lerp4_jit(a, idx[p, 0], idx[p, 1], idx[p, 2], idx[p, 3])
+        else:
+            out[p] = 0.0
+
+
+# the kernels call the inner function compiled (inlined into each kernel)
+_lerp4_jit = _lerp4 if _numba is None else _numba.njit(cache=True, inline="always")(_lerp4)
+
+
+def _resample_affine(a, base, step, n, centre, halfn, inv_s):
+    """(f, g) on an affine grid of shape ``n`` in ``a`` (see `_affine_kernel`); float64."""
+    n = tuple(int(v) for v in n)
+    f = np.empty(n, dtype=np.float64)
+    g = np.empty(n, dtype=np.float64)
+    k = _get_kernels()
+    args = [np.ascontiguousarray(v, dtype=np.float64) for v in (base, step, centre, halfn, inv_s)]
+    if k is not None:
+        k[0](a, args[0], args[1], np.array(n, dtype=np.int64), args[2], args[3], args[4], f, g)
+        return f, g
+    # pragma: no cover - without numba: the same numbers through scipy
+    from scipy.ndimage import map_coordinates
+
+    ijk = np.indices(n, dtype=np.float64).reshape(3, -1)
+    x = args[0][:, None] + args[1].T @ ijk  # (4, N)
+    g[...] = ((args[3][:, None] - np.abs(x - args[2][:, None])) * args[4][:, None]).min(axis=0).reshape(n)
+    f[...] = map_coordinates(a, x, order=1, prefilter=False, mode="nearest").reshape(n)
+    f[g < 0] = 0.0
+    return f, g
+
+
+def _resample_points(a, idx, inside):
+    """Quadrilinear values at (N, 4) index coordinates where ``inside``; float64 (N,)."""
+    out = np.empty(len(idx), dtype=np.float64)
+    k = _get_kernels()
+    if k is not None:
+        k[1](a, np.ascontiguousarray(idx, dtype=np.float64), np.ascontiguousarray(inside), out)
+        return out
+    from scipy.ndimage import map_coordinates  # pragma: no cover
+
+    out[...] = map_coordinates(a, idx.T, order=1, prefilter=False, mode="nearest")  # pragma: no cover
+    out[~inside] = 0.0  # pragma: no cover
+    return out  # pragma: no cover
+
+
+# ----------------------------------------------------------------------------- validation
+def _real(value, name: str) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
+        raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"Expected `{name}` to be finite, got {v}")
+    return v
+
+
+def _as_levels(level) -> tuple:
+    """A number or a non-empty sequence of numbers -> tuple of finite floats."""
+    if isinstance(level, (numbers.Real, np.integer, np.floating)) and not isinstance(level, (bool, np.bool_)):
+        return (_real(level, "level"),)
+    try:
+        items = list(np.asarray(level, dtype=object).ravel()) if not isinstance(level, (str, bytes)) else None
+    except Exception:
+        items = None
+    if not items:
+        raise TypeError(f"Expected `level` to be a real number or a non-empty sequence of them, got {level!r}")
+    return tuple(_real(v, f"level[{i}]") for i, v in enumerate(items))
+
+
+def _check_resolution(resolution, name: str = "resolution") -> int:
+    if isinstance(resolution, (bool, np.bool_)) or not isinstance(resolution, (numbers.Integral, np.integer)):
+        raise TypeError(f"Expected `{name}` to be an int >= 2, got {type(resolution).__name__}")
+    r = int(resolution)
+    if r < 2:
+        raise ValueError(f"Expected `{name}` >= 2 (samples along the longest side), got {r}")
+    need = r**3 * BYTES_PER_SAMPLE
+    if need > MAX_SAMPLE_BYTES:
+        r_max = int((MAX_SAMPLE_BYTES / BYTES_PER_SAMPLE) ** (1 / 3))
+        raise ValueError(
+            f"`{name}`={r} would need up to {_bytes_text(need)} of samples ({r}^3 points x "
+            f"{BYTES_PER_SAMPLE} bytes); the limit is {_bytes_text(MAX_SAMPLE_BYTES)} "
+            f"(rot4d_widget.fields.MAX_SAMPLE_BYTES), i.e. resolution <= {r_max}"
+        )
+    return r
+
+
+def _bytes_text(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024 or unit == "TiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} TiB"  # pragma: no cover
+
+
+def _check_extent(extent) -> tuple:
+    try:
+        e = np.array(extent, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError("Expected `extent` to be ((xmin, xmax), (ymin, ymax), (zmin, zmax), (wmin, wmax)) of "
+                        "real numbers") from None
+    if e.shape != (4, 2):
+        raise ValueError(f"Expected `extent` to have shape (4, 2): ((xmin, xmax), ..., (wmin, wmax)), got {e.shape}")
+    if not np.all(np.isfinite(e)):
+        raise ValueError(f"Expected `extent` to be finite, got {e.tolist()}")
+    bad = [_AXES[d] for d in range(4) if not e[d, 0] < e[d, 1]]
+    if bad:
+        raise ValueError(f"Expected min < max in `extent` for every axis; not so for {', '.join(bad)}: {e.tolist()}")
+    return tuple((float(a), float(b)) for a, b in e)
+
+
+def _check_positive(value, name: str) -> float:
+    v = _real(value, name)
+    if v <= 0:
+        raise ValueError(f"Expected `{name}` > 0, got {v}")
+    return v
+
+
+# ----------------------------------------------------------------------------- the result
+@dataclass(frozen=True, eq=False)
+class FieldSlice:
+    """The isosurface {f = level} closing {f >= level} in one slice (all arrays read-only).
+
+    vertices : (n, 3) float64 -- in slice coordinates
+    triangles : (k, 3) intp -- counter-clockwise seen from where f < level
+        (outward from {f >= level}); the surface is closed, capped on the box's faces
+    normals : (n, 3) float64 -- unit, outward
+    volume : float -- 3-volume of {f >= level} in the slice
+    area : float -- area of the surface
+    level : float
+    spacing : float -- the sample spacing of the step (slice units); 0 when nothing was sampled
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    normals: np.ndarray
+    volume: float
+    area: float
+    level: float
+    spacing: float
+
+    @property
+    def empty(self) -> bool:
+        return len(self.triangles) == 0
+
+    def __repr__(self) -> str:
+        return (f"FieldSlice(level={self.level:.6g}, V={len(self.vertices)}, T={len(self.triangles)}, "
+                f"volume={self.volume:.6g}, area={self.area:.6g})")
+
+
+_EMPTY3 = _sealed(np.zeros((0, 3)))
+_EMPTY_T = _sealed(np.zeros((0, 3), dtype=np.intp))
+
+
+def _empty_slice(level: float, spacing: float) -> FieldSlice:
+    return FieldSlice(_EMPTY3, _EMPTY_T, _EMPTY3, 0.0, 0.0, level, spacing)
+
+
+# ----------------------------------------------------------------------------- chunked reads
+class _ChunkReader:
+    """Reads chunks of a lazy 4-D array (dask, zarr, anything sliceable) and keeps recent ones."""
+
+    def __init__(self, values, cache_bytes: int):
+        self.values = values
+        self.kind = _array_kind(values)
+        shape = tuple(int(s) for s in values.shape)
+        chunks = getattr(values, "chunks", None)
+        bounds = None
+        if self.kind == "dask":
+            bounds = [np.concatenate([[0], np.cumsum(c)]).astype(np.int64) for c in chunks]
+        elif isinstance(chunks, tuple) and len(chunks) == 4 and all(isinstance(c, (int, np.integer)) for c in chunks):
+            bounds = [np.unique(np.r_[np.arange(0, n, int(c)), n]).astype(np.int64) for n, c in zip(shape, chunks)]
+        elif isinstance(chunks, tuple) and len(chunks) == 4 and all(isinstance(c, tuple) for c in chunks):
+            bounds = [np.concatenate([[0], np.cumsum(c)]).astype(np.int64) for c in chunks]
+        if bounds is None:  # no chunk grid known: one chunk per 16 samples along each axis (reads are sub-blocks)
+            bounds = [np.unique(np.r_[np.arange(0, n, 16), n]).astype(np.int64) for n in shape]
+        self.bounds = bounds
+        self.shape = shape
+        self.dtype = np.dtype(np.float32) if np.dtype(values.dtype) == np.float32 else np.dtype(np.float64)
+        self.cache_bytes = int(cache_bytes)
+        self._cache: "collections.OrderedDict[tuple, np.ndarray]" = collections.OrderedDict()
+        self._cached = 0
+        self._delayed = None
+        self._lock = threading.Lock()
+        #: chunks read from the array (not from the cache) so far
+        self.reads = 0
+
+    def _slices(self, idx):
+        return tuple(slice(int(b[i]), int(b[i + 1])) for b, i in zip(self.bounds, idx))
+
+    def read(self, wanted):
+        """{chunk index: ndarray} for the chunk indices ``wanted`` (list of 4-tuples)."""
+        with self._lock:
+            got, missing = {}, []
+            for idx in wanted:
+                a = self._cache.get(idx)
+                if a is None:
+                    missing.append(idx)
+                else:
+                    self._cache.move_to_end(idx)
+                    got[idx] = a
+        if missing:
+            if self.kind == "dask":
+                import dask
+
+                if self._delayed is None:
+                    self._delayed = self.values.to_delayed()
+                parts = dask.compute(*[self._delayed[idx] for idx in missing])
+            else:
+                parts = [self.values[self._slices(idx)] for idx in missing]
+            with self._lock:
+                self.reads += len(missing)
+                for idx, a in zip(missing, parts):
+                    a = np.asarray(a, dtype=self.dtype)
+                    got[idx] = a
+                    if a.nbytes <= self.cache_bytes:
+                        self._cache[idx] = a
+                        self._cached += a.nbytes
+                while self._cached > self.cache_bytes and self._cache:
+                    _, old = self._cache.popitem(last=False)
+                    self._cached -= old.nbytes
+        return got
+
+    def clear_cache(self) -> None:
+        with self._lock:
+            self._cache.clear()
+            self._cached = 0
+
+
+def _array_kind(values) -> str:
+    if isinstance(values, np.ndarray):
+        return "numpy"
+    mod = type(values).__module__ or ""
+    if mod.startswith("dask.") and hasattr(values, "to_delayed"):
+        return "dask"
+    if mod.startswith("zarr"):
+        return "zarr"
+    return "lazy"
+
+
+# ----------------------------------------------------------------------------- the field
+class Field4D:
+    """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
+
+    Parameters
+    ----------
+    values : 4-D array-like
+        numpy array or memmap, dask array, zarr array or anything with ``shape``,
+        ``ndim``, ``dtype`` and slicing; real numbers (NaN allowed: below every level).
+        Chunked/lazy arrays are never read whole except once for `coarse`.
+    axes : str
+        Which of x, y, z, w each array axis is, a permutation of ``"xyzw"``
+        (``"wzyx"`` for ``f[t, z, y, x]``).
+    extent : ((xmin, xmax), (ymin, ymax), (zmin, zmax), (wmin, wmax)), optional
+        Data coordinates of the first and last node along each axis (samples sit
+        on the nodes).  Default: x, y, z span ``[-(n-1)/2, (n-1)/2] * h`` with one
+        spacing ``h = 2 / (longest spatial n - 1)`` (the longest spatial side is
+        2, voxels are cubes), and w is the sample index ``0 .. nw-1``.
+    name, units : str, optional
+        Shown in the readout.
+    w_per_unit : float, optional
+        How much data-w one unit of slice space is.  Default: 1 when ``extent``
+        is given (taken literally), else ``1 / h`` (one w sample is as long as
+        one spatial sample: voxels are cubes in 4-D).  Larger values squash time.
+    w_units : str, optional
+        Unit of w for the readout (default ``"sample"`` with the default extent).
+    resolution, coarse_resolution : int
+        Samples along the longest side of a full step (default 64) and of a
+        coarse step (default ``max(24, resolution // 2)``).
+    levels : float or sequence of floats, optional
+        Iso levels (default: one, midway between the min and max of `coarse`).
+    chunk_cache_bytes : int
+        Recently read chunks of a chunked array kept in memory (default 256 MiB).
+    """
+
+    def __init__(self, values, *, axes: str = "xyzw", extent=None, name=None, units=None,
+                 w_per_unit=None, w_units=None, resolution: int = 64, coarse_resolution=None,
+                 levels=None, chunk_cache_bytes: int = 256 * 1024**2, _coords=None, _function=None):
+        self._function = _function
+        if _function is None:
+            for attr in ("shape", "ndim", "__getitem__"):
+                if not hasattr(values, attr):
+                    raise TypeError(f"Expected `values` to be a 4-D array-like (numpy, dask, zarr ...) with shape, "
+                                    f"ndim and slicing; {type(values).__name__} has no {attr!r}")
+            kind = _array_kind(values)
+            if kind == "lazy" and not hasattr(values, "dtype"):
+                values = np.asarray(values)
+                kind = "numpy"
+            if values.ndim != 4:
+                raise ValueError(f"Expected `values` to be 4-D, got {values.ndim}-D with shape {tuple(values.shape)}")
+            dtype = np.dtype(values.dtype)
+            if dtype.kind not in "fiub":
+                raise TypeError(f"Expected `values` to hold real numbers (float, int, uint or bool), got dtype {dtype}")
+            if kind == "numpy":
+                values = np.asarray(values)  # a memmap stays a memmap underneath (no copy)
+                if dtype not in (np.float32, np.float64):
+                    values = values.astype(np.float64)
+            self._values = values
+            self._kind = kind
+            if not isinstance(axes, str) or sorted(axes) != sorted(_AXES):
+                raise ValueError(f"Expected `axes` to be a permutation of 'xyzw' naming each array axis "
+                                 f"(e.g. 'wzyx' for f[t, z, y, x]), got {axes!r}")
+            self.axes = axes
+            self._axis_of = tuple(axes.index(c) for c in _AXES)  # array axis of x, y, z, w
+            self.shape = tuple(int(values.shape[a]) for a in self._axis_of)
+            small = [f"{c}={n}" for c, n in zip(_AXES, self.shape) if n < 2]
+            if small:
+                raise ValueError(f"Expected at least 2 samples along every axis, got {', '.join(small)}")
+        else:
+            self._values = None
+            self._kind = "function"
+            self.axes = _AXES
+            self._axis_of = (0, 1, 2, 3)
+            self.shape = None
+
+        if extent is None:
+            if _function is not None:
+                raise ValueError("A function field needs an `extent`")
+            h = 2.0 / (max(self.shape[:3]) - 1)
+            ext = [(-(n - 1) / 2 * h, (n - 1) / 2 * h) for n in self.shape[:3]] + [(0.0, float(self.shape[3] - 1))]
+            self.extent = tuple((float(a), float(b)) for a, b in ext)
+            self.w_per_unit = 1.0 / h if w_per_unit is None else _check_positive(w_per_unit, "w_per_unit")
+            self.w_units = "sample" if w_units is None else str(w_units)
+            self.default_extent = True
+        else:
+            self.extent = _check_extent(extent)
+            self.w_per_unit = 1.0 if w_per_unit is None else _check_positive(w_per_unit, "w_per_unit")
+            self.w_units = None if w_units is None else str(w_units)
+            self.default_extent = False
+        self._coords = (None,) * 4 if _coords is None else tuple(_coords)
+        self.name = None if name is None else str(name)
+        self.units = None if units is None else str(units)
+        e = np.array(self.extent)
+        self._centre = (e[:, 0] + e[:, 1]) / 2
+        self._unit = np.array([1.0, 1.0, 1.0, self.w_per_unit])  # data units per slice unit
+        hw = (e[:, 1] - e[:, 0]) / 2 / self._unit
+        self.half_widths = tuple(float(v) for v in hw)
+        self._hw = hw
+        self.resolution = _check_resolution(resolution)
+        self.coarse_resolution = (max(24, self.resolution // 2) if coarse_resolution is None
+                                  else _check_resolution(coarse_resolution, "coarse_resolution"))
+        self.chunk_cache_bytes = int(chunk_cache_bytes)
+        self._reader = None
+        self._coarse = None
+        self._stats = None
+        self._box = None
+        self._levels = None if levels is None else _as_levels(levels)
+
+    # -- constructors ---------------------------------------------------------
+    @classmethod
+    def from_function(cls, f, extent, *, name=None, units=None, w_per_unit=None, w_units=None, **kwargs) -> "Field4D":
+        """A field given by ``f(x, y, z, w)``, vectorised over arrays of one shape and
+        returning real values of that shape, evaluated exactly at each sample point
+        (no grid, no interpolation).  ``extent`` is required (its box is the field's)."""
+        if not callable(f):
+            raise TypeError(f"Expected `f` to be callable as f(x, y, z, w), got {type(f).__name__}")
+        if name is None:
+            name = getattr(f, "__name__", None)
+        return cls(None, extent=extent, name=name, units=units, w_per_unit=w_per_unit, w_units=w_units,
+                   _function=f, **kwargs)
+
+    @classmethod
+    def from_xarray(cls, da, *, x=None, y=None, z=None, w=None, w_per_unit=None, **kwargs) -> "Field4D":
+        """A field from a 4-D ``xarray.DataArray`` (dims by name; extents from coordinates).
+
+        Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one
+        left over is w (``("time", "z", "y", "x")``); otherwise name them with
+        ``x=, y=, z=, w=``.  Coordinates may be unevenly spaced (each maps to a
+        fractional index) and decreasing (read reversed, lazily); not monotonic
+        -> ValueError.  datetime64 coordinates become seconds since their first
+        value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
+        mean w spacing over the mean spatial spacing (voxels are cubes).
+        """
+        if not (hasattr(da, "dims") and hasattr(da, "coords") and hasattr(da, "isel")):
+            raise TypeError(f"Expected an xarray.DataArray, got {type(da).__name__}")
+        dims = tuple(str(d) for d in da.dims)
+        if len(dims) != 4:
+            raise ValueError(f"Expected a 4-D DataArray, got dims {dims}; select a 4-D part first "
+                             "(da.isel(...) / da.sel(...))")
+        given = {"x": x, "y": y, "z": z, "w": w}
+        for k, v in given.items():
+            if v is not None and v not in dims:
+                raise ValueError(f"`{k}={v!r}` is not a dim of the DataArray; its dims are {dims}")
+        chosen = {k: v for k, v in given.items() if v is not None}
+        if len(set(chosen.values())) != len(chosen):
+            raise ValueError(f"Expected distinct dims for x, y, z, w, got {chosen}")
+        for k in "xyz":
+            if k not in chosen:
+                cands = [d for d in dims if d.lower() == k and d not in chosen.values()]
+                if len(cands) == 1:
+                    chosen[k] = cands[0]
+        left = [d for d in dims if d not in chosen.values()]
+        missing = [k for k in _AXES if k not in chosen]
+        if len(missing) == 1 and len(left) == 1:
+            chosen[missing[0]] = left[0]
+        elif missing:
+            raise ValueError(
+                f"Cannot map the dims {dims} to x, y, z, w: found {chosen or 'none'}; name them, e.g. "
+                f"Field4D.from_xarray(da, x='lon', y='lat', z='depth', w='time')"
+            )
+        axes = "".join(next(k for k, v in chosen.items() if v == d) for d in dims)
+        flips, coords, extent = {}, [None] * 4, []
+        for d_i, k in enumerate(_AXES):
+            dim = chosen[k]
+            n = int(da.sizes[dim])
+            if dim in da.coords:
+                c = np.asarray(da.coords[dim].values)
+                if np.issubdtype(c.dtype, np.datetime64) or np.issubdtype(c.dtype, np.timedelta64):
+                    c = (c - c[0]) / np.timedelta64(1, "s")
+                try:
+                    c = np.asarray(c, dtype=np.float64)
+                except (TypeError, ValueError):
+                    raise TypeError(f"Expected numeric or datetime coordinates for {dim!r}, got dtype {c.dtype}") from None
+                if c.shape != (n,) or not np.all(np.isfinite(c)):
+                    raise ValueError(f"Expected finite 1-D coordinates for {dim!r}")
+            else:
+                c = np.arange(n, dtype=np.float64)
+            dc = np.diff(c)
+            if n >= 2 and np.all(dc < 0):
+                flips[dim] = slice(None, None, -1)
+                c, dc = c[::-1], -dc[::-1]
+            if not np.all(dc > 0):
+                raise ValueError(f"Expected the coordinates of {dim!r} to be strictly monotonic, got {c.tolist()[:8]}...")
+            extent.append((float(c[0]), float(c[-1])))
+            uniform = np.allclose(dc, (c[-1] - c[0]) / (n - 1), rtol=1e-6, atol=0)
+            coords[d_i] = None if uniform else _sealed(c.copy())
+        if flips:
+            da = da.isel(flips)
+        if w_per_unit is None:
+            sp = np.mean([(b - a) / (int(da.sizes[chosen[k]]) - 1) for k, (a, b) in zip("xyz", extent)])
+            w_per_unit = ((extent[3][1] - extent[3][0]) / (int(da.sizes[chosen["w"]]) - 1)) / sp
+        values = da.data if da.chunks is not None else (
+            da.values if getattr(da.variable, "_in_memory", True) else da)
+        units = da.attrs.get("units")
+        w_units = kwargs.pop("w_units", da.coords[chosen["w"]].attrs.get("units") if chosen["w"] in da.coords else None)
+        if w_units is None and chosen["w"] in da.coords and np.issubdtype(da.coords[chosen["w"]].dtype, np.datetime64):
+            w_units = "s"
+        return cls(values, axes=axes, extent=extent, name=kwargs.pop("name", da.name), units=kwargs.pop("units", units),
+                   w_per_unit=w_per_unit, w_units=w_units, _coords=coords, **kwargs)
+
+    # -- source protocol --------------------------------------------------------
+    @property
+    def size(self) -> float:
+        """Circumradius of the 4-D box about its centre, in slice units."""
+        return float(np.linalg.norm(self._hw))
+
+    @property
+    def n_groups(self) -> int:
+        return len(self.levels)
+
+    @property
+    def levels(self) -> tuple:
+        """The iso levels (tuple of floats); settable with a number or a sequence."""
+        if self._levels is None:
+            lo, hi = self.data_range
+            self._levels = ((lo + hi) / 2,) if math.isfinite(lo) and math.isfinite(hi) else (0.0,)
+        return self._levels
+
+    @levels.setter
+    def levels(self, value) -> None:
+        self._levels = _as_levels(value)
+
+    @property
+    def values(self):
+        """The array as given (None for a function field)."""
+        return self._values
+
+    @property
+    def data_range(self) -> tuple:
+        """(nanmin, nanmax) of `coarse` (of a probe grid for a function); (nan, nan) if all NaN."""
+        return self._statistics()[0]
+
+    @property
+    def level_step(self) -> float:
+        """How far o / i move the levels: 1/50 of the data range (1/50 of |value| or 0.02 when constant)."""
+        lo, hi = self.data_range
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            return 0.02
+        span = hi - lo
+        return span / 50 if span > 0 else max(abs(hi), 1.0) / 50
+
+    def step_levels(self, sign: int) -> tuple:
+        """Move every level by ``sign * level_step``, kept within one step beyond the data range."""
+        step = self.level_step
+        lo, hi = self.data_range
+        new = []
+        for v in self.levels:
+            v = v + (1 if sign > 0 else -1) * step
+            if math.isfinite(lo) and math.isfinite(hi):
+                v = min(max(v, lo - step), hi + step)
+            new.append(v)
+        self._levels = tuple(new)
+        return self._levels
+
+    @property
+    def actions(self) -> dict:
+        """``{"o": level up, "i": level down}`` (`SourceAction`), repeating while held."""
+        from .source import SourceAction
+
+        return {
+            "o": SourceAction("level up", "raise the iso level(s) by 1/50 of the data range",
+                              lambda sign=1: self.step_levels(sign)),
+            "i": SourceAction("level down", "lower the iso level(s) by 1/50 of the data range",
+                              lambda sign=1: self.step_levels(-sign)),
+        }
+
+    def w_range(self, matrix) -> tuple:
+        """(lowest, highest) w of the rotated box, in slice units."""
+        m = as_rotation_matrix(matrix)
+        s = float(np.abs(m[3]) @ self._hw)
+        return -s, s
+
+    def slice(self, matrix, c0, coarse: bool = False):
+        """The slice as the widget draws it (`SliceData`): the isosurface of every level
+        (group = level index) and the cut of the data's box as bars.  ``coarse``:
+        the in-memory coarse copy at `coarse_resolution` (for held keys)."""
+        from .source import SliceData
+
+        m = as_rotation_matrix(matrix)
+        c0 = _real(c0, "c0")
+        levels = self.levels
+        res = self.coarse_resolution if coarse else self.resolution
+        slices = slice_field(self, m, c0, levels, res, coarse=coarse)
+        box = _box_slice(self, m, c0)
+        pts, tris, nrm, groups = [], [], [], []
+        off = 0
+        for g, s in enumerate(slices):
+            pts.append(s.vertices)
+            nrm.append(s.normals)
+            tris.append(s.triangles + off)
+            groups.append(np.full(len(s.triangles), g, dtype=np.intp))
+            off += len(s.vertices)
+        bv = np.asarray(box.vertices)
+        r = np.linalg.norm(bv, axis=1, keepdims=True)
+        bn = np.where(r > 0, bv / np.where(r > 0, r, 1.0), np.array([0.0, 0.0, 1.0]))
+        pts.append(bv)
+        nrm.append(bn)
+        segments = np.asarray(box.edges) + off
+        readout = self._readout(m, c0, slices, box, coarse)
+        return SliceData.build(
+            points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
+            groups=np.concatenate(groups), normals=np.concatenate(nrm),
+            volume=float(slices[0].volume) if len(slices) == 1 else None,
+            readout=readout, convex=False, show_points=False,
+            extra={"levels": slices, "box": box},
+        )
+
+    def describe(self) -> dict:
+        """A JSON-able description; rebuilds nothing for in-memory arrays (not recordable)."""
+        d = {"kind": "field", "axes": self.axes, "extent": [list(e) for e in self.extent],
+             "w_per_unit": self.w_per_unit, "levels": list(self.levels), "name": self.name, "units": self.units}
+        if self._kind == "function":
+            f = self._function
+            d["function"] = f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', type(f).__name__)}"
+        else:
+            what = {"numpy": "in-memory numpy", "dask": "dask array", "zarr": "zarr array"}.get(
+                self._kind, type(self._values).__name__)
+            d["array"] = f"{what} (not recordable)"
+            d["shape"] = list(self._values.shape)
+            d["dtype"] = str(np.dtype(self._values.dtype))
+            store = getattr(self._values, "store", None)
+            if self._kind == "zarr" and store is not None:
+                d["store"] = str(store)
+        return d
+
+    # -- coarse copy -------------------------------------------------------------
+    def coarse(self) -> "Field4D":
+        """An in-memory copy with at most `COARSE_SAMPLES` nodes per axis over the same box
+        (linear resampling onto evenly spaced fractional indices), built once.
+
+        The field itself when it already is that small and in memory, or a function."""
+        if self._coarse is None:
+            self._coarse = self._make_coarse()
+        return self._coarse
+
+    def _make_coarse(self) -> "Field4D":
+        if self._kind == "function":
+            return self
+        nshape = self._values.shape
+        target = [min(int(n), COARSE_SAMPLES) for n in nshape]
+        if self._kind == "numpy" and list(nshape) == target:
+            return self
+        x = self._values
+        if self._kind != "numpy":
+            if "dask.array" not in sys.modules:
+                try:
+                    import dask.array  # noqa: F401
+                except ImportError:  # pragma: no cover
+                    pass
+            if "dask.array" in sys.modules:
+                import dask.array as dsa
+
+                if self._kind != "dask":
+                    ch = getattr(x, "chunks", None)
+                    x = dsa.from_array(x, chunks=ch if isinstance(ch, tuple) else "auto", asarray=False)
+            else:  # pragma: no cover
+                x = np.asarray(x)
+        xp = sys.modules["dask.array"] if self._kind != "numpy" and "dask.array" in sys.modules else np
+        coords = list(self._coords)
+        for a in np.argsort([t / n for t, n in zip(target, nshape)]):  # biggest reduction first
+            n, m = int(nshape[a]), target[a]
+            if m == n:
+                continue
+            u = np.linspace(0.0, n - 1.0, m)
+            i0 = np.minimum(np.floor(u).astype(np.int64), n - 2)
+            t = (u - i0).reshape([-1 if k == a else 1 for k in range(4)])
+            x = xp.take(x, i0, axis=a) * (1 - t) + xp.take(x, i0 + 1, axis=a) * t
+            d = self.axes[a]
+            di = _AXES.index(d)
+            if coords[di] is not None:
+                coords[di] = _sealed(np.interp(u, np.arange(n), coords[di]))
+        x = np.asarray(x.compute() if hasattr(x, "compute") else x, dtype=np.float64
+                       if np.dtype(self._values.dtype) != np.float32 else np.float32)
+        x = np.ascontiguousarray(x)
+        x.flags.writeable = False
+        c = Field4D(x, axes=self.axes, extent=self.extent, name=self.name, units=self.units,
+                    w_per_unit=self.w_per_unit, w_units=self.w_units, _coords=coords)
+        c._coarse = c
+        return c
+
+    def _statistics(self):
+        """((nanmin, nanmax), K): the data range and a typical |grad f| (level units per slice unit)."""
+        if self._stats is not None:
+            return self._stats
+        if self._kind == "function":
+            m = _FUNCTION_PROBE
+            axes = [np.linspace(a, b, m) for a, b in self.extent]
+            grids = np.meshgrid(*axes, indexing="ij")
+            a = _call(self._function, *grids)
+            spacing = [(b - a_) / (m - 1) / u for (a_, b), u in zip(self.extent, self._unit)]
+        else:
+            c = self.coarse()
+            a = np.asarray(c._values, dtype=np.float64).transpose(c._axis_of)  # x, y, z, w order
+            spacing = []
+            for d in range(4):
+                cd = c._coords[d]
+                if cd is None:
+                    lo, hi = c.extent[d]
+                    spacing.append((hi - lo) / (a.shape[d] - 1) / c._unit[d])
+                else:
+                    spacing.append(np.asarray(cd) / c._unit[d])
+        finite = np.isfinite(a)
+        if finite.any():
+            rng = (float(np.min(a[finite])), float(np.max(a[finite])))
+        else:
+            rng = (math.nan, math.nan)
+        with np.errstate(invalid="ignore"):
+            grads = np.gradient(a, *spacing)
+            gm = np.sqrt(sum(g * g for g in grads))
+        ok = np.isfinite(gm) & (gm > 0)
+        if ok.any():
+            k = float(np.median(gm[ok]))
+        else:
+            span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
+            k = max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * self.size)
+        self._stats = (rng, k)
+        return self._stats
+
+    # -- readout -------------------------------------------------------------------
+    def _readout(self, m, c0, slices, box, coarse) -> tuple:
+        rows = []
+        label = self.name or "field"
+        rows.append(("field", f"{label}" + (f" [{self.units}]" if self.units else "")))
+        lo, hi = self.data_range
+        parts = []
+        for s in slices:
+            t = f"{s.level:.4g}"
+            if math.isfinite(hi) and s.level > hi:
+                t += " (above the max: empty)"
+            elif math.isfinite(lo) and s.level <= lo:
+                t += " (at or below the min: the whole box)"
+            elif s.empty:
+                t += " (empty here)"
+            parts.append(t)
+        rng = f" of {lo:.4g} \u2026 {hi:.4g}" if math.isfinite(lo) else " (all NaN)"
+        rows.append(("level" if len(slices) == 1 else "levels", ", ".join(parts) + rng))
+        if len(slices) > 1:
+            rows.append(("volumes", ", ".join(f"{s.volume:.4g}" for s in slices)))
+        wu = f" {self.w_units}" if self.w_units else ""
+        if len(box.vertices):
+            p = np.column_stack([np.asarray(box.vertices), np.full(len(box.vertices), c0)])
+            w = (p @ m)[:, 3] * self.w_per_unit + self._centre[3]
+            rows.append(("w cut", f"{w.min():.4g} \u2026 {w.max():.4g}{wu} (data {self.extent[3][0]:.4g} \u2026 "
+                                  f"{self.extent[3][1]:.4g})"))
+        else:
+            rows.append(("w cut", "none (w = c0 misses the data)"))
+        rows.append(("w per unit", f"{self.w_per_unit:.4g}{wu} per unit of space"))
+        if coarse:
+            rows.append(("resolution", f"{self.coarse_resolution} (coarse copy)"))
+        return tuple(rows)
+
+    def __repr__(self) -> str:
+        what = "function" if self._kind == "function" else f"{self._kind} {tuple(self._values.shape)}"
+        return f"Field4D({self.name or ''!s}{' ' if self.name else ''}{what}, axes={self.axes!r}, extent={self.extent})"
+
+
+def _call(f, *arrays) -> np.ndarray:
+    """``f(*arrays)`` validated: same shape as the inputs, real numbers -> float64."""
+    out = f(*arrays)
+    try:
+        out = np.asarray(out)
+    except Exception:
+        raise TypeError(f"Expected the field function to return an array, got {type(out).__name__}") from None
+    if out.dtype.kind not in "fiub":
+        raise TypeError(f"Expected the field function to return real numbers (float, int or bool), got dtype {out.dtype}")
+    if out.shape != arrays[0].shape:
+        raise ValueError(
+            f"Expected the field function to return one value per point, shape {arrays[0].shape}, got {out.shape} "
+            "(write it with numpy operations on its arguments; for a constant use c + 0 * x)"
+        )
+    return out.astype(np.float64, copy=False)
+
+
+# ----------------------------------------------------------------------------- one step
+_BOX_CACHE: dict = {}
+
+
+def _box_polytope(hw):
+    from .polytopes import Polytope
+
+    key = tuple(float(v) for v in hw)
+    p = _BOX_CACHE.get(key)
+    if p is None:
+        corners = np.array(list(itertools.product((-1.0, 1.0), repeat=4))) * np.asarray(hw)
+        p = Polytope(corners, name="field box")
+        if len(_BOX_CACHE) > 64:
+            _BOX_CACHE.clear()
+        _BOX_CACHE[key] = p
+    return p
+
+
+def _box_slice(field, m, c0):
+    from .slicing import slice_polytope
+
+    return slice_polytope(_box_polytope(field._hw), m, c0)
+
+
+class _Samples:
+    """One step's samples: the grid (origin, spacing, shape) and f, g on it."""
+
+    __slots__ = ("origin", "spacing", "f", "g", "k", "box")
+
+
+def _geometric_nodes(field, d):
+    """Slice-space coordinate (about the centre) of every node along data axis d."""
+    n = field.shape[d]
+    c = field._coords[d]
+    if c is None:
+        return np.linspace(-field._hw[d], field._hw[d], n)
+    return (np.asarray(c) - field._centre[d]) / field._unit[d]
+
+
+def _sample(field, m, c0, res) -> _Samples | None:
+    """Resample ``field`` on the grid of one step, or None when w = c0 misses the box."""
+    box = _box_slice(field, m, c0)
+    if box.dim < 3:
+        return None
+    bv = np.asarray(box.vertices)
+    lo, hi = bv.min(axis=0), bv.max(axis=0)
+    side = hi - lo
+    L = float(side.max())
+    if not L > 0:
+        return None
+    d = L / (res - 1)
+    n = np.maximum(np.ceil(side / d - 1e-9).astype(np.int64) + 1, 2)
+    origin = (lo + hi) / 2 - (n - 1) * d / 2 - d  # one sample of padding on each side
+    n = n + 2
+    s = _Samples()
+    s.origin, s.spacing, s.box = origin, d, box
+    s.k = field._statistics()[1]
+    hw = field._hw
+    p0 = np.array([origin[0], origin[1], origin[2], c0])
+    if field._kind == "function":
+        axes = [origin[a] + d * np.arange(n[a]) for a in range(3)]
+        P = np.meshgrid(*axes, indexing="ij")
+        q = [m[0, j] * P[0] + m[1, j] * P[1] + m[2, j] * P[2] + m[3, j] * c0 for j in range(4)]
+        g = np.minimum.reduce([hw[j] - np.abs(q[j]) for j in range(4)])
+        with np.errstate(all="ignore"):
+            f = _call(field._function, *[q[j] * field._unit[j] + field._centre[j] for j in range(4)])
+        s.f, s.g = f, g
+        return s
+    uniform = all(c is None for c in field._coords)
+    # data axis j <-> array axis field._axis_of[j]
+    if uniform:
+        sc = np.array([(field.shape[j] - 1) / (2 * hw[j]) for j in range(4)])  # index steps per slice unit
+        base_d = (m.T @ p0 + hw) * sc
+        step_d = d * m[:3, :] * sc  # (3, 4): grid axis r -> data axis j
+        base = np.empty(4)
+        step = np.empty((3, 4))
+        centre = np.empty(4)
+        inv_s = np.empty(4)
+        for j in range(4):
+            a = field._axis_of[j]
+            base[a] = base_d[j]
+            step[:, a] = step_d[:, j]
+            centre[a] = (field.shape[j] - 1) / 2
+            inv_s[a] = 1.0 / sc[j]
+        halfn = centre.copy()
+        arr, start = _block(field, m, c0, box)
+        s.f, s.g = _resample_affine(arr, base - start, step, n, centre - start, halfn, inv_s)
+        return s
+    # uneven coordinates: points -> fractional indices by np.interp, then the points kernel
+    axes = [origin[a] + d * np.arange(n[a]) for a in range(3)]
+    P = np.meshgrid(*axes, indexing="ij")
+    q = [(m[0, j] * P[0] + m[1, j] * P[1] + m[2, j] * P[2] + m[3, j] * c0).ravel() for j in range(4)]
+    g = np.minimum.reduce([hw[j] - np.abs(q[j]) for j in range(4)])
+    idx = np.empty((len(g), 4))
+    for j in range(4):
+        a = field._axis_of[j]
+        idx[:, a] = np.interp(q[j], _geometric_nodes(field, j), np.arange(field.shape[j], dtype=np.float64))
+    arr, start = _block(field, m, c0, box)
+    f = _resample_points(arr, idx - start, g >= 0)
+    s.f, s.g = f.reshape(tuple(n)), g.reshape(tuple(n))
+    return s
+
+
+def _block(field, m, c0, box):
+    """(array, start): the data, or for chunked/lazy arrays a buffer holding every chunk the
+    hyperplane comes within one sample of, with the index of its first element."""
+    if field._kind == "numpy":
+        return field._values, np.zeros(4)
+    if field._reader is None:
+        field._reader = _ChunkReader(field._values, field.chunk_cache_bytes)
+    rd = field._reader
+    # hyperplane sum_j m[3, j] q_j = c0 against each chunk's slice-space box, grown by one sample
+    proj_c, proj_r = [], []
+    for a in range(4):
+        j = _AXES.index(field.axes[a])  # the data axis of array axis a
+        nodes = _geometric_nodes(field, j)
+        b = rd.bounds[a]
+        lo_q = nodes[np.maximum(b[:-1] - 1, 0)]
+        hi_q = nodes[np.minimum(b[1:], len(nodes) - 1)]
+        ctr, rad = (lo_q + hi_q) / 2, (hi_q - lo_q) / 2
+        proj_c.append(m[3, j] * ctr)
+        proj_r.append(abs(m[3, j]) * rad)
+    P = proj_c[0][:, None, None, None] + proj_c[1][None, :, None, None] + proj_c[2][None, None, :, None] \
+        + proj_c[3][None, None, None, :]
+    R = proj_r[0][:, None, None, None] + proj_r[1][None, :, None, None] + proj_r[2][None, None, :, None] \
+        + proj_r[3][None, None, None, :]
+    need = np.abs(P - c0) <= R * (1 + 1e-9) + 1e-12
+    wanted = [tuple(int(i) for i in idx) for idx in np.argwhere(need)]
+    if not wanted:  # cannot happen when the box is cut; keep the kernel's reads in bounds anyway
+        wanted = [(0, 0, 0, 0)]
+    ids = np.array(wanted)
+    cmin, cmax = ids.min(axis=0), ids.max(axis=0)
+    start = np.array([rd.bounds[a][cmin[a]] for a in range(4)], dtype=np.int64)
+    stop = np.array([rd.bounds[a][cmax[a] + 1] for a in range(4)], dtype=np.int64)
+    # at least two samples along each axis for the kernel's clamped cells
+    for a in range(4):
+        if stop[a] - start[a] < 2:
+            start[a] = max(0, stop[a] - 2)
+            stop[a] = start[a] + 2
+    buf = np.zeros(tuple(stop - start), dtype=rd.dtype)  # pages never written are never committed
+    got = rd.read(wanted)
+    for idx, chunk in got.items():
+        sl = tuple(slice(int(rd.bounds[a][idx[a]] - start[a]), int(rd.bounds[a][idx[a] + 1] - start[a]))
+                   for a in range(4))
+        buf[sl] = chunk
+    return buf, start.astype(np.float64)
+
+
+def _surface(s: _Samples, level: float) -> FieldSlice:
+    """Marching cubes of min(f - level, K g) = 0 on one step's samples."""
+    from skimage.measure import marching_cubes
+
+    d = s.spacing
+    with np.errstate(invalid="ignore"):
+        v = s.f - level
+        v[v == 0] = 1e-9 * s.k * d  # f == level belongs to {f >= level}
+        v[np.isnan(v)] = -s.k * d  # NaN: below every level
+        v = np.minimum(v, s.k * s.g).astype(np.float32)
+    if not v.max() > 0:
+        return _empty_slice(level, d)
+    verts, faces, normals, _ = marching_cubes(v, 0.0, spacing=(d, d, d), method="lewiner")
+    if len(faces) == 0:
+        return _empty_slice(level, d)
+    vertices = verts.astype(np.float64) + s.origin
+    tri = faces.astype(np.intp)
+    # skimage (gradient 'descent') winds faces clockwise seen from the low side: flip to CCW
+    tri = tri[:, ::-1].copy()
+    nrm = normals.astype(np.float64)  # skimage's normals (gradient 'descent') point out of {f >= level}
+    ln = np.linalg.norm(nrm, axis=1)
+    bad = ~(ln > 1e-12)
+    if bad.any():
+        fn = np.cross(vertices[tri[:, 1]] - vertices[tri[:, 0]], vertices[tri[:, 2]] - vertices[tri[:, 0]])
+        acc = np.zeros_like(vertices)
+        for c in range(3):
+            for axis in range(3):
+                acc[:, axis] += np.bincount(tri[:, c], weights=fn[:, axis], minlength=len(vertices))
+        nrm[bad] = acc[bad]
+        ln = np.linalg.norm(nrm, axis=1)
+        still = ~(ln > 1e-300)
+        nrm[still] = (0.0, 0.0, 1.0)
+        ln[still] = 1.0
+    nrm /= ln[:, None]
+    c = vertices.mean(axis=0)
+    A, B, C = (vertices - c)[tri[:, 0]], (vertices - c)[tri[:, 1]], (vertices - c)[tri[:, 2]]
+    cr = np.cross(B - A, C - A)
+    volume = float(np.einsum("ij,ij->", A, np.cross(B, C))) / 6.0
+    area = float(np.linalg.norm(cr, axis=1).sum()) / 2.0
+    return FieldSlice(_sealed(vertices), _sealed(tri), _sealed(nrm), volume, area, level, d)
+
+
+def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool = False):
+    """Isosurfaces of ``field`` (a `Field4D`) in the slice w = ``c0`` after the rotation ``matrix``.
+
+    Parameters
+    ----------
+    field : Field4D
+    matrix : (4, 4) rotation (validated: orthogonal, det +1); a data point q is at
+        ``matrix @ (q - centre)`` (w scaled by ``1 / field.w_per_unit``)
+    c0 : float -- the hyperplane w = c0, slice units
+    level : float or sequence of floats -- the surface closes {f >= level}
+    resolution : int -- samples along the longest side of the bounding box of the
+        box's cut (padding not counted), same spacing on all three axes
+    coarse : bool -- resample ``field.coarse()`` instead (for held keys)
+
+    Returns
+    -------
+    `FieldSlice`, or a tuple of them (one per level, sharing one resampling) when
+    ``level`` is a sequence.
+    """
+    if not isinstance(field, Field4D):
+        raise TypeError(f"Expected `field` to be a Field4D, got {type(field).__name__}")
+    m = as_rotation_matrix(matrix)
+    c0 = _real(c0, "c0")
+    many = not isinstance(level, (numbers.Real, np.integer, np.floating)) or isinstance(level, (bool, np.bool_))
+    levels = _as_levels(level)
+    res = _check_resolution(resolution)
+    src = field.coarse() if coarse else field
+    s = _sample(src, m, c0, res)
+    if s is None:
+        out = tuple(_empty_slice(lv, 0.0) for lv in levels)
+    else:
+        out = tuple(_surface(s, lv) for lv in levels)
+    return out if many else out[0]
