@@ -2,7 +2,8 @@
 //
 // Four jobs for one Scene, per displayed view of this invisible widget (job 1 also
 // applies, as it arrives, what travels with each update: the rows each layer draws,
-// `_rot4d_counts`, and a 3-D turn of the whole view, `_rot4d_turn`):
+// `_rot4d_counts`, and a 3-D turn of the whole view, `_rot4d_turn`; and it stops the
+// page from sending the row buffer's three.js `version` back after every update):
 //  1. "drawn": after the pythreejs Scene has rendered a frame that contains
 //     the latest assignment to the shared row buffer, send
 //     {event: "drawn", seq} where seq is the buffer's `_rot4d_seq` (sent in
@@ -107,8 +108,8 @@ async function render({ model, el }) {
 
   // 4. leak guard: one guard in each canvas element of this scene.  Placed on
   // render (and a few times soon after, as the canvas view may come later),
-  // after each scene render, and on mouseover: a new canvas can appear under a
-  // pointer that does not move.
+  // after a scene render (at most twice a second), and on mouseover: a new canvas
+  // can appear under a pointer that does not move.
   try {
     defineLeaveGuard();
   } catch (e) {
@@ -159,6 +160,14 @@ async function render({ model, el }) {
       Promise.all(ids("mesh_model_ids").map((id) => getModel(manager, id, isAlive))),
     ]);
     if (alive) {
+      // The kernel owns the row buffer's state.  pythreejs would send the three.js buffer's
+      // `version` back after every update (syncToModel -> save_changes): one more message
+      // each way per update, and a kernel busy/idle status pair that JupyterLab redraws.
+      const saveChanges = buffer.save_changes;
+      buffer.save_changes = () => {};
+      cleanups.push(() => {
+        buffer.save_changes = saveChanges;
+      });
       const version = () => (buffer.obj ? buffer.obj.version : undefined);
       // Draw only the rows in use: set in the same event that applied the array, so a
       // frame never draws a count with another update's rows.  Never more than the rows held.
@@ -217,9 +226,16 @@ async function render({ model, el }) {
         batch[what] = true;
       };
       const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn") };
+      let guardsAt = -Infinity;
       const onRendered = () => {
         settle();
-        ensureGuards();
+        // A scan of the document for canvases (a live class collection walks the whole page
+        // after any DOM change): at most twice a second, not on every frame.
+        const now = performance.now();
+        if (now - guardsAt > 500) {
+          guardsAt = now;
+          ensureGuards();
+        }
         const obj = buffer.obj;
         const p = pending;
         renderedVersion = version();

@@ -155,6 +155,8 @@ const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
 // (set `applyLate` to hold it back, `bump = false` to skip the version bump)
 const wrap = (name) => ({ data: "data-" + name });
 const buffer = backbone({ _rot4d_seq: 0, array: wrap("a0") });
+let saved = 0;  // what pythreejs's syncToModel would send to the kernel (the buffer's version)
+buffer.save_changes = () => { saved++; };
 buffer.obj = { array: "data-a0", version: 1, stride: 1 };  // rows = the fake array's length (7)
 let applyLate = false, bump = true;
 const apply = () => { buffer.obj.array = buffer.attrs.array.data; if (bump) buffer.obj.version++; };
@@ -185,6 +187,9 @@ const mod = await import(pathToFileURL(process.argv[2]).href);
 const cleanup = await mod.default.render({ model, el });
 out.display = el.style.display;
 out.getModelMisses = model.widget_manager.misses;
+
+buffer.save_changes(); buffer.save_changes();
+out.savedWhileShown = saved;
 
 // 3. shortcut guard
 const key = (type, extra = {}) => { const ev = { type, prevented: false, ctrlKey: false, metaKey: false, altKey: false, ...extra, preventDefault() { this.prevented = true; } }; window.fire(type, ev); return ev.prevented; };
@@ -260,6 +265,8 @@ step("focus");
 
 // cleanup
 cleanup();
+buffer.save_changes();
+out.savedAfterCleanup = saved;
 out.left = { window: window.count(), document: document.count(), buffer: buffer.count(), scene: scene.count() };
 set(14, "a9"); scene.trigger("afterRender"); frame();
 window.fire("blur", {});
@@ -285,6 +292,13 @@ def js_run(tmp_path_factory):
 
 def test_js_is_invisible(js_run):
     assert js_run["display"] == "none"
+
+
+def test_js_the_page_does_not_send_the_row_buffer_back(js_run):
+    # pythreejs syncs the three.js buffer's version to the kernel after every update; the
+    # companion makes that a no-op while it lives (one message each way fewer per update)
+    assert js_run["savedWhileShown"] == 0
+    assert js_run["savedAfterCleanup"] == 1  # restored by cleanup
 
 
 def test_js_shortcut_guard_prevents_only_while_hovered(js_run):
