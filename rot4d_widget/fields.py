@@ -1022,6 +1022,7 @@ def _surface(s: _Samples, level: float) -> FieldSlice:
         v = s.f - level
         v[v == 0] = 1e-9 * s.k * d  # f == level belongs to {f >= level}
         v[np.isnan(v)] = -s.k * d  # NaN: below every level
+        v[s.g < 0] = np.inf  # outside the box f means nothing: v is K g alone, so caps sit on the faces
         v = np.minimum(v, s.k * s.g).astype(np.float32)
     if not v.max() > 0:
         return _empty_slice(level, d)
