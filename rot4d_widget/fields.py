@@ -13,10 +13,11 @@ zarr array -- or a vectorised function f(x, y, z, w).  Each step
    the array is interpolated there, multilinearly (order 1, no prefilter),
    by a numba kernel that walks the affine grid (base + i a + j b + k c in
    index space) -- a function is evaluated exactly at those points instead;
-3. ``v = min(f - level, K * g)`` with g the signed distance to the box
-   (positive inside, piecewise linear along grid lines, so the zero of its
-   linear interpolation lies ON the box face) and K a typical |grad f|;
-   NaN counts as below every level;
+3. ``v = min(f - level, K * g)`` with g the signed distance, within the
+   slice, to the planes where the box's faces cut it (positive inside; linear
+   along a grid line near a face, so the zero of its linear interpolation lies
+   ON the face) and K a typical |grad f|; outside the box v is K g alone; NaN
+   counts as below every level;
 4. scikit-image's marching cubes (Lewiner) at v = 0 for each level, vertices
    mapped from index space to slice coordinates, wound counter-clockwise seen
    from where f < level.
@@ -124,8 +125,9 @@ def _affine_kernel(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pra
 
     a : 4-D array (a block of the data, native axis order); base (4,), step (3, 4):
     index coordinates in ``a``; centre, halfn (4,): the data box's centre and half
-    size in the same index coordinates; inv_s (4,): slice units per index step.
-    g = min_d (halfn_d - |x_d - centre_d|) inv_s_d (slice units, > 0 inside).
+    size in the same index coordinates; inv_s (4,): in-slice distance per index step
+    across each face.  g = min_d (halfn_d - |x_d - centre_d|) inv_s_d (slice units,
+    > 0 inside; see `_in_slice_distance`).
     Points outside the box are not interpolated (f = 0 there).
     """
     n0, n1, n2 = n[0], n[1], n[2]
@@ -784,7 +786,10 @@ class Field4D:
             spacing = [(b - a_) / (m - 1) / u for (a_, b), u in zip(self.extent, self._unit)]
         else:
             c = self.coarse()
-            a = np.asarray(c._values, dtype=np.float64).transpose(c._axis_of)  # x, y, z, w order
+            if c is not self:  # the same numbers: computed once, on the coarse copy
+                self._stats = c._statistics()
+                return self._stats
+            a = np.asarray(c._values, dtype=np.float32).transpose(c._axis_of)  # x, y, z, w order
             spacing = []
             for d in range(4):
                 cd = c._coords[d]
@@ -895,6 +900,24 @@ class _Samples:
     __slots__ = ("origin", "spacing", "f", "g", "k", "box")
 
 
+#: A box face whose normal has less than this in-slice part is parallel to the slice: left out of g.
+_PARALLEL = 1e-9
+
+
+def _face_norms(m):
+    """(4,) length of the in-slice part of each box face's normal, |m[:3, j]| (floored at _PARALLEL)."""
+    return np.maximum(np.linalg.norm(m[:3, :], axis=0), _PARALLEL)
+
+
+def _in_slice_distance(q, hw, m):
+    """g = min_j (hw_j - |q_j|) / |m[:3, j]|: the signed distance, within the slice, to the planes
+    where the box's faces cut it (positive inside).  Each term is the exact 3-D distance to its
+    face's plane, so g is linear along grid lines near a face (the cap lands on it); faces parallel
+    to the slice are left out (when the slice meets the box it lies between them)."""
+    nrm = _face_norms(m)
+    return np.minimum.reduce([(hw[j] - np.abs(q[j])) / nrm[j] for j in range(4) if nrm[j] > _PARALLEL])
+
+
 def _geometric_nodes(field, d):
     """Slice-space coordinate (about the centre) of every node along data axis d."""
     n = field.shape[d]
@@ -928,7 +951,7 @@ def _sample(field, m, c0, res) -> _Samples | None:
         axes = [origin[a] + d * np.arange(n[a]) for a in range(3)]
         P = np.meshgrid(*axes, indexing="ij")
         q = [m[0, j] * P[0] + m[1, j] * P[1] + m[2, j] * P[2] + m[3, j] * c0 for j in range(4)]
-        g = np.minimum.reduce([hw[j] - np.abs(q[j]) for j in range(4)])
+        g = _in_slice_distance(q, hw, m)
         with np.errstate(all="ignore"):
             f = _call(field._function, *[q[j] * field._unit[j] + field._centre[j] for j in range(4)])
         s.f, s.g = f, g
@@ -948,8 +971,8 @@ def _sample(field, m, c0, res) -> _Samples | None:
             base[a] = base_d[j]
             step[:, a] = step_d[:, j]
             centre[a] = (field.shape[j] - 1) / 2
-            inv_s[a] = 1.0 / sc[j]
-        halfn = centre.copy()
+            inv_s[a] = 1.0 / (sc[j] * _face_norms(m)[j])
+        halfn = np.where(_face_norms(m)[list(_AXES.index(c) for c in field.axes)] > _PARALLEL, centre, 1e300)
         arr, start = _block(field, m, c0, box)
         s.f, s.g = _resample_affine(arr, base - start, step, n, centre - start, halfn, inv_s)
         return s
@@ -957,7 +980,7 @@ def _sample(field, m, c0, res) -> _Samples | None:
     axes = [origin[a] + d * np.arange(n[a]) for a in range(3)]
     P = np.meshgrid(*axes, indexing="ij")
     q = [(m[0, j] * P[0] + m[1, j] * P[1] + m[2, j] * P[2] + m[3, j] * c0).ravel() for j in range(4)]
-    g = np.minimum.reduce([hw[j] - np.abs(q[j]) for j in range(4)])
+    g = _in_slice_distance(q, hw, m)
     idx = np.empty((len(g), 4))
     for j in range(4):
         a = field._axis_of[j]

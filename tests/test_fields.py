@@ -139,6 +139,13 @@ def test_cavalieri_slice_volumes_integrate_to_the_4_volume(case):
     assert cavalieri(field, random_rotation(rng), level) == pytest.approx(trapezoid_count(a, level, extent), rel=0.03)
 
 
+def open_edges(s) -> int:
+    """Edges not shared by exactly two triangles (0 for a closed surface)."""
+    t = s.triangles
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    return int((np.unique(e, axis=0, return_counts=True)[1] != 2).sum())
+
+
 def test_constant_field_slices_fill_the_box():
     extent = ((-1, 1), (-0.8, 0.9), (-1, 1), (-0.6, 0.6))
     field = Field4D(np.full((12, 12, 12, 8), 2.0), extent=extent)
@@ -146,6 +153,10 @@ def test_constant_field_slices_fill_the_box():
     for c0 in (0.0, 0.5):
         s = slice_field(field, m, c0, 1.0, 48)
         assert s.volume == pytest.approx(_box_slice(field, m, c0).volume, rel=0.01)  # caps ON the faces
+    for m, c0 in ((np.eye(4), 0.0), (np.eye(4), 0.6 - 1e-9), (random_rotation(4), 0.3)):  # faces on grid planes too
+        s = slice_field(field, m, c0, 1.0, 33)
+        assert len(s.triangles) and open_edges(s) == 0
+        assert s.volume == pytest.approx(_box_slice(field, m, c0).volume, rel=0.02)
     total = cavalieri(field, m, 1.0, res=32)
     assert total == pytest.approx(np.prod([hi - lo for lo, hi in extent]), rel=0.01)
 
@@ -176,10 +187,11 @@ def test_interpolation_equals_map_coordinates_order_1():
         inside = s.g.ravel() >= 0
         assert 0.05 < inside.mean() < 1
         np.testing.assert_allclose(s.f.ravel()[inside], ref[inside], rtol=1e-12, atol=1e-12)
-        # g is the distance to the box in slice units
+        # g: the distance within the slice to the planes where the box's faces cut it
         q = (np.column_stack([np.indices(s.f.shape).reshape(3, -1).T * s.spacing + s.origin,
                               np.full(inside.size, c0)]) @ m)
-        np.testing.assert_allclose(s.g.ravel(), (np.array(field.half_widths) - np.abs(q)).min(axis=1), atol=1e-12)
+        g = ((np.array(field.half_widths) - np.abs(q)) / np.linalg.norm(m[:3], axis=0)).min(axis=1)
+        np.testing.assert_allclose(s.g.ravel(), g, atol=1e-12)
 
 
 def test_uneven_coordinates_interpolate_exactly_a_multilinear_function():
