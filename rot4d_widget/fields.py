@@ -54,8 +54,9 @@ import numpy as np
 
 from ._arrays import sealed as _sealed
 from .rotation import as_rotation_matrix
+from .source import SliceData
 
-__all__ = ["Field4D", "FieldSlice", "slice_field", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
 
 #: Nodes per axis, at most, of the in-memory coarse copy (`Field4D.coarse`).
 COARSE_SAMPLES = 48
@@ -475,12 +476,12 @@ class Field4D:
             h = 2.0 / (max(self.shape[:3]) - 1)
             ext = [(-(n - 1) / 2 * h, (n - 1) / 2 * h) for n in self.shape[:3]] + [(0.0, float(self.shape[3] - 1))]
             self.extent = tuple((float(a), float(b)) for a, b in ext)
-            self.w_per_unit = 1.0 / h if w_per_unit is None else _check_positive(w_per_unit, "w_per_unit")
+            wpu = 1.0 / h if w_per_unit is None else w_per_unit
             self.w_units = "sample" if w_units is None else str(w_units)
             self.default_extent = True
         else:
             self.extent = _check_extent(extent)
-            self.w_per_unit = 1.0 if w_per_unit is None else _check_positive(w_per_unit, "w_per_unit")
+            wpu = 1.0 if w_per_unit is None else w_per_unit
             self.w_units = None if w_units is None else str(w_units)
             self.default_extent = False
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
@@ -488,17 +489,12 @@ class Field4D:
         self.units = None if units is None else str(units)
         e = np.array(self.extent)
         self._centre = (e[:, 0] + e[:, 1]) / 2
-        self._unit = np.array([1.0, 1.0, 1.0, self.w_per_unit])  # data units per slice unit
-        hw = (e[:, 1] - e[:, 0]) / 2 / self._unit
-        self.half_widths = tuple(float(v) for v in hw)
-        self._hw = hw
-        self.resolution = _check_resolution(resolution)
-        self.coarse_resolution = (max(24, self.resolution // 2) if coarse_resolution is None
-                                  else _check_resolution(coarse_resolution, "coarse_resolution"))
+        self._coarse = None
+        self.w_per_unit = wpu
+        self.resolution = resolution
+        self.coarse_resolution = max(24, self.resolution // 2) if coarse_resolution is None else coarse_resolution
         self.chunk_cache_bytes = int(chunk_cache_bytes)
         self._reader = None
-        self._coarse = None
-        self._stats = None
         self._box = None
         self._levels = None if levels is None else _as_levels(levels)
 
@@ -594,6 +590,41 @@ class Field4D:
         return cls(values, axes=axes, extent=extent, name=kwargs.pop("name", da.name), units=kwargs.pop("units", units),
                    w_per_unit=w_per_unit, w_units=w_units, _coords=coords, **kwargs)
 
+    # -- geometry and resolution ------------------------------------------------
+    @property
+    def w_per_unit(self) -> float:
+        """How much data-w one unit of slice space is (settable: larger squashes w, smaller stretches it)."""
+        return self._w_per_unit
+
+    @w_per_unit.setter
+    def w_per_unit(self, value) -> None:
+        self._w_per_unit = _check_positive(value, "w_per_unit")
+        e = np.array(self.extent)
+        self._unit = np.array([1.0, 1.0, 1.0, self._w_per_unit])  # data units per slice unit
+        self._hw = (e[:, 1] - e[:, 0]) / 2 / self._unit
+        self.half_widths = tuple(float(v) for v in self._hw)
+        self._stats = None  # K is per slice unit
+        if self._coarse is not None and self._coarse is not self:
+            self._coarse.w_per_unit = value
+
+    @property
+    def resolution(self) -> int:
+        """Samples along the longest side of a full step's region (int >= 2)."""
+        return self._resolution
+
+    @resolution.setter
+    def resolution(self, value) -> None:
+        self._resolution = _check_resolution(value)
+
+    @property
+    def coarse_resolution(self) -> int:
+        """Samples along the longest side of a coarse step's region (int >= 2)."""
+        return self._coarse_resolution
+
+    @coarse_resolution.setter
+    def coarse_resolution(self, value) -> None:
+        self._coarse_resolution = _check_resolution(value, "coarse_resolution")
+
     # -- source protocol --------------------------------------------------------
     @property
     def size(self) -> float:
@@ -670,8 +701,6 @@ class Field4D:
         """The slice as the widget draws it (`SliceData`): the isosurface of every level
         (group = level index) and the cut of the data's box as bars.  ``coarse``:
         the in-memory coarse copy at `coarse_resolution` (for held keys)."""
-        from .source import SliceData
-
         m = as_rotation_matrix(matrix)
         c0 = _real(c0, "c0")
         levels = self.levels
@@ -693,7 +722,7 @@ class Field4D:
         nrm.append(bn)
         segments = np.asarray(box.edges) + off
         readout = self._readout(m, c0, slices, box, coarse)
-        return SliceData.build(
+        return FieldSliceData.build(
             points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
             groups=np.concatenate(groups), normals=np.concatenate(nrm),
             volume=float(slices[0].volume) if len(slices) == 1 else None,
@@ -851,6 +880,32 @@ class Field4D:
     def __repr__(self) -> str:
         what = "function" if self._kind == "function" else f"{self._kind} {tuple(self._values.shape)}"
         return f"Field4D({self.name or ''!s}{' ' if self.name else ''}{what}, axes={self.axes!r}, extent={self.extent})"
+
+
+def _turned_slice(s: FieldSlice, t: np.ndarray) -> FieldSlice:
+    if s.empty:
+        return s
+    return FieldSlice(_sealed(s.vertices @ t.T), s.triangles, _sealed(s.normals @ t.T), s.volume, s.area,
+                      s.level, s.spacing)
+
+
+class FieldSliceData(SliceData):
+    """`SliceData` of a `Field4D`: ``extra["levels"]`` holds one `FieldSlice` per level and
+    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.slicing.Slice`)."""
+
+    def turned(self, t) -> "FieldSliceData":
+        """The same slice turned by the 3-D rotation ``t`` (3, 3): the slice at ``T @ matrix``
+        when T turns x, y, z only (points and normals ``@ t.T``; nothing is resampled).
+        ``extra["box"]`` stays the unturned cut."""
+        t = np.asarray(t, dtype=np.float64)
+        if t.shape != (3, 3) or not np.allclose(t @ t.T, np.eye(3), atol=1e-9):
+            raise ValueError(f"Expected `t` to be a (3, 3) rotation, got shape {t.shape}")
+        extra = dict(self.extra)
+        extra["levels"] = tuple(_turned_slice(s, t) for s in self.extra.get("levels", ()))
+        return type(self).build(
+            points=self.points @ t.T, segments=self.segments, triangles=self.triangles, groups=self.groups,
+            normals=None if self.normals is None else self.normals @ t.T, volume=self.volume,
+            readout=self.readout, convex=self.convex, show_points=self.show_points, extra=extra)
 
 
 def _call(f, *arrays) -> np.ndarray:

@@ -60,6 +60,11 @@ def test_three_sphere_slices_to_a_sphere(kind):
         assert np.allclose(np.linalg.norm(s.normals, axis=1), 1.0)
         assert np.all(np.einsum("ij,ij->i", s.normals, s.vertices) > 0.9 * r)
     assert slice_field(field, random_rotation(rng), 0.85, 0.0).empty  # |c0| > R
+    # w squashed: one unit of slice space is 2 units of data w, so w = c0 cuts the data at w = 2 c0
+    field.w_per_unit = 2.0
+    assert field.half_widths == (1.0, 1.0, 1.0, 0.5) and field.w_range(np.eye(4)) == (-0.5, 0.5)
+    s = slice_field(field, np.eye(4), 0.2, 0.0, 64)
+    assert np.abs(np.linalg.norm(s.vertices, axis=1) - math.sqrt(R * R - 0.4**2)).max() < tol_r
 
 
 # ---------------------------------------------------------------- the 4-D ellipsoid
@@ -392,6 +397,18 @@ def test_field_is_a_source():
     assert "the whole box" in dict(below.readout)["level"]
     assert below.volume == pytest.approx(_box_slice(field, m, 0.0).volume, rel=0.03)
     assert field.slice(m, 0.0, coarse=True).readout[-1] == ("resolution", "32 (coarse copy)")
+    # turned in 3-D = sliced at the turned orientation (what the widget shows at rest without resampling)
+    from rot4d_widget.rotation import simple_rotation
+
+    field.levels = 0.5
+    t = simple_rotation("xy", 0.4) @ simple_rotation("yz", -1.1)
+    turned, direct = field.slice(m, 0.1).turned(t[:3, :3]), field.slice(t @ m, 0.1)
+    assert turned.volume == pytest.approx(direct.volume, rel=0.03)
+    np.testing.assert_allclose(np.sort(np.linalg.norm(turned.points[-len(box.vertices):], axis=1)),
+                               np.sort(np.linalg.norm(direct.points[-len(box.vertices):], axis=1)))
+    np.testing.assert_allclose(turned.extra["levels"][0].vertices.mean(axis=0),
+                               direct.extra["levels"][0].vertices.mean(axis=0), atol=0.02)
+    assert not turned.points.flags.writeable
     assert dict(field.slice(m, 5 * field.size).readout)["w cut"].startswith("none")
 
 
@@ -474,6 +491,8 @@ def test_bad_input_is_named():
         Field4D.from_function(3.0, BOX)
     with pytest.raises(ValueError, match="w_per_unit"):
         Field4D(ok, w_per_unit=0)
+    with pytest.raises(ValueError, match="coarse_resolution"):
+        f.coarse_resolution = 1
 
 
 def test_bad_xarray_input_is_named():
