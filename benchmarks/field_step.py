@@ -12,7 +12,8 @@ full resolution; each part's time is the best of ``--repeats`` runs, the table s
 the median over orientations:
 
 * resample: the whole resampling of a step (box cut, grid, numba kernel);
-* kernel: the numba quadrilinear kernel alone;
+* kernel: the numba quadrilinear kernel alone, as the step runs it (parallel from
+  `PARALLEL_MIN_POINTS` grid points on), and in brackets its serial build;
 * map_coordinates: ``scipy.ndimage.map_coordinates(order=1, prefilter=False)`` on the
   same grid points (all of them, as a resampler without the box test would do; and
   only those inside the box, which is all the kernel interpolates);
@@ -30,10 +31,11 @@ import argparse
 import statistics
 import time
 
+import numba
 import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.fields import Field4D, _resample_affine, _sample, _surface
+from rot4d_widget.fields import PARALLEL_MIN_POINTS, Field4D, _get_kernels, _resample_affine, _sample, _surface
 from rot4d_widget.rotation import random_rotation
 
 
@@ -106,6 +108,9 @@ def measure(field: Field4D, res: int, orientations: int, repeats: int, c0: float
         base, step, centre, inv_s = kernel_inputs(field, m, c0, s)
         (f, g), t_k = best(lambda: _resample_affine(arr, base, step, s.f.shape, centre, centre, inv_s), repeats)
         assert np.array_equal(f, s.f)
+        serial = _get_kernels(False)[0]
+        fo, go, nn = np.empty(s.f.shape), np.empty(s.f.shape), np.array(s.f.shape, dtype=np.int64)
+        _, t_ser = best(lambda: serial(arr, base, step, nn, centre, centre, inv_s, fo, go), repeats)
         idx = base[:, None] + step.T @ np.indices(s.f.shape, dtype=np.float64).reshape(3, -1)
         inside = g.ravel() >= 0
         ref, t_all = best(lambda: map_coordinates(arr, idx, order=1, prefilter=False, mode="nearest"), repeats)
@@ -115,7 +120,7 @@ def measure(field: Field4D, res: int, orientations: int, repeats: int, c0: float
         surf, t_mc = best(lambda: _surface(s, field.levels[0]), repeats)
         _, t_step = best(lambda: slice_step(field, m, c0, res), repeats)
         nv, nt = len(surf.vertices), len(surf.triangles)
-        rows.append(dict(step=t_step, res=t_res, kernel=t_k, all=t_all, inside_t=t_in, mc=t_mc, grid=s.f.size,
+        rows.append(dict(step=t_step, res=t_res, kernel=t_k, serial=t_ser, all=t_all, inside_t=t_in, mc=t_mc, grid=s.f.size,
                          inside=float(inside.mean()), tri=nt, bytes=nv * 24 + nt * 12, err=err))
     return {k: statistics.median(r[k] for r in rows) for k in rows[0]} | {"max_err": max(r["err"] for r in rows)}
 
@@ -129,7 +134,8 @@ def main() -> None:
     fields = [("sphere 64^4", sphere_field()), ("blob 128^3x32", blob_field())]
     # compile (or load) the kernels outside the timing
     fields[0][1].slice(np.eye(4), 0.0)
-    print("| field | step | grid points (inside) | resample ms | kernel ms | map_coordinates ms all / inside "
+    print(f"numba threads: {numba.get_num_threads()}, parallel kernel from {PARALLEL_MIN_POINTS} points\n")
+    print("| field | step | grid points (inside) | resample ms | kernel ms (serial) | map_coordinates ms all / inside "
           "| speed-up all / inside | marching cubes ms | whole step ms | triangles | bytes | max abs diff |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, field in fields:
@@ -140,7 +146,7 @@ def main() -> None:
             r = measure(src, res, args.orientations, args.repeats)
             shape = "x".join(str(n) for n in src.values.shape)
             print(f"| {name} | {label} {res} on {shape} | {r['grid']:.0f} ({r['inside']:.0%}) | {r['res'] * 1e3:.1f} | "
-                  f"{r['kernel'] * 1e3:.1f} | {r['all'] * 1e3:.1f} / {r['inside_t'] * 1e3:.1f} | "
+                  f"{r['kernel'] * 1e3:.1f} ({r['serial'] * 1e3:.1f}) | {r['all'] * 1e3:.1f} / {r['inside_t'] * 1e3:.1f} | "
                   f"{r['all'] / r['kernel']:.1f}x / {r['inside_t'] / r['kernel']:.1f}x | {r['mc'] * 1e3:.1f} | "
                   f"{r['step'] * 1e3:.1f} | {r['tri']:.0f} | {r['bytes'] / 1024:.0f} KiB | {r['max_err']:.1e} |", flush=True)
 

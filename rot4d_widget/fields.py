@@ -77,21 +77,27 @@ except ImportError:  # pragma: no cover - numba is a dependency; scipy stands in
     _numba = None
     _prange = range
 
-_kernels = None
+#: Grids with fewer points run the serial kernel: waking a second thread costs a
+#: scheduler time slice (several ms) when the other core is busy, more than the work.
+PARALLEL_MIN_POINTS = 150_000
+
+_kernels = {}
 _kernel_lock = threading.Lock()
 
 
-def _get_kernels():
-    """The numba kernels, compiled (or loaded from numba's cache) on first call; None without numba."""
-    global _kernels
-    if _kernels is None:
+def _get_kernels(parallel: bool = True):
+    """(affine, points) numba kernels, compiled (or loaded from numba's cache) on first call;
+    None without numba."""
+    if _numba is None:
+        return None  # pragma: no cover
+    k = _kernels.get(parallel)
+    if k is None:
         with _kernel_lock:
-            if _kernels is None:
-                _kernels = () if _numba is None else (
-                    _numba.njit(parallel=True, cache=True, nogil=True)(_affine_kernel),
-                    _numba.njit(parallel=True, cache=True, nogil=True)(_points_kernel),
-                )
-    return _kernels or None
+            k = _kernels.get(parallel)
+            if k is None:
+                jit = _numba.njit(parallel=parallel, cache=True, nogil=True)
+                k = _kernels[parallel] = (jit(_affine_kernel), jit(_points_kernel))
+    return k
 
 
 def _lerp4(a, x0, x1, x2, x3):  # pragma: no cover - compiled by numba
@@ -172,7 +178,7 @@ def _resample_affine(a, base, step, n, centre, halfn, inv_s):
     n = tuple(int(v) for v in n)
     f = np.empty(n, dtype=np.float64)
     g = np.empty(n, dtype=np.float64)
-    k = _get_kernels()
+    k = _get_kernels(f.size >= PARALLEL_MIN_POINTS)
     args = [np.ascontiguousarray(v, dtype=np.float64) for v in (base, step, centre, halfn, inv_s)]
     if k is not None:
         k[0](a, args[0], args[1], np.array(n, dtype=np.int64), args[2], args[3], args[4], f, g)
@@ -191,7 +197,7 @@ def _resample_affine(a, base, step, n, centre, halfn, inv_s):
 def _resample_points(a, idx, inside):
     """Quadrilinear values at (N, 4) index coordinates where ``inside``; float64 (N,)."""
     out = np.empty(len(idx), dtype=np.float64)
-    k = _get_kernels()
+    k = _get_kernels(len(idx) >= PARALLEL_MIN_POINTS)
     if k is not None:
         k[1](a, np.ascontiguousarray(idx, dtype=np.float64), np.ascontiguousarray(inside), out)
         return out
