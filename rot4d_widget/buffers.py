@@ -56,6 +56,8 @@ __all__ = [
     "unpack_rgb",
     "quad_template",
     "triangle_template",
+    "surface_arrays",
+    "without_triangles",
 ]
 
 #: float32 values per row, and bytes per row
@@ -197,6 +199,81 @@ def slice_rows(
     out[:nt, 10:19] = p[t].reshape(nt, 9)
     out[:nt, 19] = packed[tc]
     return out
+
+
+class _NoTriangles:
+    """A slice's points and segments only (its triangles go to the surface layer)."""
+
+    __slots__ = ("points", "segments", "triangles", "groups", "convex", "show_points")
+
+    def __init__(self, data):
+        self.points = data.points
+        self.segments = data.segments
+        self.triangles = np.zeros((0, 3), dtype=np.intp)
+        self.groups = np.zeros(0, dtype=np.intp)
+        self.convex = False
+        self.show_points = getattr(data, "show_points", True)
+
+
+def without_triangles(data):
+    """The slice with its triangles left out: what the row table carries for a smooth surface."""
+    return _NoTriangles(data)
+
+
+#: Quantisation of a surface update: positions in the surface's box, normals, colours.
+POSITION_LEVELS = 65535
+NORMAL_LEVELS = 127
+
+
+def surface_arrays(data, *, scale: float = 1.0, group_rgb=None, eye=None, single_rgb=None) -> dict:
+    """A smooth surface (triangles with per-point ``normals``) as the companion uploads it.
+
+    Only the points the triangles use travel, renumbered.  Returns numpy arrays and the
+    box: ``position`` (n, 3) uint16 -- ``lo + position / 65535 * span`` is the scaled
+    point, off by at most ``span / 131070``; ``normal`` (n, 3) int8 (the unit normal
+    times 127, rounded); ``rgb`` (n, 3) uint8 (the colour of the group of the first
+    triangle that uses the point: a point belongs to one level's surface); ``index``
+    (3k,) uint32, triangles farthest first from ``eye`` by centroid (translucent
+    surfaces blend back to front); ``lo``, ``span`` (3,) floats.  About 13 bytes per
+    point and 12 per triangle.
+    """
+    v = np.asarray(data.points, dtype=np.float64) * float(scale)
+    t = np.asarray(data.triangles, dtype=np.intp)
+    g = np.asarray(data.groups, dtype=np.intp)
+    nrm = np.asarray(data.normals, dtype=np.float64)
+    if nrm.shape != v.shape:
+        raise ValueError(f"Expected `normals` with the shape of `points` {v.shape}, got {nrm.shape}")
+    if len(t) == 0:
+        z3 = np.zeros((0, 3))
+        return {"position": z3.astype(np.uint16), "normal": z3.astype(np.int8), "rgb": z3.astype(np.uint8),
+                "index": np.zeros(0, dtype=np.uint32), "lo": [0.0, 0.0, 0.0], "span": [1.0, 1.0, 1.0]}
+    if single_rgb is not None:
+        palette = np.asarray([single_rgb], dtype=np.float64)
+        g = np.zeros(len(t), dtype=np.intp)
+    else:
+        palette = np.asarray(group_palette(int(g.max()) + 1) if group_rgb is None else group_rgb, dtype=np.float64)
+        if g.max() >= len(palette):
+            raise ValueError(f"Expected `group_rgb` to have a colour for group {int(g.max())}, got {len(palette)} colours")
+    if eye is not None:
+        o = np.asarray(eye, dtype=np.float64)
+        d = v[t].sum(axis=1) / 3.0 - o
+        order = np.argsort(-np.einsum("ij,ij->i", d, d), kind="stable")  # farthest first
+        t, g = t[order], g[order]
+    used = np.zeros(len(v), dtype=bool)
+    used[t.ravel()] = True
+    keep = np.flatnonzero(used)
+    new = np.full(len(v), -1, dtype=np.int64)
+    new[keep] = np.arange(len(keep))
+    p = v[keep]
+    lo = p.min(axis=0)
+    span = np.maximum(p.max(axis=0) - lo, 1e-12)
+    position = np.rint((p - lo) / span * POSITION_LEVELS).astype(np.uint16)
+    normal = np.rint(np.clip(nrm[keep], -1.0, 1.0) * NORMAL_LEVELS).astype(np.int8)
+    vertex_group = np.empty(len(v), dtype=np.intp)
+    vertex_group[t[::-1].ravel()] = np.repeat(g[::-1], 3)  # the first triangle's group wins
+    rgb = np.rint(np.clip(palette[vertex_group[keep]], 0.0, 1.0) * 255.0).astype(np.uint8)
+    return {"position": position, "normal": normal, "rgb": rgb, "index": new[t].astype(np.uint32).ravel(),
+            "lo": [float(x) for x in lo], "span": [float(x) for x in span]}
 
 
 # -- colours (the palette itself lives in rot4d_widget.look) --------------------

@@ -191,8 +191,56 @@ async function render({ model, el }) {
           obj.quaternion.setFromRotationMatrix(obj.matrix);
         }
       };
+      // A smooth surface (a field's isosurfaces): quantised arrays that travel with the rows
+      // in the same message; uploaded into the surface mesh's geometry (placeholder arrays of
+      // the same types) and its box into the material, so it is drawn with those rows.
+      const copy = (dv, T) =>
+        dv && dv.byteLength !== undefined ? new T(dv.buffer.slice(dv.byteOffset, dv.byteOffset + dv.byteLength)) : new T(0);
+      let surfaceArrays = null; // what applySurface put into the surface geometry last
+      // pythreejs may (re)build the surface geometry's three.js object from its placeholder
+      // arrays after the companion filled it (the first view): true if it holds ours no more
+      const surfaceLost = () => {
+        const s = buffer.get("_rot4d_surface") || {};
+        if (!s.n_vertices || !s.n_indices) return false;
+        const mesh = meshes.find((m) => m.obj && m.obj.name === "surface");
+        const g = mesh && mesh.obj.geometry;
+        return !!g && !!g.attributes && !!g.attributes.position &&
+          (surfaceArrays === null || surfaceArrays.geometry !== g || g.attributes.position.array !== surfaceArrays.position);
+      };
+      const applySurface = () => {
+        const mesh = meshes.find((m) => m.obj && m.obj.name === "surface");
+        const s = buffer.get("_rot4d_surface") || {};
+        if (!mesh) return;
+        const g = mesh.obj.geometry;
+        const u = mesh.obj.material && mesh.obj.material.uniforms;
+        const n = Number.isInteger(s.n_vertices) ? s.n_vertices : 0;
+        const k = Number.isInteger(s.n_indices) ? s.n_indices : 0;
+        if (!g || !g.attributes || !g.attributes.position || !g.index) return;
+        if (!n || !k) {
+          g.setDrawRange(0, 0);
+          return;
+        }
+        const put = (attr, array) => {
+          attr.setArray(array);
+          attr.needsUpdate = true;
+        };
+        surfaceArrays = { position: copy(s.position, Uint16Array), geometry: g };
+        put(g.attributes.position, surfaceArrays.position);
+        put(g.attributes.normal, copy(s.normal, Int8Array));
+        put(g.attributes.a_rgb, copy(s.rgb, Uint8Array));
+        put(g.index, copy(s.index, Uint32Array));
+        g.setDrawRange(0, k);
+        if (u) {
+          if (u.u_lo) u.u_lo.value = s.lo;
+          if (u.u_span) u.u_span.value = s.span;
+          if (u.u_opacity) u.u_opacity.value = s.opacity;
+        }
+        // one opaque surface writes depth; nested translucent ones (sorted back to front) do not
+        if (mesh.obj.material) mesh.obj.material.depthWrite = !(s.opacity < 1);
+      };
       if (geometries.length) applyCounts();
       if (meshes.length) applyTurn();
+      if (meshes.length) applySurface();
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
@@ -205,6 +253,7 @@ async function render({ model, el }) {
         batch = null;
         if (b === null) return;
         if (b.counts || b.array) applyCounts();
+        if (b.surface) applySurface();
         if (b.turn) {
           applyTurn();
           scene.trigger("rerender", scene, {}); // a turn alone changes no three.js buffer
@@ -225,10 +274,15 @@ async function render({ model, el }) {
         }
         batch[what] = true;
       };
-      const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn") };
+      const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn"),
+                        _rot4d_surface: note("surface") };
       let guardsAt = -Infinity;
       const onRendered = () => {
         settle();
+        if (surfaceLost()) {
+          applySurface();
+          scene.trigger("rerender", scene, {});
+        }
         // A scan of the document for canvases (a live class collection walks the whole page
         // after any DOM change): at most twice a second, not on every frame.
         const now = performance.now();

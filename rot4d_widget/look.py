@@ -150,3 +150,31 @@ def group_palette(n_cells: int) -> np.ndarray:
 
 #: The name the live view has used (``rot4d_widget.buffers.cell_palette``).
 cell_palette = group_palette
+
+
+#: Opacity of nested iso-surfaces (several levels); one level alone is opaque.
+SURFACE_OPACITY = 0.45
+
+#: The colormap of iso levels (matplotlib's name).
+LEVEL_COLORMAP = "viridis"
+
+
+def level_colors(levels, lo: float, hi: float, cmap: str = LEVEL_COLORMAP) -> np.ndarray:
+    """Colours of iso ``levels`` over the data range [lo, hi]: (n, 3) float64 in [0, 1].
+
+    One level alone takes a point of the colormap's brighter half (a readable
+    surface); several are spread over the colormap in the order of their values
+    (lowest darkest), so nested surfaces differ clearly whatever their spacing.
+    ``lo``/``hi`` bound the values (non-finite levels are refused).
+    """
+    from matplotlib import colormaps
+
+    v = np.asarray(levels, dtype=np.float64).ravel()
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"Expected finite levels, got {levels!r}")
+    if len(v) == 1:
+        x = np.array([0.75])
+    else:
+        rank = np.argsort(np.argsort(v, kind="stable"), kind="stable")
+        x = 0.12 + 0.8 * rank / (len(v) - 1)
+    return np.asarray(colormaps[cmap](x))[:, :3].astype(np.float64)

@@ -67,7 +67,7 @@ import uuid
 
 import numpy as np
 import pythreejs as p3
-from traitlets import CFloat, CInt, List
+from traitlets import CFloat, CInt, Dict, List
 
 from . import buffers as bf
 from . import look
@@ -94,12 +94,16 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     ``_rot4d_seq`` the update's id; ``_rot4d_counts`` the rows each layer draws
     (balls, bars, faces: the companion sets the geometries' drawn count as it
     applies the message); ``_rot4d_turn`` a 3-D turn of the whole view as a
-    column-major 4x4 (the companion sets it on the meshes).
+    column-major 4x4 (the companion sets it on the meshes); ``_rot4d_surface``
+    a smooth surface's quantised arrays (the companion uploads them).
     """
 
     _rot4d_seq = CInt(0).tag(sync=True)
     _rot4d_counts = List(CInt(), default_value=[0, 0, 0]).tag(sync=True)
     _rot4d_turn = List(CFloat(), default_value=_IDENTITY4).tag(sync=True)
+    #: A smooth surface (`buffers.surface_arrays`, arrays as bytes): the companion uploads it
+    #: into the surface mesh as it applies the same message as the rows.  {} = none.
+    _rot4d_surface = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
@@ -299,6 +303,23 @@ class Scene:
                 depthWrite=False,
             ),
         }
+        # the smooth surface (a field's isosurfaces): indexed, quantised; the companion
+        # replaces these placeholder arrays (their types stay) as it applies an update
+        self._surface_attrs = {
+            "position": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint16), normalized=True),
+            "normal": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.int8), normalized=True),
+            "a_rgb": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint8), normalized=True),
+        }
+        self._surface_index = p3.BufferAttribute(array=np.zeros(0, dtype=np.uint32))
+        self._surface_geometry = p3.BufferGeometry(attributes=self._surface_attrs, index=self._surface_index)
+        self._materials["surface"] = p3.ShaderMaterial(
+            vertexShader=shader_source("surface.vert"),
+            fragmentShader=shader_source("surface.frag"),
+            uniforms=self._surface_uniforms(),
+            side="DoubleSide",
+            transparent=True,
+            depthWrite=True,
+        )
         names = {"ball": "balls", "bar": "bars", "face": "faces"}
         self._meshes = {
             part: p3.Mesh(
@@ -307,6 +328,10 @@ class Scene:
             )
             for part in ("ball", "bar", "face")
         }
+        self._meshes["surface"] = p3.Mesh(
+            geometry=self._surface_geometry, material=self._materials["surface"], frustumCulled=False,
+            name="surface", visible=display["show_faces"],
+        )
         self._camera = p3.PerspectiveCamera(
             position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=self.width / self.height,
             near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
@@ -332,7 +357,9 @@ class Scene:
             self._renderer, self._controls, self._three_scene, self._camera, *self._meshes.values(),
             *self._materials.values(), *self._geometries.values(), *attrs.values(), self._buffer,
             *(a for t in templates.values() for a in t.values()),
+            self._surface_geometry, *self._surface_attrs.values(), self._surface_index,
         ]  # fmt: skip
+        self._surface_shown = False
         # ipywidgets' view count, kept by the front end on request (None: not requested)
         if self._renderer._view_count is None:
             self._renderer._view_count = 0
@@ -347,6 +374,11 @@ class Scene:
 
     def _face_uniforms(self, opacity):
         return dict(self._light, u_opacity={"value": opacity})
+
+    def _surface_uniforms(self):
+        # u_lo, u_span, u_opacity: set by the companion with each surface
+        return dict(self._light, u_lo={"value": [0.0, 0.0, 0.0]}, u_span={"value": [1.0, 1.0, 1.0]},
+                    u_opacity={"value": 1.0})
 
     # -- what the widget needs ---------------------------------------------
     @property
@@ -366,8 +398,8 @@ class Scene:
 
     @property
     def mesh_model_ids(self) -> list:
-        """Model ids of the ball, bar and face meshes (the companion turns them)."""
-        return [self._meshes[k].model_id for k in ("ball", "bar", "face")]
+        """Model ids of the ball, bar, face and surface meshes (the companion turns them)."""
+        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface")]
 
     @property
     def scene_model_id(self) -> str:
@@ -450,20 +482,34 @@ class Scene:
                     self._renderer.clearColor = h
             else:
                 self._meshes[{"show_balls": "ball", "show_bars": "bar", "show_faces": "face"}[name]].visible = value
+                if name == "show_faces":
+                    self._meshes["surface"].visible = value
             self._display[name] = value
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, force=False) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False) -> bool:
         """Show a slice (`rot4d_widget.source.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
         buffer plus the new `update_id`.  Sends nothing and returns False if
         the rows equal those shown (unless ``force``); then `update_id` does
         not change and no "drawn" acknowledgement will come.  Never creates
-        widgets.
+        widgets.  A slice with ``normals`` is a smooth surface: its triangles
+        travel quantised in the same message (``_rot4d_surface``, coloured by
+        ``group_rgb`` if given), the rows carry its points' bars.
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
+        smooth = getattr(data, "normals", None) is not None
+        surface = None
+        if smooth:  # the triangles go to the surface layer, quantised; the rows carry the rest
+            arrays = bf.surface_arrays(data, scale=self.scale, eye=self.eye, single_rgb=single_rgb,
+                                       group_rgb=self.group_rgb if group_rgb is None else group_rgb)
+            n_levels = len(np.unique(np.asarray(data.groups))) if len(data.groups) else 0
+            surface = _surface_message(arrays, 1.0 if n_levels <= 1 else look.SURFACE_OPACITY)
+            data = bf.without_triangles(data)
+        elif self._surface_shown:
+            surface = {}
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -471,12 +517,18 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb, capacity=self.capacity, eye=self.eye,
             single_rgb=single_rgb,
         )
-        if not force and np.array_equal(rows, self._rows) and self._buffer._rot4d_turn == _IDENTITY4:
+        if (not force and surface is None and np.array_equal(rows, self._rows)
+                and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
         counts = [len(data.points) if getattr(data, "show_points", True) else 0, len(data.segments), len(data.triangles)]
-        self._assign(rows, self.update_id, counts)
+        self._assign(rows, self.update_id, counts, surface=surface)
         return True
+
+    @property
+    def surface(self) -> dict:
+        """The smooth surface last sent: its quantised arrays and box (empty dict if none)."""
+        return dict(self._buffer._rot4d_surface)
 
     def turn(self, rotation) -> bool:
         """Turn the whole view by the 3-D ``rotation`` (3, 3) relative to the rows shown; True if sent.
@@ -511,9 +563,12 @@ class Scene:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
         return self._buffer._rot4d_turn != _IDENTITY4
 
-    def _assign(self, rows, seq, counts=None):
+    def _assign(self, rows, seq, counts=None, surface=None):
         buf = self._buffer
         with buf.hold_sync():
+            if surface is not None:
+                buf._rot4d_surface = surface
+                self._surface_shown = bool(surface)
             buf.array = rows
             buf._rot4d_seq = seq
             if counts is not None:
@@ -549,6 +604,20 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"
+
+
+def _surface_message(arrays: dict, opacity) -> dict:
+    """`buffers.surface_arrays` as the synced dict: arrays as little-endian bytes (binary buffers)."""
+    n, k = len(arrays["position"]), len(arrays["index"])
+    return {
+        "n_vertices": int(n),
+        "n_indices": int(k),
+        "lo": list(arrays["lo"]),
+        "span": list(arrays["span"]),
+        "opacity": 1.0 if opacity is None else float(opacity),
+        **{name: memoryview(np.ascontiguousarray(arrays[name]).astype(arrays[name].dtype.newbyteorder("<")).tobytes())
+           for name in ("position", "normal", "rgb", "index")},
+    }
 
 
 def _register(callbacks, callback, remove):

@@ -119,6 +119,20 @@ class SliceData:
     show_points: bool = True
     extra: Mapping = field(default_factory=dict)
 
+    def turned(self, rotation) -> "SliceData":
+        """The same slice turned by the 3-D ``rotation`` (3, 3): points and normals turned, rest shared.
+
+        The slice at ``R3 @ matrix`` equals the slice at ``matrix`` turned by R3 when R3 leaves w
+        alone, so a view can turn what it shows without slicing again.
+        """
+        r = np.asarray(rotation, dtype=np.float64)
+        if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9):
+            raise ValueError(f"Expected `rotation` to be a (3, 3) rotation matrix, got shape {r.shape}")
+        normals = None if self.normals is None else self.normals @ r.T
+        return SliceData.build(self.points @ r.T, self.segments, self.triangles, self.groups, normals=normals,
+                               volume=self.volume, readout=self.readout, convex=self.convex,
+                               show_points=self.show_points, extra=self.extra)
+
     @classmethod
     def build(cls, points, segments=None, triangles=None, groups=None, **kwargs) -> "SliceData":
         """Validate and copy: shapes, index ranges, finiteness; arrays made read-only."""

@@ -33,6 +33,7 @@ them short.  The traits live in the kernel only (use ``link``, not
 from __future__ import annotations
 
 import html
+import inspect
 import logging
 import math
 import traceback
@@ -118,6 +119,9 @@ class Rot4DWidget(widgets.HBox):
     group_colors : sequence of colours, one per group, optional
     antialias : bool
         WebGL multisampling (default False).
+    levels : float or sequence of floats, optional
+        Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
+        o / i move them.  Several are drawn as nested translucent surfaces.
     hold_delay, tick_rate, ack_timeout : float
         Seconds before a held key repeats; repeats per second while held;
         seconds to wait for a "drawn" acknowledgement.
@@ -144,6 +148,8 @@ class Rot4DWidget(widgets.HBox):
     show_bars = _Value(True)
     show_faces = _Value(True)
     color_by = _Value("group", help='"group" or one colour for every face')
+    levels = _Value(None, help="iso levels of a field source (tuple of floats); None for sources without levels")
+    levels.allow_none = True
 
     def __init__(
         self,
@@ -165,6 +171,7 @@ class Rot4DWidget(widgets.HBox):
         show_faces: bool = True,
         color_by="group",
         group_colors=None,
+        levels=None,
         antialias: bool = False,
         hold_delay: float = HOLD_DELAY,
         tick_rate: float = TICK_RATE,
@@ -174,6 +181,10 @@ class Rot4DWidget(widgets.HBox):
     ):
         # -- validate before any widget exists --------------------------------
         src = as_source(source)
+        if levels is not None:
+            if not hasattr(src, "levels"):
+                raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {_title(src)}")
+            src.levels = levels
         repeater = KeyRepeater(hold_delay, tick_rate)
         ack_timeout = positive_seconds("ack_timeout", ack_timeout)
         if _clock is not None and not callable(_clock):
@@ -191,16 +202,20 @@ class Rot4DWidget(widgets.HBox):
         if ball_radius is None:
             ball_radius = _default_ball_radius(src, scale, state)
         if bar_radius is None:
-            bar_radius = look.default_bar_radius(ball_radius)
+            # a field's bars only outline its data's box: thin
+            bar_radius = look.default_bar_radius(ball_radius) * (0.35 if _takes_coarse(src) else 1.0)
 
         self.source = src
         self.state = state
         self._repeater = repeater
         self._custom = {a.name: (run, repeat) for a, run, repeat in actions.values()}
         self._scale = scale
-        self._slice_cache = None  # (matrix, c0, version, data)
+        self._slice_cache = None  # (matrix, c0, version, coarse, data)
+        # sources whose slice(matrix, c0, coarse=...) has a cheaper coarse version (fields):
+        # coarse while keys repeat, full at rest; their rows are turned, not re-sliced, at rest
+        self._coarse_ok = _takes_coarse(src)
         self._source_version = 0
-        self._shown = None  # what the scene shows: (matrix, c0, eye, version, color_by)
+        self._shown = None  # what the scene shows: (matrix, c0, eye, version, color_by, coarse)
         self._rows_key = None  # the state its rows were computed for (the view may be turned from it)
         self._rows_data = None  # the slice those rows show
         self._last_label = None
@@ -270,6 +285,7 @@ class Rot4DWidget(widgets.HBox):
             color_by=color_by,
         )
         self._sync_traits()
+        self._sync_levels()
 
         self.events.on_dom_event(self._handle_event)
         self.companion.on_drawn(self._handle_drawn)
@@ -279,6 +295,7 @@ class Rot4DWidget(widgets.HBox):
         self.observe(self._on_state_trait, names=list(_STATE_TRAITS))
         self.observe(self._on_display_trait, names=list(_DISPLAY_TRAITS))
         self.observe(self._on_color_by, names="color_by")
+        self.observe(self._on_levels, names="levels")
 
         # The initial picture is part of the models' state: not "in flight".
         self._pump.send_now(expect_ack=False)
@@ -366,7 +383,8 @@ class Rot4DWidget(widgets.HBox):
     def _settle(self) -> None:
         """At rest (no key held): bring the readout up to date and the rows into the turned frame."""
         turned = self._shown is not None and self._shown is not self._rows_key
-        if (self._readout_stale or turned) and not len(self._repeater) and not self._closed:
+        coarse = self._shown is not None and self._shown[5]
+        if (self._readout_stale or turned or coarse) and not len(self._repeater) and not self._closed:
             self._pump.mark_dirty()
             self._pump.flush()
 
@@ -440,6 +458,42 @@ class Rot4DWidget(widgets.HBox):
                     setattr(self, name, value)
         finally:
             self._syncing = False
+
+    def _sync_levels(self) -> None:
+        """Copy the source's iso levels (if it has any) into the `levels` trait."""
+        levels = getattr(self.source, "levels", None)
+        if levels is None:
+            return
+        self._syncing = True
+        try:
+            self.levels = tuple(float(v) for v in levels)
+        finally:
+            self._syncing = False
+
+    def _on_levels(self, change) -> None:
+        if self._syncing:
+            return
+        with self._pump.lock:
+            if not hasattr(self.source, "levels"):
+                self._syncing = True
+                try:
+                    self.levels = change["old"]
+                finally:
+                    self._syncing = False
+                raise TypeError(f"{_title(self.source)} has no iso levels: `levels` applies to field sources")
+            try:
+                self.source.levels = change["new"]
+            except Exception:
+                self._syncing = True
+                try:
+                    self.levels = change["old"]
+                finally:
+                    self._syncing = False
+                raise
+            self._source_version += 1
+            self._sync_levels()
+            self._pump.mark_dirty()
+            self._pump.flush()
 
     def _on_state_trait(self, change) -> None:
         if self._syncing:
@@ -559,6 +613,7 @@ class Rot4DWidget(widgets.HBox):
             run[0](-1 if inverted else 1)
             self._source_version += 1
             changed = True
+            self._sync_levels()
         else:
             changed = self.state.apply(action, inverted)
         if changed:
@@ -571,14 +626,15 @@ class Rot4DWidget(widgets.HBox):
             self._sync_traits()
         return changed
 
-    def _current_slice(self):
+    def _current_slice(self, coarse: bool = False):
         st = self.state
         m, c0, version = st.matrix, st.c0, self._source_version
+        coarse = bool(coarse and self._coarse_ok)
         cache = self._slice_cache
-        if cache is not None and cache[0] is m and cache[1] == c0 and cache[2] == version:
-            return cache[3]
-        data = self.source.slice(m, c0)
-        self._slice_cache = (m, c0, version, data)
+        if cache is not None and cache[0] is m and cache[1] == c0 and cache[2] == version and cache[3] == coarse:
+            return cache[4]
+        data = self.source.slice(m, c0, coarse=True) if coarse else self.source.slice(m, c0)
+        self._slice_cache = (m, c0, version, coarse, data)
         return data
 
     def _send(self):
@@ -591,20 +647,30 @@ class Rot4DWidget(widgets.HBox):
         """
         st = self.state
         scene = self.scene
-        key = (st.matrix, st.c0, scene.eye, self._source_version, self.color_by)
         held = bool(len(self._repeater))
+        coarse = held and self._coarse_ok
         shown, rows = self._shown, self._rows_key
+        key = (st.matrix, st.c0, scene.eye, self._source_version, self.color_by, coarse)
         sent = None
+        same_cut = rows is not None and key[1:4] == rows[1:4] and key[4] == rows[4]
         if shown is not None and _same(key, shown) and (shown is rows or held):
             pass  # the view shows this state (turned rows only while keys are held)
-        elif held and rows is not None and key[1:] == rows[1:] and _leaves_w_alone(key[0], rows[0]):
+        elif held and same_cut and key[5] == rows[5] and _leaves_w_alone(key[0], rows[0]):
             if scene.turn((np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]):
                 sent = scene.update_id
             self._shown = key
         else:
             single = None if self.color_by == "group" else look.as_rgb(self.color_by, "color_by")
-            self._rows_data = self._current_slice()
-            if scene.show(self._rows_data, single_rgb=single):
+            if (self._coarse_ok and same_cut and not rows[5] and not coarse and self._rows_data is not None
+                    and _leaves_w_alone(key[0], rows[0])):
+                # the same cut turned in 3-D: turn the full-resolution slice shown, no resampling
+                t = (np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]
+                self._rows_data = self._rows_data.turned(t)
+            else:
+                self._rows_data = self._current_slice(coarse)
+            colors = _level_colors(self.source) if self._coarse_ok else None
+            extra = {} if colors is None else {"group_rgb": colors}
+            if scene.show(self._rows_data, single_rgb=single, **extra):
                 sent = scene.update_id
             self._shown = self._rows_key = key
         now = self._pump.clock()
@@ -619,7 +685,7 @@ class Rot4DWidget(widgets.HBox):
     def _readout_html(self) -> str:
         st = self.state
         # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
-        data = self._rows_data if self._shown is not self._rows_key else self._current_slice()
+        data = self._rows_data if self._rows_data is not None else self._current_slice()
         if self._last_label is None:
             last = "\u2014"
         else:
@@ -652,8 +718,26 @@ class Rot4DWidget(widgets.HBox):
 
 
 # ------------------------------------------------------------------ helpers
+def _takes_coarse(source) -> bool:
+    """True if ``source.slice`` accepts ``coarse=`` (a cheaper slice while keys repeat)."""
+    try:
+        params = inspect.signature(source.slice).parameters
+    except (TypeError, ValueError):
+        return False
+    return "coarse" in params
+
+
+def _level_colors(source):
+    """Colours of a source's iso levels (a matplotlib colormap over its data range), or None."""
+    levels = getattr(source, "levels", None)
+    if not levels:
+        return None
+    lo, hi = getattr(source, "data_range", (min(levels), max(levels)))
+    return look.level_colors(levels, lo, hi)
+
+
 def _same(a, b) -> bool:
-    """Two (matrix, c0, eye, version, color_by) keys describe the same state."""
+    """Two (matrix, c0, eye, version, color_by, coarse) keys describe the same state."""
     return a[1:] == b[1:] and (a[0] is b[0] or np.array_equal(a[0], b[0]))
 
 

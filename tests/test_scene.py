@@ -135,11 +135,11 @@ def test_no_directional_light_and_shaders_do_the_lighting(scenes):
     objects = list(walk(sc.canvas.scene))
     assert not any(isinstance(o, p3.DirectionalLight) for o in objects)
     parts = [o for o in objects if isinstance(o, p3.Mesh)]
-    assert [m.name for m in parts] == ["balls", "bars", "faces"]
+    assert [m.name for m in parts] == ["balls", "bars", "faces", "surface"]
     for m in parts:
         assert m.frustumCulled is False
         assert isinstance(m.material, p3.ShaderMaterial)
-        # impostors are lit per pixel (their normal varies), flat faces per corner
+        # impostors and smooth surfaces are lit per pixel (their normal varies), flat faces per corner
         lit_in = m.material.vertexShader if m.name == "faces" else m.material.fragmentShader
         assert "vec3 shade(" in lit_in and "shade(" in lit_in.split("void main()")[1]
         assert {"u_ambient", "u_sky", "u_ground", "u_light_position"} <= set(m.material.uniforms)
@@ -176,7 +176,7 @@ def test_faces_facing_away_from_the_camera_come_first(scenes, name):
 
 def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
     sc, _ = scenes("24-cell")
-    geos = [m.geometry for m in meshes(sc).values()]
+    geos = [m.geometry for name, m in meshes(sc).items() if name != "surface"]
     buffers = set()
     for g in geos:
         assert isinstance(g, p3.InstancedBufferGeometry)
@@ -213,7 +213,9 @@ def test_impostor_shaders_write_depth_under_webgl1_and_webgl2(scenes, which):
 def test_shader_attributes_match_the_columns(scenes):
     sc, _ = scenes("5-cell")
     decl = {}
-    for m in meshes(sc).values():
+    for name_, m in meshes(sc).items():
+        if name_ == "surface":  # its own indexed geometry (test_surface_* below)
+            continue
         for typ, name in re.findall(r"attribute (vec[234]|float) (\w+);", m.material.vertexShader):
             decl[name] = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}[typ]
     assert decl == {name: size for name, (col, size) in bf.COLUMNS.items()}
@@ -347,7 +349,7 @@ def test_growth_keeps_every_intermediate_state_whole(scenes, log):
     big = src.slice(random_rotation(np.random.default_rng(0)), 0.0)
     sc.show(big)
     assert live_widgets() == widgets_before
-    geo_ids = {m.geometry.model_id for m in meshes(sc).values()}
+    geo_ids = {m.geometry.model_id for name, m in meshes(sc).items() if name != "surface"}
     assert len(geo_ids) == 3
     kinds = [("buffer" if cid == sc.buffer_model_id else "geometry" if cid in geo_ids else cid) for cid, *_ in log]
     assert kinds == ["buffer", "geometry", "geometry", "geometry", "buffer"]

@@ -92,7 +92,7 @@ class FakeScene:
     def set_display(self, **options):
         self.display.update(self.check_display(options))
 
-    def show(self, s, single_rgb=None):
+    def show(self, s, single_rgb=None, group_rgb=None):
         """Like Scene.show: True if sent, False (and no new update_id) if the picture is unchanged."""
         if self.shown and np.array_equal(self.shown[-1].points, s.points) and self.single[-1] == single_rgb:
             return False
