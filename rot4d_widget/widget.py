@@ -655,7 +655,7 @@ class Rot4DWidget(widgets.HBox):
         same_cut = rows is not None and key[1:4] == rows[1:4] and key[4] == rows[4]
         if shown is not None and _same(key, shown) and (shown is rows or held):
             pass  # the view shows this state (turned rows only while keys are held)
-        elif held and same_cut and key[5] == rows[5] and _leaves_w_alone(key[0], rows[0]):
+        elif held and same_cut and (key[5] or not rows[5]) and _leaves_w_alone(key[0], rows[0]):
             if scene.turn((np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]):
                 sent = scene.update_id
             self._shown = key
