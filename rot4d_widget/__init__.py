@@ -35,13 +35,15 @@ _LAZY = {
     "SourceAction": "source",
     "PolytopeSource": "source",
     "Rot4DWidget": "widget",
+    "Field4D": "fields",
+    "slice_field": "fields",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
 #: statement, as they were when this ``__init__`` imported the core eagerly.
 _SUBMODULES = ("buffers", "companion", "figures", "keymap", "polytopes", "rotation",
                "scene", "slicing", "source", "state", "widget",
-               "look", "readout", "keyhold", "pump")
+               "look", "readout", "keyhold", "pump", "fields")
 
 
 def _exists(module: str) -> bool:

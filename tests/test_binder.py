@@ -48,9 +48,14 @@ def _requirement_lines():
 def test_binder_folder_installs_this_package_from_the_repository_root():
     lines = _requirement_lines()
     local = [line for line in lines if line.lstrip("-e ").startswith(".")]
-    assert local == ["."], f"binder/requirements.txt must install the package as '.', got {lines}"
+    assert local == [".[notebooks]"], f"binder/requirements.txt must install the package as '.[notebooks]', got {lines}"
     # pip resolves it against the working directory, which repo2docker sets to the repository root
-    assert (ROOT / local[0] / "pyproject.toml").is_file()
+    assert (ROOT / local[0].split("[")[0] / "pyproject.toml").is_file()
+    # and the extra exists: what the notebooks import beyond the package
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    assert any(r.startswith("py-pde") for r in extras["notebooks"])
     # with a binder/ folder, repo2docker ignores root-level config; nothing here may switch build pack
     for other in ("environment.yml", "Dockerfile", "Project.toml", "install.R"):
         assert not (BINDER / other).exists(), f"binder/{other} would change how Binder builds"
