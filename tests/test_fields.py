@@ -60,6 +60,16 @@ def test_three_sphere_slices_to_a_sphere(kind):
         assert np.allclose(np.linalg.norm(s.normals, axis=1), 1.0)
         assert np.all(np.einsum("ij,ij->i", s.normals, s.vertices) > 0.9 * r)
     assert slice_field(field, random_rotation(rng), 0.85, 0.0).empty  # |c0| > R
+    # the widget's slice turned in 3-D keeps points on the sphere and normals radial
+    from rot4d_widget.rotation import simple_rotation
+
+    field.levels = 0.0
+    t = (simple_rotation("xz", 0.7) @ simple_rotation("xy", -0.4))[:3, :3]
+    d = field.slice(m, 0.35).turned(t)
+    n = len(d.extra["levels"][0].vertices)
+    p, nrm = d.points[:n], d.normals[:n]
+    assert np.abs(np.linalg.norm(p, axis=1) - math.sqrt(R * R - 0.35**2)).max() < tol_r
+    assert np.all(np.einsum("ij,ij->i", nrm, p / np.linalg.norm(p, axis=1, keepdims=True)) > 0.99)
     # w squashed: one unit of slice space is 2 units of data w, so w = c0 cuts the data at w = 2 c0
     field.w_per_unit = 2.0
     assert field.half_widths == (1.0, 1.0, 1.0, 0.5) and field.w_range(np.eye(4)) == (-0.5, 0.5)
@@ -301,6 +311,12 @@ def test_numpy_dask_xarray_zarr_give_the_same_surface_and_read_few_chunks():
     before = counting.reads
     slice_field(fields["dask"], m, 0.02, 0.5, 40)
     assert counting.reads == before
+    # a cut through the last cell of a chunk needs the first sample of the next one (identity, c0 = 0:
+    # data t = 0.5, sample 15.5, between chunk 3 (12-15) and chunk 4 (16-19))
+    for name in ("dask", "zarr"):
+        np.testing.assert_allclose(slice_field(fields[name], np.eye(4), 0.0, 0.5, 40).vertices,
+                                   slice_field(fields["numpy"], np.eye(4), 0.0, 0.5, 40).vertices, atol=1e-5)
+    before = counting.reads
     # a general orientation still reads each touched chunk once, never more than there are
     slice_field(fields["dask"], random_rotation(0), 0.0, 0.5, 40)
     assert counting.reads - before <= 8
