@@ -83,9 +83,14 @@ HEADROOM = 0.125
 
 
 def rows_needed(data) -> int:
-    """Rows a slice needs: ``max(n_balls, n_segments, n_triangles)``."""
+    """Rows a slice needs: ``max(n_balls, n_segments, n_triangles)``.
+
+    A smooth surface's triangles (a slice with ``normals``) travel in the surface
+    layer (`surface_arrays`), not in rows: they do not count.
+    """
     n_points = len(data.points) if getattr(data, "show_points", True) else 0
-    return max(n_points, len(data.segments), len(data.triangles))
+    n_triangles = 0 if getattr(data, "normals", None) is not None else len(data.triangles)
+    return max(n_points, len(data.segments), n_triangles)
 
 
 def capacity_for(rows: int, headroom: float = HEADROOM, quantum: int = ROW_QUANTUM) -> int:
@@ -234,7 +239,7 @@ def surface_arrays(data, *, scale: float = 1.0, group_rgb=None, eye=None, single
     times 127, rounded); ``rgb`` (n, 3) uint8 (the colour of the group of the first
     triangle that uses the point: a point belongs to one level's surface); ``index``
     (3k,) uint32, triangles farthest first from ``eye`` by centroid (translucent
-    surfaces blend back to front); ``lo``, ``span`` (3,) floats.  About 13 bytes per
+    surfaces blend back to front); ``lo``, ``span`` (3,) floats.  12 bytes per
     point and 12 per triangle.
     """
     v = np.asarray(data.points, dtype=np.float64) * float(scale)

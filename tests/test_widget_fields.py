@@ -183,3 +183,17 @@ def test_an_empty_surface_clears_the_layer(make, clock):
     service(w, clock.t)
     assert w.scene.surface["n_indices"] == 0
     assert w.scene.counts[1] >= 12  # the box is still drawn
+
+
+def test_the_rows_carry_only_the_box_so_an_update_stays_small(make):
+    """The row table is sized for the box's bars, not the surface's triangles (they travel quantised)."""
+    from rot4d_widget import buffers as bf
+
+    f = ball_field()
+    w = make(f)
+    assert len(w.slice.triangles) > 200
+    assert w.scene.capacity <= bf.capacity_for(32)  # a box slice has at most 32 edges (a 4-D box has 32)
+    s = w.scene.surface
+    surface_bytes = sum(len(s[k]) for k in ("position", "normal", "rgb", "index"))
+    assert surface_bytes == 12 * s["n_vertices"] + 4 * s["n_indices"]  # 6 + 3 + 3 B per point, 4 per index
+    assert w.scene.rows.nbytes < surface_bytes / 4
