@@ -37,6 +37,8 @@ _LAZY = {
     "Rot4DWidget": "widget",
     "Field4D": "fields",
     "slice_field": "fields",
+    "FieldSlice": "fields",
+    "FieldSliceData": "fields",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
