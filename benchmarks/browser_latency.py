@@ -140,7 +140,26 @@ from conftest import (  # noqa: E402  (the browser tests' building blocks)
 from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
 POLYCHORA = ["5-cell", "8-cell", "16-cell", "24-cell", "600-cell", "120-cell"]
-LARGE = {"600-cell", "120-cell"}
+#: 4-D fields (issue 9), not in the default run: ``--cases sphere64,...``.  Each builds ``field``.
+FIELD_CASES = {
+    # f = R^2 - |q|^2 sampled on a 64^4 grid (numpy, float32): a ball in every slice
+    "sphere64": (
+        "import numpy as np\nfrom rot4d_widget import Field4D\n"
+        "g = np.linspace(-1.0, 1.0, 64, dtype=np.float32)\n"
+        "x, y, z, t = np.ix_(g, g, g, g)\n"
+        "field = Field4D(0.64 - (x * x + y * y + z * z + t * t), extent=[(-1.0, 1.0)] * 4, levels=[0.0])"
+    ),
+    # a smooth random-looking field on a 128^3 x 32 grid (sums of a few plane waves)
+    "waves128": (
+        "import numpy as np\nfrom rot4d_widget import Field4D\n"
+        "x, y, z = (np.linspace(-1, 1, 128, dtype=np.float32)[s] for s in np.ix_(*[range(128)] * 3))\n"
+        "t = np.linspace(-1, 1, 32, dtype=np.float32)[:, None, None, None]\n"
+        "field = Field4D(np.cos(4 * x + 2 * t) * np.cos(3 * y - t) + np.cos(5 * z + 3 * t) * np.cos(2 * x),"
+        " axes='wxyz', extent=[(-1.0, 1.0)] * 4, levels=[0.3])"
+    ),
+}
+ALL_CASES = POLYCHORA + list(FIELD_CASES)
+LARGE = {"600-cell", "120-cell", *FIELD_CASES}
 FRAME_MS = 1000.0 / 60.0
 PRESS_KEYS = ["2", "3", "4", "6", "8", "c", "y", "z", "w"]
 HOLD_KEY = "4"
@@ -490,6 +509,9 @@ def ws_on(page):
 def run_case(context, server, case: str, args, rng: random.Random, hold_baseline: bool) -> dict:
     name = f"bench_{case.replace('-', '_')}.ipynb"
     cells = [c.format(name=case) for c in CELLS]
+    if case in FIELD_CASES:
+        cells[1] = (f"{FIELD_CASES[case]}\nfrom rot4d_widget import Rot4DWidget\n"
+                    "w = bench.probe(Rot4DWidget(field))\nw")
     if IN_FLIGHT is not None:  # --in-flight: the widget's bound on updates in flight, for comparisons
         head, _, last = cells[1].rpartition("\n")  # ... w = bench.probe(...) / w
         cells[1] = f"{head}\nw._pump.max_in_flight = {IN_FLIGHT}\n{last}"
@@ -1155,7 +1177,7 @@ def summary(runs: list[dict]) -> str:
     """Every run's excess and held fps per case, their medians and the targets."""
     ok = lambda b: "ok" if b else "MISSED"  # noqa: E731
     n = len(runs)
-    cases = [c for c in POLYCHORA if any(c in r for r in runs)]
+    cases = [c for c in ALL_CASES if any(c in r for r in runs)]
     lines = [
         f"Over {n} runs (each a full measurement as above): mean key→pixel excess over the paired "
         "baseline and distinct frames per second while '4' is held, per run and their median.",
@@ -1267,7 +1289,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--presses", type=int, default=40, help="single presses per canvas per notebook (default 40)")
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
-    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six)")
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six) or fields (sphere64, waves128)")
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
                          "(default 60-120, a human tap; 0 = Playwright's instant press)")
@@ -1331,9 +1353,9 @@ def main(argv=None) -> int:
     elif args.busy:
         ap.error("--busy needs --cpus")
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
-    unknown = [c for c in cases if c not in POLYCHORA]
+    unknown = [c for c in cases if c not in ALL_CASES]
     if unknown or not cases:
-        ap.error(f"unknown cases {unknown}; choose from {', '.join(POLYCHORA)}")
+        ap.error(f"unknown cases {unknown}; choose from {', '.join(ALL_CASES)}")
     args.case_list = cases
     rng = random.Random(args.seed)
 
