@@ -700,6 +700,12 @@ class Rot4DWidget(widgets.HBox):
             ("last", last),
         ]
         rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
+        colors = _level_colors(self.source) if self._coarse_ok else None
+        if colors is not None and self.color_by == "group":  # the legend of the surfaces' colours
+            rows.append(("colours", " ".join(
+                f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
+                f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{lv:.4g}"
+                for lv, rgb in zip(self.source.levels, colors))))
         volume = getattr(data, "volume", None)
         if volume is not None:
             rows.append(("volume", f"{volume * self._scale ** 3:.4f} as drawn"))

@@ -228,3 +228,14 @@ def test_the_readme_field_example_runs_as_written_and_shows_a_surface(clock):
     finally:
         for x in made:
             x.close()
+
+
+def test_the_readout_has_a_colour_legend_of_the_levels(make, clock):
+    f = ball_field()
+    w = make(f, levels=[-0.2, 0.1])
+    html = w.readout.value
+    colors = look.level_colors(f.levels, *f.data_range)
+    for lv, rgb in zip(f.levels, colors):
+        hexed = "#" + "".join(f"{round(255 * c):02x}" for c in rgb)
+        assert hexed in html and f"{lv:.4g}" in html
+    assert "w cut" in html  # the time span the cut covers
