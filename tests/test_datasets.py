@@ -17,7 +17,7 @@ pytest.importorskip("pde")
 pytest.importorskip("xarray")
 
 #: a small run that still separates into domains and coarsens (about 0.3 s)
-SMALL = dict(n=16, steps=11, t_end=10.0, interface=1.0, seed=3)
+SMALL = dict(n=16, steps=11, t_end=10.0, interface=1.0, bias=-0.1, seed=3)
 
 
 @pytest.fixture
@@ -57,7 +57,7 @@ def test_the_cache_key_follows_every_parameter():
     base = phase_separation_key(**SMALL)
     assert base == phase_separation_key(**SMALL)
     assert phase_separation_key(**{**SMALL, "t_end": 10}) == base  # 10 and 10.0 are one run
-    changed = {"n": 17, "steps": 12, "t_end": 11.0, "interface": 1.1, "seed": 4}
+    changed = {"n": 17, "steps": 12, "t_end": 11.0, "interface": 1.1, "bias": 0.0, "seed": 4}
     keys = {name: phase_separation_key(**{**SMALL, name: value}) for name, value in changed.items()}
     assert base not in keys.values()
     assert len(set(keys.values())) == len(keys)
@@ -138,6 +138,7 @@ def test_the_simulation_separates_phases_and_coarsens(small_run):
     c = small_run.values
     xi = SMALL["interface"]
     # Allen-Cahn is the gradient flow of F: F falls at every stored frame
+    assert abs(c[0].mean() - SMALL["bias"]) < 1e-6  # the initial state's mean is the bias
     F = free_energy(c, xi)
     assert np.all(np.diff(F) < 0), F
     # two phases, c = +-1, form out of a state with |c| of about 0.4 ...
@@ -168,6 +169,7 @@ def test_the_interfaces_are_resolved(small_run):
         (dict(interface=0.3), r"fewer than 2 grid points"),
         (dict(n=16, interface=3.0), r"n/8 = 2"),
         (dict(seed=-1), r"`seed` in \[0, "),
+        (dict(bias=0.8), r"`bias` \(the mean of the initial state\) in \[-0.5, 0.5\]"),
         (dict(backend="gpu"), r"'numpy' or 'numba'"),
     ],
 )

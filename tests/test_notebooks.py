@@ -33,6 +33,7 @@ PROJECT_NOTEBOOKS = [
     "01_pentachoron.ipynb",
     "02_regular_polychora.ipynb",
     "03_paper_figures.ipynb",
+    "04_time_varying_field.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
