@@ -27,6 +27,14 @@ H if there is one, otherwise the lower-numbered of its two cells.
 
 Everything per step is vectorised over precomputed incidence tables (built
 once per polytope): no Python loop over edges, faces or cells.
+
+Many levels at once (a stack of parallel slices): ``slice_polytope(p, m, c0s)``
+with a 1-D array of levels rotates once, classifies every vertex against every
+level in one (L, V) comparison, finds the crossing faces and cells of all
+levels from their w-ranges, and runs the single slice's steps on arrays that
+carry a level index; each level's `Slice` is a read-only view of the shared
+arrays, equal to the single slice at that level.  Levels within the tolerance
+of a vertex height (the on-H cases) take the single-slice path.
 """
 
 from __future__ import annotations
@@ -91,6 +99,10 @@ class _Tables:
         self.cell_normals = np.ascontiguousarray(p.cell_normals)
         self.vertices = p.vertices
         self.tol = TOLERANCE * p.circumradius
+        # fixed-width rows for many levels at once: each face's / cell's edges, padded with the
+        # index E (a column that never crosses)
+        self.fe_pad = _padded(self.fe_face, self.fe_edge, F, len(self.ea))
+        self.ce_pad = _padded(self.ce_cell, self.ce_edge, C, len(self.ea))
         self.empty3 = np.zeros((0, 3))
         self.empty_i2 = np.zeros((0, 2), dtype=np.intp)
         self.empty_i3 = np.zeros((0, 3), dtype=np.intp)
@@ -100,6 +112,16 @@ class _Tables:
         for name, a in vars(self).items():
             if isinstance(a, np.ndarray) and a.flags.writeable:
                 setattr(self, name, _sealed(a))
+
+
+def _padded(owner: np.ndarray, item: np.ndarray, n: int, pad: int) -> np.ndarray:
+    """Rows ``owner -> items`` (owner sorted) as an (n, widest) table padded with ``pad``."""
+    counts = np.bincount(owner, minlength=n)
+    table = np.full((n, int(counts.max()) if n else 0), pad, dtype=np.intp)
+    starts = np.zeros(n, dtype=np.intp)
+    np.cumsum(counts[:-1], out=starts[1:])
+    table[owner, np.arange(len(owner)) - starts[owner]] = item
+    return table
 
 
 _TABLES: "weakref.WeakKeyDictionary[Polytope, _Tables]" = weakref.WeakKeyDictionary()
@@ -176,21 +198,58 @@ class _Inconsistent(Exception):
     """A face chord without exactly two ends: classification hit a near-degenerate case."""
 
 
-def slice_polytope(polytope, matrix, c0: float = 0.0) -> Slice:
+def slice_polytope(polytope, matrix, c0=0.0):
     """Cut ``polytope`` (a `Polytope` or a name), rotated by ``matrix``, with w = ``c0``.
 
     ``matrix`` is a (4, 4) rotation (validated: orthogonal, det +1); the rotated
-    vertices are ``vertices @ matrix.T``.  Returns a `Slice`.
+    vertices are ``vertices @ matrix.T``.
+
+    ``c0`` a real number (or a 0-d array): returns a `Slice`.  ``c0`` a 1-D
+    array-like of levels (a stack of parallel hyperplanes): returns a tuple of
+    `Slice`, one per level in the order given, each equal to the single slice
+    at its level.  The levels are cut in one batched pass (the vertices rotated
+    once, every vertex classified against every level at once, the crossing
+    edges, face chords and cell polygons of all levels found and ordered by the
+    same vectorised steps as a single slice, then split by level); a level
+    within `TOLERANCE` of a vertex height, or one that does not cross the
+    polytope, takes the single-slice path (its explicit on-H case table).
     """
     p = _get_polytope(polytope)
     m = as_rotation_matrix(matrix)
-    if isinstance(c0, (bool, np.bool_)) or not isinstance(c0, (int, float, np.integer, np.floating)):
-        raise TypeError(f"Expected `c0` to be a real number, got {type(c0).__name__}")
-    c0 = float(c0)
-    if not math.isfinite(c0):
-        raise ValueError(f"Expected `c0` to be finite, got {c0}")
+    levels, many = _as_levels(c0)
     t = _tables(p)
     x = p.vertices @ m.T
+    if not many:
+        return _slice_level(t, x, m, float(levels[0]), p.circumradius)
+    return _slice_many(t, x, m, levels, p.circumradius)
+
+
+def _as_levels(c0):
+    """``c0`` -> (levels (L,) float64, many): a real number or 0-d array, or a 1-D array-like."""
+    if isinstance(c0, (bool, np.bool_)) or isinstance(c0, (str, bytes)):
+        raise TypeError(f"Expected `c0` to be a real number or a 1-D array of levels, got {type(c0).__name__}")
+    if isinstance(c0, (int, float, np.integer, np.floating)):
+        arr = np.array([float(c0)])
+        many = False
+    else:
+        try:
+            arr = np.asarray(c0)
+        except (TypeError, ValueError):
+            raise TypeError(f"Expected `c0` to be a real number or a 1-D array of levels, got {type(c0).__name__}") from None
+        if arr.dtype.kind not in "iuf" or arr.ndim > 1:
+            what = f"shape {arr.shape}" if arr.ndim > 1 else f"dtype {arr.dtype}"
+            raise (ValueError if arr.ndim > 1 else TypeError)(
+                f"Expected `c0` to be a real number or a 1-D array of levels, got {what}")
+        many = arr.ndim == 1
+        arr = np.array(arr, dtype=np.float64).reshape(-1)
+    if not np.all(np.isfinite(arr)):
+        bad = arr[~np.isfinite(arr)][0]
+        raise ValueError(f"Expected `c0` to be finite, got {bad}")
+    return arr, many
+
+
+def _slice_level(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, radius: float) -> Slice:
+    """One level, with the fallbacks for near-degenerate classifications."""
     try:
         return _slice(t, x, m, c0, t.tol)
     except _Inconsistent:
@@ -200,7 +259,201 @@ def slice_polytope(polytope, matrix, c0: float = 0.0) -> Slice:
     try:
         return _slice(t, x, m, c0, 0.0)
     except _Inconsistent:
-        return _slice(t, x, m, c0 + 1e-7 * p.circumradius, t.tol)
+        return _slice(t, x, m, c0 + 1e-7 * radius, t.tol)
+
+
+def _slice_many(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, radius: float) -> tuple:
+    """Every level of ``levels`` in one pass; see `slice_polytope`."""
+    L = len(levels)
+    out = [None] * L
+    if L == 0:
+        return ()
+    tol = t.tol
+    h = x[:, 3][None, :] - levels[:, None]  # (L, V), the same numbers as a single slice's h
+    pos = h > tol
+    neg = h < -tol
+    n_pos = pos.sum(axis=1)
+    n_neg = neg.sum(axis=1)
+    # generic: every vertex strictly off H and some on each side (solid, no on-H cases)
+    generic = (n_pos + n_neg == t.V) & (n_pos > 0) & (n_neg > 0)
+    gi = generic.nonzero()[0]
+    if len(gi):
+        try:
+            for i, s in zip(gi, _slice_generic(t, x, m, levels[gi], h[gi], pos[gi])):
+                out[i] = s
+        except _Inconsistent:
+            for i in gi:
+                out[i] = _slice_level(t, x, m, float(levels[i]), radius)
+    for i in (~generic).nonzero()[0]:
+        out[i] = _slice_level(t, x, m, float(levels[i]), radius)
+    return tuple(out)
+
+
+def _seal(a: np.ndarray) -> np.ndarray:
+    """Make an array that owns its data read-only (views taken from it cannot be unlocked)."""
+    a.flags.writeable = False
+    return a
+
+
+def _nonzero2(a: np.ndarray) -> tuple:
+    """``a.nonzero()`` of a 2-D array, row-major (flatnonzero is several times faster)."""
+    k = np.flatnonzero(a)
+    row = k // a.shape[1]
+    return row, k - row * a.shape[1]
+
+
+def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, h: np.ndarray,
+                   pos: np.ndarray) -> list:
+    """Slices of G levels whose vertices are all strictly above or below H, some on each side.
+
+    ``h`` (G, V) heights above each level, ``pos`` (G, V) h > tol (every other vertex is below).
+    The steps and their order are `_slice`'s restricted to the crossing case with no vertex on H,
+    done for all levels at once (arrays carry a level index, level-major), so each level's
+    vertices, edges, polygons and triangles come out in the same order as its single slice.
+    """
+    G = len(h)
+    C = t.C
+    ea, eb = t.ea, t.eb
+    cross = pos[:, ea] != pos[:, eb]  # (G, E): with no vertex on H, one end above and one below
+    lv, e_idx = _nonzero2(cross)  # level-major: each level's crossing edges in edge order
+    n_v = np.bincount(lv, minlength=G)
+    voff = np.zeros(G + 1, dtype=np.intp)
+    np.cumsum(n_v, out=voff[1:])
+    a, b = ea[e_idx], eb[e_idx]
+    ha = h[lv, a]
+    s = (ha / (ha - h[lv, b]))[:, None]
+    xa = x[a, :3]
+    vertices = _seal(xa + s * (x[b, :3] - xa))
+    edge_sv = np.full(cross.shape, -1, dtype=np.intp)  # (G, E) -> global slice-vertex index
+    edge_sv[lv, e_idx] = np.arange(len(e_idx))
+
+    # which faces and cells cross each level, from their w-ranges: min(w) - c0 is the min of
+    # the h above (rounding is monotone), so this agrees with pos exactly
+    w = x[:, 3]
+    lev = levels[:, None]
+    cross_pad = np.zeros((G, len(ea) + 1), dtype=bool)
+    cross_pad[:, :-1] = cross
+    flat_cross = cross_pad.ravel()
+    stride = len(ea) + 1
+
+    # edges of S: the chords of crossing 2-faces, their two crossing edges in face order
+    wf = w[t.fv_vert]
+    f_cross = (np.minimum.reduceat(wf, t.f_starts)[None, :] - lev < -t.tol) & (
+        np.maximum.reduceat(wf, t.f_starts)[None, :] - lev > t.tol)
+    lf, fc = _nonzero2(f_cross)
+    fe = t.fe_pad[fc]
+    hit = np.take(flat_cross, fe + (lf * stride)[:, None])
+    rr, kk = _nonzero2(hit)
+    if len(rr) != 2 * len(fc) or (rr[0::2] != rr[1::2]).any():
+        raise _Inconsistent
+    seg = edge_sv[lf[rr], fe[rr, kk]]
+    seg -= voff[lf[rr]]
+    edges = _seal(seg).reshape(-1, 2)
+    eoff = np.zeros(G + 1, dtype=np.intp)
+    np.cumsum(np.bincount(lf, minlength=G), out=eoff[1:])
+
+    # polygons of S: one per crossing cell, its corners the cell's crossing edges (level-major,
+    # cells in order, as `_slice` numbers them)
+    wc = w[t.cv_vert]
+    c_cross = (np.minimum.reduceat(wc, t.c_starts)[None, :] - lev < -t.tol) & (
+        np.maximum.reduceat(wc, t.c_starts)[None, :] - lev > t.tol)
+    p_level, cell_ids = _nonzero2(c_cross)
+    ce = t.ce_pad[cell_ids]
+    rank, kk = _nonzero2(np.take(flat_cross, ce + (p_level * stride)[:, None]))
+    cell_of = cell_ids[rank]
+    poly_sv = edge_sv[p_level[rank], ce[rank, kk]]
+    n_poly = len(cell_ids)
+    counts = np.bincount(rank, minlength=n_poly)
+    starts = np.zeros(n_poly, dtype=np.intp)
+    np.cumsum(counts[:-1], out=starts[1:])
+    # corner mean of each polygon, coordinate by coordinate (bincount sums in entry order, as `_slice`)
+    px = np.take(vertices[:, 0], poly_sv)
+    py = np.take(vertices[:, 1], poly_sv)
+    pz = np.take(vertices[:, 2], poly_sv)
+    cx = np.bincount(rank, weights=px) / counts
+    cy = np.bincount(rank, weights=py) / counts
+    cz = np.bincount(rank, weights=pz) / counts
+    # in-plane axes u, v of every cell's outward normal restricted to H (`_slice`'s formulas),
+    # computed once per cell for all levels
+    n = t.cell_normals @ m[:3].T
+    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
+    use_x = nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)
+    uv = np.empty((C, 6))
+    uv[:, 0] = np.where(use_x, 0.0, -nz)
+    uv[:, 1] = np.where(use_x, nz, 0.0)
+    uv[:, 2] = np.where(use_x, -ny, nx)
+    uv[:, 3] = np.where(use_x, -(ny * ny + nz * nz), nx * ny)
+    uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
+    uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
+    uvr = np.take(uv, cell_of, axis=0)
+    dx = px - np.take(cx, rank)
+    dy = py - np.take(cy, rank)
+    dz = pz - np.take(cz, rank)
+    cu = dx * uvr[:, 0] + dy * uvr[:, 1] + dz * uvr[:, 2]
+    cv = dx * uvr[:, 3] + dy * uvr[:, 4] + dz * uvr[:, 5]
+    # a pseudo-angle strictly increasing with arctan2(cv, cu) on (-pi, pi] (same order, cheaper):
+    # cv / (|cu| + |cv|) for cu >= 0, else +-2 minus it
+    r = cv / (np.abs(cu) + np.abs(cv))
+    ang = np.where(cu >= 0, r, np.copysign(2.0, cv) - r)
+    # the corners of each polygon by angle, the same order as argsort(rank * 8 + ang) in
+    # `_slice`: a polygon has at most K corners (a few), so each corner's place is the number
+    # of corners of its polygon with a smaller angle, counted column by column
+    K = int(counts.max())
+    at = np.arange(len(rank)) - np.take(starts, rank)
+    table = np.full((n_poly, K), np.inf)
+    table[rank, at] = ang
+    place = np.zeros((n_poly, K), dtype=np.intp)
+    for k in range(K):
+        place += table[:, k : k + 1] < table
+    order = np.empty(len(rank), dtype=np.intp)
+    order[np.take(starts, rank) + place[rank, at]] = np.arange(len(rank))
+    flat = poly_sv[order]
+    offsets = np.zeros(n_poly + 1, dtype=np.intp)
+    np.cumsum(counts, out=offsets[1:])
+
+    # fan triangulation: corners 1..k-2 of each polygon open a triangle
+    prank = rank[order]
+    start = offsets[prank]
+    pos_in = np.arange(len(flat)) - start
+    j = ((pos_in >= 1) & (pos_in <= counts[prank] - 2)).nonzero()[0]
+    triangles = np.empty((len(j), 3), dtype=np.intp)
+    triangles[:, 0] = flat[start[j]]
+    triangles[:, 1] = flat[j]
+    triangles[:, 2] = flat[j + 1]
+    t_level = p_level[prank[j]]
+    triangle_cells = _seal(cell_ids[prank[j]])
+
+    # volume by the divergence theorem about each level's vertex centroid
+    vsum = np.add.reduceat(vertices, voff[:-1], axis=0)
+    centre = vsum / n_v[:, None]
+    tri = np.take(vertices - np.take(centre, lv, axis=0), triangles.ravel(), axis=0).reshape(-1, 3, 3)
+    A, B, D = tri[:, 0], tri[:, 1], tri[:, 2]
+    six = (
+        A[:, 0] * (B[:, 1] * D[:, 2] - B[:, 2] * D[:, 1])
+        + A[:, 1] * (B[:, 2] * D[:, 0] - B[:, 0] * D[:, 2])
+        + A[:, 2] * (B[:, 0] * D[:, 1] - B[:, 1] * D[:, 0])
+    )
+    volumes = np.bincount(t_level, weights=six, minlength=G) / 6.0
+
+    # indices local to each level, then one Slice per level (views of the sealed arrays)
+    triangles -= voff[t_level][:, None]
+    _seal(triangles)
+    flat -= voff[p_level[prank]]
+    _seal(flat)
+    _seal(cell_ids)
+    poff = np.zeros(G + 1, dtype=np.intp)
+    np.cumsum(np.bincount(p_level, minlength=G), out=poff[1:])
+    toff = np.zeros(G + 1, dtype=np.intp)
+    np.cumsum(np.bincount(t_level, minlength=G), out=toff[1:])
+    out = []
+    for g in range(G):
+        p0, p1, t0, t1 = poff[g], poff[g + 1], toff[g], toff[g + 1]
+        o = offsets[p0 : p1 + 1] - offsets[p0]
+        out.append(Slice(
+            vertices[voff[g] : voff[g + 1]], edges[eoff[g] : eoff[g + 1]], flat[offsets[p0] : offsets[p1]],
+            o, cell_ids[p0:p1], triangles[t0:t1], triangle_cells[t0:t1], float(volumes[g]), 3,
+        ))
+    return out
 
 
 def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> Slice:
