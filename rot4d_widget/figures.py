@@ -64,6 +64,7 @@ __all__ = [
     "render_key_sequence",
     "paper_figure_3",
     "paper_figure_4",
+    "render_tomography",
 ]
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
@@ -542,3 +543,163 @@ def paper_figure_4(path=None, *, panel_size: float = 2.0, dpi: float = 100, titl
     )
     _save(fig, path)
     return fig
+
+
+# --------------------------------------------------------------------------- stacks of slices
+def render_tomography(
+    source="24-cell",
+    matrix=None,
+    c0: float = 0.0,
+    slices: int = 5,
+    spacing: float | None = None,
+    arrangement: str = "oval",
+    path=None,
+    *,
+    color_by: str = "w",
+    width: float = 6.0,
+    height: float = 5.0,
+    dpi: float = 100,
+    title: str | bool | None = True,
+    labels: bool = True,
+    face_alpha: float = look.FACE_OPACITY,
+) -> Figure:
+    """N parallel slices w_k = c0 + (k - (N-1)/2) Δ of ``source``, in one scene, as the live view lays them out.
+
+    ``source`` is a polytope name, a Polytope or any source (a `Field4D` ...), ``matrix`` the
+    (4, 4) orientation (identity by default); ``slices``, ``spacing`` (None: 2 size / N),
+    ``arrangement`` ("oval", "grid", "stack") and ``color_by`` ("w" or "cell") as in
+    :class:`rot4d_widget.tomography.StackSource`, whose slice this draws: each slice is placed
+    at its arrangement's centre and scale, the whole scene scaled to the live view's displayed
+    size and seen through its camera (``width`` / ``height`` inches: the default 6 x 5 has the
+    canvas's 600 x 500 aspect).  Slices are painted back to front by the depth of their centres
+    (they never intersect), each slice's own faces, bars and balls by depth as in
+    :func:`draw_slice`.  ``labels``: each slice's w under it; the slice at w = c0 (or the first
+    above it, for even N) is ringed and its label bold.  Saved to ``path`` (.png, .svg or .pdf)
+    if given.  Returns the Figure.
+    """
+    from .source import as_source
+    from .tomography import StackSource
+
+    src = source if isinstance(source, StackSource) else None
+    if src is None:
+        inner = as_source(source)
+        src = StackSource(inner, slices=slices, spacing=spacing, arrangement=arrangement, color_by=color_by)
+    matrix = np.eye(4) if matrix is None else matrix
+    c0 = _real("c0", c0)
+    width = _real("width", width, minimum=0.0, inclusive=False)
+    height = _real("height", height, minimum=0.0, inclusive=False)
+    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    data = src.slice(matrix, c0)
+    ex = data.extra
+    n = src.slices
+    scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
+    centres = np.asarray(ex["centres"]) * scale
+    scales = np.asarray(ex["scales"])
+    levels = np.asarray(ex["levels"])
+    hi = int(ex["highlighted"])
+    group_rgb = ex.get("group_rgb")
+
+    top = TITLE_HEIGHT if title else 0.0
+    fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=look.BACKGROUND)
+    ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
+    ax.set_axis_off()
+    d = CAMERA_DISTANCE
+    limit = d * math.tan(math.radians(CAMERA_FOV) / 2.0)
+    aspect = width / height
+    ax.set_xlim(-limit * aspect, limit * aspect)
+    ax.set_ylim(-limit, limit)
+    ax.set_aspect("equal")
+
+    edge = getattr(src.source, "edge_length", None)
+    base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
+    poly = getattr(src.source, "polytope", None)
+    offs = np.asarray(ex["point_offsets"])
+    toff = np.asarray(ex["triangle_offsets"])
+    soff = np.asarray(ex["segment_offsets"])
+    # back to front by the depth of each slice's centre; zorders of slices never interleave
+    for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
+        z_shift = 1e3 * rank
+        ball = base_ball * scales[k]
+        if poly is not None:
+            s = ex["slices"][k]
+            placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
+                           s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
+                           s.volume, s.dim)
+            cmap = None if group_rgb is None else ListedColormap([group_rgb[k]])
+            drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV, ball_radius=ball,
+                                 bar_radius=look.default_bar_radius(ball), face_alpha=face_alpha, cmap=cmap)
+            for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
+                a.set_zorder(a.get_zorder() + z_shift)
+        else:
+            _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, src.source, face_alpha, z_shift,
+                          0.35 * look.default_bar_radius(ball))
+        if labels:
+            _label_slice(ax, centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift)
+    ax.set_xlim(-limit * aspect, limit * aspect)
+    ax.set_ylim(-limit, limit)
+    if title:
+        name = getattr(src.source, "name", None) or type(src.source).__name__
+        text = title if isinstance(title, str) else (
+            f"{name}: {n} slice{'s' if n != 1 else ''} w = c0 + (k \u2212 {(n - 1) / 2:g})\u0394, "
+            f"c0 = {c0:.3g}, \u0394 = {src.spacing:.3g}, {src.arrangement}")
+        fig.text(0.5, 1.0 - 0.5 * top / (height + top), text, ha="center", va="center", fontsize=9)
+    _save(fig, path)
+    return fig
+
+
+def _label_slice(ax, centre, radius, w, highlighted, z_shift):
+    """'w = ...' at the upper left of a slice's projected bounding circle (inside its square, like a
+    CT film's corner text), painted with its slice (nearer slices cover it); the highlighted slice
+    ringed, its label bold."""
+    (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
+    r = radius * f
+    fs = max(5.0, min(9.0, 30.0 * r))
+    z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
+    ax.text(xy[0] - 0.98 * r, xy[1] + 0.98 * r, f"w = {w:.3g}", ha="left", va="top", fontsize=fs,
+            fontweight="bold" if highlighted else "normal", zorder=z, gid="label")
+    if highlighted:
+        ax.add_patch(Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
+                            zorder=z, gid="highlight-ring"))
+
+
+def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width):
+    """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines."""
+    from matplotlib.collections import LineCollection, PolyCollection
+
+    p0, p1 = offs[k], offs[k + 1]
+    pts = np.asarray(data.points[p0:p1]) * scale
+    tri = np.asarray(data.triangles[toff[k]:toff[k + 1]]) - p0
+    seg = np.asarray(data.segments[soff[k]:soff[k + 1]]) - p0
+    if not len(pts):
+        return
+    xy, _ = perspective(pts)
+    z_base = _Z_BASE + float(pts[:, 2].mean()) + z_shift
+    if len(tri):
+        groups = np.asarray(data.groups[toff[k]:toff[k + 1]])
+        if group_rgb is not None:
+            rgb = np.asarray(group_rgb, dtype=np.float64)[groups]
+        else:
+            levels = getattr(inner, "levels", None)
+            if levels:
+                lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
+                rgb = look.level_colors(levels, lo, hi)[groups]
+            else:
+                rgb = look.group_palette(int(groups.max()) + 1)[groups].astype(np.float64)
+        nrm = data.normals
+        if nrm is not None:
+            n = np.asarray(nrm[p0:p1])[tri].mean(axis=1)
+            n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+            light = np.array([-0.35, 0.45, 0.82])
+            shade = 0.45 + 0.55 * np.abs(n @ (light / np.linalg.norm(light)))
+            rgb = np.clip(rgb * shade[:, None], 0.0, 1.0)
+        depth = pts[tri].mean(axis=1)[:, 2]
+        order = np.argsort(depth, kind="stable")
+        alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, look.SURFACE_OPACITY)
+        coll = PolyCollection(xy[tri[order]], facecolors=np.column_stack([rgb[order], np.full(len(order), alpha)]),
+                              edgecolors="none", zorder=z_base, gid="surface")
+        ax.add_collection(coll)
+    if len(seg):
+        lines = LineCollection(xy[seg], colors=look.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
+                               zorder=z_base + 1e-3, gid="bar")
+        ax.add_collection(lines)
