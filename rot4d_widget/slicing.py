@@ -386,11 +386,11 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
     uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
     uvr = np.take(uv, cell_of, axis=0)
-    dx = px - np.take(cx, rank)
-    dy = py - np.take(cy, rank)
-    dz = pz - np.take(cz, rank)
-    cu = dx * uvr[:, 0] + dy * uvr[:, 1] + dz * uvr[:, 2]
-    cv = dx * uvr[:, 3] + dy * uvr[:, 4] + dz * uvr[:, 5]
+    # d . u and d . v with `_slice`'s very expressions (the same rounding, so a corner on the
+    # branch cut of the angle lands on the same side of it)
+    d = np.stack([px - np.take(cx, rank), py - np.take(cy, rank), pz - np.take(cz, rank)], axis=1)
+    cu = np.einsum("ij,ij->i", d, uvr[:, :3])
+    cv = np.einsum("ij,ij->i", d, uvr[:, 3:])
     # a pseudo-angle strictly increasing with arctan2(cv, cu) on (-pi, pi] (same order, cheaper):
     # cv / (|cu| + |cv|) for cu >= 0, else +-2 minus it
     r = cv / (np.abs(cu) + np.abs(cv))

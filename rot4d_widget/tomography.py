@@ -134,8 +134,12 @@ def default_spacing(size: float, n: int) -> float:
 
 
 def stack_levels(c0: float, n: int, spacing: float) -> np.ndarray:
-    """(n,) float64: w_k = c0 + (k - (n - 1) / 2) spacing; the middle one is c0 exactly for odd n."""
-    n = _check_slices(n)
+    """(n,) float64: w_k = c0 + (k - (n - 1) / 2) spacing; the middle one is c0 exactly for odd n.
+
+    Any n >= 1 (a `StackSource` holds at most `MAX_SLICES`; tests integrate with more)."""
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, Integral) or n < 1:
+        raise ValueError(f"Expected `n` to be an int >= 1, got {n!r}")
+    n = int(n)
     return float(c0) + (np.arange(n) - (n - 1) / 2.0) * float(spacing)
 
 
@@ -398,10 +402,9 @@ class StackSource:
         if self._polytope is not None:
             from .slicing import slice_polytope
 
-            out = []
-            for s in slice_polytope(self._polytope, matrix, levels):
-                out.append(_PolytopePiece(s))
-            return out
+            if len(levels) == 1:  # today's single slice, bit for bit
+                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])))]
+            return [_PolytopePiece(s) for s in slice_polytope(self._polytope, matrix, levels)]
         if coarse:
             return [self.source.slice(matrix, float(w), coarse=True) for w in levels]
         return [self.source.slice(matrix, float(w)) for w in levels]
