@@ -843,7 +843,7 @@ class Field4D:
             gm = np.sqrt(sum(g * g for g in grads))
         ok = np.isfinite(gm) & (gm > 0)
         if ok.any():
-            k = float(np.median(gm[ok]))
+            k = float(np.percentile(gm[ok], 95))  # steep places: a phase field's plateaus must not set it
         else:
             span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
             k = max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * self.size)
