@@ -36,6 +36,8 @@ _LAZY = {
     "PolytopeSource": "source",
     "Rot4DWidget": "widget",
     "Field4D": "fields",
+    "StackSource": "tomography",
+    "arrangement_layout": "tomography",
     "slice_field": "fields",
     "FieldSlice": "fields",
     "FieldSliceData": "fields",
@@ -45,7 +47,7 @@ _LAZY = {
 #: statement, as they were when this ``__init__`` imported the core eagerly.
 _SUBMODULES = ("buffers", "companion", "figures", "keymap", "polytopes", "rotation",
                "scene", "slicing", "source", "state", "widget",
-               "look", "readout", "keyhold", "pump", "fields")
+               "look", "readout", "keyhold", "pump", "fields", "tomography", "datasets")
 
 
 def _exists(module: str) -> bool:

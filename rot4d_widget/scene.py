@@ -514,8 +514,8 @@ class Scene:
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
         rows = bf.slice_rows(
-            data, scale=self.scale, group_rgb=self.group_rgb, capacity=self.capacity, eye=self.eye,
-            single_rgb=single_rgb,
+            data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
+            capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
         if (not force and surface is None and np.array_equal(rows, self._rows)
                 and self._buffer._rot4d_turn == _IDENTITY4):

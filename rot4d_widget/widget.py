@@ -119,6 +119,11 @@ class Rot4DWidget(widgets.HBox):
     group_colors : sequence of colours, one per group, optional
     antialias : bool
         WebGL multisampling (default False).
+    slices, spacing, arrangement : int, float, str, optional
+        Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
+        `rot4d_widget.tomography.StackSource`), placed "oval" (on a parabola, the slice at
+        c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the
+        spacing (default 2 * size / N).  Also traits; chosen at construction.
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
@@ -150,6 +155,12 @@ class Rot4DWidget(widgets.HBox):
     color_by = _Value("group", help='"group" or one colour for every face')
     levels = _Value(None, help="iso levels of a field source (tuple of floats); None for sources without levels")
     levels.allow_none = True
+    slices = _Value(None, help="parallel slices shown (int 1...64); None unless built with slices=")
+    slices.allow_none = True
+    spacing = _Value(None, help="distance between parallel slices, in the source's units")
+    spacing.allow_none = True
+    arrangement = _Value(None, help='"oval", "grid" or "stack": where the parallel slices are placed')
+    arrangement.allow_none = True
 
     def __init__(
         self,
@@ -172,6 +183,9 @@ class Rot4DWidget(widgets.HBox):
         color_by="group",
         group_colors=None,
         levels=None,
+        slices=None,
+        spacing=None,
+        arrangement="oval",
         antialias: bool = False,
         hold_delay: float = HOLD_DELAY,
         tick_rate: float = TICK_RATE,
@@ -185,6 +199,12 @@ class Rot4DWidget(widgets.HBox):
             if not hasattr(src, "levels"):
                 raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {_title(src)}")
             src.levels = levels
+        if slices is not None:  # parallel slices (4-D tomography): a source that wraps the source
+            from .tomography import StackSource
+
+            src = StackSource(src, slices=slices, spacing=spacing, arrangement=arrangement)
+        elif spacing is not None:
+            raise TypeError("`spacing` applies to parallel slices: give `slices=N` too")
         repeater = KeyRepeater(hold_delay, tick_rate)
         ack_timeout = positive_seconds("ack_timeout", ack_timeout)
         if _clock is not None and not callable(_clock):
@@ -286,6 +306,7 @@ class Rot4DWidget(widgets.HBox):
         )
         self._sync_traits()
         self._sync_levels()
+        self._sync_stack()
 
         self.events.on_dom_event(self._handle_event)
         self.companion.on_drawn(self._handle_drawn)
@@ -296,6 +317,7 @@ class Rot4DWidget(widgets.HBox):
         self.observe(self._on_display_trait, names=list(_DISPLAY_TRAITS))
         self.observe(self._on_color_by, names="color_by")
         self.observe(self._on_levels, names="levels")
+        self.observe(self._on_stack_trait, names=["slices", "spacing", "arrangement"])
 
         # The initial picture is part of the models' state: not "in flight".
         self._pump.send_now(expect_ack=False)
@@ -459,9 +481,47 @@ class Rot4DWidget(widgets.HBox):
         finally:
             self._syncing = False
 
+    @property
+    def _level_source(self):
+        """The source whose iso levels the `levels` trait holds (a stack's inner source)."""
+        return getattr(self.source, "source", self.source) if _is_stack(self.source) else self.source
+
+    def _sync_stack(self) -> None:
+        """Copy a stack's N, spacing and arrangement into the traits."""
+        if not _is_stack(self.source):
+            return
+        self._syncing = True
+        try:
+            self.slices = self.source.slices
+            self.spacing = float(self.source.spacing)
+            self.arrangement = self.source.arrangement
+        finally:
+            self._syncing = False
+
+    def _on_stack_trait(self, change) -> None:
+        if self._syncing:
+            return
+        name = change["name"]
+        with self._pump.lock:
+            try:
+                if not _is_stack(self.source):
+                    raise TypeError(f"`{name}` applies to parallel slices: build the widget with slices=N")
+                setattr(self.source, name, change["new"])
+            except Exception:
+                self._syncing = True
+                try:
+                    setattr(self, name, change["old"])
+                finally:
+                    self._syncing = False
+                raise
+            self._source_version += 1
+            self._sync_stack()
+            self._pump.mark_dirty()
+            self._pump.flush()
+
     def _sync_levels(self) -> None:
         """Copy the source's iso levels (if it has any) into the `levels` trait."""
-        levels = getattr(self.source, "levels", None)
+        levels = getattr(self._level_source, "levels", None)
         if levels is None:
             return
         self._syncing = True
@@ -474,7 +534,7 @@ class Rot4DWidget(widgets.HBox):
         if self._syncing:
             return
         with self._pump.lock:
-            if not hasattr(self.source, "levels"):
+            if not hasattr(self._level_source, "levels"):
                 self._syncing = True
                 try:
                     self.levels = change["old"]
@@ -482,7 +542,7 @@ class Rot4DWidget(widgets.HBox):
                     self._syncing = False
                 raise TypeError(f"{_title(self.source)} has no iso levels: `levels` applies to field sources")
             try:
-                self.source.levels = change["new"]
+                self._level_source.levels = change["new"]
             except Exception:
                 self._syncing = True
                 try:
@@ -614,6 +674,7 @@ class Rot4DWidget(widgets.HBox):
             self._source_version += 1
             changed = True
             self._sync_levels()
+            self._sync_stack()
         else:
             changed = self.state.apply(action, inverted)
         if changed:
@@ -655,7 +716,8 @@ class Rot4DWidget(widgets.HBox):
         same_cut = rows is not None and key[1:4] == rows[1:4] and key[4] == rows[4]
         if shown is not None and _same(key, shown) and (shown is rows or held):
             pass  # the view shows this state (turned rows only while keys are held)
-        elif held and same_cut and (key[5] or not rows[5]) and _leaves_w_alone(key[0], rows[0]):
+        elif (held and same_cut and (key[5] or not rows[5]) and not _is_stack(self.source)
+              and _leaves_w_alone(key[0], rows[0])):  # a stack turns each slice about its own centre
             if scene.turn((np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]):
                 sent = scene.update_id
             self._shown = key
@@ -668,7 +730,7 @@ class Rot4DWidget(widgets.HBox):
                 self._rows_data = self._rows_data.turned(t)
             else:
                 self._rows_data = self._current_slice(coarse)
-            colors = _level_colors(self.source) if self._coarse_ok else None
+            colors = self._group_colors()
             extra = {} if colors is None else {"group_rgb": colors}
             if scene.show(self._rows_data, single_rgb=single, **extra):
                 sent = scene.update_id
@@ -700,16 +762,26 @@ class Rot4DWidget(widgets.HBox):
             ("last", last),
         ]
         rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
-        colors = _level_colors(self.source) if self._coarse_ok else None
-        if colors is not None and self.color_by == "group":  # the legend of the surfaces' colours
+        colors = self._group_colors()
+        if colors is not None and self.color_by == "group":  # the legend: what each colour is
+            if _is_stack(self.source):
+                labels = [f"w {w:.3g}" for w in self.source.levels_at(st.c0)]
+            else:
+                labels = [f"{lv:.4g}" for lv in self.source.levels]
             rows.append(("colours", " ".join(
                 f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
-                f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{lv:.4g}"
-                for lv, rgb in zip(self.source.levels, colors))))
+                f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
+                for t, rgb in zip(labels, colors))))
         volume = getattr(data, "volume", None)
         if volume is not None:
             rows.append(("volume", f"{volume * self._scale ** 3:.4f} as drawn"))
         return ro.readout_html(_title(self.source), rows, gizmo=ro.gizmo_svg(st.matrix))
+
+    def _group_colors(self):
+        """Colours the source asks for (a stack's colours by w, a field's by level), or None."""
+        if _is_stack(self.source):
+            return self.source.group_colors()
+        return _level_colors(self.source) if self._coarse_ok else None
 
     def _report_error(self, exc: BaseException) -> None:
         """Show an exception in the ``errors`` area (and the log); never raises."""
@@ -724,6 +796,11 @@ class Rot4DWidget(widgets.HBox):
 
 
 # ------------------------------------------------------------------ helpers
+def _is_stack(source) -> bool:
+    """True for parallel slices (`rot4d_widget.tomography.StackSource`) without importing it."""
+    return type(source).__name__ == "StackSource" and hasattr(source, "levels_at")
+
+
 def _takes_coarse(source) -> bool:
     """True if ``source.slice`` accepts ``coarse=`` (a cheaper slice while keys repeat)."""
     try:
