@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .fields import _real
+
 __all__ = ["phase_separation", "moving_sphere", "default_cache_dir", "phase_separation_key", "INSTALL_HINT"]
 
 #: What to install when py-pde or xarray is missing.
@@ -61,13 +63,7 @@ def _int(value, name: str, lo: int, hi: int) -> int:
     return v
 
 
-def _float(value, name: str) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
-        raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"Expected `{name}` to be finite, got {v}")
-    return v
+_float = _real  # a finite real number, or a TypeError/ValueError naming it
 
 
 def _params(n, steps, t_end, interface, bias, seed) -> dict:

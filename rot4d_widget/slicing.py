@@ -39,7 +39,6 @@ of a vertex height (the on-H cases) take the single-slice path.
 
 from __future__ import annotations
 
-import math
 import weakref
 from dataclasses import dataclass
 
@@ -312,7 +311,6 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     vertices, edges, polygons and triangles come out in the same order as its single slice.
     """
     G = len(h)
-    C = t.C
     ea, eb = t.ea, t.eb
     cross = pos[:, ea] != pos[:, eb]  # (G, E): with no vertex on H, one end above and one below
     lv, e_idx = _nonzero2(cross)  # level-major: each level's crossing edges in edge order
@@ -375,16 +373,7 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     cz = np.bincount(rank, weights=pz) / counts
     # in-plane axes u, v of every cell's outward normal restricted to H (`_slice`'s formulas),
     # computed once per cell for all levels
-    n = t.cell_normals @ m[:3].T
-    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
-    use_x = nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)
-    uv = np.empty((C, 6))
-    uv[:, 0] = np.where(use_x, 0.0, -nz)
-    uv[:, 1] = np.where(use_x, nz, 0.0)
-    uv[:, 2] = np.where(use_x, -ny, nx)
-    uv[:, 3] = np.where(use_x, -(ny * ny + nz * nz), nx * ny)
-    uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
-    uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
+    uv = _inplane_axes(t.cell_normals @ m[:3].T)
     uvr = np.take(uv, cell_of, axis=0)
     # d . u and d . v with `_slice`'s very expressions (the same rounding, so a corner on the
     # branch cut of the angle lands on the same side of it)
@@ -411,17 +400,10 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     offsets = np.zeros(n_poly + 1, dtype=np.intp)
     np.cumsum(counts, out=offsets[1:])
 
-    # fan triangulation: corners 1..k-2 of each polygon open a triangle
     prank = rank[order]
-    start = offsets[prank]
-    pos_in = np.arange(len(flat)) - start
-    j = ((pos_in >= 1) & (pos_in <= counts[prank] - 2)).nonzero()[0]
-    triangles = np.empty((len(j), 3), dtype=np.intp)
-    triangles[:, 0] = flat[start[j]]
-    triangles[:, 1] = flat[j]
-    triangles[:, 2] = flat[j + 1]
-    t_level = p_level[prank[j]]
-    triangle_cells = _seal(cell_ids[prank[j]])
+    triangles, poly_of = _fan(flat, prank, offsets, counts)
+    t_level = p_level[poly_of]
+    triangle_cells = _seal(cell_ids[poly_of])
 
     # volume by the divergence theorem about each level's vertex centroid
     vsum = np.add.reduceat(vertices, voff[:-1], axis=0)
@@ -455,6 +437,41 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
         ))
     return out
 
+
+
+
+def _fan(flat, prank, offsets, counts):
+    """Fan triangulation of polygons stored back to back: corners 1..k-2 of each open a triangle.
+
+    ``flat`` the corners in order, ``prank`` the polygon of each, ``offsets`` where each
+    polygon starts, ``counts`` its corners.  Returns ((t, 3) corner ids, (t,) polygon of each).
+    """
+    start = offsets[prank]
+    pos_in = np.arange(len(flat)) - start
+    j = ((pos_in >= 1) & (pos_in <= counts[prank] - 2)).nonzero()[0]
+    triangles = np.empty((len(j), 3), dtype=np.intp)
+    triangles[:, 0] = flat[start[j]]
+    triangles[:, 1] = flat[j]
+    triangles[:, 2] = flat[j + 1]
+    return triangles, prank[j]
+
+def _inplane_axes(n):
+    """(k, 3) plane normals -> (k, 6): two in-plane axes u (columns 0-2) and v (3-5) per plane.
+
+    u is n crossed with the coordinate axis least aligned with n, v = n x u; neither is unit
+    (ordering directions by angle needs only a positive-determinant frame).  One formula for
+    the single and the batched slicer, so both round a corner on the angle's branch cut alike.
+    """
+    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
+    use_x = nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)
+    uv = np.empty((len(n), 6))
+    uv[:, 0] = np.where(use_x, 0.0, -nz)
+    uv[:, 1] = np.where(use_x, nz, 0.0)
+    uv[:, 2] = np.where(use_x, -ny, nx)
+    uv[:, 3] = np.where(use_x, -(ny * ny + nz * nz), nx * ny)
+    uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
+    uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
+    return uv
 
 def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> Slice:
     h = x[:, 3] - c0
@@ -554,16 +571,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     centres[:, 1] = np.bincount(rank, weights=pts[:, 1])
     centres[:, 2] = np.bincount(rank, weights=pts[:, 2])
     centres /= counts[:, None]
-    n = normals[ids]
-    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
-    use_x = nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)
-    uv = np.empty((n_poly, 6))
-    uv[:, 0] = np.where(use_x, 0.0, -nz)
-    uv[:, 1] = np.where(use_x, nz, 0.0)
-    uv[:, 2] = np.where(use_x, -ny, nx)
-    uv[:, 3] = np.where(use_x, -(ny * ny + nz * nz), nx * ny)
-    uv[:, 4] = np.where(use_x, nx * ny, -(nx * nx + nz * nz))
-    uv[:, 5] = np.where(use_x, nx * nz, ny * nz)
+    uv = _inplane_axes(normals[ids])
     d = pts - centres[rank]
     uvr = uv[rank]
     ang = np.arctan2(
@@ -582,16 +590,8 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         c_on = np.logical_and.reduceat(on[t.cv_vert], t.c_starts)
         cell_ids[is_face] = np.where(c_on[fc[:, 1]] & ~c_on[fc[:, 0]], fc[:, 1], fc[:, 0])
 
-    # fan triangulation: corners 1..k-2 of each polygon open a triangle
-    prank = rank[order]
-    start = offsets[prank]
-    pos_in = np.arange(len(flat)) - start
-    j = ((pos_in >= 1) & (pos_in <= counts[prank] - 2)).nonzero()[0]
-    triangles = np.empty((len(j), 3), dtype=np.intp)
-    triangles[:, 0] = flat[start[j]]
-    triangles[:, 1] = flat[j]
-    triangles[:, 2] = flat[j + 1]
-    triangle_cells = cell_ids[prank[j]]
+    triangles, poly_of = _fan(flat, rank[order], offsets, counts)
+    triangle_cells = cell_ids[poly_of]
 
     # volume by the divergence theorem, about the vertex centroid (keeps slivers exact)
     tri = (vertices - centre)[triangles]

@@ -490,70 +490,52 @@ class Rot4DWidget(widgets.HBox):
         """Copy a stack's N, spacing and arrangement into the traits."""
         if not _is_stack(self.source):
             return
+        self._set_quietly("slices", self.source.slices)
+        self._set_quietly("spacing", float(self.source.spacing))
+        self._set_quietly("arrangement", self.source.arrangement)
+
+    def _set_quietly(self, name, value) -> None:
+        """Set a trait without acting on it (the widget copying its own state)."""
         self._syncing = True
         try:
-            self.slices = self.source.slices
-            self.spacing = float(self.source.spacing)
-            self.arrangement = self.source.arrangement
+            setattr(self, name, value)
         finally:
             self._syncing = False
 
-    def _on_stack_trait(self, change) -> None:
+    def _source_setting(self, change, target, why_not: str) -> None:
+        """A trait that is a setting of (part of) the source: set it on ``target`` and redraw,
+        or, if ``target`` is None or refuses the value, put the trait back and raise."""
         if self._syncing:
             return
-        name = change["name"]
         with self._pump.lock:
             try:
-                if not _is_stack(self.source):
-                    raise TypeError(f"`{name}` applies to parallel slices: build the widget with slices=N")
-                setattr(self.source, name, change["new"])
+                if target is None:
+                    raise TypeError(why_not)
+                setattr(target, change["name"], change["new"])
             except Exception:
-                self._syncing = True
-                try:
-                    setattr(self, name, change["old"])
-                finally:
-                    self._syncing = False
+                self._set_quietly(change["name"], change["old"])
                 raise
             self._source_version += 1
+            self._sync_levels()
             self._sync_stack()
             self._pump.mark_dirty()
             self._pump.flush()
+
+    def _on_stack_trait(self, change) -> None:
+        self._source_setting(change, self.source if _is_stack(self.source) else None,
+                             f"`{change['name']}` applies to parallel slices: build the widget with slices=N")
 
     def _sync_levels(self) -> None:
         """Copy the source's iso levels (if it has any) into the `levels` trait."""
         levels = getattr(self._level_source, "levels", None)
         if levels is None:
             return
-        self._syncing = True
-        try:
-            self.levels = tuple(float(v) for v in levels)
-        finally:
-            self._syncing = False
+        self._set_quietly("levels", tuple(float(v) for v in levels))
 
     def _on_levels(self, change) -> None:
-        if self._syncing:
-            return
-        with self._pump.lock:
-            if not hasattr(self._level_source, "levels"):
-                self._syncing = True
-                try:
-                    self.levels = change["old"]
-                finally:
-                    self._syncing = False
-                raise TypeError(f"{_title(self.source)} has no iso levels: `levels` applies to field sources")
-            try:
-                self._level_source.levels = change["new"]
-            except Exception:
-                self._syncing = True
-                try:
-                    self.levels = change["old"]
-                finally:
-                    self._syncing = False
-                raise
-            self._source_version += 1
-            self._sync_levels()
-            self._pump.mark_dirty()
-            self._pump.flush()
+        src = self._level_source
+        self._source_setting(change, src if hasattr(src, "levels") else None,
+                             f"{_title(self.source)} has no iso levels: `levels` applies to field sources")
 
     def _on_state_trait(self, change) -> None:
         if self._syncing:
