@@ -433,12 +433,13 @@ class Field4D:
     levels : float or sequence of floats, optional
         Iso levels (default: one, midway between the min and max of `coarse`).
     chunk_cache_bytes : int
-        Recently read chunks of a chunked array kept in memory (default 256 MiB).
+        Recently read chunks of a chunked array kept in memory (default 128 MiB: with the
+        rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
     """
 
     def __init__(self, values, *, axes: str = "xyzw", extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, resolution: int = 64, coarse_resolution=None,
-                 levels=None, chunk_cache_bytes: int = 256 * 1024**2, _coords=None, _function=None):
+                 levels=None, chunk_cache_bytes: int = 128 * 1024**2, _coords=None, _function=None):
         self._function = _function
         if _function is None:
             for attr in ("shape", "ndim", "__getitem__"):
@@ -1034,8 +1035,15 @@ def _sample(field, m, c0, res) -> _Samples | None:
             centre[a] = (field.shape[j] - 1) / 2
             inv_s[a] = 1.0 / (sc[j] * _face_norms(m)[j])
         halfn = np.where(_face_norms(m)[list(_AXES.index(c) for c in field.axes)] > _PARALLEL, centre, 1e300)
-        arr, start = _block(field, m, c0, box)
-        s.f, s.g = _resample_affine(arr, base - start, step, n, centre - start, halfn, inv_s)
+        if field._kind == "numpy":
+            s.f, s.g = _resample_affine(field._values, base, step, n, centre, halfn, inv_s)
+            return s
+        # chunked or lazy: the same numbers, each touched chunk read once (memory stays bounded)
+        ijk = np.indices(tuple(int(v) for v in n), dtype=np.float64).reshape(3, -1).T
+        x = base[None, :] + ijk @ step  # (N, 4) index coordinates, array axis order
+        g = ((halfn[None, :] - np.abs(x - centre[None, :])) * inv_s[None, :]).min(axis=1)
+        s.f = _chunked_values(field, x, g >= 0.0).reshape(tuple(n))
+        s.g = g.reshape(tuple(n))
         return s
     # uneven coordinates: points -> fractional indices by np.interp, then the points kernel
     axes = [origin[a] + d * np.arange(n[a]) for a in range(3)]
@@ -1046,55 +1054,59 @@ def _sample(field, m, c0, res) -> _Samples | None:
     for j in range(4):
         a = field._axis_of[j]
         idx[:, a] = np.interp(q[j], _geometric_nodes(field, j), np.arange(field.shape[j], dtype=np.float64))
-    arr, start = _block(field, m, c0, box)
-    f = _resample_points(arr, idx - start, g >= 0)
+    if field._kind == "numpy":
+        f = _resample_points(field._values, idx, g >= 0)
+    else:
+        f = _chunked_values(field, idx, g >= 0)
     s.f, s.g = f.reshape(tuple(n)), g.reshape(tuple(n))
     return s
 
 
-def _block(field, m, c0, box):
-    """(array, start): the data, or for chunked/lazy arrays a buffer holding every chunk the
-    hyperplane comes within one sample of, with the index of its first element."""
-    if field._kind == "numpy":
-        return field._values, np.zeros(4)
+#: Points interpolated per pass of `_chunked_values` (its tables take ~2 KB per point).
+CHUNKED_POINTS = 16384
+#: Chunks read per call of the reader (one dask.compute: a distributed Client reads them in parallel).
+CHUNK_BATCH = 32
+_CORNERS = np.array([(a, b, c, d) for a in (0, 1) for b in (0, 1) for c in (0, 1) for d in (0, 1)], dtype=np.int64)
+
+
+def _chunked_values(field, x, inside):
+    """Quadrilinear values of a chunked or lazy array at index points ``x`` (N, 4), where ``inside``.
+
+    The same numbers as the kernels (clamped into the array, the last cell closed), but the
+    array is never assembled: the 16 corners of every point's cell are grouped by the chunk
+    they lie in and each chunk is read once per pass (through the field's chunk reader and its
+    cache), ``CHUNK_BATCH`` at a time.  Memory: one pass's corner tables (``CHUNKED_POINTS``
+    points) plus a batch of chunks, whatever the array's size.  0 outside.
+    """
     if field._reader is None:
         field._reader = _ChunkReader(field._values, field.chunk_cache_bytes)
     rd = field._reader
-    # hyperplane sum_j m[3, j] q_j = c0 against each chunk's slice-space box, grown by one sample
-    proj_c, proj_r = [], []
-    for a in range(4):
-        j = _AXES.index(field.axes[a])  # the data axis of array axis a
-        nodes = _geometric_nodes(field, j)
-        b = rd.bounds[a]
-        lo_q = nodes[np.maximum(b[:-1] - 1, 0)]
-        hi_q = nodes[np.minimum(b[1:], len(nodes) - 1)]
-        ctr, rad = (lo_q + hi_q) / 2, (hi_q - lo_q) / 2
-        proj_c.append(m[3, j] * ctr)
-        proj_r.append(abs(m[3, j]) * rad)
-    P = proj_c[0][:, None, None, None] + proj_c[1][None, :, None, None] + proj_c[2][None, None, :, None] \
-        + proj_c[3][None, None, None, :]
-    R = proj_r[0][:, None, None, None] + proj_r[1][None, :, None, None] + proj_r[2][None, None, :, None] \
-        + proj_r[3][None, None, None, :]
-    need = np.abs(P - c0) <= R * (1 + 1e-9) + 1e-12
-    wanted = [tuple(int(i) for i in idx) for idx in np.argwhere(need)]
-    if not wanted:  # cannot happen when the box is cut; keep the kernel's reads in bounds anyway
-        wanted = [(0, 0, 0, 0)]
-    ids = np.array(wanted)
-    cmin, cmax = ids.min(axis=0), ids.max(axis=0)
-    start = np.array([rd.bounds[a][cmin[a]] for a in range(4)], dtype=np.int64)
-    stop = np.array([rd.bounds[a][cmax[a] + 1] for a in range(4)], dtype=np.int64)
-    # at least two samples along each axis for the kernel's clamped cells
-    for a in range(4):
-        if stop[a] - start[a] < 2:
-            start[a] = max(0, stop[a] - 2)
-            stop[a] = start[a] + 2
-    buf = np.zeros(tuple(stop - start), dtype=rd.dtype)  # pages never written are never committed
-    got = rd.read(wanted)
-    for idx, chunk in got.items():
-        sl = tuple(slice(int(rd.bounds[a][idx[a]] - start[a]), int(rd.bounds[a][idx[a] + 1] - start[a]))
-                   for a in range(4))
-        buf[sl] = chunk
-    return buf, start.astype(np.float64)
+    shape = np.array(rd.shape, dtype=np.int64)
+    nch = tuple(len(b) - 1 for b in rd.bounds)
+    out = np.zeros(len(x), dtype=np.float64)
+    todo = np.flatnonzero(inside)
+    for p0 in range(0, len(todo), CHUNKED_POINTS):
+        rows = todo[p0:p0 + CHUNKED_POINTS]
+        xc = np.clip(x[rows], 0.0, (shape - 1).astype(np.float64))
+        i0 = np.minimum(xc.astype(np.int64), shape - 2)
+        t = xc - i0
+        corner = (i0[:, None, :] + _CORNERS[None]).reshape(-1, 4)  # (16 M, 4)
+        weight = np.prod(np.where(_CORNERS[None] == 1, t[:, None, :], 1.0 - t[:, None, :]), axis=2).ravel()
+        cid = np.stack([np.searchsorted(rd.bounds[a], corner[:, a], side="right") - 1 for a in range(4)], axis=1)
+        key = np.ravel_multi_index(tuple(cid.T), nch)
+        order = np.argsort(key, kind="stable")
+        keys, first = np.unique(key[order], return_index=True)
+        last = np.r_[first[1:], len(order)]
+        vals = np.empty(len(key), dtype=np.float64)
+        for b0 in range(0, len(keys), CHUNK_BATCH):
+            ids = [tuple(int(v) for v in np.unravel_index(k, nch)) for k in keys[b0:b0 + CHUNK_BATCH]]
+            got = rd.read(ids)
+            for idx, lo, hi in zip(ids, first[b0:b0 + CHUNK_BATCH], last[b0:b0 + CHUNK_BATCH]):
+                sel = order[lo:hi]
+                local = corner[sel] - np.array([rd.bounds[a][idx[a]] for a in range(4)], dtype=np.int64)
+                vals[sel] = got[idx][local[:, 0], local[:, 1], local[:, 2], local[:, 3]]
+        out[rows] = (vals * weight).reshape(-1, 16).sum(axis=1)
+    return out
 
 
 def _surface(s: _Samples, level: float) -> FieldSlice:

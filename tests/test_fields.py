@@ -533,3 +533,31 @@ def test_bad_xarray_input_is_named():
                                                                         dtype="datetime64[ns]")})
     f = Field4D.from_xarray(named)
     assert (f.name, f.units, f.w_units, f.extent[3]) == ("T", "K", "s", (0.0, 3 * 86400.0))
+
+
+def test_a_chunked_full_step_never_assembles_the_array(tmp_path):
+    """A full step on a zarr array reads chunks into small tables, never a block of the whole cut:
+    the memory it allocates (tracemalloc sees numpy's buffers) stays far below the array's size."""
+    zarr = pytest.importorskip("zarr")
+    import tracemalloc
+
+    n = 80  # 164 MB of float32
+    z = zarr.create_array(store=str(tmp_path / "big.zarr"), shape=(n,) * 4, chunks=(16,) * 4, dtype="float32")
+    g = np.linspace(-1.0, 1.0, n, dtype=np.float32)
+    for i in range(0, n, 16):
+        gi = g[i:i + 16]
+        z[i:i + 16] = 0.5 - (gi[:, None, None, None] ** 2 + g[None, :, None, None] ** 2
+                             + g[None, None, :, None] ** 2 + g[None, None, None, :] ** 2)
+    f = Field4D(z, extent=[(-1.0, 1.0)] * 4, levels=[0.0], chunk_cache_bytes=1 << 22, resolution=40)
+    m = random_rotation(np.random.default_rng(5))
+    f.slice(m, 0.1, coarse=True)  # the coarse copy is built first (it reads every chunk once)
+    tracemalloc.start()
+    try:
+        full = f.slice(m, 0.1)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    r = math.sqrt(0.5 - 0.1**2)
+    assert full.volume == pytest.approx(4 / 3 * math.pi * r**3, rel=0.03)
+    nbytes = n**4 * 4
+    assert peak < 0.4 * nbytes, f"a full step allocated {peak / 2**20:.0f} MiB for a {nbytes / 2**20:.0f} MiB array"
