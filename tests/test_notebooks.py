@@ -34,6 +34,7 @@ PROJECT_NOTEBOOKS = [
     "02_regular_polychora.ipynb",
     "03_paper_figures.ipynb",
     "04_time_varying_field.ipynb",
+    "05_tomography.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
