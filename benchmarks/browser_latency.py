@@ -158,6 +158,11 @@ FIELD_CASES = {
         " axes='wxyz', extent=[(-1.0, 1.0)] * 4, levels=[0.3])"
     ),
 }
+# notebook 04's data: the Allen-Cahn simulation (py-pde; cached after its first run)
+FIELD_CASES["allen-cahn"] = (
+    "from rot4d_widget import Field4D\nfrom rot4d_widget.datasets import phase_separation\n"
+    "field = Field4D.from_xarray(phase_separation(), w='time', levels=[0.0])"
+)
 ALL_CASES = POLYCHORA + list(FIELD_CASES)
 LARGE = {"600-cell", "120-cell", *FIELD_CASES}
 FRAME_MS = 1000.0 / 60.0
@@ -1286,7 +1291,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--presses", type=int, default=40, help="single presses per canvas per notebook (default 40)")
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
-    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six) or fields (sphere64, waves128)")
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six) or fields (sphere64, waves128, allen-cahn)")
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
                          "(default 60-120, a human tap; 0 = Playwright's instant press)")

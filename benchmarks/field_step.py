@@ -3,6 +3,8 @@
 Two fields (float32, in memory):
 
 * ``sphere 64^4``: f = R^2 - |q|^2 on a 64^4 grid over [-1, 1]^4, R = 0.8, level 0;
+* ``Allen-Cahn 32^3x36``: notebook 04's simulation (`rot4d_widget.datasets.phase_separation`),
+  c[t, x, y, z] from py-pde, level 0;
 * ``blob 128^3x32``: a Gaussian blob travelling along x as t grows plus a smooth
   random field, f[x, y, z, t] with the default extent (w = sample index, cubic voxels).
 
@@ -63,6 +65,13 @@ def blob_field(n: int = 128, nt: int = 32, seed: int = 0) -> Field4D:
     f = Field4D(a, name="blob")
     f.levels = 0.5
     return f
+
+
+def simulation_field() -> Field4D:
+    """Notebook 04's data: py-pde's Allen-Cahn coarsening, c[t, x, y, z] (cached after the first run)."""
+    from rot4d_widget.datasets import phase_separation
+
+    return Field4D.from_xarray(phase_separation(), w="time", levels=[0.0])
 
 
 def best(fn, repeats: int):
@@ -131,7 +140,8 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--resolution", type=int, default=64)
     args = ap.parse_args()
-    fields = [("sphere 64^4", sphere_field()), ("blob 128^3x32", blob_field())]
+    fields = [("sphere 64^4", sphere_field()), ("blob 128^3x32", blob_field()),
+              ("Allen-Cahn 32^3x36 (notebook 04)", simulation_field())]
     # compile (or load) the kernels outside the timing
     fields[0][1].slice(np.eye(4), 0.0)
     print(f"numba threads: {numba.get_num_threads()}, parallel kernel from {PARALLEL_MIN_POINTS} points\n")

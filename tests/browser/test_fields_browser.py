@@ -1,4 +1,4 @@
-"""A 4-D field in the page (issue 9): the simulated phase separation of notebook 04 in the widget.
+"""A 4-D field in the page (issue 9): notebook 04, run whole in JupyterLab, and its widget.
 
 The surface is drawn (pixels of the level's colour inside the canvas); a held ``4`` (time into
 x) changes the picture while held, with coarse slices; after the release the view settles on a
@@ -15,29 +15,27 @@ import time
 import numpy as np
 import pytest
 
-from jupyter_page import JupyterPage, write_notebook
+from jupyter_page import JupyterPage
 from rot4d_widget import look, simple_rotation
 from test_widget_browser import TAP_KEYS, _bad_console, _canvas, _hover, _state, _timing_bound
 
 #: Screenshots to look at (not test artifacts: the issue asks for them here).
 SHOTS = pathlib.Path("/tmp/shots04")
 
-# The field of notebook 04, built the same way (the simulation is read from the cache after the
-# first run), and every call of the field's slice recorded with its coarse flag.
-FIELD_CELL = """\
-from rot4d_widget import Rot4DWidget
-from rot4d_widget.datasets import phase_separation
-from rot4d_widget.fields import Field4D
-da = phase_separation()
-field = Field4D.from_xarray(da, w="time", levels=[0.0])
-w = Rot4DWidget(field, levels=[0.0])
+NOTEBOOK_04 = pathlib.Path(__file__).resolve().parents[2] / "notebooks" / "04_time_varying_field.ipynb"
+
+# Appended to a copy of notebook 04 (which the page runs whole): back to the w = c0 snapshot at the
+# default step, and every call of the field's slice recorded with its coarse flag.
+TAIL_CELL = """\
+w.press("r")
+w.theta0 = math.pi / 64
 calls = []
 _slice = field.slice
 def _counted(matrix, c0, coarse=False):
     calls.append(bool(coarse))
     return _slice(matrix, c0, coarse=coarse)
-field.slice = _counted
-w"""
+field.slice = _counted"""
+
 
 #: Pixels whose colour is the level's hue: the single level is drawn in viridis(0.75), a green
 #: (r, g, b) ~ (0.48, 0.82, 0.32), shaded; the background is white and the box's bars grey.
@@ -73,9 +71,13 @@ def test_phase_separation_field_held_key_then_full_resolution(jupyter_server, pa
     if jupyter_server.kind == "notebook":
         pytest.skip("JupyterLab only: the page side of fields is the same in Notebook 7 (one field case is enough)")
     SHOTS.mkdir(exist_ok=True)
-    write_notebook(jupyter_server.root / "field.ipynb", [FIELD_CELL])
-    jp = JupyterPage(page, jupyter_server, "field.ipynb").open()
-    jp.run_all(timeout=300)  # a first run simulates (a few seconds) and compiles numba kernels
+    import nbformat
+
+    nb = nbformat.read(NOTEBOOK_04, as_version=4)
+    nb.cells.append(nbformat.v4.new_code_cell(TAIL_CELL))
+    nbformat.write(nb, jupyter_server.root / "04_field.ipynb")
+    jp = JupyterPage(page, jupyter_server, "04_field.ipynb").open()
+    jp.run_all(timeout=300)  # notebook 04 whole: a first run simulates (a few seconds) and compiles numba kernels
     sel = _canvas(jp)
 
     # 1. the isosurface is drawn: many pixels of the level's colour, inside the canvas
