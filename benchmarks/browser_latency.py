@@ -163,8 +163,14 @@ FIELD_CASES["allen-cahn"] = (
     "from rot4d_widget import Field4D\nfrom rot4d_widget.datasets import phase_separation\n"
     "field = Field4D.from_xarray(phase_separation(), w='time', levels=[0.0])"
 )
-ALL_CASES = POLYCHORA + list(FIELD_CASES)
-LARGE = {"600-cell", "120-cell", *FIELD_CASES}
+#: Parallel slices (issue 10): the widget's arguments.
+STACK_CASES = {
+    "oval24": "'24-cell', slices=12, spacing=0.3, arrangement='oval'",
+    "oval600": "'600-cell', slices=12, spacing=0.3, arrangement='oval'",
+}
+ALL_CASES = POLYCHORA + list(FIELD_CASES) + list(STACK_CASES)
+LARGE = {"600-cell", "120-cell", *FIELD_CASES, *STACK_CASES}
+
 FRAME_MS = 1000.0 / 60.0
 PRESS_KEYS = ["2", "3", "4", "6", "8", "c", "y", "z", "w"]
 HOLD_KEY = "4"
@@ -514,6 +520,8 @@ def ws_on(page):
 def run_case(context, server, case: str, args, rng: random.Random, hold_baseline: bool) -> dict:
     name = f"bench_{case.replace('-', '_')}.ipynb"
     cells = [c.format(name=case) for c in CELLS]
+    if case in STACK_CASES:
+        cells[1] = f"from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({STACK_CASES[case]}))\nw"
     if case in FIELD_CASES:
         cells[1] = (f"{FIELD_CASES[case]}\nfrom rot4d_widget import Rot4DWidget\n"
                     "w = bench.probe(Rot4DWidget(field))\nw")
@@ -1291,7 +1299,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--presses", type=int, default=40, help="single presses per canvas per notebook (default 40)")
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
-    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six) or fields (sphere64, waves128, allen-cahn)")
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six), fields (sphere64, waves128, allen-cahn) or "
+                         "parallel slices (oval24, oval600)")
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
                          "(default 60-120, a human tap; 0 = Playwright's instant press)")
