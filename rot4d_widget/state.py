@@ -14,16 +14,28 @@ Defaults (documented in the README):
   polytope's circumradius).
 * "+"/"-" multiply/divide theta0 by ``THETA0_FACTOR`` (sqrt 2), keeping alpha/theta0;
   theta0 stays within (0, pi].
+
+``to_dict()`` / ``from_dict(d)`` turn a state into JSON-able data and back, exactly (floats
+are written with Python's shortest round-tripping repr): the orientation, theta0, alpha, c0,
+the c0 step and the key bindings.  A state read with ``from_dict`` is also where ``reset()``
+goes back to.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Mapping
 
 import numpy as np
 
 from .keymap import DEFAULT_KEYMAP, Action, Keymap
-from .rotation import as_rotation_matrix, double_rotation, reorthonormalize, simple_rotation
+from .rotation import (
+    ORTHOGONALITY_TOLERANCE,
+    as_rotation_matrix,
+    double_rotation,
+    reorthonormalize,
+    simple_rotation,
+)
 
 __all__ = [
     "RotationState",
@@ -32,7 +44,18 @@ __all__ = [
     "ALPHA_STEP_FRACTION",
     "DEFAULT_C0_STEP",
     "THETA0_FACTOR",
+    "STATE_FORMAT",
+    "action_to_data",
+    "action_from_data",
+    "keymap_to_dict",
+    "keymap_from_dict",
 ]
+
+#: The version of `RotationState.to_dict`'s layout (``d["format"]``).
+STATE_FORMAT = 1
+#: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
+#: further off, up to `ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
+_EXACT_ENOUGH = 1e-14
 
 DEFAULT_THETA0 = math.pi / 64
 PAPER_ALPHA_RATIO = math.pi * math.sqrt(2.0) / (8.0 * math.sqrt(3.0))
@@ -215,13 +238,180 @@ class RotationState:
         return self.apply(*found)
 
     def reset(self) -> None:
-        """Back to the state as constructed (orientation, theta0, alpha, c0)."""
+        """Back to the initial state (orientation, theta0, alpha, c0): the state as constructed,
+        as read by `from_dict` / `restore`, or as marked by `set_initial`."""
         self._theta0, self._alpha, self._c0, m = self._initial
         self._matrix = _read_only(m.copy())  # a new object, like every step
         self._steps.clear()
+
+    def set_initial(self) -> None:
+        """Make the current orientation, theta0, alpha and c0 what `reset` returns to."""
+        self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
+
+    # -- to and from JSON-able data -------------------------------------------
+    def to_dict(self, *, initial: bool = False) -> dict:
+        """The state as JSON-able data (lists, floats, strings); `from_dict` reads it back exactly.
+
+        ``{"format": 1, "orientation": 4 x 4 list (rows), "theta0", "alpha", "c0", "c0_step",
+        "keymap": {key: action}}``; an action is its name as `Action.parse` reads it
+        (``"xw"``, ``"xz,yw"``, ``"c0+"`` ...) or, for a source's own action, a dict of the
+        `Action` fields.  ``initial=True`` adds ``"initial"``: the state `reset` returns to
+        (orientation, theta0, alpha, c0) -- recordings keep it so that a recorded reset replays
+        the same; state files leave it out, so the state they hold becomes the reset point.
+        """
+        d = {
+            "format": STATE_FORMAT,
+            "orientation": np.asarray(self._matrix).tolist(),
+            "theta0": self._theta0,
+            "alpha": self._alpha,
+            "c0": self._c0,
+            "c0_step": self._c0_step,
+            "keymap": keymap_to_dict(self.keymap),
+        }
+        if initial:
+            t, a, c, m = self._initial
+            d["initial"] = {"orientation": np.asarray(m).tolist(), "theta0": t, "alpha": a, "c0": c}
+        return d
+
+    @classmethod
+    def from_dict(cls, d, *, keymap: Keymap | None = None) -> "RotationState":
+        """A state from `to_dict`'s data (a dict, e.g. read from JSON).
+
+        The orientation is validated: within 1e-6 of orthogonal (max |M M^T - I|) it is
+        re-orthonormalised (`rotation.reorthonormalize`, repeated until orthogonal to
+        rounding), further off -- or a reflection, or not 4 x 4 -- ``ValueError`` says how far
+        it is.  Missing fields take their defaults (the default keymap, ``c0_step`` 0.02);
+        unknown fields, or a newer ``format``, are refused.  ``keymap`` replaces the stored
+        bindings.  The state read is what `reset` returns to (unless ``d`` has ``"initial"``).
+        """
+        if not isinstance(d, Mapping):
+            raise TypeError(f"Expected a dict from RotationState.to_dict, got {type(d).__name__}")
+        unknown = sorted(set(d) - _DICT_KEYS)
+        if unknown:
+            raise ValueError(f"Unknown state field(s) {', '.join(map(repr, unknown))}; expected some of "
+                             f"{', '.join(sorted(_DICT_KEYS))}")
+        fmt = d.get("format", STATE_FORMAT)
+        if isinstance(fmt, bool) or not isinstance(fmt, int) or not 1 <= fmt <= STATE_FORMAT:
+            raise ValueError(f"Unsupported state format {fmt!r}; this version reads format 1 ... {STATE_FORMAT}")
+        if "orientation" not in d:
+            raise ValueError("A state needs its 'orientation' (a 4 x 4 list of rows)")
+        if keymap is None:
+            keymap = keymap_from_dict(d["keymap"]) if "keymap" in d else DEFAULT_KEYMAP
+        kwargs = {k: d[k] for k in ("theta0", "alpha", "c0", "c0_step") if k in d}
+        state = cls(keymap=keymap, matrix=_loaded_rotation(d["orientation"], "orientation"), **kwargs)
+        if "initial" in d:
+            init = d["initial"]
+            if not isinstance(init, Mapping) or set(init) != {"orientation", "theta0", "alpha", "c0"}:
+                raise ValueError("Expected 'initial' to hold 'orientation', 'theta0', 'alpha' and 'c0'")
+            state._initial = (_theta0(init["theta0"]), _finite("initial alpha", init["alpha"]),
+                              _finite("initial c0", init["c0"]),
+                              _read_only(_loaded_rotation(init["orientation"], "initial orientation")))
+        return state
+
+    def restore(self, d) -> None:
+        """Set this state (in place) from `to_dict`'s data, as `from_dict` reads it; it becomes
+        what `reset` returns to.  The keymap is kept unless ``d`` has one."""
+        other = type(self).from_dict(d, keymap=None if "keymap" in d else self.keymap)
+        self.keymap = other.keymap
+        self._theta0, self._alpha, self._c0, self._c0_step = other._theta0, other._alpha, other._c0, other._c0_step
+        self._matrix = other._matrix
+        self._initial = other._initial
+        self._steps.clear()
+
+    def copy(self) -> "RotationState":
+        """An independent state with the same values, keymap and reset point."""
+        return type(self).from_dict(self.to_dict(initial=True), keymap=self.keymap)
 
     def __repr__(self) -> str:
         return (
             f"RotationState(theta0={self._theta0:.6g}, alpha={self._alpha:.6g}, "
             f"beta={self.beta:.6g}, c0={self._c0:.6g})"
         )
+
+
+# ----------------------------------------------------------------------------- data helpers
+_DICT_KEYS = frozenset({"format", "orientation", "theta0", "alpha", "c0", "c0_step", "keymap", "initial"})
+_ACTION_FIELDS = ("kind", "planes", "sign", "name", "text")
+
+
+def _loaded_rotation(value, name: str) -> np.ndarray:
+    """A stored orientation: exact if orthogonal to rounding, re-orthonormalised within 1e-6, else refused."""
+    try:
+        m = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"Expected `{name}` to be a 4 x 4 list of numbers") from None
+    if m.shape != (4, 4):
+        raise ValueError(f"Expected `{name}` to have shape (4, 4), got {m.shape}")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"Expected `{name}` to be finite, got non-finite entries")
+    err = float(np.abs(m @ m.T - np.eye(4)).max())
+    if err > ORTHOGONALITY_TOLERANCE:
+        raise ValueError(
+            f"`{name}` is not a rotation: |M M^T - I| = {err:.3g} > {ORTHOGONALITY_TOLERANCE:g} "
+            "(only a matrix within that of orthogonal is re-orthonormalised)"
+        )
+    for _ in range(4):  # Newton-Schulz squares the error: 1e-6 -> 1e-12 -> rounding
+        if err <= _EXACT_ENOUGH:
+            break
+        m = reorthonormalize(m)
+        err = float(np.abs(m @ m.T - np.eye(4)).max())
+    return as_rotation_matrix(m, name)  # det +1, fresh copy
+
+
+def action_to_data(action: Action):
+    """An `Action` as JSON-able data: its `Action.parse` name when that gives it back, else a dict."""
+    if not isinstance(action, Action):
+        raise TypeError(f"Expected a rot4d_widget.Action, got {type(action).__name__}")
+    if action.kind == "rotate":
+        spec = action.planes
+    elif action.kind == "custom":
+        spec = None
+    else:
+        spec = _spec_name(action)
+    if spec is not None:
+        try:
+            if Action.parse(spec) == action:
+                return spec
+        except ValueError:
+            pass
+    return {f: getattr(action, f) for f in _ACTION_FIELDS}
+
+
+def _spec_name(action: Action):
+    from .keymap import ACTION_NAMES
+
+    for name in ACTION_NAMES:
+        if Action.parse(name) == action:
+            return name
+    return None
+
+
+def action_from_data(data) -> Action:
+    """`action_to_data`'s output back to the `Action`; ValueError names what is wrong."""
+    if isinstance(data, str):
+        return Action.parse(data)
+    if isinstance(data, Mapping):
+        unknown = sorted(set(data) - set(_ACTION_FIELDS))
+        if unknown or "kind" not in data:
+            raise ValueError(f"Expected an action dict with 'kind' and some of {', '.join(_ACTION_FIELDS)}, got {dict(data)!r}")
+        sign = data.get("sign", 0)
+        if isinstance(sign, bool) or not isinstance(sign, int):
+            raise ValueError(f"Expected an action's 'sign' to be an int, got {sign!r}")
+        for f in ("kind", "planes", "name", "text"):
+            if not isinstance(data.get(f, ""), str):
+                raise ValueError(f"Expected an action's {f!r} to be a string, got {data[f]!r}")
+        return Action(data["kind"], planes=data.get("planes", ""), sign=sign, name=data.get("name", ""),
+                      text=data.get("text", ""))
+    raise ValueError(f"Expected an action name such as 'xw' or an action dict, got {data!r}")
+
+
+def keymap_to_dict(keymap: Keymap) -> dict:
+    """``{key: action data}`` in binding order (`action_to_data`)."""
+    return {k: action_to_data(a) for k, a in keymap.items()}
+
+
+def keymap_from_dict(d) -> Keymap:
+    """`keymap_to_dict`'s output back to a `Keymap` (same bindings, same order)."""
+    if not isinstance(d, Mapping):
+        raise ValueError(f"Expected 'keymap' to be a dict of key -> action, got {type(d).__name__}")
+    return Keymap({k: action_from_data(v) for k, v in d.items()})

@@ -292,3 +292,103 @@ def test_custom_actions_change_nothing_in_the_core():
     before = st.matrix
     assert st.apply(Action("custom", name="phase+", sign=1, text="advance the phase")) is False
     assert st.matrix is before
+
+
+# ----------------------------------------------------------------- to_dict / from_dict (issue 12)
+def _walked_state():
+    from rot4d_widget import Action
+    from rot4d_widget.rotation import random_rotation
+
+    st = RotationState(0.13, alpha=0.05, c0=0.1, c0_step=0.03, matrix=random_rotation(7))
+    st.keymap = st.keymap.extended({"o": Action("custom", name="level up", sign=1, text="raise the level")})
+    for key in "4zZkkl8+wh":
+        st.press(key)
+    return st
+
+
+def test_to_dict_round_trips_exactly_through_json():
+    import json
+
+    st = _walked_state()
+    d = json.loads(json.dumps(st.to_dict()))
+    back = RotationState.from_dict(d)
+    assert np.array_equal(back.matrix, st.matrix)  # bit for bit
+    assert (back.theta0, back.alpha, back.c0, back.c0_step) == (st.theta0, st.alpha, st.c0, st.c0_step)
+    assert list(back.keymap.items()) == list(st.keymap.items())  # same bindings, same order
+    assert back.keymap["o"].kind == "custom" and back.keymap["o"].text == "raise the level"
+    assert d["keymap"]["4"] == "xw" and d["keymap"]["l"] == "c0+" and d["format"] == 1
+    # the loaded state steps like the original
+    st.press("y"), back.press("y")
+    assert np.array_equal(back.matrix, st.matrix)
+
+
+def test_a_loaded_state_is_where_reset_returns():
+    st = _walked_state()
+    back = RotationState.from_dict(st.to_dict())
+    back.press("4"), back.press("l"), back.press("k")
+    back.reset()
+    assert np.array_equal(back.matrix, st.matrix)
+    assert (back.theta0, back.alpha, back.c0) == (st.theta0, st.alpha, st.c0)
+    # restore() does the same in place, keeping the object
+    fresh = RotationState()
+    fresh.restore(st.to_dict())
+    fresh.press("3")
+    fresh.reset()
+    assert np.array_equal(fresh.matrix, st.matrix) and fresh.c0 == st.c0
+    # initial=True keeps the original reset point instead (recordings)
+    keep = RotationState.from_dict(st.to_dict(initial=True))
+    keep.reset()
+    assert not np.allclose(keep.matrix, st.matrix)
+    st.reset()
+    assert np.array_equal(keep.matrix, st.matrix)
+
+
+def test_from_dict_reorthonormalises_a_nearly_orthogonal_orientation():
+    from rot4d_widget.rotation import random_rotation
+
+    m = random_rotation(5)
+    d = RotationState(matrix=m).to_dict()
+    noisy = m + 4e-7 * np.random.default_rng(0).standard_normal((4, 4)) / 4
+    err = np.abs(noisy @ noisy.T - np.eye(4)).max()
+    assert 1e-9 < err <= 1e-6
+    d["orientation"] = noisy.tolist()
+    got = RotationState.from_dict(d).matrix
+    assert np.abs(got @ got.T - np.eye(4)).max() < 1e-14
+    assert np.abs(got - m).max() < 1e-6
+
+
+@pytest.mark.parametrize("orientation, match", [
+    ((np.eye(4) + 1e-5 * np.arange(16).reshape(4, 4) / 16).tolist(), r"not a rotation: \|M M\^T - I\| = "),
+    (np.diag([1.0, 1.0, 1.0, -1.0]).tolist(), "reflection"),
+    (np.eye(3).tolist(), r"shape \(4, 4\)"),
+    ("identity", "4 x 4 list"),
+])
+def test_from_dict_refuses_what_is_not_a_rotation(orientation, match):
+    d = RotationState().to_dict()
+    d["orientation"] = orientation
+    with pytest.raises(ValueError, match=match):
+        RotationState.from_dict(d)
+
+
+@pytest.mark.parametrize("change, exc, match", [
+    ({"colour": "red"}, ValueError, "Unknown state field"),
+    ({"format": 99}, ValueError, "Unsupported state format 99"),
+    ({"theta0": 7.0}, ValueError, r"theta0"),
+    ({"keymap": {"4": "sideways"}}, ValueError, "Unknown action 'sideways'"),
+    ({"keymap": {"4": {"kind": "rotate", "planes": "xw", "colour": 1}}}, ValueError, "action dict"),
+])
+def test_from_dict_names_what_is_wrong(change, exc, match):
+    d = {**RotationState().to_dict(), **change}
+    with pytest.raises(exc, match=match):
+        RotationState.from_dict(d)
+    with pytest.raises(TypeError, match="Expected a dict"):
+        RotationState.from_dict([1, 2])
+
+
+def test_copy_is_independent_and_keeps_the_reset_point():
+    st = _walked_state()
+    c = st.copy()
+    c.press("4")
+    assert not np.array_equal(c.matrix, st.matrix)
+    c.reset(), st.reset()
+    assert np.array_equal(c.matrix, st.matrix)
