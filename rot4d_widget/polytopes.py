@@ -1,4 +1,4 @@
-"""Convex 4-polytopes: vertices plus combinatorics built from the geometry.
+"""4-polytopes: vertices plus combinatorics, convex from points or any closed mesh given whole.
 
 `Polytope(vertices)` finds everything else once: the cells are the facets of
 scipy's 4-D convex hull (coplanar simplices merged), the 2-faces are the
@@ -6,6 +6,12 @@ intersections of pairs of cells that share three or more vertices, each
 ordered as a cycle, and the edges are consecutive vertices of those cycles.
 So any convex 4-polytope can be given, and the six regular polychora are
 built with the same code.
+
+`Polytope(vertices, faces, cells)` takes the 2-faces (vertex cycles) and the
+cells (lists of face indices) as given, checks them (closed, orientable, convex
+cells; vectorised, so tens of thousands of faces take a fraction of a second)
+and derives the outward normals from the boundary's orientation: such a
+polytope need not be convex.
 
 `polytope(name)` gives the six regular polychora, all with edge length 2 and
 centred on the origin, from the textbook coordinates (scaled to edge 2):
@@ -156,13 +162,122 @@ _BUILDERS = {
 }
 
 
+#: Relative tolerance of a mesh's geometric checks (planar faces, flat and convex cells,
+#: distinct vertices): this times the largest extent of the vertices' bounding box.  Looser
+#: than the slicer's `TOLERANCE` so that coordinates written with 7 significant digits pass.
+MESH_TOLERANCE = 1e-6
+
+
+def _ptr(sizes: np.ndarray) -> np.ndarray:
+    """(n,) sizes -> (n + 1,) start offsets."""
+    ptr = np.zeros(len(sizes) + 1, dtype=np.intp)
+    np.cumsum(sizes, out=ptr[1:])
+    return ptr
+
+
+def _owner(ptr: np.ndarray) -> np.ndarray:
+    """For offsets ``ptr`` (n + 1,), the owner (0..n-1) of every entry."""
+    return np.repeat(np.arange(len(ptr) - 1, dtype=np.intp), np.diff(ptr))
+
+
+def _gather(ptr: np.ndarray, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Entries of the rows ``which`` of a ragged table with offsets ``ptr``, back to back:
+    (entry indices, position in ``which`` of each)."""
+    sizes = ptr[which + 1] - ptr[which]
+    row = np.repeat(np.arange(len(which), dtype=np.intp), sizes)
+    first = _ptr(sizes)
+    return ptr[which][row] + np.arange(first[-1], dtype=np.intp) - first[row], row
+
+
+def _index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.ndarray]:
+    """A sequence of sequences of indices -> (sizes (n,) intp, flat (sum,) intp), checked:
+    integers in ``0 .. n_max - 1``.  TypeError / ValueError name the first bad entry."""
+    expected = f"a sequence of sequences of {item} indices (integers 0 to {n_max - 1})"
+    if isinstance(seq, (str, bytes)):
+        raise TypeError(f"Expected `{what}` to be {expected}, got {type(seq).__name__}")
+    if isinstance(seq, np.ndarray) and seq.ndim == 2 and seq.dtype.kind in "iu":
+        sizes = np.full(len(seq), seq.shape[1], dtype=np.intp)
+        flat = seq.astype(np.intp).ravel()
+    else:
+        try:
+            items = list(seq)
+        except TypeError:
+            raise TypeError(f"Expected `{what}` to be {expected}, got {type(seq).__name__}") from None
+        sizes = np.empty(len(items), dtype=np.intp)
+        for i, it in enumerate(items):
+            if isinstance(it, (str, bytes)):
+                raise TypeError(f"Expected `{what}[{i}]` to be a sequence of {item} indices, got {it!r}")
+            try:
+                sizes[i] = len(it)
+            except TypeError:
+                raise TypeError(f"Expected `{what}[{i}]` to be a sequence of {item} indices, "
+                                f"got {type(it).__name__}") from None
+        flat = np.array(list(itertools.chain.from_iterable(items)))
+        if flat.size == 0:
+            flat = np.zeros(0, dtype=np.intp)
+        if flat.ndim != 1 or flat.dtype.kind not in "iu":
+            for i, it in enumerate(items):
+                a = np.asarray(it)
+                if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
+                    raise TypeError(f"Expected `{what}[{i}]` to be a sequence of integer {item} indices, "
+                                    f"got {list(it)[:8]!r}")
+            raise TypeError(f"Expected `{what}` to be {expected}")
+        flat = flat.astype(np.intp)
+    bad = np.flatnonzero((flat < 0) | (flat >= n_max))
+    if len(bad):
+        i = int(np.searchsorted(_ptr(sizes), bad[0], side="right") - 1)
+        raise ValueError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}")
+    return sizes, flat
+
+
+def _duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
+    """First (row, value) that occurs twice in one row of a ragged table, or None."""
+    key = _owner(ptr) * n + flat
+    s = np.sort(key)
+    dup = np.flatnonzero(s[1:] == s[:-1])
+    if len(dup):
+        return int(s[dup[0]] // n), int(s[dup[0]] % n)
+    return None
+
+
 class Polytope:
-    """A convex 4-polytope.
+    """A 4-polytope: vertices, edges, 2-faces and cells.
+
+    ``Polytope(vertices)`` builds a convex polytope from its points (the cells
+    are the facets of scipy's 4-D convex hull).  ``Polytope(vertices, faces,
+    cells)`` takes the combinatorics as given, so the polytope need not be
+    convex:
+
+    vertices : (V, 4) array of real numbers
+    faces : F vertex cycles (sequences of vertex indices, in order around the face)
+    cells : C sequences of face indices, the faces bounding each cell
+
+    and checks it (ValueError / TypeError naming the first offence; the geometric
+    checks use `MESH_TOLERANCE` times the vertices' largest extent):
+
+    * every face has >= 3 distinct vertices, is planar and a strictly convex polygon
+      in the order given (no three consecutive corners collinear, no star);
+    * every face is in exactly two cells (the boundary is closed), every vertex in a face;
+    * every cell has >= 4 distinct faces, lies in a hyperplane, spans 3-D, is closed
+      (each of its edges in exactly two of its faces) and strictly convex (every
+      vertex of the cell on the inner side of each face's plane, and only the face's
+      own corners on it);
+    * the boundary is consistently orientable.  The outward normals then come from that
+      orientation, not from the origin: each boundary component is oriented so that it
+      encloses positive 4-volume, and a component inside another (a cavity, found by
+      casting a ray) the other way.
+
+    Two cells sharing a face may lie in one hyperplane (a flat ridge, as where two
+    cubes of glued tesseracts meet side by side): that is allowed, and the slicer
+    gives their slices as two polygons.  Not checked: that the boundary does not
+    intersect itself.  ``validate=False`` skips the per-cell convexity and closedness
+    checks (the costly part for big meshes; for combinatorics known to be right, e.g.
+    from a Wythoff construction); the orientation is still derived and checked.
 
     Attributes
     ----------
     vertices : (V, 4) float64
-    edges : (E, 2) intp, each row sorted
+    edges : (E, 2) intp, each row sorted, rows sorted
     faces : tuple of F intp arrays, each an ordered cycle of vertex indices
     cells : tuple of C tuples of face indices
     face_cells : (F, 2) intp, the two cells of each face, ascending
@@ -175,7 +290,9 @@ class Polytope:
     once), so an edit anywhere would corrupt every later slice.
     """
 
-    def __init__(self, vertices, name: str = "polytope"):
+    def __init__(self, vertices, faces=None, cells=None, name: str = "polytope", *, validate: bool = True):
+        if isinstance(faces, str) and cells is None:
+            raise TypeError("Expected `faces` to be a sequence of vertex cycles; pass the name as name=...")
         try:
             v = np.array(vertices, dtype=np.float64)
         except (TypeError, ValueError):
@@ -184,13 +301,18 @@ class Polytope:
             raise ValueError(f"Expected `vertices` to have shape (V, 4) with V >= 5, got {v.shape}")
         if not np.all(np.isfinite(v)):
             raise ValueError("Expected `vertices` to be finite")
+        if (faces is None) != (cells is None):
+            raise TypeError("Expected both `faces` and `cells`, or neither (then the convex hull of the vertices)")
         self.name = str(name)
         self.vertices = _sealed(v)
         self.circumradius = float(np.sqrt((v * v).sum(axis=1)).max())
-        self._build()
+        if faces is None:
+            self._build_hull()
+        else:
+            self._build_mesh(faces, cells, bool(validate))
 
     # -- construction ------------------------------------------------------
-    def _build(self) -> None:
+    def _build_hull(self) -> None:
         v = self.vertices
         scale = float(np.abs(v).max())
         tol = 1e-9 * scale
@@ -213,21 +335,16 @@ class Polytope:
         ci, cj = np.nonzero(np.triu(shared >= 3, k=1))
         face_sets = cell_vertices[ci] & cell_vertices[cj]  # (F, V)
         faces = [self._order_cycle(np.flatnonzero(row)) for row in face_sets]
-        cells = [[] for _ in range(len(first))]
-        for f, (a, b) in enumerate(zip(ci, cj)):
-            cells[a].append(f)
-            cells[b].append(f)
-        edges = set()
-        for cyc in faces:
-            for a, b in zip(cyc, np.roll(cyc, -1)):
-                edges.add((min(a, b), max(a, b)))
-        self.edges = _sealed(np.array(sorted(edges), dtype=np.intp).reshape(-1, 2))
-        self.faces = tuple(_sealed(f) for f in faces)
-        self.cells = tuple(tuple(int(f) for f in c) for c in cells)
+        face_sizes = np.array([len(f) for f in faces], dtype=np.intp)
+        # each cell's faces in ascending order: face f is in cells ci[f] < cj[f]
+        both = np.concatenate([ci, cj])
+        face_of = np.tile(np.arange(len(ci), dtype=np.intp), 2)
+        cell_fidx = face_of[np.lexsort((face_of, both))]
+        cell_sizes = np.bincount(both, minlength=len(first))
+        self._set_combinatorics(_ptr(face_sizes), np.concatenate(faces), _ptr(cell_sizes), cell_fidx)
         self.cell_normals = _sealed(np.ascontiguousarray(normals))
         self.cell_offsets = _sealed(np.ascontiguousarray(offsets))
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
-        self._cell_vertex_mask = _sealed(cell_vertices)
 
     def _order_cycle(self, idx: np.ndarray) -> np.ndarray:
         """Order the vertices of a planar convex polygon in 4-D as a cycle."""
@@ -237,6 +354,85 @@ class Polytope:
         xy = (p - c) @ vt[:2].T
         return idx[np.argsort(np.arctan2(xy[:, 1], xy[:, 0]))].astype(np.intp)
 
+    def _set_combinatorics(self, face_ptr, face_vidx, cell_ptr, cell_fidx) -> None:
+        """Edges, faces, cells and the flat incidence tables (also used by the slicer).
+
+        Private tables (all read-only):  ``_face_ptr``/``_face_vidx`` the face cycles back to back;
+        ``_face_eidx`` the edge of each side (corner k to k + 1);  ``_cell_ptr``/``_cell_fidx``
+        each cell's faces;  ``_cell_vptr``/``_cell_vidx`` each cell's vertices, ascending;
+        ``_cell_eptr``/``_cell_eidx`` each cell's edges, ascending, with ``_cell_ecount`` the
+        number of the cell's faces that have each.
+        """
+        V = len(self.vertices)
+        F, C = len(face_ptr) - 1, len(cell_ptr) - 1
+        nxt = np.arange(1, len(face_vidx) + 1, dtype=np.intp)
+        nxt[face_ptr[1:] - 1] = face_ptr[:-1]
+        a, b = face_vidx, face_vidx[nxt]
+        ekey, face_eidx = np.unique(np.minimum(a, b) * V + np.maximum(a, b), return_inverse=True)
+        E = len(ekey)
+        self.edges = _sealed(np.stack([ekey // V, ekey % V], axis=1).astype(np.intp).reshape(-1, 2))
+        # each face a read-only view of one sealed array (cannot be unlocked: its base is read-only)
+        flat = _sealed(face_vidx.astype(np.intp))
+        bounds = face_ptr.tolist()
+        self.faces = tuple(flat[a:b] for a, b in zip(bounds[:-1], bounds[1:]))
+        cf = cell_fidx.tolist()
+        bounds = cell_ptr.tolist()
+        self.cells = tuple(tuple(cf[a:b]) for a, b in zip(bounds[:-1], bounds[1:]))
+        # (cell, face corner) entries: each cell's vertices and edges, with multiplicity
+        idx, row = _gather(face_ptr, cell_fidx)
+        cell_of = _owner(cell_ptr)[row]
+        vkey = np.unique(cell_of * V + face_vidx[idx])
+        ekeys, ecount = np.unique(cell_of * E + face_eidx.reshape(-1)[idx], return_counts=True)
+        self._face_ptr, self._face_vidx = _sealed(face_ptr), _sealed(face_vidx.astype(np.intp))
+        self._face_eidx = _sealed(face_eidx.reshape(-1).astype(np.intp))
+        self._cell_ptr, self._cell_fidx = _sealed(cell_ptr), _sealed(cell_fidx.astype(np.intp))
+        self._cell_vptr = _sealed(_ptr(np.bincount(vkey // V, minlength=C)))
+        self._cell_vidx = _sealed((vkey % V).astype(np.intp))
+        self._cell_eptr = _sealed(_ptr(np.bincount(ekeys // E, minlength=C)))
+        self._cell_eidx = _sealed((ekeys % E).astype(np.intp))
+        self._cell_ecount = _sealed(ecount.astype(np.intp))
+        self._mask = None
+
+    def _build_mesh(self, faces, cells, validate: bool) -> None:
+        v = self.vertices
+        V = len(v)
+        face_sizes, face_vidx = _index_lists(faces, "faces", "vertex", V)
+        F = len(face_sizes)
+        cell_sizes, cell_fidx = _index_lists(cells, "cells", "face", max(F, 1))
+        C = len(cell_sizes)
+        if F < 10 or C < 5:
+            raise ValueError(f"Expected at least 10 faces and 5 cells (a 4-polytope's least), got {F} and {C}")
+        face_ptr, cell_ptr = _ptr(face_sizes), _ptr(cell_sizes)
+        small = np.flatnonzero(face_sizes < 3)
+        if len(small):
+            raise ValueError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3")
+        small = np.flatnonzero(cell_sizes < 4)
+        if len(small):
+            raise ValueError(f"`cells[{small[0]}]` has {cell_sizes[small[0]]} faces; a cell needs at least 4")
+        dup = _duplicate_in_rows(face_ptr, face_vidx, V)
+        if dup:
+            raise ValueError(f"`faces[{dup[0]}]` has vertex {dup[1]} twice; a face is a cycle of distinct vertices")
+        dup = _duplicate_in_rows(cell_ptr, cell_fidx, F)
+        if dup:
+            raise ValueError(f"`cells[{dup[0]}]` has face {dup[1]} twice")
+        use = np.bincount(cell_fidx, minlength=F)
+        bad = np.flatnonzero(use != 2)
+        if len(bad):
+            f = int(bad[0])
+            holders = _owner(cell_ptr)[cell_fidx == f].tolist()
+            raise ValueError(f"face {f} is in {use[f]} cell(s) {holders}; every face must be in exactly two "
+                             f"cells (a closed boundary)")
+        unused = np.flatnonzero(np.bincount(face_vidx, minlength=V) == 0)
+        if len(unused):
+            raise ValueError(f"vertex {unused[0]} is in no face; every vertex must be a corner of some face")
+        self._set_combinatorics(face_ptr, face_vidx, cell_ptr, cell_fidx)
+        order = np.argsort(cell_fidx, kind="stable")
+        cell_of = _owner(cell_ptr)
+        self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
+        normals, offsets = _mesh_geometry(self, validate)
+        self.cell_normals = _sealed(normals)
+        self.cell_offsets = _sealed(offsets)
+
     # -- conveniences ------------------------------------------------------
     @property
     def counts(self) -> tuple[int, int, int, int]:
@@ -244,12 +440,207 @@ class Polytope:
         return len(self.vertices), len(self.edges), len(self.faces), len(self.cells)
 
     def cell_vertices(self, c: int) -> np.ndarray:
-        """Vertex indices of cell ``c``."""
-        return np.flatnonzero(self._cell_vertex_mask[c])
+        """Vertex indices of cell ``c``, ascending (a fresh array)."""
+        c = range(len(self.cells))[c]
+        return self._cell_vidx[self._cell_vptr[c] : self._cell_vptr[c + 1]].copy()
+
+    @property
+    def _cell_vertex_mask(self) -> np.ndarray:
+        """(C, V) bool, read-only: vertex v is in cell c (built on first use)."""
+        if self._mask is None:
+            mask = np.zeros((len(self.cells), len(self.vertices)), dtype=bool)
+            mask[_owner(self._cell_vptr), self._cell_vidx] = True
+            self._mask = _sealed(mask)
+        return self._mask
 
     def __repr__(self) -> str:
         v, e, f, c = self.counts
         return f"Polytope({self.name!r}, V={v}, E={e}, F={f}, C={c}, circumradius={self.circumradius:.4g})"
+
+
+def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Check an explicit mesh's geometry; its outward cell normals and offsets."""
+    v = p.vertices
+    V, F, C = len(v), len(p._face_ptr) - 1, len(p._cell_ptr) - 1
+    tol = MESH_TOLERANCE * float(np.ptp(v, axis=0).max())
+    if tol == 0:
+        raise ValueError("`vertices` are all the same point")
+    # distinct vertices
+    key = np.round(v / tol).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    if len(first) < V:
+        i = int(np.flatnonzero(first[inverse.reshape(-1)] != np.arange(V))[0])
+        raise ValueError(f"vertices {int(first[inverse.reshape(-1)[i]])} and {i} coincide")
+    fptr, fv = p._face_ptr, p._face_vidx
+    fsize = np.diff(fptr)
+    face_c = np.empty((F, 4))
+    face_e = np.empty((F, 2, 4))
+    face_area = np.empty(F)
+    for k in np.unique(fsize).tolist():
+        fs = np.flatnonzero(fsize == k)
+        P = v[fv[fptr[fs][:, None] + np.arange(k)]]  # (n, k, 4)
+        c = P.mean(axis=1)
+        Q = P - c[:, None]
+        _, s, vt = np.linalg.svd(Q, full_matrices=False)
+        B = vt[:, :2]  # (n, 2, 4) the face's plane
+        xy = np.einsum("nkd,njd->nkj", Q, B)
+        off = np.linalg.norm(Q - np.einsum("nkj,njd->nkd", xy, B), axis=2).max(axis=1)
+        bad = np.flatnonzero(off > tol)
+        if len(bad):
+            f = int(fs[bad[0]])
+            raise ValueError(f"face {f} is not planar: a corner is {off[bad[0]]:.3g} from its plane "
+                             f"(tolerance {tol:.3g})")
+        e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
+        e2 = np.roll(e, -1, axis=1)
+        cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
+        dot = (e * e2).sum(axis=2)
+        chord = np.linalg.norm(e + e2, axis=2)
+        dist = np.abs(cross) / np.maximum(chord, 1e-300)  # corner k + 1 from the line of its neighbours
+        turning = np.arctan2(cross, dot).sum(axis=1)
+        sign = np.sign(cross)
+        ok = (dist > tol).all(axis=1) & (sign == sign[:, :1]).all(axis=1) & (np.abs(np.abs(turning) - 2 * np.pi) < 1)
+        bad = np.flatnonzero(~ok)
+        if len(bad):
+            f = int(fs[bad[0]])
+            raise ValueError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
+                             f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
+                             f"strictly convex polygons with their vertices in cyclic order")
+        face_c[fs] = c
+        face_e[fs] = B
+        face_area[fs] = 0.5 * np.abs((xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
+                                      - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1]).sum(axis=1))
+    # cells: flat, 3-D, normal
+    cptr, cfx = p._cell_ptr, p._cell_fidx
+    vptr, cvx = p._cell_vptr, p._cell_vidx
+    nv = np.diff(vptr)
+    g = np.empty((C, 4))
+    n = np.empty((C, 4))
+    for k in np.unique(nv).tolist():
+        cs = np.flatnonzero(nv == k)
+        P = v[cvx[vptr[cs][:, None] + np.arange(k)]]
+        gc = P.mean(axis=1)
+        Q = P - gc[:, None]
+        R = np.linalg.qr(Q, mode="r") if k > 4 else Q
+        _, s, vt = np.linalg.svd(R, full_matrices=True)
+        normal = vt[:, 3]
+        off = np.abs(np.einsum("nkd,nd->nk", Q, normal)).max(axis=1)
+        bad = np.flatnonzero(off > tol)
+        if len(bad):
+            c = int(cs[bad[0]])
+            raise ValueError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]]:.3g} from it "
+                             f"(tolerance {tol:.3g})")
+        bad = np.flatnonzero(s[:, 2] <= tol)
+        if len(bad):
+            raise ValueError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D")
+        g[cs] = gc
+        n[cs] = normal
+    pc = _owner(cptr)  # the (cell, face) pairs, cell by cell
+    pf = cfx
+    m = face_c[pf] - g[pc]
+    for basis in (n[pc], face_e[pf, 0], face_e[pf, 1]):
+        m -= np.einsum("id,id->i", m, basis)[:, None] * basis
+    height = np.linalg.norm(m, axis=1)  # the cell's centroid from each face's plane, in the cell
+    bad = np.flatnonzero(height <= tol)
+    if len(bad):
+        raise ValueError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
+                         f"{int(pf[bad[0]])}")
+    m /= height[:, None]  # each face's outward normal within each of its cells
+    if validate:
+        _check_cells(p, v, tol, pc, pf, m, face_c)
+    # orientation: the sign of det[n_c, m_cf, plane of f] relates the two cells of each face
+    sigma = np.sign(np.linalg.det(np.stack([n[pc], m, face_e[pf, 0], face_e[pf, 1]], axis=1)))
+    order = np.argsort(pf, kind="stable")
+    c1, c2 = pc[order[0::2]], pc[order[1::2]]
+    same = -sigma[order[0::2]] * sigma[order[1::2]] > 0  # s_c1 == s_c2 for a consistent orientation
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    a = np.concatenate([c1, c1 + C])
+    b = np.concatenate([np.where(same, c2, c2 + C), np.where(same, c2 + C, c2)])
+    _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * C, 2 * C)), directed=False)
+    bad = np.flatnonzero(lab[:C] == lab[C:])
+    if len(bad):
+        raise ValueError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
+                         f"given outward normals that agree across their shared faces")
+    s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
+    ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
+    vol3 = np.bincount(pc, weights=face_area[pf] * height, minlength=C) / 3.0
+    offsets = np.einsum("cd,cd->c", n, g)
+    vol4 = np.bincount(comp, weights=s * offsets * vol3, minlength=ncomp) / 4.0
+    small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
+    if len(small):
+        raise ValueError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
+                         f"no 4-volume")
+    flip = vol4 < 0
+    if ncomp > 1:
+        flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
+    s = np.where(flip[comp], -s, s)
+    normals = np.ascontiguousarray(n * s[:, None])
+    return normals, np.ascontiguousarray(offsets * s)
+
+
+def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
+    """Every cell closed and strictly convex (ValueError naming the cell)."""
+    C = len(p._cell_ptr) - 1
+    E = len(p.edges)
+    open_ = np.flatnonzero(p._cell_ecount != 2)
+    if len(open_):
+        i = int(open_[0])
+        c = int(np.searchsorted(p._cell_eptr, i, side="right") - 1)
+        e = p.edges[p._cell_eidx[i]].tolist()
+        raise ValueError(f"cell {c} is not closed: its edge {tuple(e)} is in {p._cell_ecount[i]} of its faces; "
+                         f"each edge of a cell must be in exactly two of its faces")
+    cptr, vptr, cvx = p._cell_ptr, p._cell_vptr, p._cell_vidx
+    nf, nv = np.diff(cptr), np.diff(vptr)
+    fsize = np.diff(p._face_ptr)
+    kinds, kind = np.unique(nf * (nv.max() + 1) + nv, return_inverse=True)
+    for j in range(len(kinds)):
+        cells_j = np.flatnonzero(kind.reshape(-1) == j)
+        q, k = int(nf[cells_j[0]]), int(nv[cells_j[0]])
+        step = max(1, 2_000_000 // (q * k))
+        for lo in range(0, len(cells_j), step):
+            cs = cells_j[lo : lo + step]
+            P = v[cvx[vptr[cs][:, None] + np.arange(k)]]  # (n, k, 4)
+            pairs = cptr[cs][:, None] + np.arange(q)  # (n, q)
+            M = m[pairs]
+            D = M @ P.transpose(0, 2, 1) - np.einsum("nqd,nqd->nq", M, face_c[pf[pairs]])[..., None]
+            out = D > tol
+            if out.any():
+                i, j2, k2 = np.argwhere(out)[0]
+                raise ValueError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
+                                 f"outside the plane of its face {int(pf[pairs[i, j2]])}")
+            on = (D >= -tol).sum(axis=2)
+            wrong = on != fsize[pf[pairs]]
+            if wrong.any():
+                i, j2 = np.argwhere(wrong)[0]
+                raise ValueError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
+                                 f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)")
+
+
+def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:
+    """(ncomp,) bool: boundary components that lie inside an odd number of the others.
+
+    A ray from a point of each component (a cell's centre) in a fixed generic direction
+    counts the cells of every other component it passes through.
+    """
+    C = len(g)
+    rng = np.random.default_rng(12345)
+    r = rng.normal(size=4)
+    r /= np.linalg.norm(r)
+    first = np.array([np.flatnonzero(comp == k)[0] for k in range(ncomp)])
+    q = g[first]  # (K, 4)
+    depth = np.zeros(ncomp, dtype=np.intp)
+    nr = normals @ r  # (C,)
+    t = (offsets[None, :] - q @ normals.T) / np.where(np.abs(nr) > 1e-300, nr, 1e-300)[None, :]  # (K, C)
+    hit_pt = q[:, None, :] + t[..., None] * r  # (K, C, 4)
+    for k in range(ncomp):
+        x = hit_pt[k]  # (C, 4)
+        inside_face = np.einsum("id,id->i", x[pc] - face_c[pf], m) <= 0
+        inside = np.logical_and.reduceat(inside_face, np.searchsorted(pc, np.arange(C)))
+        ok = inside & (t[k] > 0) & (comp != k) & (np.abs(nr) > 1e-12)
+        crossings = np.bincount(comp[ok], minlength=ncomp)
+        depth[k] = int((crossings % 2).sum())
+    return depth % 2 == 1
 
 
 @functools.lru_cache(maxsize=None)

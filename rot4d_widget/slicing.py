@@ -46,7 +46,7 @@ import numpy as np
 
 from ._arrays import sealed as _sealed
 
-from .polytopes import Polytope, polytope as _get_polytope
+from .polytopes import Polytope, _owner, polytope as _get_polytope
 from .rotation import as_rotation_matrix
 
 __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
@@ -66,34 +66,20 @@ class _Tables:
         self.V, self.F, self.C = V, F, C
         self.ea = np.ascontiguousarray(p.edges[:, 0])
         self.eb = np.ascontiguousarray(p.edges[:, 1])
-        edge_index = {(int(a), int(b)): i for i, (a, b) in enumerate(p.edges)}
-        fv_face, fv_vert, fe_face, fe_edge = [], [], [], []
-        for f, cyc in enumerate(p.faces):
-            fv_face.extend([f] * len(cyc))
-            fv_vert.extend(cyc.tolist())
-            for a, b in zip(cyc.tolist(), np.roll(cyc, -1).tolist()):
-                fe_face.append(f)
-                fe_edge.append(edge_index[(min(a, b), max(a, b))])
-        self.fv_face = np.array(fv_face, dtype=np.intp)
-        self.fv_vert = np.array(fv_vert, dtype=np.intp)
-        self.fe_face = np.array(fe_face, dtype=np.intp)
-        self.fe_edge = np.array(fe_edge, dtype=np.intp)
-        self.f_starts = np.searchsorted(self.fv_face, np.arange(F))
-        cv_cell, cv_vert, ce_cell, ce_edge = [], [], [], []
-        for c, faces in enumerate(p.cells):
-            verts = np.unique(np.concatenate([p.faces[f] for f in faces]))
-            edges = np.unique(self.fe_edge[np.isin(self.fe_face, faces)])
-            cv_cell.extend([c] * len(verts))
-            cv_vert.extend(verts.tolist())
-            ce_cell.extend([c] * len(edges))
-            ce_edge.extend(edges.tolist())
-        self.cv_cell = np.array(cv_cell, dtype=np.intp)
-        self.cv_vert = np.array(cv_vert, dtype=np.intp)
-        self.ce_cell = np.array(ce_cell, dtype=np.intp)
-        self.ce_edge = np.array(ce_edge, dtype=np.intp)
-        self.c_starts = np.searchsorted(self.cv_cell, np.arange(C))
+        # the polytope's flat incidence tables (see Polytope._set_combinatorics): each face's
+        # corners and sides in cycle order, each cell's vertices and edges ascending
+        self.fv_face = _owner(p._face_ptr)
+        self.fv_vert = p._face_vidx
+        self.fe_face = self.fv_face
+        self.fe_edge = p._face_eidx
+        self.f_starts = p._face_ptr[:-1]
+        self.cv_cell = _owner(p._cell_vptr)
+        self.cv_vert = p._cell_vidx
+        self.ce_cell = _owner(p._cell_eptr)
+        self.ce_edge = p._cell_eidx
+        self.c_starts = p._cell_vptr[:-1]
         # first three vertices of each face cycle: two non-parallel edge vectors
-        self.face_abc = np.array([cyc[:3] for cyc in p.faces], dtype=np.intp).reshape(-1, 3)
+        self.face_abc = p._face_vidx[p._face_ptr[:-1, None] + np.arange(3)]
         self.face_cells = p.face_cells
         self.cell_normals = np.ascontiguousarray(p.cell_normals)
         self.vertices = p.vertices

@@ -1,0 +1,104 @@
+"""4-D meshes with explicit combinatorics for the tests: duoprisms, unions of unit tesseracts.
+
+Built here by counting, independently of `Polytope`'s convex-hull path, so the
+tests can compare the two.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from rot4d_widget import Polytope
+
+
+def duoprism_mesh(p: int, q: int, edge: float = 2.0):
+    """The p-q duoprism, edge ``edge``: (vertices, faces, cells).
+
+    Vertex i * q + j is (R_p cos 2πi/p, R_p sin 2πi/p, R_q cos 2πj/q, R_q sin 2πj/q).
+    Faces: q p-gons (j fixed), p q-gons (i fixed), p q squares.  Cells: p q-gonal
+    prisms (between q-gons i and i + 1), q p-gonal prisms.
+    """
+    rp, rq = edge / (2 * np.sin(np.pi / p)), edge / (2 * np.sin(np.pi / q))
+    a, b = 2 * np.pi * np.arange(p) / p, 2 * np.pi * np.arange(q) / q
+    i, j = np.meshgrid(np.arange(p), np.arange(q), indexing="ij")
+    vertices = np.stack([rp * np.cos(a[i]), rp * np.sin(a[i]), rq * np.cos(b[j]), rq * np.sin(b[j])], -1).reshape(-1, 4)
+
+    def vid(i, j):
+        return (i % p) * q + (j % q)
+
+    pgons = [[vid(i, j) for i in range(p)] for j in range(q)]  # faces 0 .. q-1
+    qgons = [[vid(i, j) for j in range(q)] for i in range(p)]  # faces q .. q+p-1
+    squares = [[vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)] for i in range(p) for j in range(q)]
+    faces = pgons + qgons + squares
+
+    def sq(i, j):
+        return q + p + (i % p) * q + (j % q)
+
+    qprisms = [[q + i, q + (i + 1) % p] + [sq(i, j) for j in range(q)] for i in range(p)]
+    pprisms = [[j, (j + 1) % q] + [sq(i, j) for i in range(p)] for j in range(q)]
+    return vertices, faces, qprisms + pprisms
+
+
+def duoprism(p: int, q: int, **kw) -> Polytope:
+    v, f, c = duoprism_mesh(p, q)
+    return Polytope(v, f, c, name=f"{p}-{q} duoprism", **kw)
+
+
+def tesseract_union_mesh(cubes, centre=True):
+    """Boundary of a union of unit tesseracts [k, k+1]^4 at integer positions ``cubes``.
+
+    Every facet of a tesseract whose neighbour across it is not in the union is a
+    cell (a unit cube); faces are the unit squares of those cubes, each listed once.
+    Cells stay separate cubes where two of them are coplanar and adjacent (a flat
+    ridge).  Returns (vertices, faces, cells, pieces) where ``pieces`` are the
+    tesseracts' corners, and the vertices are shifted by the union's centroid when
+    ``centre``.
+    """
+    cubes = [tuple(int(x) for x in c) for c in cubes]
+    occupied = set(cubes)
+    eye = np.eye(4, dtype=int)
+    vid, faces, fid, cells = {}, [], {}, []
+
+    def vertex(pt):
+        return vid.setdefault(tuple(int(x) for x in pt), len(vid))
+
+    def face(base, a1, a2):
+        key = (tuple(int(x) for x in base), a1, a2)
+        if key not in fid:
+            b = np.array(base)
+            fid[key] = len(faces)
+            faces.append([vertex(b), vertex(b + eye[a1]), vertex(b + eye[a1] + eye[a2]), vertex(b + eye[a2])])
+        return fid[key]
+
+    for c in cubes:
+        for axis in range(4):
+            for side in (0, 1):
+                nb = tuple(np.array(c) + (1 if side else -1) * eye[axis])
+                if nb in occupied:
+                    continue
+                base = np.array(c) + side * eye[axis]
+                others = [a for a in range(4) if a != axis]
+                cell = []
+                for a1, a2 in itertools.combinations(others, 2):
+                    (a3,) = [a for a in others if a not in (a1, a2)]
+                    cell.append(face(base, a1, a2))
+                    cell.append(face(base + eye[a3], a1, a2))
+                cells.append(cell)
+    vertices = np.array(sorted(vid, key=vid.get), dtype=float)
+    shift = vertices.mean(axis=0) if centre else np.zeros(4)
+    pieces = [np.array(list(itertools.product(*[(x, x + 1) for x in c])), dtype=float) - shift for c in cubes]
+    return vertices - shift, faces, cells, pieces
+
+
+SHAPES = {
+    "L": [(0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0)],
+    "plus": [(0, 0, 0, 0), (1, 0, 0, 0), (-1, 0, 0, 0), (0, 1, 0, 0), (0, -1, 0, 0)],
+    "2x2 minus one": [(0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0)],
+}
+
+
+def tesseract_union(name: str) -> tuple[Polytope, list]:
+    v, f, c, pieces = tesseract_union_mesh(SHAPES[name])
+    return Polytope(v, f, c, name=name), pieces
