@@ -723,14 +723,18 @@ def family(name) -> str:
     return _table()[0][_canonical_or_raise(name)]["family"]
 
 
-@functools.lru_cache(maxsize=64)
 def combinatorics(name) -> Combinatorics:
     """Vertices, edges, 2-faces (vertex cycles) and cells (face indices) of a polychoron.
 
     For the regular six this is the Wythoff construction (vertices in the group's order and
-    orientation, not the core's arrays): `build` returns the core's objects instead.
+    orientation, not the core's arrays): `build` returns the core's objects instead.  Cached:
+    treat the arrays as read-only.
     """
-    canon = _canonical_or_raise(name)
+    return _combinatorics(_canonical_or_raise(name))
+
+
+@functools.lru_cache(maxsize=64)
+def _combinatorics(canon: str) -> Combinatorics:
     if canon in _REGULAR_DYNKIN:
         sym = _REGULAR_DYNKIN[canon]
         labels = tuple(int(c) for c in sym[1::2])
@@ -753,8 +757,13 @@ def combinatorics(name) -> Combinatorics:
 
 
 def _as_polytope(comb: Combinatorics, name: str):
-    """A core `Polytope` from explicit combinatorics (the constructor with faces= and cells=)."""
-    return _polytopes.Polytope(comb.vertices, faces=comb.faces, cells=comb.cells, name=name)
+    """A core `Polytope` from explicit combinatorics (``Polytope(vertices, faces, cells)``).
+
+    Validated even though the construction is exact: the constructor's checks (planar convex
+    faces, closed convex cells, orientable boundary) cost ~0.1 s for the 14400-vertex
+    omnitruncated 120-cell, within the noise of this machine.
+    """
+    return _polytopes.Polytope(comb.vertices, comb.faces, comb.cells, name=name)
 
 
 @functools.lru_cache(maxsize=None)
