@@ -1,0 +1,555 @@
+"""Keep what you see: the slice as a mesh (trimesh) and the state as a JSON file.
+
+Meshes
+    `slice_mesh(data)` turns what a source's ``slice(matrix, c0)`` returned -- a polytope's
+    slice, a field's isosurfaces, a stack of parallel slices, or a list of any of them -- into
+    one `trimesh.Trimesh`: the triangles of every face, concatenated, in the source's own units
+    (see `slice_mesh` for what a unit is for each kind), each face keeping its colour group
+    (``mesh.face_attributes["group"]``: a polytope's 4-D cell, a field's level index, a stack's
+    slice index when coloured by w) and its colour (``mesh.visual.face_colors``, the live view's
+    palette from `rot4d_widget.look`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
+    extension (trimesh's own writers); what each keeps is listed in `MESH_FORMATS`.
+    `load_mesh(path)` reads one back with the groups a PLY file carries.
+
+State files
+    `save_state(path, state, source, settings)` writes a JSON file with the `RotationState`
+    (`RotationState.to_dict`), what the source is (`describe_source`: the source's
+    ``describe()`` plus what rebuilding it needs), the widget's settings (levels, slices,
+    display options: any JSON-able dict) and a format version; `load_state(path)` reads it
+    back as ``(state, source or None, settings)``.  A polytope is rebuilt from its name (or its
+    vertices); a stack from its inner source and its settings; a `Field4D` from a module-level
+    function (``module.name``) or from the file `open_field` opened.  An in-memory array is not
+    written into the file: saving says so (`SourceNotRebuildable` warning) and loading then
+    needs the source passed in (``load_state(path, source=field)``).
+
+numpy, trimesh (and xarray for `open_field`); nothing here knows about widgets.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import os
+import tempfile
+import warnings
+from typing import Mapping, NamedTuple, Sequence
+
+import numpy as np
+
+from . import look
+from .state import RotationState
+
+__all__ = [
+    "MESH_FORMATS",
+    "STATE_FILE_FORMAT",
+    "STATE_FILE_VERSION",
+    "SourceNotRebuildable",
+    "LoadedState",
+    "slice_mesh",
+    "face_colors",
+    "load_mesh",
+    "describe_source",
+    "rebuild_source",
+    "open_field",
+    "save_state",
+    "load_state",
+]
+
+#: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
+#: float32 by every format (float64 in none).
+MESH_FORMATS = {
+    ".ply": "vertices, faces, per-face RGBA colours and the face attribute 'group' (a face property "
+            "'int group'; `load_mesh` puts it back in face_attributes)",
+    ".obj": "vertices, faces, per-vertex colours (a face colour averaged over the faces at a vertex: "
+            "use separate_groups=True to keep every face's colour exact); no groups",
+    ".glb": "vertices, faces, per-vertex colours (as OBJ); no groups",
+    ".stl": "faces only (a triangle soup: trimesh merges equal vertices on loading); no colours, no groups",
+}
+
+#: ``"format"`` and ``"version"`` of a state file.
+STATE_FILE_FORMAT = "rot4d_widget state"
+STATE_FILE_VERSION = 1
+
+
+class SourceNotRebuildable(UserWarning):
+    """A source that a state file describes but cannot rebuild (an in-memory array, a lambda,
+    a user's own source): loading the file needs the source passed in."""
+
+
+class _CannotRebuild(ValueError):
+    """`rebuild_source`: the description is fine, the source just cannot be made from it."""
+
+
+# ============================================================================ meshes
+def _is_stack_data(data) -> bool:
+    ex = getattr(data, "extra", None) or {}
+    return "triangle_offsets" in ex and "centres" in ex
+
+
+def _is_field_data(data) -> bool:
+    ex = getattr(data, "extra", None) or {}
+    return "levels" in ex and "box" in ex
+
+
+def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
+    """(k, 3) float64 in [0, 1]: the colour of each triangle of ``data`` as the live view draws it.
+
+    ``color_by`` is the widget's: ``"group"`` or one colour for every face (``"#9fb6cd"``).
+    Groups are coloured by ``group_colors`` (one colour per group) if given, else as the widget
+    chooses: a stack coloured by w by its levels' colormap, a field by its levels' colormap
+    (`look.level_colors`), anything else by `look.group_palette` (a polytope's cells).
+    """
+    groups = np.asarray(data.groups, dtype=np.intp)
+    if color_by != "group":
+        return np.tile(np.asarray(look.as_rgb(color_by, "color_by"), dtype=np.float64), (len(groups), 1))
+    n = int(groups.max()) + 1 if len(groups) else 0
+    if group_colors is not None:
+        palette = np.array([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
+                           dtype=np.float64).reshape(-1, 3)
+    elif _is_stack_data(data) and data.extra.get("group_rgb") is not None:
+        palette = np.asarray(data.extra["group_rgb"], dtype=np.float64)
+    elif _is_field_data(data) and len(data.extra["levels"]):
+        levels = [s.level for s in data.extra["levels"]]
+        palette = look.level_colors(levels, min(levels), max(levels))
+    else:
+        palette = look.group_palette(n).astype(np.float64)
+    if n > len(palette):
+        raise ValueError(f"Expected a colour for every group (0 ... {n - 1}), got {len(palette)} colours")
+    return palette[groups].reshape(-1, 3)
+
+
+def _one_mesh_arrays(data, color_by, group_colors):
+    """vertices (n, 3), faces (k, 3), rgb (k, 3), attributes {name: (k,)}, volume or None, kind."""
+    try:
+        points = np.asarray(data.points, dtype=np.float64).reshape(-1, 3)
+        tris = np.asarray(data.triangles, dtype=np.intp).reshape(-1, 3)
+        groups = np.asarray(data.groups, dtype=np.intp).reshape(-1)
+    except AttributeError:
+        raise TypeError(
+            "Expected slice data (what a source's slice(matrix, c0) returns: points, triangles, groups), "
+            f"got {type(data).__name__}"
+        ) from None
+    rgb = face_colors(data, color_by=color_by, group_colors=group_colors)
+    attrs = {"group": groups}
+    if _is_stack_data(data):
+        ex = data.extra
+        toff = np.asarray(ex["triangle_offsets"])
+        attrs["slice"] = np.repeat(np.arange(len(toff) - 1), np.diff(toff))
+        scales = np.asarray(ex["scales"], dtype=np.float64)
+        vols = ex.get("volumes", ())
+        n = len(scales)
+        if n == 1:
+            volume = None if vols[0] is None else float(vols[0])
+        else:
+            volume = None if any(v is None for v in vols) else float(sum(s**3 * v for s, v in zip(scales, vols)))
+        kind = "stack"
+    elif _is_field_data(data):
+        volume = float(sum(s.volume for s in data.extra["levels"]))
+        kind = "field"
+    else:
+        v = getattr(data, "volume", None)
+        volume = None if v is None else float(v)
+        kind = "polytope" if hasattr(data, "extra") and "slice" in data.extra else "slice"
+    return points, tris, rgb, attrs, volume, kind
+
+
+def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bool = False,
+               opacity: float = 1.0):
+    """One `trimesh.Trimesh` of the faces of a slice (or of several), as the live view colours them.
+
+    Parameters
+    ----------
+    data : slice data, or a sequence of them
+        What a source's ``slice(matrix, c0)`` returns: a polytope's slice (its triangles, the
+        polygons fanned, grouped by 4-D cell), a `Field4D`'s (the isosurface of every level,
+        grouped by level index), a `StackSource`'s (the N parallel slices placed as the view
+        places them, grouped by slice index when coloured by w, else by cell / level).  A
+        sequence is concatenated in order.
+    color_by, group_colors :
+        As the widget's ``color_by`` (``"group"`` or one colour) and ``group_colors``
+        (see `face_colors`).
+    separate_groups : bool
+        False: one vertex per slice vertex (each slice's surface closed and watertight).
+        True: a vertex shared by faces of different groups is repeated for each group, so the
+        formats that keep only vertex colours (OBJ, GLB) show every face in its own colour.
+    opacity : float in [0, 1]
+        The colours' alpha (default opaque; the live view draws polytope faces at
+        `look.FACE_OPACITY`).
+
+    Returns
+    -------
+    trimesh.Trimesh (built with ``process=False``: nothing merged, reordered or dropped but the
+    points no face uses -- balls and bars are not part of it, nor a field's box outline).
+
+    * ``mesh.vertices`` (n, 3) float64 in the source's own units: a polytope's vertex
+      coordinates (the six regular ones have edge 2); a field's *slice units* -- x, y, z in the
+      data's units about the centre of its box, the w axis counted in units of
+      ``field.w_per_unit`` (a turn mixes them); a stack in its inner source's units, slice k
+      moved to its place and shrunk by its scale (``data.extra["centres"]``,
+      ``data.extra["scales"]``) as in the view.
+    * ``mesh.faces`` (k, 3), counter-clockwise seen from outside (a field's: from where f < level).
+    * ``mesh.face_attributes["group"]`` (k,) int32: each face's colour group; a stack adds
+      ``"slice"`` (k,) int32, a sequence adds ``"item"`` (k,) int32 (its index in the sequence).
+    * ``mesh.visual.face_colors`` (k, 4) uint8 RGBA (`face_colors`).
+    * ``mesh.metadata["rot4d_widget"]``: ``{"kind", "volume"}``, the volume the slicer computed
+      (a polytope's `Slice.volume`, the sum of a field's level volumes, a stack's
+      ``sum scale_k^3 V_k``; None where it has no meaning), for checks against ``mesh.volume``.
+    """
+    import trimesh
+
+    opacity = float(opacity)
+    if not 0.0 <= opacity <= 1.0:
+        raise ValueError(f"Expected `opacity` in [0, 1], got {opacity}")
+    items = list(data) if isinstance(data, (list, tuple)) else [data]
+    if not items:
+        raise ValueError("Expected slice data or a non-empty sequence of them, got an empty sequence")
+    many = isinstance(data, (list, tuple))
+    verts, faces, rgbs, attrs, kinds = [], [], [], {}, []
+    volume = 0.0
+    off = 0
+    for i, item in enumerate(items):
+        p, t, rgb, a, vol, kind = _one_mesh_arrays(item, color_by, group_colors)
+        if separate_groups and len(t):
+            key = a["group"][:, None] * len(p) + t  # (group, vertex) pairs
+            uniq, inv = np.unique(key.ravel(), return_inverse=True)
+            p, t = p[uniq % len(p)], inv.reshape(-1, 3)
+        elif len(t):
+            used, inv = np.unique(t.ravel(), return_inverse=True)  # only the points faces use
+            p, t = p[used], inv.reshape(-1, 3)
+        else:
+            p = p[:0]
+        if many:
+            a["item"] = np.full(len(t), i)
+        verts.append(p)
+        faces.append(t + off)
+        rgbs.append(rgb)
+        for name, values in a.items():
+            attrs.setdefault(name, []).append(values)
+        off += len(p)
+        kinds.append(kind)
+        volume = None if volume is None or vol is None else volume + vol
+    names = [n for n in attrs if len(attrs[n]) == len(items)]  # attributes every item has
+    rgb = np.concatenate(rgbs) if rgbs else np.zeros((0, 3))
+    colors = np.column_stack([np.rint(rgb * 255), np.full(len(rgb), round(opacity * 255))]).astype(np.uint8)
+    mesh = trimesh.Trimesh(vertices=np.concatenate(verts), faces=np.concatenate(faces).astype(np.int64),
+                           face_colors=colors, process=False, validate=False)
+    for name in names:
+        mesh.face_attributes[name] = np.concatenate(attrs[name]).astype(np.int32)
+    mesh.metadata["rot4d_widget"] = {"kind": kinds[0] if len(set(kinds)) == 1 else "mixed", "volume": volume}
+    return mesh
+
+
+def load_mesh(path):
+    """Read a mesh file with trimesh (nothing merged), restoring ``face_attributes["group"]``
+    (and "slice", "item") from a PLY file's face properties."""
+    import trimesh
+
+    mesh = trimesh.load(os.fspath(path), force="mesh", process=False)
+    raw = mesh.metadata.get("_ply_raw") if isinstance(mesh.metadata, dict) else None
+    if raw is not None:
+        data = raw.get("face", {}).get("data")
+        names = getattr(getattr(data, "dtype", None), "names", None) or ()
+        for name in ("group", "slice", "item"):
+            if name in names:
+                mesh.face_attributes[name] = np.asarray(data[name]).reshape(-1)
+    return mesh
+
+
+# ============================================================================ sources
+def _function_path(f):
+    module = getattr(f, "__module__", None)
+    qual = getattr(f, "__qualname__", None)
+    if not module or not qual:
+        return None, f"{type(f).__name__} has no module-level name"
+    if "<" in qual:
+        return None, f"{module}.{qual} is a lambda or a local function"
+    if module == "__main__":
+        return None, f"{qual} is defined in a notebook or script (__main__)"
+    return f"{module}:{qual}", None
+
+
+def describe_source(source) -> dict:
+    """``source.describe()`` plus what `rebuild_source` needs, and ``"rebuild"``: True, or the reason
+    it cannot be rebuilt.
+
+    A polytope whose vertices are not those of its name (a scaled pentachoron) keeps its
+    vertices; a field keeps its resolution, w units and how to reopen it (a module-level function
+    ``"module:qualname"``, or the file `open_field` read); a stack describes its inner source the
+    same way.
+    """
+    from .fields import Field4D
+    from .source import PolytopeSource
+    from .tomography import StackSource
+
+    if isinstance(source, StackSource):
+        d = dict(source.describe())
+        d["source"] = describe_source(source.source)
+        d["rebuild"] = d["source"]["rebuild"]
+        return d
+    d = dict(source.describe())
+    if isinstance(source, PolytopeSource):
+        from .polytopes import POLYTOPE_NAMES, polytope
+
+        p = source.polytope
+        if "vertices" not in d and (p.name not in POLYTOPE_NAMES or not np.array_equal(
+                np.asarray(p.vertices), np.asarray(polytope(p.name).vertices))):
+            d["vertices"] = np.asarray(p.vertices).tolist()
+        d["rebuild"] = True
+    elif isinstance(source, Field4D):
+        d.update(resolution=source.resolution, coarse_resolution=source.coarse_resolution, w_units=source.w_units)
+        origin = getattr(source, "origin", None)
+        if source._kind == "function":
+            path, why = _function_path(source._function)
+            d["function"] = path or d.get("function")
+            d["rebuild"] = True if path else f"its function cannot be imported again: {why}"
+        elif isinstance(origin, Mapping):
+            d["origin"] = dict(origin)
+            d["array"] = f"read from {origin.get('path')!r} (reopened from there)"
+            d["rebuild"] = True
+        else:
+            d["rebuild"] = (f"its values are a {d.get('array', 'array').replace(' (not recordable)', '')} held in "
+                            "memory, not written into a state file; open it with rot4d_widget.export.open_field(path, "
+                            "variable) to record where it comes from")
+    else:
+        d["rebuild"] = f"a source of kind {d.get('kind', type(source).__name__)!r} cannot be rebuilt from its description"
+    return _jsonable(d, "source.describe()")
+
+
+def rebuild_source(description: Mapping):
+    """The source a `describe_source` dict describes.
+
+    ``ValueError`` says why it cannot be rebuilt and what to do (pass the source to
+    `load_state`), or what is wrong with the description (an unknown polytope name ...).
+    """
+    if not isinstance(description, Mapping) or "kind" not in description:
+        raise ValueError(f"Expected a source description with a 'kind', got {description!r}")
+    kind = description["kind"]
+    why = description.get("rebuild", True)
+    if kind == "polytope":
+        from .polytopes import Polytope, polytope
+        from .source import PolytopeSource
+
+        if "vertices" in description:
+            return PolytopeSource(Polytope(np.asarray(description["vertices"], dtype=np.float64),
+                                           name=str(description.get("name", "polytope"))))
+        return PolytopeSource(polytope(description["name"]))
+    if kind == "stack":
+        from .tomography import StackSource
+
+        inner = rebuild_source(description["source"])
+        return StackSource(inner, slices=description["slices"], spacing=description.get("spacing"),
+                           arrangement=description.get("arrangement", "oval"),
+                           color_by=description.get("color_by", "w"))
+    if why is not True:
+        raise _CannotRebuild(f"The state file's source cannot be rebuilt: {why}. "
+                         "Pass it in: load_state(path, source=...)")
+    if kind == "field":
+        return _rebuild_field(description)
+    raise _CannotRebuild(f"Unknown source kind {kind!r}; pass the source in: load_state(path, source=...)")
+
+
+def _rebuild_field(d):
+    from .fields import Field4D
+
+    common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
+    if d.get("w_units") is not None:
+        common["w_units"] = d["w_units"]
+    if "origin" in d:
+        origin = dict(d["origin"])
+        field = open_field(origin.pop("path"), origin.pop("variable", None), engine=origin.pop("engine", None),
+                           **origin.pop("kwargs", {}))
+        field.w_per_unit = d["w_per_unit"]
+    else:
+        spec = d.get("function") or ""
+        module, _, qual = spec.partition(":")
+        try:
+            obj = importlib.import_module(module)
+            for part in qual.split("."):
+                obj = getattr(obj, part)
+        except (ImportError, AttributeError, ValueError) as exc:
+            raise _CannotRebuild(f"The field's function {spec!r} cannot be imported ({exc}); "
+                             "pass the source in: load_state(path, source=...)") from None
+        field = Field4D.from_function(obj, d["extent"], **common)
+    for attr in ("resolution", "coarse_resolution"):
+        if d.get(attr) is not None:
+            setattr(field, attr, d[attr])
+    if d.get("levels"):
+        field.levels = d["levels"]
+    return field
+
+
+def open_field(path, variable=None, *, engine=None, **from_xarray_kwargs):
+    """`Field4D.from_xarray` of ``variable`` in the file (or zarr store) at ``path``, remembering
+    where it came from (``field.origin``) so that a state file can reopen it.
+
+    ``variable`` may be omitted when the dataset has one data variable; ``engine`` goes to
+    ``xarray.open_dataset`` (a directory ending in ``.zarr`` opens with ``engine="zarr"``);
+    other keywords go to `Field4D.from_xarray` (``x=, y=, z=, w=, w_per_unit=`` ...).
+    """
+    import xarray
+
+    from .fields import Field4D
+
+    p = os.path.abspath(os.fspath(path))
+    if engine is None and p.rstrip("/").endswith(".zarr"):
+        engine = "zarr"
+    ds = xarray.open_dataset(p, engine=engine)
+    if variable is None:
+        names = list(ds.data_vars)
+        if len(names) != 1:
+            raise ValueError(f"{path!r} has data variables {names}; name one: open_field(path, variable)")
+        variable = names[0]
+    if variable not in ds.data_vars:
+        raise ValueError(f"{path!r} has no data variable {variable!r}; it has {list(ds.data_vars)}")
+    field = Field4D.from_xarray(ds[variable], **from_xarray_kwargs)
+    field.origin = {"kind": "xarray", "path": p, "variable": variable, "engine": engine,
+                    "kwargs": _jsonable(dict(from_xarray_kwargs), "from_xarray keywords")}
+    return field
+
+
+def _inner_identity(d):
+    while d.get("kind") == "stack":
+        d = d.get("source", {})
+    return d.get("kind"), d.get("name") if d.get("kind") == "polytope" else None
+
+
+# ============================================================================ state files
+def _jsonable(value, where: str):
+    """``value`` with tuples as lists and numpy scalars/arrays as Python numbers/lists; TypeError
+    naming ``where`` for anything JSON cannot hold (NaN and infinities included)."""
+    if isinstance(value, Mapping):
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise TypeError(f"Expected string keys in {where}, got {k!r}")
+            out[k] = _jsonable(v, f"{where}[{k!r}]")
+        return out
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist(), where)
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        if not math.isfinite(value):
+            raise TypeError(f"{where} = {value}: a state file holds finite numbers only")
+        return float(value)
+    if value is None or isinstance(value, str):
+        return value
+    raise TypeError(f"{where} is a {type(value).__name__}, which a JSON state file cannot hold")
+
+
+class LoadedState(NamedTuple):
+    """What `load_state` returns: ``state, source, settings = load_state(path)``."""
+
+    state: RotationState
+    source: object
+    settings: dict
+
+
+def save_state(path, state: RotationState, source=None, settings: Mapping | None = None) -> dict:
+    """Write ``state``, what ``source`` is and the widget's ``settings`` to the JSON file ``path``.
+
+    ``settings`` is any dict of JSON-able values (tuples and numpy numbers are converted), for
+    the widget: its traits (``levels``, ``slices``, ``spacing``, ``arrangement``,
+    ``face_opacity``, ``ball_radius``, ``bar_radius``, ``background``, ``show_balls``,
+    ``show_bars``, ``show_faces``, ``color_by``) -- `rot4d_widget.figures.render_state` takes the
+    same names.  A source that cannot be rebuilt (an in-memory array, a lambda) is described
+    anyway, with a `SourceNotRebuildable` warning saying so.  Returns the dict written.
+    The file is replaced atomically (written beside it, then renamed).
+    """
+    if not isinstance(state, RotationState):
+        raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+    src = None
+    if source is not None:
+        from .source import as_source
+
+        src = describe_source(as_source(source))
+        if src["rebuild"] is not True:
+            warnings.warn(f"The source is described in {os.fspath(path)!r} but cannot be rebuilt from it: "
+                          f"{src['rebuild']}. Loading the file will need it passed in: "
+                          "load_state(path, source=...)", SourceNotRebuildable, stacklevel=2)
+    doc = {
+        "format": STATE_FILE_FORMAT,
+        "version": STATE_FILE_VERSION,
+        "state": state.to_dict(),
+        "source": src,
+        "settings": _jsonable(dict(settings or {}), "settings"),
+    }
+    from . import __version__
+
+    doc["rot4d_widget"] = __version__
+    text = json.dumps(doc, indent=1, allow_nan=False)
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".rot4d-state-", suffix=".json", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text + "\n")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return doc
+
+
+def load_state(path, source=None) -> LoadedState:
+    """Read a `save_state` file: ``(state, source, settings)``.
+
+    The state is validated (`RotationState.from_dict`: an orientation within 1e-6 of orthogonal
+    is re-orthonormalised, further off refused) and is what its ``reset()`` returns to.  The
+    source is ``source`` if given -- then it must be of the kind the file describes (a
+    polytope of the same name), else ``ValueError`` -- or rebuilt from the file; when it cannot
+    be (an in-memory array), the source is None and a `SourceNotRebuildable` warning says why.
+    ``ValueError`` names what is wrong with a file that is not a state file, or a newer one.
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path!r} is not a rot4d_widget state file: not JSON ({exc})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path!r} is not a rot4d_widget state file: not UTF-8 text") from None
+    if not isinstance(doc, dict) or doc.get("format") != STATE_FILE_FORMAT:
+        raise ValueError(f"{path!r} is not a rot4d_widget state file (no \"format\": \"{STATE_FILE_FORMAT}\")")
+    version = doc.get("version")
+    if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= STATE_FILE_VERSION:
+        raise ValueError(f"{path!r} is a state file of version {version!r}; this rot4d_widget reads versions "
+                         f"1 ... {STATE_FILE_VERSION}")
+    missing = [k for k in ("state", "source", "settings") if k not in doc]
+    if missing:
+        raise ValueError(f"{path!r} lacks {', '.join(map(repr, missing))}")
+    try:
+        state = RotationState.from_dict(doc["state"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path!r}: bad state: {exc}") from None
+    settings = doc["settings"]
+    if not isinstance(settings, dict):
+        raise ValueError(f"{path!r}: expected 'settings' to be a dict, got {type(settings).__name__}")
+    desc = doc["source"]
+    if source is not None:
+        from .source import as_source
+
+        source = as_source(source)
+        if desc is not None:
+            want, got = _inner_identity(desc), _inner_identity(describe_source(source))
+            if want != got:
+                raise ValueError(f"{path!r} was saved with a source of kind {want[0]!r}"
+                                 f"{'' if want[1] is None else f' ({want[1]})'}, got {got[0]!r}"
+                                 f"{'' if got[1] is None else f' ({got[1]})'}")
+        return LoadedState(state, source, settings)
+    if desc is None:
+        return LoadedState(state, None, settings)
+    try:
+        rebuilt = rebuild_source(desc)
+    except _CannotRebuild as exc:
+        warnings.warn(str(exc), SourceNotRebuildable, stacklevel=2)
+        rebuilt = None
+    except (TypeError, ValueError, KeyError) as exc:
+        raise ValueError(f"{path!r}: bad source description: {exc}") from None
+    return LoadedState(state, rebuilt, settings)
