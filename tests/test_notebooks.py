@@ -35,6 +35,7 @@ PROJECT_NOTEBOOKS = [
     "03_paper_figures.ipynb",
     "04_time_varying_field.ipynb",
     "05_tomography.ipynb",
+    "06_uniform_polychora.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
