@@ -459,3 +459,10 @@ def test_widest_slice_census_of_the_omnitruncated_120_cell():
     crossed = sum(1 for cell in p.cells
                   if (lambda ws: ws.min() < 0 < ws.max())(w[np.unique(np.concatenate([p.faces[f] for f in cell]))]))
     assert len(s.cell_ids) == crossed
+
+
+def test_cached_combinatorics_are_read_only():
+    c = uniform.combinatorics("rectified 5-cell")
+    for a in (c.vertices, c.edges, c.faces[0], c.cells[0], c.cell_types):
+        with pytest.raises(ValueError, match="read-only"):
+            a[0] = a[0]
