@@ -466,3 +466,22 @@ def test_cached_combinatorics_are_read_only():
     for a in (c.vertices, c.edges, c.faces[0], c.cells[0], c.cell_types):
         with pytest.raises(ValueError, match="read-only"):
             a[0] = a[0]
+
+
+@explicit
+@pytest.mark.parametrize("name", ["truncated tesseract", "runcinated 24-cell", "grand antiprism", "5-7 duoprism",
+                                  "snub cubic prism"])
+def test_hyperplane_through_a_cell_gives_that_cell(name):
+    """H turned onto a cell's hyperplane (an on-H case): the slice is that cell, its volume the
+    cell's own (scipy hull in the cell's 3-space), one polygon per face of the cell."""
+    from reference_geometry import rotation_with_w_row
+
+    p = uniform.build(name)
+    c = uniform.combinatorics(name)
+    for k in np.unique(c.cell_types, return_index=True)[1]:
+        m = rotation_with_w_row(p.cell_normals[k])
+        s = slice_polytope(p, m, float(p.cell_offsets[k]))
+        pts = p.vertices[np.unique(np.concatenate([p.faces[f] for f in p.cells[k]]))] @ m.T
+        assert s.dim == 3
+        assert s.volume == pytest.approx(ConvexHull(pts[:, :3]).volume, rel=1e-9)
+        assert len(s.cell_ids) == len(p.cells[k])
