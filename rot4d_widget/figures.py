@@ -22,6 +22,8 @@ face's centroid), so nearer things cover farther ones.
 
 ``render_key_sequence(key, n_panels)`` shows what holding a key does: panel k is drawn after k
 presses; :func:`paper_figure_3` and :func:`paper_figure_4` reproduce the paper's figures.
+:func:`render_state` draws what a widget shows -- a `RotationState` and any source (polytope,
+field, stack) with the widget's display settings -- at a chosen size in pixels.
 
 Functions build :class:`matplotlib.figure.Figure` objects directly and never touch
 ``matplotlib.pyplot``, so they work under any backend and leave pyplot's state alone.
@@ -65,6 +67,8 @@ __all__ = [
     "paper_figure_3",
     "paper_figure_4",
     "render_tomography",
+    "render_state",
+    "state_source",
 ]
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
@@ -509,7 +513,7 @@ def _save(fig: Figure, path) -> None:
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in _SAVE_FORMATS:
         raise ValueError(f"Expected `path` to end in one of {', '.join(_SAVE_FORMATS)}, got {os.fspath(path)!r}")
-    fig.savefig(path, dpi=fig.dpi, facecolor=look.BACKGROUND)
+    fig.savefig(path, dpi=fig.dpi, facecolor=fig.get_facecolor())
 
 
 def paper_figure_3(path=None, *, panel_size: float = 2.0, dpi: float = 100, title: bool = True) -> Figure:
@@ -562,6 +566,14 @@ def render_tomography(
     title: str | bool | None = True,
     labels: bool = True,
     face_alpha: float = look.FACE_OPACITY,
+    ball_radius: float | None = None,
+    bar_radius: float | None = None,
+    show_balls: bool = True,
+    show_bars: bool = True,
+    show_faces: bool = True,
+    face_color=None,
+    group_colors=None,
+    background=look.BACKGROUND,
 ) -> Figure:
     """N parallel slices w_k = c0 + (k - (N-1)/2) Δ of ``source``, in one scene, as the live view lays them out.
 
@@ -576,6 +588,12 @@ def render_tomography(
     :func:`draw_slice`.  ``labels``: each slice's w under it; the slice at w = c0 (or the first
     above it, for even N) is ringed and its label bold.  Saved to ``path`` (.png, .svg or .pdf)
     if given.  Returns the Figure.
+
+    The live view's display options: ``ball_radius`` / ``bar_radius`` in displayed units, the
+    same for every slice (default: the widest slice's, shrunk with each slice's scale),
+    ``show_balls`` / ``show_bars`` / ``show_faces``, ``face_color`` one colour for every face
+    (the widget's ``color_by`` when it is a colour), ``group_colors`` one colour per group,
+    ``background``.
     """
     from .source import as_source
     from .tomography import StackSource
@@ -590,6 +608,17 @@ def render_tomography(
     height = _real("height", height, minimum=0.0, inclusive=False)
     dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
     face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    if ball_radius is not None:
+        ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+    if bar_radius is not None:
+        bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
+    palette = None  # an override of the group colours: one colour, or the caller's
+    if face_color is not None:
+        palette = np.asarray([look.as_rgb(face_color, "face_color")], dtype=np.float64)
+    elif group_colors is not None:
+        palette = np.asarray([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
+                             dtype=np.float64).reshape(-1, 3)
+    background = to_rgba(background)
     data = src.slice(matrix, c0)
     ex = data.extra
     n = src.slices
@@ -601,9 +630,10 @@ def render_tomography(
     group_rgb = ex.get("group_rgb")
 
     top = TITLE_HEIGHT if title else 0.0
-    fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=look.BACKGROUND)
+    fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
     ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
     ax.set_axis_off()
+    ax.set_facecolor(background)
     d = CAMERA_DISTANCE
     limit = d * math.tan(math.radians(CAMERA_FOV) / 2.0)
     aspect = width / height
@@ -620,20 +650,30 @@ def render_tomography(
     # back to front by the depth of each slice's centre; zorders of slices never interleave
     for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
         z_shift = 1e3 * rank
-        ball = base_ball * scales[k]
+        ball = base_ball * scales[k] if ball_radius is None else ball_radius
+        bar = look.default_bar_radius(ball) if bar_radius is None else bar_radius
         if poly is not None:
             s = ex["slices"][k]
             placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
                            s.volume, s.dim)
-            cmap = None if group_rgb is None else ListedColormap([group_rgb[k]])
-            drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV, ball_radius=ball,
-                                 bar_radius=look.default_bar_radius(ball), face_alpha=face_alpha, cmap=cmap)
+            if palette is not None:
+                cmap = ListedColormap(palette[[0]] if len(palette) == 1 else palette)
+            else:
+                cmap = None if group_rgb is None else ListedColormap([group_rgb[k]])
+            if not show_faces:
+                placed = Slice(placed.vertices, placed.edges, placed.polygon_indices[:0], placed.polygon_offsets[:1],
+                               placed.cell_ids[:0], placed.triangles[:0], placed.triangle_cells[:0], placed.volume,
+                               placed.dim)
+            drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV, ball_radius=ball if show_balls else 0.0,
+                                 bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap)
             for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
                 a.set_zorder(a.get_zorder() + z_shift)
         else:
-            _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, src.source, face_alpha, z_shift,
-                          0.35 * look.default_bar_radius(ball))
+            _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
+                          src.source, face_alpha, z_shift,
+                          (0.35 * look.default_bar_radius(ball) if bar_radius is None else bar_radius) if show_bars else 0.0,
+                          show_faces=show_faces)
         if labels:
             _label_slice(ax, centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift)
     ax.set_xlim(-limit * aspect, limit * aspect)
@@ -663,7 +703,8 @@ def _label_slice(ax, centre, radius, w, highlighted, z_shift):
                             zorder=z, gid="highlight-ring"))
 
 
-def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width):
+def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width,
+                  show_faces=True):
     """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines."""
     from matplotlib.collections import LineCollection, PolyCollection
 
@@ -675,10 +716,11 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
         return
     xy, _ = perspective(pts)
     z_base = _Z_BASE + float(pts[:, 2].mean()) + z_shift
-    if len(tri):
+    if len(tri) and show_faces:
         groups = np.asarray(data.groups[toff[k]:toff[k + 1]])
         if group_rgb is not None:
-            rgb = np.asarray(group_rgb, dtype=np.float64)[groups]
+            pal = np.asarray(group_rgb, dtype=np.float64)
+            rgb = pal[np.minimum(groups, len(pal) - 1)] if len(pal) == 1 else pal[groups]
         else:
             levels = getattr(inner, "levels", None)
             if levels:
@@ -699,7 +741,106 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
         coll = PolyCollection(xy[tri[order]], facecolors=np.column_stack([rgb[order], np.full(len(order), alpha)]),
                               edgecolors="none", zorder=z_base, gid="surface")
         ax.add_collection(coll)
-    if len(seg):
+    if len(seg) and bar_width > 0:
         lines = LineCollection(xy[seg], colors=look.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
                                zorder=z_base + 1e-3, gid="bar")
         ax.add_collection(lines)
+
+
+# --------------------------------------------------------------------------- the live view's picture
+def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=None):
+    """``source`` (a name, a Polytope or any source) with a widget's source settings applied, as a
+    `StackSource` (N = 1 is today's single slice, point for point).  The source given is not
+    changed: a field whose ``levels`` differ is copied (shallowly, sharing its array), a stack is
+    rebuilt around its inner source."""
+    from .source import as_source
+    from .tomography import StackSource
+
+    src = as_source(source)
+    inner, color_by, n, spc, arr = src, "w", 1, None, "oval"
+    if isinstance(src, StackSource):
+        inner, color_by, n, arr = src.source, src.color_by, src.slices, src.arrangement
+        spc = None if src.spacing_is_default else src.spacing
+    if slices is not None:
+        n = slices
+    if spacing is not None:
+        spc = spacing
+    if arrangement is not None:
+        arr = arrangement
+    if levels is not None:
+        if not hasattr(inner, "levels"):
+            raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {type(inner).__name__}")
+        if tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist()) != tuple(inner.levels):
+            inner = copy.copy(inner)
+            inner.levels = levels
+    return StackSource(inner, slices=n, spacing=spc, arrangement=arr, color_by=color_by)
+
+
+def render_state(
+    state: RotationState,
+    source="5-cell",
+    path=None,
+    *,
+    levels=None,
+    slices: int | None = None,
+    spacing: float | None = None,
+    arrangement: str | None = None,
+    color_by="group",
+    group_colors=None,
+    face_opacity: float = look.FACE_OPACITY,
+    ball_radius: float | None = None,
+    bar_radius: float | None = None,
+    background=look.BACKGROUND,
+    show_balls: bool = True,
+    show_bars: bool = True,
+    show_faces: bool = True,
+    size=(600, 500),
+    dpi: float = 100,
+    labels: bool = False,
+    title: str | None = None,
+) -> Figure:
+    """The picture the widget shows for ``state`` and ``source``, without a browser.
+
+    ``state`` is a `RotationState` (its matrix and c0 are used); ``source`` a polytope name, a
+    Polytope, a `Field4D`, a `StackSource` or any source.  The keywords are the widget's
+    settings, by the names of its traits (`rot4d_widget.export.save_state` stores them so):
+    ``levels`` (a field's iso levels), ``slices``, ``spacing``, ``arrangement`` (parallel
+    slices: `state_source`), ``color_by`` (``"group"`` or one colour), ``group_colors``,
+    ``face_opacity``, ``ball_radius`` / ``bar_radius`` (displayed units; default as the widget
+    chooses them: from the polytope's edge, the same for every slice), ``background``,
+    ``show_balls`` / ``show_bars`` / ``show_faces``.
+
+    The scene is the live view's: every source scaled to the displayed circumradius
+    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z with the vertical
+    field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
+    widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
+    `look.level_colors`; a stack coloured by w: its levels' colormap).  It does not follow a
+    camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
+    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels.
+    Returns the Figure.
+    """
+    if not isinstance(state, RotationState):
+        raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+    try:
+        w_px, h_px = (float(v) for v in size)
+    except (TypeError, ValueError):
+        raise TypeError(f"Expected `size` to be (width, height) in pixels, got {size!r}") from None
+    w_px = _real("size[0]", w_px, minimum=1.0)
+    h_px = _real("size[1]", h_px, minimum=1.0)
+    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    if title is not None and not isinstance(title, str):
+        raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
+    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement)
+    face_color = None
+    if color_by != "group":
+        face_color = look.as_rgb(color_by, "color_by")
+    if ball_radius is None:
+        edge = getattr(stack, "edge_length", None)
+        if edge:
+            ball_radius = look.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
+    return render_tomography(
+        stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi, dpi=dpi,
+        title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
+        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
+        face_color=face_color, group_colors=group_colors, background=background,
+    )

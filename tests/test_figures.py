@@ -377,3 +377,128 @@ def test_panel_style_keeps_dense_polytopes_readable():
     assert dense["ball_radius"] == pytest.approx(0.1 * 2.0 * dense["scale"])
     assert dense["ball_radius"] < five["ball_radius"]
     assert dense["bar_radius"] == pytest.approx(0.4 * dense["ball_radius"])
+
+
+# --------------------------------------------------------------------------- render_state (issue 12)
+def _ndc_pixel(p3, size):
+    """Where the live view's three.js camera (look: eye (0, 0, 5), vertical fov 40 deg, aspect
+    w / h) puts the displayed point p3: pixel (column, row) of a w x h image, written out here."""
+    from rot4d_widget import look
+
+    w, h = size
+    d = look.CAMERA_POSITION[2]
+    t = math.tan(math.radians(look.CAMERA_FOV) / 2)
+    x, y, z = p3
+    ndc_x = x / ((d - z) * t * (w / h))
+    ndc_y = y / ((d - z) * t)
+    return (ndc_x + 1) / 2 * w, (1 - ndc_y) / 2 * h
+
+
+@pytest.mark.parametrize("size", [(600, 500), (320, 400)])
+def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path, size):
+    from rot4d_widget import look, polytope
+    from rot4d_widget.figures import render_state
+    from rot4d_widget.rotation import random_rotation
+
+    st = RotationState(matrix=random_rotation(4), c0=0.1)
+    path = tmp_path / "s.png"
+    render_state(st, "24-cell", path, size=size, dpi=80, ball_radius=0.09)
+    img = imread(path)
+    assert img.shape[:2] == (size[1], size[0])  # the size asked for, in pixels
+    s = slice_polytope(polytope("24-cell"), st.matrix, st.c0)
+    v = np.asarray(s.vertices) * look.REFERENCE_RADIUS / 2.0  # displayed units (24-cell: circumradius 2)
+    near = v[np.argmax(v[:, 2])]
+    col, row = _ndc_pixel(near, size)
+    pixel = img[int(row), int(col), :3]
+    np.testing.assert_allclose(pixel, look.as_rgb(look.BALL_COLOR), atol=0.03)
+    # a corner is background
+    np.testing.assert_allclose(img[2, 2, :3], [1, 1, 1], atol=1e-6)
+    # balls only: every vertex, the widest ones too, is drawn where the camera puts it
+    render_state(st, "24-cell", path, size=size, dpi=80, show_faces=False, show_bars=False)
+    img = imread(path)[..., :3]
+    for p3 in v:
+        col, row = _ndc_pixel(p3, size)
+        r, g, b = img[int(row), int(col)]
+        assert r > 0.45 and g < 0.3 and b < 0.3, (p3, (r, g, b))
+    assert np.abs(v[:, 0]).max() > 0.8  # some are far from the centre (the aspect matters)
+
+
+def test_render_state_display_options_and_colours(tmp_path):
+    from rot4d_widget import look
+    from rot4d_widget.figures import render_state
+
+    st = RotationState()
+    path = tmp_path / "c.png"
+    # one opaque colour, no balls or bars, a dark background: only two colours in the picture
+    render_state(st, "5-cell", path, color_by="#ff0000", face_opacity=1.0, show_balls=False, show_bars=False,
+                 background="#000000", size=(200, 200), dpi=50)
+    img = imread(path)[..., :3]
+    col, row = _ndc_pixel((0.0, 0.0, 0.0), (200, 200))
+    np.testing.assert_allclose(img[int(row), int(col)], [1, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(img[1, 1], [0, 0, 0], atol=1e-6)
+    reddish = (img[..., 0] > 0.5) & (img[..., 1] < 0.2)
+    assert 0.05 < reddish.mean() < 0.6
+    # by group (the default): the cells' palette colours over white, no pure red
+    render_state(st, "5-cell", path, face_opacity=1.0, show_balls=False, show_bars=False, size=(200, 200), dpi=50)
+    img = imread(path)[..., :3].reshape(-1, 3)
+    pal = look.group_palette(5)
+    drawn = img[np.abs(img - 1).max(axis=1) > 0.02]  # not background
+    near = np.abs(drawn[:, None, :] - pal[None]).max(axis=2).min(axis=1) < 0.02
+    assert len(drawn) > 0.05 * len(img) and near.mean() > 0.75  # (edges antialiased) opaque faces in the cells' colours
+    # show_faces=False leaves balls and bars on white
+    def green(**kw):
+        render_state(st, "5-cell", path, color_by="#00ff00", face_opacity=1.0, size=(200, 200), dpi=50, **kw)
+        r, g, b = np.moveaxis(imread(path)[..., :3], -1, 0)
+        return ((g > r + 0.3) & (g > b + 0.3)).mean()
+
+    assert green() > 0.05
+    assert green(show_faces=False) == 0  # balls (red) and bars (grey) only
+
+
+def test_render_state_field_levels_and_stack(tmp_path):
+    from rot4d_widget import Field4D, look
+    from rot4d_widget.figures import render_state, state_source
+    from rot4d_widget.tomography import StackSource
+
+    f = Field4D.from_function(lambda x, y, z, w: 1 - (x * x + y * y + z * z) - 0.3 * w,
+                              [(-1.2, 1.2)] * 3 + [(-1.0, 1.0)], resolution=24, levels=(0.4,))
+    st = RotationState()
+    path = tmp_path / "f.png"
+    render_state(st, f, path, size=(240, 200), dpi=60, show_bars=False)
+    img = imread(path)[..., :3]
+    col, row = _ndc_pixel((0.0, 0.0, 0.0), (240, 200))
+    pixel = img[int(row), int(col)]
+    want = look.level_colors([0.4], *f.data_range)[0]
+    cos = pixel @ want / np.linalg.norm(pixel) / np.linalg.norm(want)
+    assert cos > 0.995  # the level's colour, shaded
+    # levels given: the field itself is left alone
+    render_state(st, f, path, levels=(0.2, 0.6), size=(240, 200), dpi=60)
+    assert f.levels == (0.4,)
+    assert state_source(f, levels=(0.2, 0.6)).source.levels == (0.2, 0.6)
+    # a stack: parallel slices of the same source (slices= wraps, a StackSource is re-set)
+    stack = state_source("24-cell", slices=5, spacing=0.4, arrangement="grid")
+    assert isinstance(stack, StackSource) and (stack.slices, stack.spacing, stack.arrangement) == (5, 0.4, "grid")
+    again = state_source(stack, slices=3)
+    assert (again.slices, again.spacing, again.arrangement, stack.slices) == (3, 0.4, "grid", 5)
+    for ext, magic in (("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")):
+        render_state(st, stack, tmp_path / f"s.{ext}", size=(300, 250), dpi=50)
+        assert (tmp_path / f"s.{ext}").read_bytes()[:5].startswith(magic)
+    one = imread(tmp_path / "s.png")[..., :3]
+    render_state(st, "24-cell", tmp_path / "one.png", size=(300, 250), dpi=50)
+    assert not np.array_equal(one, imread(tmp_path / "one.png")[..., :3])
+
+
+@pytest.mark.parametrize("kwargs, exc, match", [
+    (dict(state="not a state"), TypeError, "RotationState"),
+    (dict(size=(600,)), TypeError, "size"),
+    (dict(size=(0, 100)), ValueError, r"size\[0\]"),
+    (dict(color_by="blue-ish"), ValueError, "color_by"),
+    (dict(levels=(0.1,)), TypeError, "levels.*Field4D"),
+    (dict(path="x.gif"), ValueError, "end in one of"),
+])
+def test_render_state_bad_input(kwargs, exc, match):
+    from rot4d_widget.figures import render_state
+
+    state = kwargs.pop("state", RotationState())
+    with pytest.raises(exc, match=match):
+        render_state(state, "5-cell", **kwargs)
