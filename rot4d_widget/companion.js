@@ -55,6 +55,15 @@ function defineLeaveGuard() {
   );
 }
 
+// three.js re-uploads an attribute only when its `version` exceeds the one it uploaded last.
+// pythreejs resets `version` to its model's (small) value when it re-syncs an attribute from the
+// kernel, so counting up from there can stay below what the GPU holds and the upload is
+// skipped: the old, shorter buffer is drawn with the new index count ("glDrawElements:
+// Insufficient buffer size", no surface).  The surface's versions come from one counter that
+// starts far above any pythreejs value and only rises.
+let surfaceVersion = 2 ** 30;
+const nextSurfaceVersion = () => ++surfaceVersion;
+
 function modelId(ref) {
   return typeof ref === "string" && ref.startsWith("IPY_MODEL_") ? ref.slice(10) : ref;
 }
@@ -222,7 +231,7 @@ async function render({ model, el }) {
         }
         const put = (attr, array) => {
           attr.setArray(array);
-          attr.needsUpdate = true;
+          attr.version = nextSurfaceVersion();
         };
         surfaceArrays = { position: copy(s.position, Uint16Array), geometry: g };
         put(g.attributes.position, surfaceArrays.position);

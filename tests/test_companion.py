@@ -167,10 +167,18 @@ scene.on("rerender", () => rerenders++);
 const geometries = [0, 1, 2].map(() => ({ obj: { maxInstancedCount: 16 } }));
 const meshes = [0, 1, 2].map(() => ({ obj: { matrix: { elements: new Array(16).fill(0) },
   quaternion: { setFromRotationMatrix(m) { this.from = m.elements.slice(); } } } }));
+// the surface mesh: three.js BufferAttributes (setArray; needsUpdate bumps the version)
+const attr = (array) => ({ array, version: 0, setArray(a) { this.array = a; }, set needsUpdate(v) { if (v) this.version++; } });
+const surfaceGeometry = {
+  attributes: { position: attr(new Uint16Array(9)), normal: attr(new Int8Array(9)), a_rgb: attr(new Uint8Array(9)) },
+  index: attr(new Uint32Array(0)), drawRange: null, setDrawRange(start, count) { this.drawRange = { start, count }; },
+};
+meshes.push({ obj: { name: "surface", geometry: surfaceGeometry, matrix: { elements: new Array(16).fill(0) },
+  quaternion: { setFromRotationMatrix(m) { this.from = m.elements.slice(); } }, material: { uniforms: { u_lo: {}, u_span: {}, u_opacity: {} } } } });
 const sent = [];
 const model = {
   get: (k) => ({ buffer_model_id: "IPY_MODEL_buf", scene_model_id: "scn", canvas_class: CLS,
-                 geometry_model_ids: ["IPY_MODEL_g0", "g1", "g2"], mesh_model_ids: ["m0", "m1", "m2"] })[k],
+                 geometry_model_ids: ["IPY_MODEL_g0", "g1", "g2"], mesh_model_ids: ["m0", "m1", "m2", "m3"] })[k],
   send: (m) => sent.push(m),
   // the buffer model is not registered at first: get_model rejects twice
   widget_manager: {
@@ -178,7 +186,7 @@ const model = {
     async get_model(id) {
       if (id === "buf" && this.misses < 2) { this.misses++; throw new Error("widget model not found"); }
       return ({ buf: buffer, scn: scene, g0: geometries[0], g1: geometries[1], g2: geometries[2],
-                m0: meshes[0], m1: meshes[1], m2: meshes[2] })[id];
+                m0: meshes[0], m1: meshes[1], m2: meshes[2], m3: meshes[3] })[id];
     },
   },
 };
@@ -257,6 +265,37 @@ step("turnBeforeRender");
 scene.trigger("afterRender"); frame();
 step("turnAck");
 
+// 4. a smooth surface.  Like three.js, the fake GPU re-uploads an attribute only when its version
+// exceeds the one uploaded last; pythreejs may put its placeholder arrays back with a small version.
+const gpu = new Map();
+const surfaceAttrs = () => [...Object.values(surfaceGeometry.attributes), surfaceGeometry.index];
+const draw = () => {
+  for (const a of surfaceAttrs()) {
+    const d = gpu.get(a);
+    if (!d || d.version < a.version) gpu.set(a, { version: a.version, length: a.array.length });
+  }
+  scene.trigger("afterRender"); frame();
+};
+const stale = () => surfaceAttrs().filter((a) => gpu.get(a).length !== a.array.length).length;
+const bytes = (n) => new DataView(new ArrayBuffer(n));
+const surface = (seq, n, k) => buffer.setState({ _rot4d_seq: seq, _rot4d_surface: {
+  n_vertices: n, n_indices: k, lo: [0, 0, 0], span: 1, opacity: 1,
+  position: bytes(6 * n), normal: bytes(3 * n), rgb: bytes(3 * n), index: bytes(4 * k) } });
+out.staleSurfaces = [];
+for (const [seq, n, k] of [[20, 4, 6], [21, 5, 9], [22, 3, 3]]) {
+  surface(seq, n, k); await null; draw();
+  out.staleSurfaces.push(stale());
+}
+out.surfaceLengths = surfaceAttrs().map((a) => a.array.length);
+out.drawRange = surfaceGeometry.drawRange;
+for (const a of surfaceAttrs()) { a.array = new a.array.constructor(9); a.version = 1; }  // pythreejs re-sync
+draw(); draw();  // the companion puts the surface back (and asks for a render)
+out.staleSurfaces.push(stale());
+out.restoredLengths = surfaceAttrs().map((a) => a.array.length);
+surface(23, 6, 12); await null; draw();  // a bigger surface after the re-sync
+out.staleSurfaces.push(stale());
+step("surfaceMessages");
+
 // 2. focus loss
 window.fire("blur", {});
 document.visibilityState = "hidden"; document.fire("visibilitychange", {});
@@ -288,6 +327,16 @@ def js_run(tmp_path_factory):
     proc = subprocess.run([node, str(driver), str(JS)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_js_the_surface_is_uploaded_even_after_pythreejs_resets_its_versions(js_run):
+    # three.js uploads an attribute only when its version exceeds the last one uploaded; pythreejs
+    # re-syncing the placeholder arrays sets a small version: counting up from it, the next surface
+    # stayed below the GPU's version and its upload was skipped (a shorter buffer drawn with the
+    # new index count: "glDrawElements: Insufficient buffer size", no surface)
+    assert js_run["surfaceLengths"] == [9, 9, 9, 3] and js_run["drawRange"] == {"start": 0, "count": 3}
+    assert js_run["restoredLengths"] == [9, 9, 9, 3]  # the re-synced placeholders replaced by ours
+    assert js_run["staleSurfaces"] == [0, 0, 0, 0, 0]
 
 
 def test_js_is_invisible(js_run):
@@ -335,7 +384,7 @@ def test_js_draws_only_the_rows_in_use_set_with_the_rows(js_run):
 
 
 def test_js_a_turn_alone_turns_every_mesh_and_is_acknowledged_when_drawn(js_run):
-    assert js_run["turned"] == [True, True, True]
+    assert js_run["turned"] == [True, True, True, True]  # balls, bars, faces, surface
     assert js_run["rerendered"] == 1  # no buffer changed: the scene is asked to render
     assert js_run["turnBeforeRender"] == []
     assert js_run["turnAck"] == [{"event": "drawn", "seq": 13}]

@@ -87,7 +87,8 @@ def test_phase_separation_field_held_key_then_full_resolution(jupyter_server, pa
     got = jp.wait_for(lambda: (s := _surface_pixels(jp, sel))["count"] > 0.02 * s["total"] and s, timeout=30)
     before_px = _surface_pixels(jp, sel)
     surface = jp.kernel_json("dict(n=w.scene.surface.get('n_vertices', 0), k=w.scene.surface.get('n_indices', 0))")
-    assert got, f"no surface drawn: {before_px} level-coloured pixels; the kernel sent {surface}"
+    gl = [t for _, t in page.console_messages if "GL_INVALID" in t][:3]  # e.g. a buffer not uploaded
+    assert got, f"no surface drawn: {before_px} level-coloured pixels; the kernel sent {surface}; WebGL: {gl}"
 
     x0, y0, x1, y1 = before_px["bbox"]
     stats = jp.canvas_stats(sel)
