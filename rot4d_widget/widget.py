@@ -123,7 +123,8 @@ class Rot4DWidget(widgets.HBox):
         Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
         `rot4d_widget.tomography.StackSource`), placed "oval" (on a parabola, the slice at
         c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the
-        spacing (default 2 * size / N).  Also traits; chosen at construction.
+        spacing (default 2 * size / N).  Also traits: setting `slices` (or pressing n) on a
+        single view turns it into parallel slices (oval, default spacing).
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
@@ -155,7 +156,7 @@ class Rot4DWidget(widgets.HBox):
     color_by = _Value("group", help='"group" or one colour for every face')
     levels = _Value(None, help="iso levels of a field source (tuple of floats); None for sources without levels")
     levels.allow_none = True
-    slices = _Value(None, help="parallel slices shown (int 1...64); None unless built with slices=")
+    slices = _Value(None, help="parallel slices shown (int 1...64); None for a single view until set (or n pressed)")
     slices.allow_none = True
     spacing = _Value(None, help="distance between parallel slices, in the source's units")
     spacing.allow_none = True
@@ -522,8 +523,39 @@ class Rot4DWidget(widgets.HBox):
             self._pump.flush()
 
     def _on_stack_trait(self, change) -> None:
+        if (change["name"] == "slices" and not self._syncing and not _is_stack(self.source)
+                and change["new"] is not None):
+            with self._pump.lock:  # parallel slices asked for at run time: wrap the source now
+                try:
+                    self._wrap_in_stack(change["new"])
+                except Exception:
+                    self._set_quietly("slices", change["old"])
+                    raise
+                self._pump.mark_dirty()
+                self._pump.flush()
+            return
         self._source_setting(change, self.source if _is_stack(self.source) else None,
-                             f"`{change['name']}` applies to parallel slices: build the widget with slices=N")
+                             f"`{change['name']}` applies to parallel slices: set `slices` (or press n) first")
+
+    def _wrap_in_stack(self, slices) -> None:
+        """Show ``slices`` parallel slices of the current source from now on (the lock is held).
+
+        The source is wrapped in a `rot4d_widget.tomography.StackSource` (oval, default
+        spacing), its keys n / b / g / f join the keymap and the help.  Raises before any
+        change if ``slices`` is not allowed.
+        """
+        from .tomography import StackSource
+
+        stack = StackSource(self.source, slices=slices)
+        actions = _source_actions(stack)
+        self.state.keymap = self.state.keymap.extended({k: a for k, (a, _, _) in actions.items()})
+        self._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
+        self.source = stack
+        self.help_panel.value = ro.help_html(_help_groups(self.state.keymap), self._repeater.hold_delay,
+                                             self._repeater.tick_rate)
+        self._source_version += 1
+        self._slice_cache = None
+        self._sync_stack()
 
     def _sync_levels(self) -> None:
         """Copy the source's iso levels (if it has any) into the `levels` trait."""
@@ -657,6 +689,11 @@ class Rot4DWidget(widgets.HBox):
             changed = True
             self._sync_levels()
             self._sync_stack()
+        elif action.kind == "slices" and not _is_stack(self.source):
+            # n on a single slice: the first added slice makes the view a stack of two
+            changed = (-1 if inverted else 1) * action.sign > 0
+            if changed:
+                self._wrap_in_stack(2)
         else:
             changed = self.state.apply(action, inverted)
         if changed:
@@ -866,8 +903,10 @@ def _help_groups(keymap: Keymap) -> list:
     """The key table, one row per action; reserved keys that do nothing here yet in one honest row."""
     rows, reserved = [], []
     for keys, label, text in keymap.help_groups():
-        kinds = {keymap[k].kind for k in keys.split() if k in keymap}
-        if kinds and kinds <= RESERVED_KINDS:
+        acts = [keymap[k] for k in keys.split() if k in keymap]
+        kinds = {a.kind for a in acts}
+        adds_slice = kinds == {"slices"} and all(a.sign > 0 for a in acts)  # n: makes the view a stack
+        if kinds and kinds <= RESERVED_KINDS and not adds_slice:
             reserved.append(keys)
         else:
             rows.append((keys, label, text))

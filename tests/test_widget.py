@@ -568,7 +568,8 @@ def test_help_key_toggles_the_key_table(make):
             continue
         assert f"<kbd>{html.escape(keys)}</kbd>" in w.help_panel.value
         assert html.escape(label) in w.help_panel.value
-    assert "<kbd>o i n b g f p</kbd><td>reserved" in w.help_panel.value.replace("</td>", "")
+    assert "<kbd>o i b g f p</kbd><td>reserved" in w.help_panel.value.replace("</td>", "")
+    assert "<kbd>n</kbd><td>slices+<td>add a parallel slice" in w.help_panel.value.replace("</td>", "")  # n works
     assert "Numpad" not in w.help_panel.value and "Drag" in w.help_panel.value
     w.press("?")
     assert not w.help_visible

@@ -36,14 +36,37 @@ def test_slices_spacing_arrangement_are_traits_and_keys_follow(make):
     assert w.slices == 9
 
 
-def test_a_single_view_has_no_stack_traits(make):
+def _same_picture(a, b):
+    """The same rows drawn (the capacities may differ: a wrapped view keeps its first one)."""
+    assert a.scene.counts == b.scene.counts
+    n = max(a.scene.counts)  # the layers share rows: each draws the first counts[i]
+    np.testing.assert_array_equal(a.scene.rows[:n], b.scene.rows[:n])
+
+
+def test_a_single_view_becomes_parallel_slices_when_asked(make):
+    """slices is None on a single view; setting it (or pressing n) wraps the source at run time."""
     w = make("24-cell")
     assert w.slices is None and w.spacing is None
     with pytest.raises(TypeError, match="slices"):
-        w.slices = 3
-    assert w.slices is None
+        w.spacing = 0.5  # no stack yet: nothing to space
+    with pytest.raises(ValueError, match="slices"):
+        w.slices = 0
+    assert w.slices is None and not isinstance(w.source, StackSource)
+    w.slices = 5
+    assert isinstance(w.source, StackSource) and w.source.slices == 5
+    assert (w.slices, w.arrangement) == (5, "oval") and w.spacing == pytest.approx(2 * 2.0 / 5)
+    _same_picture(w, make("24-cell", slices=5))
+    w.press("n")  # the stack's keys are bound now
+    assert w.slices == 6 and "add a parallel slice" in w.help_panel.value
     with pytest.raises(TypeError, match="slices"):
         make("24-cell", spacing=0.5)
+
+    pressed = make("5-cell")
+    assert not pressed.press("b")  # one slice: nothing to remove
+    assert pressed.slices is None
+    assert pressed.press("n")
+    assert isinstance(pressed.source, StackSource) and pressed.slices == 2
+    _same_picture(pressed, make("5-cell", slices=2))
 
 
 def test_one_slice_is_today_s_view(make):
