@@ -1,0 +1,499 @@
+"""Recorded key sequences: what was applied, when, replayed and rendered as GIF or MP4.
+
+A `Recorder` is the widget's hook: created with the `RotationState` as it is when recording
+starts, it is told every action the widget applies (``recorder.record(key, shift, action,
+inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
+(``recorder.record_set("c0", 0.3)``, a slider), with a time stamp.  It keeps at most
+``max_events``; older events are folded into the starting state, so a recording always replays
+to the live state.  ``recorder.recording()`` is an immutable `Recording`:
+
+* ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
+  so a recorded ``r`` resets where the live one did);
+* ``events``: `Step` (t, key, shift, action, inverted, label) and `Setting` (t, name, value);
+* ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
+
+Replaying applies the same floating-point operations in the same order, so the final state is
+the recorded one bit for bit (tested).  A source's own actions (a field's level keys, a stack's
+slice keys) are replayed on a source when one is given (`Recording.replay`), else skipped.
+
+`render_animation` draws a recording with `rot4d_widget.figures.render_state` -- one frame
+per step, or one per 1/fps seconds of the recorded time -- into an animated GIF (Pillow) or an
+MP4 (imageio with imageio-ffmpeg's ffmpeg).  `paper_animation(3)` / `paper_animation(4)` are
+the paper's Figs. 3 and 4 (the key sequences of `figures.paper_figure_3` / ``_4``) as animations.
+"""
+
+from __future__ import annotations
+
+import collections
+import copy
+import dataclasses
+import json
+import math
+import os
+import threading
+import time
+from dataclasses import dataclass
+from numbers import Real
+from typing import Iterator, Mapping
+
+import numpy as np
+
+from .keymap import Action
+from .state import RotationState, action_from_data, action_to_data
+
+__all__ = [
+    "RECORDING_FORMAT",
+    "RECORDING_VERSION",
+    "MAX_EVENTS",
+    "ANIMATION_FORMATS",
+    "Step",
+    "Setting",
+    "Recording",
+    "Recorder",
+    "animation_states",
+    "render_frames",
+    "render_animation",
+    "paper_recording",
+    "paper_animation",
+]
+
+RECORDING_FORMAT = "rot4d_widget recording"
+RECORDING_VERSION = 1
+#: Default bound of a `Recorder`: 100 000 events is about 55 minutes of a key held at 30 Hz
+#: (some 10 MB of JSON).
+MAX_EVENTS = 100_000
+ANIMATION_FORMATS = (".gif", ".mp4")
+#: What `Recorder.record_set` accepts: the state's settable parameters.
+SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
+
+
+# ============================================================================ events
+@dataclass(frozen=True)
+class Step:
+    """One applied action: ``t`` seconds after the recording started, the ``key`` pressed (None for
+    a step not from a key), ``shift``, the `Action` and whether it was ``inverted``."""
+
+    t: float
+    key: str | None
+    shift: bool
+    action: Action
+    inverted: bool
+
+    @property
+    def label(self) -> str:
+        """``"R_xw"``, ``"R_xz,yw⁻¹"``, ``"c0+"`` ... (`Action.label`)."""
+        return self.action.label(self.inverted)
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, "key": self.key, "shift": self.shift, "action": action_to_data(self.action),
+                "inverted": self.inverted, "label": self.label}
+
+
+@dataclass(frozen=True)
+class Setting:
+    """A parameter set from outside the keys (a slider, code): ``name`` in `SETTABLE` and its
+    ``value`` (a float, or a 4 x 4 list for ``"matrix"``)."""
+
+    t: float
+    name: str
+    value: object
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} set"
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, "set": self.name, "value": self.value}
+
+
+def _time(t) -> float:
+    if isinstance(t, bool) or not isinstance(t, Real) or not math.isfinite(t) or t < 0:
+        raise ValueError(f"Expected a time stamp >= 0 (seconds), got {t!r}")
+    return float(t)
+
+
+def _check_setting(name, value):
+    if name not in SETTABLE:
+        raise ValueError(f"Expected a setting among {', '.join(map(repr, SETTABLE))}, got {name!r}")
+    if name == "matrix":
+        from .rotation import as_rotation_matrix
+
+        return as_rotation_matrix(value).tolist()
+    if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
+        raise ValueError(f"Expected {name!r} to be set to a finite number, got {value!r}")
+    return float(value)
+
+
+def _event_from_dict(d):
+    if not isinstance(d, Mapping) or "t" not in d:
+        raise ValueError(f"Expected a recorded event with a time 't', got {d!r}")
+    t = _time(d["t"])
+    if "set" in d:
+        return Setting(t, d["set"], _check_setting(d["set"], d.get("value")))
+    if "action" not in d:
+        raise ValueError(f"Expected a recorded event with an 'action' or a 'set', got {dict(d)!r}")
+    key = d.get("key")
+    if key is not None and not isinstance(key, str):
+        raise ValueError(f"Expected an event's 'key' to be a string or null, got {key!r}")
+    shift, inverted = d.get("shift", False), d.get("inverted", False)
+    if not isinstance(shift, bool) or not isinstance(inverted, bool):
+        raise ValueError(f"Expected 'shift' and 'inverted' to be true or false in {dict(d)!r}")
+    return Step(t, key, shift, action_from_data(d["action"]), inverted)
+
+
+# ============================================================================ applying
+def _source_action(source, name: str):
+    actions = getattr(source, "actions", None) or {}
+    for sa in actions.values():
+        if getattr(sa, "name", None) == name:
+            return sa
+    return None
+
+
+def _apply(state: RotationState, event, source=None) -> bool:
+    """Apply one event to ``state`` (and a source's own action to ``source``); True if applied."""
+    if isinstance(event, Setting):
+        setattr(state, event.name, np.asarray(event.value) if event.name == "matrix" else event.value)
+        return True
+    action = event.action
+    if action.kind == "custom":
+        sa = _source_action(source, action.name) if source is not None else None
+        if sa is None:
+            return False
+        sa.run(-1 if event.inverted else 1)
+        return True
+    state.apply(action, event.inverted)
+    return True
+
+
+# ============================================================================ recordings
+class Recording:
+    """A starting state and the events applied to it (immutable; see the module docstring)."""
+
+    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0):
+        RotationState.from_dict(initial)  # validates
+        self._initial = json.loads(json.dumps(dict(initial)))  # a private, JSON-clean copy
+        self.events = tuple(events)
+        for e in self.events:
+            if not isinstance(e, (Step, Setting)):
+                raise TypeError(f"Expected Step or Setting events, got {type(e).__name__}")
+        self.dropped = int(dropped)
+
+    @property
+    def initial(self) -> dict:
+        """The starting state as `RotationState.to_dict(initial=True)` data (a copy)."""
+        return json.loads(json.dumps(self._initial))
+
+    def initial_state(self, keymap=None) -> RotationState:
+        """A fresh `RotationState` at the start of the recording (its reset point as recorded)."""
+        return RotationState.from_dict(self._initial, keymap=keymap)
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the start to the last event (0 without events)."""
+        return self.events[-1].t if self.events else 0.0
+
+    def __len__(self) -> int:
+        return len(self.events)
+
+    def __repr__(self) -> str:
+        return f"Recording({len(self.events)} events over {self.duration:.3g} s, {self.dropped} dropped)"
+
+    # -- data ------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        return {"format": RECORDING_FORMAT, "version": RECORDING_VERSION, "initial": self.initial,
+                "dropped": self.dropped, "events": [e.to_dict() for e in self.events]}
+
+    @classmethod
+    def from_dict(cls, d) -> "Recording":
+        if not isinstance(d, Mapping) or d.get("format") != RECORDING_FORMAT:
+            raise ValueError(f"Not a rot4d_widget recording (no \"format\": \"{RECORDING_FORMAT}\")")
+        v = d.get("version")
+        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= RECORDING_VERSION:
+            raise ValueError(f"A recording of version {v!r}; this rot4d_widget reads versions 1 ... {RECORDING_VERSION}")
+        if "initial" not in d or not isinstance(d.get("events"), list):
+            raise ValueError("A recording needs its 'initial' state and a list of 'events'")
+        events = [_event_from_dict(e) for e in d["events"]]
+        if any(b.t < a.t for a, b in zip(events, events[1:])):
+            raise ValueError("Expected a recording's events in time order")
+        return cls(d["initial"], events, dropped=d.get("dropped", 0))
+
+    def save(self, path) -> None:
+        """Write the recording as JSON to ``path``."""
+        with open(os.fspath(path), "w", encoding="utf-8") as fh:
+            json.dump(self.to_dict(), fh, allow_nan=False)
+            fh.write("\n")
+
+    @classmethod
+    def load(cls, path) -> "Recording":
+        """Read a recording `save` wrote; ``ValueError`` naming what is wrong otherwise."""
+        try:
+            with open(os.fspath(path), encoding="utf-8") as fh:
+                d = json.load(fh)
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{os.fspath(path)!r} is not a rot4d_widget recording: not JSON ({exc})") from None
+        return cls.from_dict(d)
+
+    # -- replay ----------------------------------------------------------------------------
+    def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True) -> RotationState:
+        """Apply the events to ``state`` (in place; default a fresh state) and return it.
+
+        ``restart``: set ``state`` to the recording's starting state first (its orientation,
+        parameters and reset point; its keymap is kept).  ``source``: a source whose own actions
+        (``source.actions``, matched by name) are replayed on it, changing it; without one they
+        are skipped.  The result equals the recorded final state bit for bit.
+        """
+        if state is None:
+            state = self.initial_state()
+        elif not isinstance(state, RotationState):
+            raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+        elif restart:
+            d = dict(self._initial)
+            d.pop("keymap", None)
+            state.restore(d)  # with the recorded reset point ("initial")
+        for e in self.events:
+            _apply(state, e, source)
+        return state
+
+
+class Recorder:
+    """The widget's hook: collects the actions it applies, bounded to ``max_events``.
+
+    ``Recorder(state)`` starts from ``state`` as it is now (copied).  Call ``record(key, shift,
+    action, inverted)`` after each applied action and ``record_set(name, value)`` after a
+    parameter set from outside the keys; ``t`` defaults to the seconds since the recorder was
+    made (``clock``, default `time.monotonic`).  Thread-safe (the widget's ticker thread records
+    while the kernel's thread may read).  Past ``max_events`` the oldest event is folded into
+    the starting state, so `recording` always replays to the live state (custom source actions
+    that fall out are lost: count in ``dropped``).
+    """
+
+    def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic):
+        if not isinstance(state, RotationState):
+            raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+        if isinstance(max_events, bool) or not isinstance(max_events, int) or max_events < 1:
+            raise ValueError(f"Expected `max_events` to be an int >= 1, got {max_events!r}")
+        if not callable(clock):
+            raise TypeError("Expected `clock` to be a callable returning seconds")
+        self.max_events = max_events
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._start(state)
+
+    def _start(self, state):
+        self._t0 = self._clock()
+        self._shadow = state.copy()  # the state before the oldest kept event
+        self._events = collections.deque()
+        self.dropped = 0
+
+    def restart(self, state: RotationState) -> None:
+        """Forget everything; record from ``state`` as it is now."""
+        with self._lock:
+            self._start(state)
+
+    def _stamp(self, t):
+        return max(0.0, self._clock() - self._t0) if t is None else _time(t)
+
+    def _push(self, event):
+        with self._lock:
+            if self._events and event.t < self._events[-1].t:  # a clock that stepped back: keep the order
+                event = dataclasses.replace(event, t=self._events[-1].t)
+            self._events.append(event)
+            while len(self._events) > self.max_events:
+                _apply(self._shadow, self._events.popleft())
+                self.dropped += 1
+
+    def record(self, key, shift, action, inverted: bool | None = None, t=None) -> Step:
+        """One applied ``action`` (an `Action` or its name, ``"xw"``), from ``key`` with ``shift``;
+        ``inverted`` defaults to ``shift`` for rotations (as `Keymap.resolve`)."""
+        action = Action.parse(action)
+        if key is not None and not isinstance(key, str):
+            raise TypeError(f"Expected `key` to be a string or None, got {type(key).__name__}")
+        shift = bool(shift)
+        inverted = (shift and action.is_rotation) if inverted is None else bool(inverted)
+        step = Step(self._stamp(t), key, shift, action, inverted)
+        self._push(step)
+        return step
+
+    def record_set(self, name: str, value, t=None) -> Setting:
+        """A parameter (``"theta0"``, ``"alpha"``, ``"c0"``, ``"c0_step"``, ``"matrix"``) set to ``value``."""
+        setting = Setting(self._stamp(t), name, _check_setting(name, value))
+        self._push(setting)
+        return setting
+
+    def recording(self) -> Recording:
+        """The events so far as an immutable `Recording`."""
+        with self._lock:
+            return Recording(self._shadow.to_dict(initial=True), tuple(self._events), dropped=self.dropped)
+
+    def __len__(self) -> int:
+        return len(self._events)
+
+
+# ============================================================================ animations
+def _own_copy(source):
+    """A copy of ``source`` that replaying its own actions may change (the original stays)."""
+    from .source import as_source
+    from .tomography import StackSource
+
+    src = as_source(source)
+    if isinstance(src, StackSource):
+        return StackSource(_own_copy(src.source), slices=src.slices,
+                           spacing=None if src.spacing_is_default else src.spacing,
+                           arrangement=src.arrangement, color_by=src.color_by)
+    return copy.copy(src)
+
+
+def animation_states(recording: Recording, initial_state: RotationState | None = None, source=None, *,
+                     per: str = "step", fps: float = 10.0) -> Iterator[tuple]:
+    """``(t, state, source)`` for each frame: after each step (``per="step"``, the first frame the
+    starting state) or at t = k / fps over the recorded time (``per="time"``: the state after every
+    event up to t).  ``state`` and ``source`` are the same objects every time, changed in place:
+    draw them before taking the next.  ``initial_state``: start there instead of the recording's
+    starting state (its copy is used).  ``source`` is copied before its own actions change it."""
+    if per not in ("step", "time"):
+        raise ValueError(f"Expected `per` to be 'step' or 'time', got {per!r}")
+    fps = _positive("fps", fps)
+    if initial_state is None:
+        state = recording.initial_state()
+    elif isinstance(initial_state, RotationState):
+        state = initial_state.copy()
+    else:
+        raise TypeError(f"Expected `initial_state` to be a RotationState or None, got {type(initial_state).__name__}")
+    src = None if source is None else _own_copy(source)
+    events = recording.events
+    yield 0.0, state, src
+    if per == "step":
+        for e in events:
+            _apply(state, e, src)
+            yield e.t, state, src
+        return
+    n = int(math.ceil(recording.duration * fps - 1e-9)) + 1
+    i = 0
+    for k in range(1, n):
+        t = k / fps
+        while i < len(events) and events[i].t <= t + 1e-9:
+            _apply(state, events[i], src)
+            i += 1
+        yield t, state, src
+
+
+def _positive(name, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):
+        raise ValueError(f"Expected `{name}` to be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def _figure_rgb(fig) -> np.ndarray:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
+
+def render_frames(recording: Recording, initial_state=None, source="5-cell", *, per: str = "step",
+                  fps: float = 10.0, max_frames: int = 3000, titles=None, **settings) -> Iterator[np.ndarray]:
+    """The frames of `render_animation`, one (H, W, 3) uint8 array at a time.
+
+    ``settings`` go to `rot4d_widget.figures.render_state` (``size``, ``dpi``, ``levels``,
+    ``slices``, ``color_by`` ...).  ``titles``: a callable ``(k, t, state) -> str`` giving each
+    frame a title, or None.  More than ``max_frames`` frames raises ``ValueError`` before any is drawn.
+    """
+    from .figures import render_state
+
+    fps = _positive("fps", fps)
+    n = len(recording.events) + 1 if per == "step" else int(math.ceil(recording.duration * fps - 1e-9)) + 1
+    if n > max_frames:
+        raise ValueError(f"The animation would have {n} frames, more than max_frames = {max_frames}; "
+                         "lower fps, use per='step', or raise max_frames")
+    for k, (t, state, src) in enumerate(animation_states(recording, initial_state, source, per=per, fps=fps)):
+        title = titles(k, t, state) if titles is not None else None
+        fig = render_state(state, src if src is not None else "5-cell", title=title, **settings)
+        yield _figure_rgb(fig)
+
+
+def render_animation(recording: Recording, initial_state=None, source="5-cell", path=None, *,
+                     fps: float = 10.0, per: str = "step", max_frames: int = 3000, titles=None,
+                     **settings) -> int:
+    """Draw ``recording`` (from ``initial_state``, default its own start) of ``source`` into ``path``.
+
+    ``.gif``: an animated GIF (Pillow), looping, 1/fps s per frame (Pillow merges identical
+    consecutive frames into one longer frame); ``.mp4``: H.264 (imageio with imageio-ffmpeg's
+    ffmpeg), ``fps`` frames per second.  One frame per step (``per="step"``, plus the
+    starting state) or per 1/``fps`` s of the recorded time (``per="time"``).  ``settings``
+    are `rot4d_widget.figures.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
+    ``slices``, ``color_by`` ...; an MP4's size is rounded up to even numbers of pixels).
+    Returns the number of frames drawn.
+    """
+    if path is None:
+        raise TypeError("Expected `path`, a file name ending in .gif or .mp4")
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext not in ANIMATION_FORMATS:
+        raise ValueError(f"Expected `path` to end in one of {', '.join(ANIMATION_FORMATS)}, got {os.fspath(path)!r}")
+    fps = _positive("fps", fps)
+    frames = render_frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames,
+                           titles=titles, **settings)
+    if ext == ".gif":
+        from PIL import Image
+
+        images = [Image.fromarray(f) for f in frames]
+        images[0].save(os.fspath(path), save_all=True, append_images=images[1:], duration=round(1000.0 / fps),
+                       loop=0)
+        return len(images)
+    import imageio.v2 as imageio
+
+    count = 0
+    with imageio.get_writer(os.fspath(path), format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                            pixelformat="yuv420p", macro_block_size=1, ffmpeg_log_level="error") as writer:
+        for f in frames:
+            h, w = f.shape[:2]
+            if h % 2 or w % 2:  # yuv420p needs even sizes: repeat the last row / column
+                f = np.pad(f, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+            writer.append_data(f)
+            count += 1
+    return count
+
+
+# ============================================================================ the paper's figures
+def paper_recording(figure: int, frames: int = 16, fps: float = 4.0) -> tuple:
+    """``(recording, source)`` of the paper's Fig. 3 (key "4", R_xw, theta0 = pi/16) or Fig. 4
+    (key "z", R_xz,yw, alpha = pi sqrt2 / (8 sqrt3), beta = 1 - alpha) on the a = 2 pentachoron:
+    ``frames - 1`` presses 1/fps s apart, the sequences of `figures.paper_figure_3` / ``_4``
+    (frame k is panel k)."""
+    from .figures import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0
+    from .polytopes import pentachoron
+    from .source import PolytopeSource
+
+    if figure == 3:
+        state, key = RotationState(theta0=FIG3_THETA0), "4"
+    elif figure == 4:
+        state, key = RotationState(theta0=FIG4_THETA0, alpha=FIG4_ALPHA), "z"
+    else:
+        raise ValueError(f"Expected `figure` 3 or 4 (the paper's key sequences), got {figure!r}")
+    if isinstance(frames, bool) or not isinstance(frames, int) or frames < 2:
+        raise ValueError(f"Expected `frames` to be an int >= 2, got {frames!r}")
+    fps = _positive("fps", fps)
+    rec = Recorder(state, clock=lambda: 0.0)
+    action, inverted = state.keymap.resolve(key)
+    for k in range(1, frames):
+        rec.record(key, False, action, inverted, t=k / fps)
+    return rec.recording(), PolytopeSource(pentachoron(2.0))
+
+
+def paper_animation(figure: int, path, *, frames: int = 16, fps: float = 4.0, size=(400, 400), dpi: float = 100,
+                    labels: bool = True, **settings) -> int:
+    """The paper's Fig. 3 or 4 as an animation (GIF or MP4 by ``path``'s extension): frame k is the
+    figure's panel k, labelled (a), (b) ... like its panels when ``labels``.  Returns the number of
+    frames (``frames``)."""
+    import string
+
+    rec, src = paper_recording(figure, frames, fps)
+    key = "4" if figure == 3 else "z"
+
+    def title(k, t, state):
+        letter = f"({string.ascii_lowercase[k]})" if k < 26 else f"({k + 1})"
+        return f"Fig. {figure} {letter}: key \u201c{key}\u201d \u00d7 {k}"
+
+    return render_animation(rec, None, src, path, fps=fps, per="step", size=size, dpi=dpi,
+                            titles=title if labels else None, **settings)
