@@ -54,7 +54,14 @@ __all__ = [
     "open_field",
     "save_state",
     "load_state",
+    "SETTING_NAMES",
+    "settings_of",
 ]
+
+#: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
+#: `rot4d_widget.figures.render_state` takes them as keywords).
+SETTING_NAMES = ("levels", "slices", "spacing", "arrangement", "color_by", "face_opacity", "ball_radius",
+                 "bar_radius", "background", "show_balls", "show_bars", "show_faces")
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
 #: float32 by every format (float64 in none).
@@ -100,6 +107,7 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
     chooses: a stack coloured by w by its levels' colormap, a field by its levels' colormap
     (`look.level_colors`), anything else by `look.group_palette` (a polytope's cells).
     """
+    data = _as_slice_data(data)
     groups = np.asarray(data.groups, dtype=np.intp)
     if color_by != "group":
         return np.tile(np.asarray(look.as_rgb(color_by, "color_by"), dtype=np.float64), (len(groups), 1))
@@ -119,8 +127,23 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
     return palette[groups].reshape(-1, 3)
 
 
+def _as_slice_data(obj):
+    """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; else as is."""
+    from .fields import FieldSlice
+    from .slicing import Slice
+    from .source import SliceData
+
+    if isinstance(obj, Slice):
+        return SliceData.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells, volume=float(obj.volume),
+                               extra={"slice": obj})
+    if isinstance(obj, FieldSlice):
+        return SliceData.build(obj.vertices, None, obj.triangles, None, volume=float(obj.volume))
+    return obj
+
+
 def _one_mesh_arrays(data, color_by, group_colors):
     """vertices (n, 3), faces (k, 3), rgb (k, 3), attributes {name: (k,)}, volume or None, kind."""
+    data = _as_slice_data(data)
     try:
         points = np.asarray(data.points, dtype=np.float64).reshape(-1, 3)
         tris = np.asarray(data.triangles, dtype=np.intp).reshape(-1, 3)
@@ -161,7 +184,8 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
     Parameters
     ----------
     data : slice data, or a sequence of them
-        What a source's ``slice(matrix, c0)`` returns: a polytope's slice (its triangles, the
+        What a source's ``slice(matrix, c0)`` returns (or a bare `Slice` from `slice_polytope`,
+        a `FieldSlice` from `slice_field`): a polytope's slice (its triangles, the
         polygons fanned, grouped by 4-D cell), a `Field4D`'s (the isosurface of every level,
         grouped by level index), a `StackSource`'s (the N parallel slices placed as the view
         places them, grouped by slice index when coloured by w, else by cell / level).  A
@@ -440,6 +464,20 @@ def _jsonable(value, where: str):
     if value is None or isinstance(value, str):
         return value
     raise TypeError(f"{where} is a {type(value).__name__}, which a JSON state file cannot hold")
+
+
+def settings_of(widget) -> dict:
+    """The `SETTING_NAMES` a widget (or any object) has, as JSON-able values: what `save_state`
+    stores and `rot4d_widget.figures.render_state` takes (``render_state(w.state, w.source,
+    **settings_of(w))``).  A stack's ``spacing`` is None while it follows its default."""
+    out = {}
+    for name in SETTING_NAMES:
+        if hasattr(widget, name):
+            out[name] = getattr(widget, name)
+    src = getattr(widget, "source", None)
+    if out.get("spacing") is not None and getattr(src, "spacing_is_default", False):
+        out["spacing"] = None
+    return _jsonable(out, "settings")
 
 
 class LoadedState(NamedTuple):

@@ -49,6 +49,7 @@ __all__ = [
     "action_from_data",
     "keymap_to_dict",
     "keymap_from_dict",
+    "without_source_keys",
 ]
 
 #: The version of `RotationState.to_dict`'s layout (``d["format"]``).
@@ -415,3 +416,12 @@ def keymap_from_dict(d) -> Keymap:
     if not isinstance(d, Mapping):
         raise ValueError(f"Expected 'keymap' to be a dict of key -> action, got {type(d).__name__}")
     return Keymap({k: action_from_data(v) for k, v in d.items()})
+
+
+def without_source_keys(keymap: Keymap) -> Keymap:
+    """``keymap`` without a source's own actions (``Action("custom", ...)``): each such key gets back
+    its `DEFAULT_KEYMAP` binding (a reserved one: o/i, n/b, g/f) or is unbound.  A stored keymap
+    passes through this before a widget extends it with its source's actions again
+    (`Keymap.extended` refuses to rebind a key a custom action holds)."""
+    changes = {k: DEFAULT_KEYMAP.get(k) for k, a in keymap.items() if a.kind == "custom"}
+    return keymap.replace(**changes) if changes else keymap

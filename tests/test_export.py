@@ -361,3 +361,37 @@ def test_describe_source_says_why_not():
 
     d = describe_source(Torus())
     assert d["rebuild"] == "a source of kind 'clifford-torus' cannot be rebuilt from its description"
+
+
+def test_bare_slices_from_the_slicers(field_data):
+    s = polytope("8-cell")
+    from rot4d_widget import slice_polytope
+
+    cut = slice_polytope(s, M, 0.2)
+    mesh = slice_mesh(cut)
+    assert mesh.volume == pytest.approx(cut.volume, rel=1e-12)
+    np.testing.assert_array_equal(mesh.face_attributes["group"], cut.triangle_cells)
+    fs = field_data[1].extra["levels"][0]
+    assert slice_mesh(fs).volume == pytest.approx(fs.volume, rel=1e-12)
+
+
+def test_a_widget_settings_go_to_a_state_file_and_a_picture(tmp_path):
+    from rot4d_widget import Rot4DWidget
+    from rot4d_widget.export import settings_of
+    from rot4d_widget.figures import render_state
+
+    w = Rot4DWidget("24-cell", slices=3, arrangement="grid", show_balls=False)
+    try:
+        w.press("4"), w.press("l")
+        settings = settings_of(w)
+        assert settings["slices"] == 3 and settings["arrangement"] == "grid" and settings["spacing"] is None
+        assert settings["show_balls"] is False and settings["levels"] is None
+        save_state(tmp_path / "w.json", w.state, w.source, settings)
+        state, source, back = load_state(tmp_path / "w.json")
+        assert back == settings and isinstance(source, StackSource) and source.slices == 3
+        assert np.array_equal(state.matrix, w.state.matrix) and state.c0_step == w.state.c0_step
+        render_state(state, source, tmp_path / "w.png", size=(300, 250), dpi=50, **back)
+        mesh = slice_mesh(w.slice)
+        assert set(np.unique(mesh.face_attributes["slice"])) == {0, 1, 2}
+    finally:
+        w.close()

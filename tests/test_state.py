@@ -392,3 +392,17 @@ def test_copy_is_independent_and_keeps_the_reset_point():
     assert not np.array_equal(c.matrix, st.matrix)
     c.reset(), st.reset()
     assert np.array_equal(c.matrix, st.matrix)
+
+
+def test_without_source_keys_lets_a_widget_extend_a_stored_keymap_again():
+    from rot4d_widget import Action
+    from rot4d_widget.state import without_source_keys
+
+    custom = {"o": Action("custom", name="level up", sign=1), "x": Action("custom", name="phase", sign=1)}
+    stored = RotationState.from_dict(RotationState(keymap=DEFAULT_KEYMAP.extended(custom)).to_dict()).keymap
+    with pytest.raises(ValueError, match="already bound"):
+        stored.extended(custom)
+    base = without_source_keys(stored)
+    assert base["o"] == DEFAULT_KEYMAP["o"] and "x" not in base
+    assert list(base.items()) == list(DEFAULT_KEYMAP.items())
+    assert base.extended(custom)["x"].name == "phase"
