@@ -318,6 +318,49 @@ async function render({ model, el }) {
       }
       scene.on("afterRender", onRendered);
       cleanups.push(() => scene.off("afterRender", onRendered));
+
+      // 5. screenshot: {event: "screenshot", id} from the kernel -> the canvas as a PNG data URL.
+      // Read in the task that rendered (after a render asked for here): only then is the
+      // WebGL drawing buffer sure to hold the picture.  A frozen view that does not render is
+      // read after a second, as it stands.
+      const findCanvas = () => {
+        const cls = model.get("canvas_class");
+        if (!cls) return null;
+        for (const host of document.getElementsByClassName(cls)) {
+          const c = host.localName === "canvas" ? host : host.querySelector("canvas");
+          if (c && c.isConnected && c.width > 0 && c.height > 0) return c;
+        }
+        return null;
+      };
+      const onMessage = (msg) => {
+        if (!msg || msg.event !== "screenshot") return;
+        const id = msg.id;
+        const canvas = findCanvas();
+        if (!canvas) {
+          send({ event: "screenshot", id, error: "no canvas of this view is in the page" });
+          return;
+        }
+        let done = false;
+        const grab = () => {
+          if (done) return;
+          done = true;
+          scene.off("afterRender", grab);
+          try {
+            send({ event: "screenshot", id, png: canvas.toDataURL("image/png"), width: canvas.width, height: canvas.height });
+          } catch (e) {
+            send({ event: "screenshot", id, error: String(e) });
+          }
+        };
+        scene.on("afterRender", grab);
+        const t = setTimeout(grab, 1000);
+        cleanups.push(() => {
+          clearTimeout(t);
+          scene.off("afterRender", grab);
+        });
+        scene.trigger("rerender", scene, {});
+      };
+      model.on("msg:custom", onMessage);
+      cleanups.push(() => model.off("msg:custom", onMessage));
     }
   } catch (e) {
     console.warn("rot4d_widget companion: scene models not found; no drawn acknowledgements", e);

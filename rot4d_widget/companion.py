@@ -44,11 +44,21 @@ step) and does four things in JupyterLab 4 and Notebook 7 alike:
    removes its listener.  The guard lives in the canvas element, so it works
    whichever of the canvas and companion views goes first.
 
+5. **screenshot** -- `request_screenshot` sends ``{"event": "screenshot", "id": n}``;
+   the view asks the scene to render and, in that render's ``afterRender``
+   (the WebGL drawing buffer holds the picture only then), replies with the
+   canvas as a PNG data URL (``{"event": "screenshot", "id": n, "png": ...,
+   "width": w, "height": h}`` or ``{"error": ...}`` when no canvas of the
+   view is in the page).  `on_screenshot` callbacks get ``(n, png_bytes,
+   error)``.  Every displayed view answers; the widget keeps the first.
+
 Listeners are removed when the view is removed.
 """
 
 from __future__ import annotations
 
+import base64
+import binascii
 import pathlib
 
 import anywidget
@@ -88,7 +98,16 @@ class Companion(anywidget.AnyWidget):
         super().__init__(**kwargs)
         self._drawn_handlers = CallbackDispatcher()
         self._focus_handlers = CallbackDispatcher()
+        self._screenshot_handlers = CallbackDispatcher()
         self.on_msg(self._handle_message)
+
+    def request_screenshot(self, request_id: int) -> None:
+        """Ask every displayed view for a PNG of its canvas; the answers reach `on_screenshot`."""
+        self.send({"event": "screenshot", "id": int(request_id)})
+
+    def on_screenshot(self, callback, remove=False):
+        """Call ``callback(request_id, png_bytes_or_None, error_or_None)`` as a view answers."""
+        self._screenshot_handlers.register_callback(callback, remove=remove)
 
     def on_drawn(self, callback, remove=False):
         """Call ``callback(update_id)`` when the page has drawn that update."""
@@ -106,6 +125,29 @@ class Companion(anywidget.AnyWidget):
             seq = content.get("seq")
             if isinstance(seq, int) and not isinstance(seq, bool):
                 self._drawn_handlers(seq)
+        elif event == "screenshot":
+            rid = content.get("id")
+            if not isinstance(rid, int) or isinstance(rid, bool):
+                return
+            png, error = _png_from_data_url(content.get("png")), content.get("error")
+            if png is None and not error:
+                error = "the page sent no PNG"
+            self._screenshot_handlers(rid, png, None if png is not None else str(error))
         elif event == "focus_lost":
             reason = content.get("reason")
             self._focus_handlers(reason if isinstance(reason, str) else "")
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _png_from_data_url(url):
+    """The bytes of a ``data:image/png;base64,...`` URL, or None if it is not one."""
+    prefix = "data:image/png;base64,"
+    if not isinstance(url, str) or not url.startswith(prefix):
+        return None
+    try:
+        data = base64.b64decode(url[len(prefix):], validate=True)
+    except (ValueError, binascii.Error):
+        return None
+    return data if data.startswith(_PNG_SIGNATURE) else None

@@ -246,6 +246,11 @@ class Rot4DWidget(widgets.HBox):
         self._closed = False
         self._was_displayed = False
         self._syncing = False
+        self._note = None  # one line for the readout: what a screenshot did
+        self._screenshots = {}  # request id -> (path, callback): asked, not answered yet
+        self._screenshot_seq = 0
+        #: The PNG of the view the page sent last (`screenshot`, key p), or None.
+        self.last_screenshot = None
         self._pump = UpdatePump(
             self._send, tick=self._tick, deadline=repeater.next_deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
@@ -312,6 +317,7 @@ class Rot4DWidget(widgets.HBox):
         self.events.on_dom_event(self._handle_event)
         self.companion.on_drawn(self._handle_drawn)
         self.companion.on_focus_lost(self._handle_focus_lost)
+        self.companion.on_screenshot(self._on_screenshot)
         self.scene.on_view_count(self._on_view_count)
         self.scene.on_eye_moved(self._eye_moved)
         self.observe(self._on_state_trait, names=list(_STATE_TRAITS))
@@ -387,6 +393,81 @@ class Rot4DWidget(widgets.HBox):
             self._pump.flush()
             return changed
 
+    def screenshot(self, path=None, callback=None):
+        """Ask the page for a PNG of the view as shown; returns at once (the request id, or None).
+
+        The kernel handles the page's answer only after the running cell ends, so nothing
+        here waits: when the PNG arrives it is written to ``path`` (str or path-like; None:
+        not written), handed to ``callback(png_bytes)`` and kept as `last_screenshot`
+        (bytes).  The readout says what happened, also when no view is displayed to answer
+        (then None is returned).  Key p does the same with a numbered file in the current
+        directory (next to the notebook).
+        """
+        if path is not None:
+            import os
+
+            if not isinstance(path, (str, os.PathLike)):
+                raise TypeError(f"Expected `path` to be a str, a path-like or None, got {type(path).__name__}")
+        if callback is not None and not callable(callback):
+            raise TypeError(f"Expected `callback` to be callable or None, got {type(callback).__name__}")
+        with self._pump.lock:
+            if self._closed:
+                raise RuntimeError("This Rot4DWidget is closed")
+            return self._ask_screenshot(path, callback)
+
+    def _ask_screenshot(self, path, callback):
+        # asked in any case: a front end that does not count views (count 0) may still answer
+        self._screenshot_seq += 1
+        rid = self._screenshot_seq
+        self._screenshots[rid] = (path, callback)
+        self.companion.request_screenshot(rid)
+        if self.scene.view_count == 0:
+            self._set_note("no view is displayed to answer: no screenshot (display the widget first)")
+            return None
+        self._set_note(f"screenshot asked{' for ' + str(path) if path is not None else ''}\u2026")
+        return rid
+
+    def _on_screenshot(self, rid, png, error) -> None:
+        """A view answered request ``rid`` (the first answer counts; later views' are dropped)."""
+        with self._pump.lock:
+            asked = self._screenshots.pop(rid, None)
+            if asked is None or self._closed:
+                return
+            path, callback = asked
+            if png is None:
+                self._set_note(f"screenshot failed: {error}")
+                return
+            self.last_screenshot = png
+            where = "kept as last_screenshot"
+            if path is not None:
+                try:
+                    with open(path, "wb") as f:
+                        f.write(png)
+                except OSError as exc:
+                    self._set_note(f"screenshot not saved: {exc}")
+                    return
+                where = f"saved {path}"
+            self._set_note(f"{where} ({_png_size_text(png)})")
+        if callback is not None:
+            try:
+                callback(png)
+            except Exception as exc:  # shown like any callback error, never lost
+                self._report_error(exc)
+
+    def _screenshot_key(self) -> None:
+        """Key p: a numbered PNG in the current directory (rot4d-001.png, ...), never overwriting."""
+        import pathlib
+
+        n = 1
+        while pathlib.Path(f"rot4d-{n:03d}.png").exists() or any(
+                str(p) == f"rot4d-{n:03d}.png" for p, _ in self._screenshots.values()):
+            n += 1
+        self._ask_screenshot(f"rot4d-{n:03d}.png", None)
+
+    def _set_note(self, text: str) -> None:
+        self._note = text
+        self.readout.value = self._readout_html()
+
     def refresh(self) -> None:
         """Redraw after changing `state` or the source directly; obeys the flow control."""
         with self._pump.lock:
@@ -429,6 +510,7 @@ class Rot4DWidget(widgets.HBox):
             if companion is not None:
                 companion.on_drawn(self._handle_drawn, remove=True)
                 companion.on_focus_lost(self._handle_focus_lost, remove=True)
+                companion.on_screenshot(self._on_screenshot, remove=True)
             if scene is not None:
                 scene.on_view_count(self._on_view_count, remove=True)
                 scene.on_eye_moved(self._eye_moved, remove=True)
@@ -689,6 +771,9 @@ class Rot4DWidget(widgets.HBox):
             changed = True
             self._sync_levels()
             self._sync_stack()
+        elif action.kind == "screenshot":
+            self._screenshot_key()
+            return False
         elif action.kind == "slices" and not _is_stack(self.source):
             # n on a single slice: the first added slice makes the view a stack of two
             changed = (-1 if inverted else 1) * action.sign > 0
@@ -794,6 +879,8 @@ class Rot4DWidget(widgets.HBox):
         volume = getattr(data, "volume", None)
         if volume is not None:
             rows.append(("volume", f"{volume * self._scale ** 3:.4f} as drawn"))
+        if self._note:
+            rows.append(("picture", html.escape(self._note)))
         return ro.readout_html(_title(self.source), rows, gizmo=ro.gizmo_svg(st.matrix))
 
     def _group_colors(self):
@@ -906,13 +993,20 @@ def _help_groups(keymap: Keymap) -> list:
         acts = [keymap[k] for k in keys.split() if k in keymap]
         kinds = {a.kind for a in acts}
         adds_slice = kinds == {"slices"} and all(a.sign > 0 for a in acts)  # n: makes the view a stack
-        if kinds and kinds <= RESERVED_KINDS and not adds_slice:
+        if kinds and kinds <= RESERVED_KINDS and not adds_slice and kinds != {"screenshot"}:
             reserved.append(keys)
         else:
             rows.append((keys, label, text))
     if reserved:
-        rows.append((" ".join(reserved), "reserved", "iso levels, parallel slices, pictures: not active in this view yet"))
+        rows.append((" ".join(reserved), "reserved", "iso levels (fields), fewer slices and spacing (parallel slices): not active in this view"))
     return rows
+
+
+def _png_size_text(png: bytes) -> str:
+    """'600 x 500 px' from a PNG's header (IHDR), or its byte count if it has none."""
+    if len(png) >= 24 and png[12:16] == b"IHDR":
+        return f"{int.from_bytes(png[16:20], 'big')} \u00d7 {int.from_bytes(png[20:24], 'big')} px"
+    return f"{len(png)} bytes"
 
 
 def _close_quietly(w) -> None:
