@@ -40,7 +40,7 @@ import numpy as np
 from ._arrays import sealed as _sealed
 from scipy.spatial import ConvexHull
 
-__all__ = ["Polytope", "polytope", "pentachoron", "POLYTOPE_NAMES"]
+__all__ = ["Polytope", "MeshError", "polytope", "pentachoron", "POLYTOPE_NAMES", "MESH_TOLERANCE"]
 
 PHI = (1.0 + math.sqrt(5.0)) / 2.0
 
@@ -168,6 +168,18 @@ _BUILDERS = {
 MESH_TOLERANCE = 1e-6
 
 
+class MeshError(ValueError):
+    """An explicit mesh given to `Polytope` is not a valid 4-polytope.
+
+    ``item`` is the offending ``("face" | "cell" | "vertex", index)`` when there is one
+    (the 4OFF reader turns it into a line number), else None.
+    """
+
+    def __init__(self, message: str, item: tuple | None = None):
+        super().__init__(message)
+        self.item = item
+
+
 def _ptr(sizes: np.ndarray) -> np.ndarray:
     """(n,) sizes -> (n + 1,) start offsets."""
     ptr = np.zeros(len(sizes) + 1, dtype=np.intp)
@@ -226,7 +238,7 @@ def _index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.
     bad = np.flatnonzero((flat < 0) | (flat >= n_max))
     if len(bad):
         i = int(np.searchsorted(_ptr(sizes), bad[0], side="right") - 1)
-        raise ValueError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}")
+        raise MeshError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}", item=("face" if what == "faces" else "cell", i))
     return sizes, flat
 
 
@@ -405,26 +417,26 @@ class Polytope:
         face_ptr, cell_ptr = _ptr(face_sizes), _ptr(cell_sizes)
         small = np.flatnonzero(face_sizes < 3)
         if len(small):
-            raise ValueError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3")
+            raise MeshError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3", item=("face", int(small[0])))
         small = np.flatnonzero(cell_sizes < 4)
         if len(small):
-            raise ValueError(f"`cells[{small[0]}]` has {cell_sizes[small[0]]} faces; a cell needs at least 4")
+            raise MeshError(f"`cells[{small[0]}]` has {cell_sizes[small[0]]} faces; a cell needs at least 4", item=("cell", int(small[0])))
         dup = _duplicate_in_rows(face_ptr, face_vidx, V)
         if dup:
-            raise ValueError(f"`faces[{dup[0]}]` has vertex {dup[1]} twice; a face is a cycle of distinct vertices")
+            raise MeshError(f"`faces[{dup[0]}]` has vertex {dup[1]} twice; a face is a cycle of distinct vertices", item=("face", dup[0]))
         dup = _duplicate_in_rows(cell_ptr, cell_fidx, F)
         if dup:
-            raise ValueError(f"`cells[{dup[0]}]` has face {dup[1]} twice")
+            raise MeshError(f"`cells[{dup[0]}]` has face {dup[1]} twice", item=("cell", dup[0]))
         use = np.bincount(cell_fidx, minlength=F)
         bad = np.flatnonzero(use != 2)
         if len(bad):
             f = int(bad[0])
             holders = _owner(cell_ptr)[cell_fidx == f].tolist()
-            raise ValueError(f"face {f} is in {use[f]} cell(s) {holders}; every face must be in exactly two "
-                             f"cells (a closed boundary)")
+            raise MeshError(f"face {f} is in {use[f]} cell(s) {holders}; every face must be in exactly two "
+                             f"cells (a closed boundary)", item=("face", f))
         unused = np.flatnonzero(np.bincount(face_vidx, minlength=V) == 0)
         if len(unused):
-            raise ValueError(f"vertex {unused[0]} is in no face; every vertex must be a corner of some face")
+            raise MeshError(f"vertex {unused[0]} is in no face; every vertex must be a corner of some face", item=("vertex", int(unused[0])))
         self._set_combinatorics(face_ptr, face_vidx, cell_ptr, cell_fidx)
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
@@ -432,6 +444,48 @@ class Polytope:
         normals, offsets = _mesh_geometry(self, validate)
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets)
+
+    # -- files -------------------------------------------------------------
+    @classmethod
+    def from_off(cls, path_or_text, name: str | None = None, *, validate: bool = True) -> "Polytope":
+        """A polytope from Stella4D's 4OFF format: a path, or the file's text (see `rot4d_widget.offfile`).
+
+        The faces and cells are taken as written and checked as by ``Polytope(vertices, faces,
+        cells)``; every error is a ValueError naming the file's line.  Colours are read and
+        checked, then dropped.  A Geomview 4OFF (homogeneous 3-D coordinates) is refused.
+        ``name`` defaults to the file's stem (or "4OFF" for text).
+        """
+        import os
+
+        from .offfile import read_off
+
+        data = read_off(path_or_text)
+        if name is None:
+            is_path = isinstance(path_or_text, os.PathLike) or (
+                isinstance(path_or_text, str) and "\n" not in path_or_text and not path_or_text.lstrip().startswith("4OFF"))
+            name = os.path.splitext(os.path.basename(os.fspath(path_or_text)))[0] if is_path else "4OFF"
+        try:
+            p = cls(data.vertices, data.faces, data.cells, name=name, validate=validate)
+        except MeshError as exc:
+            if exc.item is None:
+                raise ValueError(f"lines {data.cell_lines[0]}-{data.cell_lines[-1]} (the cells): {exc}") from None
+            kind, i = exc.item
+            line = {"face": data.face_lines, "cell": data.cell_lines, "vertex": data.vertex_lines}[kind][i]
+            raise ValueError(f"line {line} ({kind} {i}): {exc}") from None
+        if data.edge_count and data.edge_count != len(p.edges):
+            raise ValueError(f"line {data.counts_line}: E = {data.edge_count} but the faces have {len(p.edges)} "
+                             f"edges (E may be 0 when not counted)")
+        return p
+
+    def to_off(self, path=None) -> str:
+        """This polytope in Stella4D's 4OFF format (exact coordinates); also written to ``path`` if given."""
+        from .offfile import write_off
+
+        text = write_off(self.vertices, [f.tolist() for f in self.faces], self.cells, comment=self.name)
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(text)
+        return text
 
     # -- conveniences ------------------------------------------------------
     @property
@@ -470,7 +524,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     if len(first) < V:
         i = int(np.flatnonzero(first[inverse.reshape(-1)] != np.arange(V))[0])
-        raise ValueError(f"vertices {int(first[inverse.reshape(-1)[i]])} and {i} coincide")
+        raise MeshError(f"vertices {int(first[inverse.reshape(-1)[i]])} and {i} coincide", item=("vertex", i))
     fptr, fv = p._face_ptr, p._face_vidx
     fsize = np.diff(fptr)
     face_c = np.empty((F, 4))
@@ -488,8 +542,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
         bad = np.flatnonzero(off > tol)
         if len(bad):
             f = int(fs[bad[0]])
-            raise ValueError(f"face {f} is not planar: a corner is {off[bad[0]]:.3g} from its plane "
-                             f"(tolerance {tol:.3g})")
+            raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]]:.3g} from its plane "
+                             f"(tolerance {tol:.3g})", item=("face", f))
         e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
         e2 = np.roll(e, -1, axis=1)
         cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
@@ -502,13 +556,15 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
         bad = np.flatnonzero(~ok)
         if len(bad):
             f = int(fs[bad[0]])
-            raise ValueError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
+            raise MeshError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
                              f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
-                             f"strictly convex polygons with their vertices in cyclic order")
+                             f"strictly convex polygons with their vertices in cyclic order", item=("face", f))
         face_c[fs] = c
         face_e[fs] = B
         face_area[fs] = 0.5 * np.abs((xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
                                       - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1]).sum(axis=1))
+    if validate:  # before the cells' geometry: an open cell is a mistake in the lists, named as such
+        _check_closed(p)
     # cells: flat, 3-D, normal
     cptr, cfx = p._cell_ptr, p._cell_fidx
     vptr, cvx = p._cell_vptr, p._cell_vidx
@@ -527,11 +583,11 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
         bad = np.flatnonzero(off > tol)
         if len(bad):
             c = int(cs[bad[0]])
-            raise ValueError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]]:.3g} from it "
-                             f"(tolerance {tol:.3g})")
+            raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]]:.3g} from it "
+                             f"(tolerance {tol:.3g})", item=("cell", c))
         bad = np.flatnonzero(s[:, 2] <= tol)
         if len(bad):
-            raise ValueError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D")
+            raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D", item=("cell", int(cs[bad[0]])))
         g[cs] = gc
         n[cs] = normal
     pc = _owner(cptr)  # the (cell, face) pairs, cell by cell
@@ -542,8 +598,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
     height = np.linalg.norm(m, axis=1)  # the cell's centroid from each face's plane, in the cell
     bad = np.flatnonzero(height <= tol)
     if len(bad):
-        raise ValueError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
-                         f"{int(pf[bad[0]])}")
+        raise MeshError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
+                         f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
     m /= height[:, None]  # each face's outward normal within each of its cells
     if validate:
         _check_cells(p, v, tol, pc, pf, m, face_c)
@@ -560,8 +616,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
     _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * C, 2 * C)), directed=False)
     bad = np.flatnonzero(lab[:C] == lab[C:])
     if len(bad):
-        raise ValueError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
-                         f"given outward normals that agree across their shared faces")
+        raise MeshError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
+                         f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
     s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
     ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
     vol3 = np.bincount(pc, weights=face_area[pf] * height, minlength=C) / 3.0
@@ -569,7 +625,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
     vol4 = np.bincount(comp, weights=s * offsets * vol3, minlength=ncomp) / 4.0
     small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
     if len(small):
-        raise ValueError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
+        raise MeshError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
                          f"no 4-volume")
     flip = vol4 < 0
     if ncomp > 1:
@@ -579,17 +635,19 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
     return normals, np.ascontiguousarray(offsets * s)
 
 
-def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
-    """Every cell closed and strictly convex (ValueError naming the cell)."""
-    C = len(p._cell_ptr) - 1
-    E = len(p.edges)
+def _check_closed(p: Polytope) -> None:
+    """Every cell closed: each of its edges in exactly two of its faces (MeshError naming the cell)."""
     open_ = np.flatnonzero(p._cell_ecount != 2)
     if len(open_):
         i = int(open_[0])
         c = int(np.searchsorted(p._cell_eptr, i, side="right") - 1)
         e = p.edges[p._cell_eidx[i]].tolist()
-        raise ValueError(f"cell {c} is not closed: its edge {tuple(e)} is in {p._cell_ecount[i]} of its faces; "
-                         f"each edge of a cell must be in exactly two of its faces")
+        raise MeshError(f"cell {c} is not closed: its edge {tuple(e)} is in {p._cell_ecount[i]} of its faces; "
+                        f"each edge of a cell must be in exactly two of its faces", item=("cell", c))
+
+
+def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
+    """Every cell strictly convex (MeshError naming the cell)."""
     cptr, vptr, cvx = p._cell_ptr, p._cell_vptr, p._cell_vidx
     nf, nv = np.diff(cptr), np.diff(vptr)
     fsize = np.diff(p._face_ptr)
@@ -607,14 +665,14 @@ def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
             out = D > tol
             if out.any():
                 i, j2, k2 = np.argwhere(out)[0]
-                raise ValueError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
-                                 f"outside the plane of its face {int(pf[pairs[i, j2]])}")
+                raise MeshError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
+                                 f"outside the plane of its face {int(pf[pairs[i, j2]])}", item=("cell", int(cs[i])))
             on = (D >= -tol).sum(axis=2)
             wrong = on != fsize[pf[pairs]]
             if wrong.any():
                 i, j2 = np.argwhere(wrong)[0]
-                raise ValueError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
-                                 f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)")
+                raise MeshError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
+                                 f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)", item=("cell", int(cs[i])))
 
 
 def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:

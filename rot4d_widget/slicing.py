@@ -1,4 +1,4 @@
-"""Exact slice of a convex 4-polytope by the hyperplane H: w = c0.
+"""Exact slice of a 4-polytope (convex or not) by the hyperplane H: w = c0.
 
 The polytope is rotated (``vertices @ matrix.T``) and cut by H.  Its pieces are
 classified against H with ONE tolerance, `TOLERANCE` times the polytope's
@@ -13,14 +13,48 @@ polytope piece        crosses H                  lies in H
 ====================  =========================  ==============================
 vertex                --                         a vertex of S
 edge                  a vertex of S (lerp)       an edge of S
-2-face                an edge of S (its chord)   a polygon of S (if S is solid)
-cell                  a polygon of S             S itself (the cell is the slice)
+2-face                an edge of S (its chord)   a polygon of S if it bounds S
+cell                  a polygon of S             a 3-D part of S (no polygon)
 ====================  =========================  ==============================
 
-S is solid (3-D) when some vertex is strictly above and some strictly below
-H, or when a whole cell lies in H (the 8-cell at c0 = ±1).  Otherwise H only
-touches P (in a vertex, edge or 2-face: the slice keeps those vertices and
-edges, with no polygons and volume 0) or misses it (empty arrays).
+Nothing here assumes the polytope convex; only its cells are (each crossing
+cell gives ONE convex polygon, whose corners are ordered by angle about their
+own mean, and oriented by the cell's outward normal -- from the boundary's
+orientation, see `Polytope`).  Where convexity was once relied on, and what
+replaced it:
+
+* A 2-face lying in H was always a polygon, oriented away from the slice's
+  vertex centroid.  Now it is a polygon only if it bounds S: seen in the plane
+  orthogonal to the face, the polytope fills the angle between its two cells on
+  their inner side; the face bounds S when exactly one of the two directions
+  along H from it is filled (or runs along a cell lying in H), and faces the
+  other way (`_faces_in_h`).  A convex polytope cut through its interior always
+  has one cell above and one below (no change); a non-convex one may have the
+  face inside S (at a reflex ridge, or between coplanar cells lying in H) or
+  only touching it.
+* "Vertices on both sides" meant "solid".  A polytope in separate pieces can
+  have pieces above and below and none crossing: S is then empty (or only
+  touches), decided by whether any polygon comes out.
+* In a solid slice every vertex on H and every edge in H was on S's boundary.
+  Now a solid slice is given by its boundary alone: vertices on H and edges in
+  H that no polygon uses (inside S, or where P touches H away from S) are
+  dropped (`_boundary_only`; for a convex polytope nothing is dropped).
+* H touching P: the dimension is 2 if a face lies in H, else 1 if an edge
+  does, else 0 (a convex polytope touches in one face, edge or vertex).
+
+The volume (divergence theorem over the outward triangles, about any point)
+and the per-cell polygons never relied on convexity: S may have several
+pieces and holes and tunnels.  Where H passes through a reflex vertex of P, S
+may not be a manifold there: two solids touching at that vertex.  The slice
+keeps it as ONE vertex shared by both; the surface is still closed (each edge
+in two polygons) and outward, the volume exact, but two fans of polygons meet
+at that vertex (so V - E + F counts it once: 3 for two balls touching).
+
+S is solid (3-D) when some polygon comes out: some cell crosses H, or some
+2-face lying in H bounds a 3-D part (a cell lying in H, as the 8-cell at
+c0 = ±1).  Otherwise H only touches P (in vertices, edges or 2-faces: the
+slice keeps those vertices and edges, with no polygons and volume 0) or
+misses it (empty arrays).
 
 For a 2-face lying in H, ``cell_ids`` names a cell containing it that lies in
 H if there is one, otherwise the lower-numbered of its two cells.
@@ -34,7 +68,8 @@ level in one (L, V) comparison, finds the crossing faces and cells of all
 levels from their w-ranges, and runs the single slice's steps on arrays that
 carry a level index; each level's `Slice` is a read-only view of the shared
 arrays, equal to the single slice at that level.  Levels within the tolerance
-of a vertex height (the on-H cases) take the single-slice path.
+of a vertex height (the on-H cases), and levels with vertices on both sides
+but no crossing edge (a polytope in pieces), take the single-slice path.
 """
 
 from __future__ import annotations
@@ -82,6 +117,10 @@ class _Tables:
         self.face_abc = p._face_vidx[p._face_ptr[:-1, None] + np.arange(3)]
         self.face_cells = p.face_cells
         self.cell_normals = np.ascontiguousarray(p.cell_normals)
+        # each cell's vertex mean (a point inside the convex cell), for 2-faces lying in H
+        nv = np.diff(np.append(self.c_starts, len(self.cv_vert)))
+        self.cell_centres = np.stack([np.bincount(self.cv_cell, weights=p.vertices[self.cv_vert, k], minlength=C)
+                                      for k in range(4)], axis=1) / nv[:, None]
         self.vertices = p.vertices
         self.tol = TOLERANCE * p.circumradius
         # fixed-width rows for many levels at once: each face's / cell's edges, padded with the
@@ -183,6 +222,14 @@ class _Inconsistent(Exception):
     """A face chord without exactly two ends: classification hit a near-degenerate case."""
 
 
+class _NoCrossing(Exception):
+    """Levels with vertices on both sides but no crossing edge (a polytope in separate pieces)."""
+
+    def __init__(self, levels: np.ndarray):
+        super().__init__()
+        self.levels = levels
+
+
 def slice_polytope(polytope, matrix, c0=0.0):
     """Cut ``polytope`` (a `Polytope` or a name), rotated by ``matrix``, with w = ``c0``.
 
@@ -262,13 +309,18 @@ def _slice_many(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, ra
     # generic: every vertex strictly off H and some on each side (solid, no on-H cases)
     generic = (n_pos + n_neg == t.V) & (n_pos > 0) & (n_neg > 0)
     gi = generic.nonzero()[0]
-    if len(gi):
+    while len(gi):
         try:
             for i, s in zip(gi, _slice_generic(t, x, m, levels[gi], h[gi], pos[gi])):
                 out[i] = s
         except _Inconsistent:
             for i in gi:
                 out[i] = _slice_level(t, x, m, float(levels[i]), radius)
+        except _NoCrossing as exc:  # pieces on both sides, none crossing: single path for those
+            generic[gi[exc.levels]] = False
+            gi = generic.nonzero()[0]
+            continue
+        break
     for i in (~generic).nonzero()[0]:
         out[i] = _slice_level(t, x, m, float(levels[i]), radius)
     return tuple(out)
@@ -301,6 +353,8 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     cross = pos[:, ea] != pos[:, eb]  # (G, E): with no vertex on H, one end above and one below
     lv, e_idx = _nonzero2(cross)  # level-major: each level's crossing edges in edge order
     n_v = np.bincount(lv, minlength=G)
+    if not n_v.all():
+        raise _NoCrossing(n_v == 0)
     voff = np.zeros(G + 1, dtype=np.intp)
     np.cumsum(n_v, out=voff[1:])
     a, b = ea[e_idx], eb[e_idx]
@@ -468,6 +522,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     crossing = bool(pos.any() and neg.any())
     on_idx = on.nonzero()[0]
     fv_on = on[t.fv_vert]
+    c_on = np.logical_and.reduceat(on[t.cv_vert], t.c_starts) if len(on_idx) else None  # cells lying in H
     if crossing:
         cross_e = (pos[ea] & neg[eb]) | (neg[ea] & pos[eb])
         ce_idx = cross_e.nonzero()[0]
@@ -479,12 +534,12 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         n_e = len(ce_idx)
         edge_sv = np.full(len(ea), -1, dtype=np.intp)
         edge_sv[ce_idx] = np.arange(n_e)
-        solid = True
+        solid = True  # unless no polygon comes out: pieces of a polytope may lie apart, none crossing
     else:
         cross_e = None
         n_e = 0
         vertices = x[on_idx, :3]
-        solid = bool(len(on_idx)) and bool(np.logical_and.reduceat(on[t.cv_vert], t.c_starts).any())
+        solid = bool(len(on_idx)) and bool(c_on.any())
     vert_sv = np.full(len(h), -1, dtype=np.intp)
     vert_sv[on_idx] = np.arange(n_e, n_e + len(on_idx))
 
@@ -507,23 +562,25 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     else:
         edges = in_h_edges
 
+    f_on = np.logical_and.reduceat(fv_on, t.f_starts) if len(on_idx) else None  # faces lying in H
     if not solid:
-        dim = -1 if not len(on_idx) else (0 if not len(edges) else (1 if len(edges) == 1 else 2))
-        return Slice(vertices, edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
+        return _touching(t, vertices, edges, on_idx, f_on)
 
-    # polygons of S: one per crossing cell, one per 2-face lying in H
+    # polygons of S: one per crossing cell, one per 2-face lying in H on the boundary of S
     C = t.C
-    centre = vertices.sum(axis=0) / len(vertices)
-    f_on = np.logical_and.reduceat(fv_on, t.f_starts)
-    k3 = f_on[t.fv_face]
-    face_ids = f_on.nonzero()[0]
+    face_ids = f_on.nonzero()[0] if f_on is not None else t.empty_i
     if len(face_ids):
         abc = x[t.face_abc[face_ids], :3]  # (nf, 3, 3)
         fn = np.cross(abc[:, 1] - abc[:, 0], abc[:, 2] - abc[:, 1])
-        flip = np.einsum("ij,ij->i", abc[:, 0] - centre, fn) < 0
-        fn[flip] *= -1.0
+        keep, outward = _faces_in_h(t, x, m, face_ids, fn, c_on)
+        face_ids, fn = face_ids[keep], fn[keep]
+        fn[~outward[keep]] *= -1.0
+        k3 = np.zeros(t.F, dtype=bool)
+        k3[face_ids] = True
+        k3 = k3[t.fv_face]
     else:
         fn = t.empty3
+        k3 = np.zeros(len(t.fv_face), dtype=bool)
     if crossing:
         cv_pos = pos[t.cv_vert]
         cv_neg = neg[t.cv_vert]
@@ -538,6 +595,8 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         poly_id = C + t.fv_face[k3]
         poly_sv = vert_sv[t.fv_vert[k3]]
         normals = np.empty((C + t.F, 3))
+    if not len(poly_id):  # no cell crosses H and no face in H bounds a solid part
+        return _touching(t, vertices, edges, on_idx, f_on)
     normals[C + face_ids] = fn
 
     present = np.bincount(poly_id, minlength=C + t.F)
@@ -548,7 +607,8 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     rank_of[ids] = np.arange(n_poly)
     rank = rank_of[poly_id]
     pts = vertices[poly_sv]
-    # Angular order about each polygon's outward normal n, around its corner mean.
+    # Angular order about each polygon's outward normal n, around its corner mean (each
+    # polygon is a section of one convex cell, or a face: convex).
     # In-plane axes u = n x e_x (or n x e_y when n is near e_x) and v = n x u,
     # written out: they need not be unit, a linear map of positive determinant
     # keeps the cyclic order of directions.
@@ -573,13 +633,13 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         is_face = ids >= C
         fc = t.face_cells[ids[is_face] - C]
         # prefer a cell lying in H (the whole-cell case), else the lower-numbered one
-        c_on = np.logical_and.reduceat(on[t.cv_vert], t.c_starts)
         cell_ids[is_face] = np.where(c_on[fc[:, 1]] & ~c_on[fc[:, 0]], fc[:, 1], fc[:, 0])
 
     triangles, poly_of = _fan(flat, rank[order], offsets, counts)
     triangle_cells = cell_ids[poly_of]
 
     # volume by the divergence theorem, about the vertex centroid (keeps slivers exact)
+    centre = vertices.sum(axis=0) / len(vertices)
     tri = (vertices - centre)[triangles]
     A, B, D = tri[:, 0], tri[:, 1], tri[:, 2]
     volume = float(
@@ -589,4 +649,77 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
             + A[:, 2] * (B[:, 0] * D[:, 1] - B[:, 1] * D[:, 0])
         ).sum()
     ) / 6.0
+    if len(on_idx):
+        vertices, edges, flat, triangles = _boundary_only(vertices, edges, flat, offsets, triangles, n_e)
     return Slice(vertices, edges, flat, offsets, cell_ids, triangles, triangle_cells, volume, 3)
+
+
+def _touching(t: _Tables, vertices, edges, on_idx, f_on) -> Slice:
+    """A slice with no polygons: H touches P in faces (dim 2), edges (1) or vertices (0), or misses it."""
+    if not len(on_idx):
+        dim = -1
+    else:
+        dim = 2 if f_on.any() else (1 if len(edges) else 0)
+    return Slice(vertices, edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
+
+
+def _faces_in_h(t: _Tables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, fn: np.ndarray, c_on: np.ndarray):
+    """Which 2-faces lying in H bound the solid slice, and on which side of each is the outside.
+
+    Seen in the plane orthogonal to face f (axes: its normal ``fn`` within H, and w), each of
+    its two cells is a ray from f (towards the cell's centre) and the polytope fills the angle
+    between the rays on the inner side of the first cell (against its outward normal).  A
+    direction ±fn along H is *filled* when it lies strictly inside that angle or along a cell
+    lying in H.  f is a polygon of S when exactly one of ±fn is filled, and its outward normal
+    is the other one.  (A convex polytope cut through its interior always has one cell above
+    and one below: the filled side is the one towards the interior.  A non-convex one may
+    have both sides filled -- f inside S, at a reflex ridge or between two coplanar cells
+    lying in H -- or neither.)
+
+    Returns ``keep`` (nf,) bool and ``outward`` (nf,) bool: +fn is the outside.
+    """
+    fc = t.face_cells[face_ids]  # (nf, 2)
+    corners = x[t.fv_vert[np.isin(t.fv_face, face_ids)]]
+    fcount = np.diff(np.append(t.f_starts, len(t.fv_face)))[face_ids]
+    owner = np.repeat(np.arange(len(face_ids)), fcount)
+    p_f = np.stack([np.bincount(owner, weights=corners[:, k]) for k in range(4)], axis=1) / fcount[:, None]
+    g = t.cell_centres[fc] @ m.T  # (nf, 2, 4) the two cells' centres, rotated
+    r = g - p_f[:, None, :]
+    ra = np.einsum("fcd,fd->fc", r[..., :3], fn)  # the rays in (fn, w) coordinates
+    rb = np.where(c_on[fc], 0.0, r[..., 3])
+    nrm = t.cell_normals[fc[:, 0]] @ m.T  # first cell's outward normal
+    na, nb = np.einsum("fd,fd->f", nrm[:, :3], fn), nrm[:, 3]
+    a1, b1, a2, b2 = ra[:, 0], rb[:, 0], ra[:, 1], rb[:, 1]
+    ccw = a1 * (-nb) - b1 * (-na) > 0  # the polytope lies counter-clockwise from ray 1
+
+    def angle(ax, ay, bx, by):  # counter-clockwise angle from a to b in [0, 2 pi)
+        return np.mod(np.arctan2(ax * by - ay * bx, ax * bx + ay * by), 2 * np.pi)
+
+    filled = []
+    for sgn in (1.0, -1.0):
+        ang1x, ang12 = angle(a1, b1, sgn, 0.0), angle(a1, b1, a2, b2)
+        angx1, ang21 = angle(sgn, 0.0, a1, b1), angle(a2, b2, a1, b1)
+        inside = np.where(ccw, (ang1x > 0) & (ang1x < ang12), (angx1 > 0) & (angx1 < ang21))
+        along = (c_on[fc[:, 0]] & (np.sign(a1) == sgn)) | (c_on[fc[:, 1]] & (np.sign(a2) == sgn))
+        filled.append(inside | along)
+    plus, minus = filled
+    return plus != minus, minus
+
+
+def _boundary_only(vertices, edges, flat, offsets, triangles, n_e):
+    """Drop the on-H vertices and in-H edges that no polygon uses (a solid slice of a non-convex
+    polytope is given by its boundary: a face inside S, or P touching H away from S, adds none).
+
+    A convex polytope's solid slice uses them all: then nothing changes (same arrays)."""
+    n = len(vertices)
+    used = np.zeros(n, dtype=bool)
+    used[flat] = True
+    nxt = np.arange(1, len(flat) + 1)
+    nxt[offsets[1:] - 1] = offsets[:-1]
+    sides = np.minimum(flat, flat[nxt]) * n + np.maximum(flat, flat[nxt])
+    ekey = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
+    side = np.isin(ekey, sides)
+    if used.all() and side.all():
+        return vertices, edges, flat, triangles
+    new = np.cumsum(used) - 1
+    return vertices[used], new[edges[side]], new[flat], new[triangles]

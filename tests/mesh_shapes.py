@@ -46,6 +46,25 @@ def duoprism(p: int, q: int, **kw) -> Polytope:
     return Polytope(v, f, c, name=f"{p}-{q} duoprism", **kw)
 
 
+def prism_mesh(vertices3, faces3, height: float = 1.0):
+    """The 4-D prism over a polyhedron (its vertices (n, 3) and faces): (vertices, faces, cells).
+
+    Vertices: the polyhedron at w = 0, then at w = ``height``.  Faces: the polyhedron's
+    faces below (0 .. k-1) and above (k .. 2k-1), then a square over each of its edges.
+    Cells: the two caps, then a prism over each face.
+    """
+    v3 = np.asarray(vertices3, dtype=float)
+    n, k = len(v3), len(faces3)
+    vertices = np.concatenate([np.column_stack([v3, np.zeros(n)]), np.column_stack([v3, np.full(n, height)])])
+    edges = sorted({tuple(sorted((f[i], f[(i + 1) % len(f)]))) for f in faces3 for i in range(len(f))})
+    side = {e: 2 * k + i for i, e in enumerate(edges)}
+    faces = [list(f) for f in faces3] + [[i + n for i in f] for f in faces3] + [[a, b, b + n, a + n] for a, b in edges]
+    cells = [list(range(k)), list(range(k, 2 * k))]
+    for j, f in enumerate(faces3):
+        cells.append([j, k + j] + [side[tuple(sorted((f[i], f[(i + 1) % len(f)])))] for i in range(len(f))])
+    return vertices, faces, cells
+
+
 def tesseract_union_mesh(cubes, centre=True):
     """Boundary of a union of unit tesseracts [k, k+1]^4 at integer positions ``cubes``.
 
@@ -92,10 +111,17 @@ def tesseract_union_mesh(cubes, centre=True):
     return vertices - shift, faces, cells, pieces
 
 
+#: unions of unit tesseracts, by their integer positions: in the xy-plane unless said
 SHAPES = {
-    "L": [(0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0)],
+    "L": [(0, 0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 0), (0, 1, 0, 0)],
     "plus": [(0, 0, 0, 0), (1, 0, 0, 0), (-1, 0, 0, 0), (0, 1, 0, 0), (0, -1, 0, 0)],
     "2x2 minus one": [(0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0)],
+    "U": [(0, 0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 0), (0, 1, 0, 0), (2, 1, 0, 0)],
+    "ring": [(x, y, 0, 0) for x in range(3) for y in range(3) if (x, y) != (1, 1)],
+    # bends in every direction of 4-D: a corner with an arm along each axis
+    "tripod": [(0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1)],
+    # a step in the zw-plane on top of an L in the xy-plane
+    "staircase": [(0, 0, 0, 0), (1, 0, 0, 0), (1, 1, 0, 0), (1, 1, 1, 0), (1, 1, 1, 1)],
 }
 
 
