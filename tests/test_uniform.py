@@ -485,3 +485,13 @@ def test_hyperplane_through_a_cell_gives_that_cell(name):
         assert s.dim == 3
         assert s.volume == pytest.approx(ConvexHull(pts[:, :3]).volume, rel=1e-9)
         assert len(s.cell_ids) == len(p.cells[k])
+
+
+def test_every_listed_name_is_canonical_and_listed_once():
+    names = uniform.polytope_names()
+    flat = [n for ns in names.values() for n in ns]
+    assert len(flat) == len(set(flat)) == 47 + 17 + 464 + 29
+    assert all(uniform.canonical_name(n) == n for n in flat)
+    assert all(uniform.family(n) == fam for fam, ns in names.items() for n in ns)
+    names["A4: 5-cell family [3,3,3]"].clear()  # a copy: the table is not changed
+    assert len(uniform.polytope_names()["A4: 5-cell family [3,3,3]"]) == 9
