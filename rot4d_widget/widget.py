@@ -128,6 +128,11 @@ class Rot4DWidget(widgets.HBox):
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
+    keypad : bool
+        An on-screen key pad under the canvas (default False; also the `keypad` trait): a
+        button per action (simple and double rotations and their inverses, alpha, c0, the
+        step, reset) for a mouse or a touch screen.  A click is one step; a button held
+        down repeats exactly like a held key and stops on release or on leaving it.
     hold_delay, tick_rate, ack_timeout : float
         Seconds before a held key repeats; repeats per second while held;
         seconds to wait for a "drawn" acknowledgement.
@@ -154,6 +159,7 @@ class Rot4DWidget(widgets.HBox):
     show_bars = _Value(True)
     show_faces = _Value(True)
     color_by = _Value("group", help='"group" or one colour for every face')
+    keypad = traitlets.Bool(False, help="show the on-screen key pad (buttons for every action)")
     levels = _Value(None, help="iso levels of a field source (tuple of floats); None for sources without levels")
     levels.allow_none = True
     slices = _Value(None, help="parallel slices shown (int 1...64); None for a single view until set (or n pressed)")
@@ -188,6 +194,7 @@ class Rot4DWidget(widgets.HBox):
         spacing=None,
         arrangement="oval",
         antialias: bool = False,
+        keypad: bool = False,
         hold_delay: float = HOLD_DELAY,
         tick_rate: float = TICK_RATE,
         ack_timeout: float = ACK_TIMEOUT,
@@ -195,6 +202,8 @@ class Rot4DWidget(widgets.HBox):
         _autotick: bool = True,
     ):
         # -- validate before any widget exists --------------------------------
+        if not isinstance(keypad, bool):
+            raise TypeError(f"Expected `keypad` to be a bool, got {type(keypad).__name__}")
         src = as_source(source)
         if levels is not None:
             if not hasattr(src, "levels"):
@@ -247,6 +256,8 @@ class Rot4DWidget(widgets.HBox):
         self._was_displayed = False
         self._syncing = False
         self._note = None  # one line for the readout: what a screenshot did
+        self._pad = None  # the key pad's box, built when first shown
+        self._pad_events = []
         self._screenshots = {}  # request id -> (path, callback): asked, not answered yet
         self._screenshot_seq = 0
         #: The PNG of the view the page sent last (`screenshot`, key p), or None.
@@ -325,6 +336,8 @@ class Rot4DWidget(widgets.HBox):
         self.observe(self._on_color_by, names="color_by")
         self.observe(self._on_levels, names="levels")
         self.observe(self._on_stack_trait, names=["slices", "spacing", "arrangement"])
+        self.observe(self._on_keypad, names="keypad")
+        self.keypad = keypad
 
         # The initial picture is part of the models' state: not "in flight".
         self._pump.send_now(expect_ack=False)
@@ -464,6 +477,74 @@ class Rot4DWidget(widgets.HBox):
             n += 1
         self._ask_screenshot(f"rot4d-{n:03d}.png", None)
 
+    # ------------------------------------------------------------ key pad
+    def _on_keypad(self, change) -> None:
+        if change["new"] and self._pad is None:
+            self._pad = self._build_keypad()
+            self._canvas_box.children = (*self._canvas_box.children, self._pad)
+        if self._pad is not None:
+            self._pad.layout.display = None if change["new"] else "none"
+            if not change["new"]:
+                self.release_keys()
+
+    def _build_keypad(self):
+        """Rows of buttons, one per bound action in `_PAD_ROWS`; each button's presses feed the
+        same repeater as keys (ipyevents mouse and touch events on the button)."""
+        rows = []
+        for title, row in _PAD_ROWS:
+            buttons = []
+            for key, shift in row:
+                found = self.state.keymap.resolve(key, shift)
+                if found is None:
+                    continue
+                action, inverted = found
+                b = widgets.Button(
+                    description=action.label(inverted),
+                    tooltip=f"{'Shift+' if shift else ''}{key}: {action.describe()}",
+                    layout=widgets.Layout(width="auto", min_width="3.6em", height="2.2em", padding="0 0.3em"),
+                )
+                b.add_class("rot4d-pad-button")
+                ev = Event(source=b, watched_events=list(_PAD_EVENTS), prevent_default_action=True)
+                ev.on_dom_event(lambda event, key=key, shift=shift: self._handle_pad_event(key, shift, event))
+                self._pad_events.append(ev)
+                buttons.append(b)
+            if buttons:
+                label = widgets.HTML(f"<small>{html.escape(title)}</small>", layout=widgets.Layout(width="4.5em"))
+                rows.append(widgets.HBox([label, *buttons], layout=widgets.Layout(flex_flow="row wrap")))
+        box = widgets.VBox(rows, layout=widgets.Layout(margin="0.3em 0 0 0"))
+        box.add_class("rot4d-keypad")
+        return box
+
+    def _handle_pad_event(self, key, shift, event) -> None:
+        """A key pad button: mousedown / touchstart press its key, the rest release it. Never raises."""
+        try:
+            etype = event.get("type") if isinstance(event, Mapping) else None
+            key_id = f"pad:{key}{'+shift' if shift else ''}"
+            if etype in ("mousedown", "touchstart"):
+                if etype == "mousedown" and event.get("button", 0) != 0:
+                    return  # the main button only (a right click opens no repeat)
+                found = self.state.keymap.resolve(key, shift)
+                if found is None or self._has_no_view():
+                    return
+                action, inverted = found
+                with self._pump.lock:
+                    if self._closed or key_id in self._repeater.held_keys:
+                        return  # a touch's emulated mousedown: one press only
+                    now = self._pump.clock()
+                    if action.kind == "help":
+                        self.help_visible = not self.help_visible
+                        return
+                    self._step(action, inverted)
+                    if action.kind in REPEATING_KINDS or (action.kind == "custom" and self._custom[action.name][1]):
+                        self._repeater.press(key_id, action, inverted, now)
+                    self._pump.flush(now)
+            elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):
+                with self._pump.lock:
+                    self._repeater.release(key_id)
+                    self._settle()
+        except Exception as exc:  # shown, never lost, never raised into the kernel
+            self._report_error(exc)
+
     def _set_note(self, text: str) -> None:
         self._note = text
         self.readout.value = self._readout_html()
@@ -516,7 +597,16 @@ class Rot4DWidget(widgets.HBox):
                 scene.on_eye_moved(self._eye_moved, remove=True)
         finally:
             # The Event first, so its document listeners go before the canvas does.
-            for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
+            for ev in self.__dict__.get("_pad_events", ()):
+                _close_quietly(ev)
+            pad = self.__dict__.get("_pad")
+            if pad is not None:
+                for row in pad.children:
+                    for w in row.children:
+                        _close_quietly(w)
+                    _close_quietly(row)
+            for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_pad", "_canvas_box",
+                         "_side_box"):
                 w = getattr(self, name, None)
                 if w is not None:
                     _close_quietly(w)
@@ -1000,6 +1090,17 @@ def _help_groups(keymap: Keymap) -> list:
     if reserved:
         rows.append((" ".join(reserved), "reserved", "iso levels (fields), fewer slices and spacing (parallel slices): not active in this view"))
     return rows
+
+
+#: The key pad: (row title, ((key, shift), ...)); keys not bound in the keymap are left out.
+_PAD_ROWS = (
+    ("simple", tuple((k, False) for k in "23468c")),
+    ("inverse", tuple((k, True) for k in "23468c")),
+    ("double", (("y", False), ("z", False), ("w", False), ("y", True), ("z", True), ("w", True))),
+    ("\u03b1, c0", (("k", False), ("j", False), ("l", False), ("h", False))),
+    ("step", (("+", False), ("-", False), ("r", False))),
+)
+_PAD_EVENTS = ("mousedown", "mouseup", "mouseleave", "touchstart", "touchend", "touchcancel")
 
 
 def _png_size_text(png: bytes) -> str:
