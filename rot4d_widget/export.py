@@ -297,8 +297,9 @@ def describe_source(source) -> dict:
     """``source.describe()`` plus what `rebuild_source` needs, and ``"rebuild"``: True, or the reason
     it cannot be rebuilt.
 
-    A polytope whose vertices are not those of its name (a scaled pentachoron) keeps its
-    vertices; a field keeps its resolution, w units and how to reopen it (a module-level function
+    A polytope that is not one of the six named ones as `polytope(name)` builds them (a scaled
+    pentachoron, a uniform polychoron, one read from 4OFF, possibly non-convex) keeps its
+    vertices, faces and cells; a field keeps its resolution, w units and how to reopen it (a module-level function
     ``"module:qualname"``, or the file `open_field` read); a stack describes its inner source the
     same way.
     """
@@ -316,9 +317,13 @@ def describe_source(source) -> dict:
         from .polytopes import POLYTOPE_NAMES, polytope
 
         p = source.polytope
-        if "vertices" not in d and (p.name not in POLYTOPE_NAMES or not np.array_equal(
-                np.asarray(p.vertices), np.asarray(polytope(p.name).vertices))):
+        if "vertices" in d or p.name not in POLYTOPE_NAMES or not np.array_equal(
+                np.asarray(p.vertices), np.asarray(polytope(p.name).vertices)):
+            # not one of the named six as `polytope(name)` builds it: its vertices, faces and
+            # cells (a non-convex polytope is not the hull of its vertices)
             d["vertices"] = np.asarray(p.vertices).tolist()
+            d["faces"] = [np.asarray(f).tolist() for f in p.faces]
+            d["cells"] = [np.asarray(c).tolist() for c in p.cells]
         d["rebuild"] = True
     elif isinstance(source, Field4D):
         d.update(resolution=source.resolution, coarse_resolution=source.coarse_resolution, w_units=source.w_units)
@@ -355,7 +360,10 @@ def rebuild_source(description: Mapping):
         from .source import PolytopeSource
 
         if "vertices" in description:
+            faces, cells = description.get("faces"), description.get("cells")
             return PolytopeSource(Polytope(np.asarray(description["vertices"], dtype=np.float64),
+                                           None if faces is None else [np.asarray(f, dtype=np.intp) for f in faces],
+                                           None if cells is None else [tuple(c) for c in cells],
                                            name=str(description.get("name", "polytope"))))
         return PolytopeSource(polytope(description["name"]))
     if kind == "stack":

@@ -395,3 +395,21 @@ def test_a_widget_settings_go_to_a_state_file_and_a_picture(tmp_path):
         assert set(np.unique(mesh.face_attributes["slice"])) == {0, 1, 2}
     finally:
         w.close()
+
+
+def test_a_non_convex_polytope_keeps_its_faces_and_cells(tmp_path):
+    from mesh_shapes import tesseract_union
+
+    from rot4d_widget import slice_polytope
+
+    p, _ = tesseract_union("L")
+    save_state(tmp_path / "l.json", RotationState(), PolytopeSource(p))
+    _, back, _ = load_state(tmp_path / "l.json")
+    q = back.polytope
+    assert q.name == p.name and len(q.cells) == len(p.cells) and len(q.faces) == len(p.faces)
+    np.testing.assert_array_equal(q.vertices, p.vertices)
+    m = random_rotation(5)
+    a, b = slice_polytope(p, m, 0.1), slice_polytope(q, m, 0.1)
+    assert b.volume == pytest.approx(a.volume, rel=1e-12) and a.volume > 0
+    with pytest.raises(ValueError, match="convex hull"):  # the vertices alone would not rebuild it
+        type(p)(p.vertices)
