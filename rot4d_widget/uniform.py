@@ -324,9 +324,9 @@ _POLYHEDRON_OF = {  # (labels, rings) of a 3-node linear diagram -> name
 }
 
 
-def _polygon_name(m: int, both: bool) -> str:
-    k = 2 * m if both else m
-    return {3: "triangle", 4: "square", 5: "pentagon", 6: "hexagon", 8: "octagon", 10: "decagon"}.get(k, f"{k}-gon")
+def _prism_cell(m: int) -> str:
+    """The name of the uniform m-gonal prism (the 4-gonal one is the cube)."""
+    return "cube" if m == 4 else f"{_POLYGON_WORDS.get(m, f'{m}-gonal')} prism"
 
 
 def _cell_name(labels, rings, K) -> str:
@@ -343,10 +343,7 @@ def _cell_name(labels, rings, K) -> str:
     pair = [k for k in K if any(abs(k - o) == 1 for o in K if o != k)]
     m = labels[min(pair)]
     both = all(rings[k] for k in pair)
-    k = 2 * m if both else m
-    if k == 4:
-        return "cube"
-    return f"{_POLYGON_WORDS.get(k, f'{k}-gonal')} prism"
+    return _prism_cell(2 * m if both else m)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -519,7 +516,7 @@ def _prism(base: Combinatorics, base_name: str) -> Combinatorics:
     for k, f in enumerate(bf):
         sq = [2 * nf + edge_index[(min(a, b), max(a, b))] for a, b in zip(f.tolist(), np.roll(f, -1).tolist())]
         cells.append(np.array([k, k + nf] + sq))
-        nm = "cube" if len(f) == 4 else f"{_POLYGON_WORDS.get(len(f), f'{len(f)}-gonal')} prism"
+        nm = _prism_cell(len(f))
         if nm not in names:
             names.append(nm)
         types.append(names.index(nm))
@@ -557,13 +554,8 @@ def _duoprism(p: int, q: int) -> Combinatorics:
         cells.append(np.array([jj, (jj + 1) % q] + [sq0 + ii * q + jj for ii in range(p)]))
     for ii in range(p):  # the q-gonal prism between q-gons ii and ii+1
         cells.append(np.array([q + ii, q + (ii + 1) % p] + [sq0 + ii * q + jj for jj in range(q)]))
-    names = []
-    for m in (p, q):
-        nm = "cube" if m == 4 else f"{_POLYGON_WORDS.get(m, f'{m}-gonal')} prism"
-        if nm not in names:
-            names.append(nm)
-    types = [names.index("cube" if p == 4 else f"{_POLYGON_WORDS.get(p, f'{p}-gonal')} prism")] * q
-    types += [names.index("cube" if q == 4 else f"{_POLYGON_WORDS.get(q, f'{q}-gonal')} prism")] * p
+    names = list(dict.fromkeys([_prism_cell(p), _prism_cell(q)]))
+    types = [names.index(_prism_cell(p))] * q + [names.index(_prism_cell(q))] * p
     ftypes = [0] * q + [1 if p != q else 0] * p + [2] * (p * q)
     return Combinatorics(vertices, _edges_of(faces), faces, cells, ftypes, types, names)
 
@@ -592,8 +584,7 @@ _FAMILY = {"A4": "A4: 5-cell family [3,3,3]", "B4": "B4: tesseract / 16-cell fam
            "F4": "F4: 24-cell family [3,4,3]", "H4": "H4: 120-cell / 600-cell family [5,3,3]"}
 _REGULAR_DYNKIN = {"5-cell": "x3o3o3o", "8-cell": "x4o3o3o", "16-cell": "o4o3o3x", "24-cell": "x3o4o3o",
                    "120-cell": "x5o3o3o", "600-cell": "o5o3o3x"}
-_POLYGON_PREFIX = {3: "triangular", 4: "square", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal",
-                   8: "octagonal", 9: "enneagonal", 10: "decagonal", 11: "hendecagonal", 12: "dodecagonal"}
+_POLYGON_PREFIX = _POLYGON_WORDS
 
 
 def _symbol(labels, pattern: str) -> str:
