@@ -224,7 +224,10 @@ def _index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.
             except TypeError:
                 raise TypeError(f"Expected `{what}[{i}]` to be a sequence of {item} indices, "
                                 f"got {type(it).__name__}") from None
-        flat = np.array(list(itertools.chain.from_iterable(items)))
+        if items and all(isinstance(it, np.ndarray) and it.ndim == 1 for it in items):
+            flat = np.concatenate(items)  # e.g. a Wythoff construction's cycles: no Python loop over entries
+        else:
+            flat = np.array(list(itertools.chain.from_iterable(items)))
         if flat.size == 0:
             flat = np.zeros(0, dtype=np.intp)
         if flat.ndim != 1 or flat.dtype.kind not in "iu":
@@ -232,7 +235,7 @@ def _index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.
                 a = np.asarray(it)
                 if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
                     raise TypeError(f"Expected `{what}[{i}]` to be a sequence of integer {item} indices, "
-                                    f"got {list(it)[:8]!r}")
+                                    f"got {np.asarray(it).tolist()[:8]!r}")
             raise TypeError(f"Expected `{what}` to be {expected}")
         flat = flat.astype(np.intp)
     bad = np.flatnonzero((flat < 0) | (flat >= n_max))
@@ -294,6 +297,9 @@ class Polytope:
     cells : tuple of C tuples of face indices
     face_cells : (F, 2) intp, the two cells of each face, ascending
     circumradius : float, max distance of a vertex from the origin
+    convex : bool, the polytope is convex (always from the hull; for a mesh: one
+        boundary component and no reflex ridge, i.e. each cell's neighbours across
+        its faces on its inner side -- locally convex and connected is convex)
     cell_normals : (C, 4) float64 outward unit normals; ``cell_offsets`` (C,)
         so that cell c lies in ``vertices @ cell_normals[c] == cell_offsets[c]``
 
@@ -357,6 +363,7 @@ class Polytope:
         self.cell_normals = _sealed(np.ascontiguousarray(normals))
         self.cell_offsets = _sealed(np.ascontiguousarray(offsets))
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
+        self.convex = True
 
     def _order_cycle(self, idx: np.ndarray) -> np.ndarray:
         """Order the vertices of a planar convex polygon in 4-D as a cycle."""
@@ -441,9 +448,12 @@ class Polytope:
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
         self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
-        normals, offsets = _mesh_geometry(self, validate)
+        normals, offsets, centres, ncomp, tol = _mesh_geometry(self, validate)
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets)
+        c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
+        self.convex = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
+                           and np.all(np.einsum("fd,fd->f", normals[c2], centres[c1]) <= offsets[c2] + tol))
 
     # -- files -------------------------------------------------------------
     @classmethod
@@ -512,8 +522,9 @@ class Polytope:
         return f"Polytope({self.name!r}, V={v}, E={e}, F={f}, C={c}, circumradius={self.circumradius:.4g})"
 
 
-def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Check an explicit mesh's geometry; its outward cell normals and offsets."""
+def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
+    """Check an explicit mesh's geometry: (outward cell normals, offsets, cell centres, number of
+    boundary components, the tolerance used)."""
     v = p.vertices
     V, F, C = len(v), len(p._face_ptr) - 1, len(p._cell_ptr) - 1
     tol = MESH_TOLERANCE * float(np.ptp(v, axis=0).max())
@@ -632,7 +643,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple[np.ndarray, np.ndarray]
         flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
     s = np.where(flip[comp], -s, s)
     normals = np.ascontiguousarray(n * s[:, None])
-    return normals, np.ascontiguousarray(offsets * s)
+    return normals, np.ascontiguousarray(offsets * s), g, ncomp, tol
 
 
 def _check_closed(p: Polytope) -> None:

@@ -461,3 +461,14 @@ def test_from_off_reads_a_path_and_refuses_other_types(tmp_path):
         Polytope.from_off(3.5)
     with pytest.raises(FileNotFoundError):
         Polytope.from_off(str(tmp_path / "missing.off"))
+
+
+def test_convex_says_whether_the_polytope_is_convex():
+    assert all(polytope(n).convex for n in NAMES)
+    assert all(Polytope(polytope(n).vertices, *as_lists(polytope(n))).convex for n in NAMES)
+    assert duoprism(5, 7).convex and duoprism(3, 12).convex
+    assert not any(tesseract_union(shape)[0].convex for shape in ("L", "plus", "ring", "tripod"))
+    v, f, c, _ = tesseract_union_mesh([(0, 0, 0, 0), (1, 0, 0, 0)])  # a 2x1x1x1 box: flat ridges only
+    assert Polytope(v, f, c).convex
+    v, f, c, _ = tesseract_union_mesh([(0, 0, 0, 0), (0, 0, 0, 3)])  # two pieces apart
+    assert not Polytope(v, f, c).convex
