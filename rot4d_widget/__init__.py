@@ -41,13 +41,21 @@ _LAZY = {
     "slice_field": "fields",
     "FieldSlice": "fields",
     "FieldSliceData": "fields",
+    "polytope_names": "uniform",
+    "slice_mesh": "export",
+    "save_state": "export",
+    "load_state": "export",
+    "Recording": "recording",
+    "Recorder": "recording",
+    "render_state": "figures",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
 #: statement, as they were when this ``__init__`` imported the core eagerly.
 _SUBMODULES = ("buffers", "companion", "figures", "keymap", "polytopes", "rotation",
                "scene", "slicing", "source", "state", "widget",
-               "look", "readout", "keyhold", "pump", "fields", "tomography", "datasets")
+               "look", "readout", "keyhold", "pump", "fields", "tomography", "datasets",
+               "uniform", "export", "recording")
 
 
 def _exists(module: str) -> bool:

@@ -267,6 +267,10 @@ class Rot4DWidget(widgets.HBox):
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
             name=f"rot4d-ticker-{id(self):x}",
         )
+        from .recording import Recorder
+
+        # every applied action and parameter set, time-stamped (bounded; see `recording`)
+        self._recorder = Recorder(state, clock=self._pump.clock)
 
         # -- widgets ------------------------------------------------------------
         Scene, Companion = _scene_classes()
@@ -555,9 +559,168 @@ class Rot4DWidget(widgets.HBox):
             if self._closed:
                 raise RuntimeError("This Rot4DWidget is closed")
             self._source_version += 1
+            st = self.state
+            for name in ("c0_step", "theta0", "alpha", "c0", "matrix"):  # `state` may have been set directly
+                self._recorder.record_set(name, getattr(st, name))
             self._sync_traits()
             self._pump.mark_dirty()
             self._pump.flush()
+
+    # ------------------------------------------------------- keeping what you see
+    @property
+    def recording(self):
+        """What was applied since the widget was made (or `start_recording`): a
+        `rot4d_widget.recording.Recording` of every step (keys, key pad, `press`, repeats) and
+        every parameter set (sliders, traits, `refresh`), time-stamped.  Save it
+        (``.save(path)``), replay it (`replay`) or render it (`render_animation`)."""
+        return self._recorder.recording()
+
+    def start_recording(self) -> None:
+        """Forget what was recorded; record from the current state on."""
+        with self._pump.lock:
+            self._recorder.restart(self.state)
+
+    def replay(self, recording) -> None:
+        """Apply a `Recording` (or a path to a saved one) to this widget: its starting state,
+        then every event, ending where the recording ended (to rounding; a source's own
+        actions, e.g. a stack's n / b, are replayed on this widget's source).  Redraws once."""
+        from .recording import Recording
+
+        if not isinstance(recording, Recording):
+            import os
+
+            if not isinstance(recording, (str, os.PathLike)):
+                raise TypeError(f"Expected a Recording or a path to one, got {type(recording).__name__}")
+            recording = Recording.load(recording)
+        with self._pump.lock:
+            if self._closed:
+                raise RuntimeError("This Rot4DWidget is closed")
+            recording.replay(self.state, self.source)
+            self._source_version += 1
+            self._sync_levels()
+            self._sync_stack()
+            self._recorder.restart(self.state)
+            self._sync_traits()
+            self._pump.mark_dirty()
+            self._pump.flush()
+
+    def render_animation(self, path, *, recording=None, fps: float = 10.0, per: str = "step", **options) -> int:
+        """Draw `recording` (default: this widget's) without a browser into an animated GIF
+        (Pillow) or MP4 (imageio-ffmpeg), by ``path``'s extension; one frame per step
+        (``per="step"``) or per 1/fps s of recorded time (``per="time"``); the widget's look
+        (`render` settings).  Returns the number of frames.  See
+        `rot4d_widget.recording.render_animation` for ``options`` (size, dpi, max_frames ...)."""
+        from .export import settings_of
+        from .recording import render_animation
+
+        rec = self.recording if recording is None else recording
+        kwargs = {**settings_of(self), **options}
+        return render_animation(rec, None, self._source_for_pictures(), path, fps=fps, per=per, **kwargs)
+
+    def render(self, path=None, *, size=None, dpi: float = 100, **options):
+        """The view as a static matplotlib figure (no browser): the current state, source and
+        display settings, the live view's camera, palette and scale; written to ``path`` (PNG,
+        SVG or PDF by extension) if given.  ``size`` in pixels, default the canvas's.  Returns
+        the `matplotlib.figure.Figure`."""
+        from .export import settings_of
+        from .figures import render_state
+
+        with self._pump.lock:
+            state = self.state.copy()
+            kwargs = {**settings_of(self), **options}
+        size = (self.scene.width, self.scene.height) if size is None else size
+        return render_state(state, self._source_for_pictures(), path, size=size, dpi=dpi, **kwargs)
+
+    def _source_for_pictures(self):
+        """The inner source for `render_state` (which stacks it again from the `slices` setting)."""
+        return self._level_source
+
+    def slice_mesh(self, **options):
+        """What the view shows as one `trimesh.Trimesh`: every face of the slice (all levels of a
+        field, all slices of a stack, placed as shown), in the source's own units, with each
+        face's group (cell / level / slice) in ``mesh.face_attributes["group"]`` and the
+        view's colours.  ``.export("slice.ply")`` writes OBJ, PLY, STL or GLB by extension.
+        See `rot4d_widget.export.slice_mesh` for ``options``."""
+        from .export import slice_mesh
+
+        with self._pump.lock:
+            data = self._current_slice()
+            colors = self._group_colors()
+        kwargs = {"color_by": self.color_by, **options}
+        if colors is not None and "group_colors" not in options:
+            kwargs["group_colors"] = colors
+        return slice_mesh(data, **kwargs)
+
+    def save_state(self, path) -> dict:
+        """Write the state (orientation, θ0, α, c0, c0 step, key bindings), what the source is
+        and the widget's settings to the JSON file ``path`` (`rot4d_widget.export.save_state`).
+        A source that cannot be rebuilt from the file (an in-memory array) is described with a
+        warning; `load_state` into a widget showing it still works.  Returns the dict written."""
+        from .export import save_state, settings_of
+
+        with self._pump.lock:
+            state = self.state.copy()
+            settings = settings_of(self)
+        return save_state(path, state, self.source, settings)
+
+    def load_state(self, path) -> None:
+        """Read a `save_state` file into this widget: its state (which `r` now resets to), key
+        bindings and settings.  The file's source must be of this widget's kind
+        (``ValueError`` otherwise; `from_state` builds a widget for the file's own source)."""
+        from .export import load_state
+
+        loaded = load_state(path, source=self.source)
+        self._apply_loaded(loaded.state, loaded.settings)
+
+    @classmethod
+    def from_state(cls, path, source=None, **kwargs) -> "Rot4DWidget":
+        """A widget for a `save_state` file: its source rebuilt from the file (or ``source``,
+        needed when the file says it cannot be rebuilt), its settings, its state."""
+        from .export import load_state
+
+        loaded = load_state(path, source=source)
+        if loaded.source is None:
+            raise ValueError(f"{path!r} does not say how to rebuild its source: pass it, "
+                             "Rot4DWidget.from_state(path, source=...)")
+        settings = dict(loaded.settings)
+        if _is_stack(loaded.source):  # already parallel slices: not wrapped twice
+            for name in ("slices", "spacing", "arrangement"):
+                settings.pop(name, None)
+        allowed = set(inspect.signature(cls.__init__).parameters)
+        init = {k: v for k, v in settings.items() if k in allowed and v is not None}
+        w = cls(loaded.source, **{**init, **kwargs})
+        w._apply_loaded(loaded.state, {})
+        return w
+
+    def _apply_loaded(self, state, settings) -> None:
+        from .state import without_source_keys
+
+        keymap = without_source_keys(state.keymap)
+        actions = _source_actions(self.source)
+        if actions:
+            keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
+        d = state.to_dict()
+        d.pop("keymap")
+        with self._pump.lock:
+            if self._closed:
+                raise RuntimeError("This Rot4DWidget is closed")
+            self.state.restore(d)  # the loaded state becomes what r resets to
+            self.state.keymap = keymap
+            self.help_panel.value = ro.help_html(_help_groups(keymap), self._repeater.hold_delay,
+                                                 self._repeater.tick_rate)
+            self._recorder.restart(self.state)
+        for name in ("slices", "arrangement", "spacing", "levels", "color_by", "face_opacity", "ball_radius",
+                     "bar_radius", "background", "show_balls", "show_bars", "show_faces"):
+            value = settings.get(name)
+            if value is None or not self.has_trait(name):
+                continue
+            if isinstance(value, list):
+                value = tuple(value)
+            if getattr(self, name) != value:
+                setattr(self, name, value)
+        self.refresh()
+        with self._pump.lock:
+            self._recorder.restart(self.state)
 
     def release_keys(self) -> None:
         """Forget every held key (what mouseleave and focus loss do)."""
@@ -746,6 +909,7 @@ class Rot4DWidget(widgets.HBox):
             return
         with self._pump.lock:
             setattr(self.state, change["name"], change["new"])
+            self._recorder.record_set(change["name"], change["new"])
             if change["name"] == "theta0":  # alpha keeps its ratio to theta0
                 self._sync_traits()
             self._pump.mark_dirty()
@@ -872,6 +1036,8 @@ class Rot4DWidget(widgets.HBox):
         else:
             changed = self.state.apply(action, inverted)
         if changed:
+            if action.kind != "slices" or _is_stack(self.source):  # not n wrapping a single view
+                self._recorder.record(None, False, action, inverted)
             self._pump.mark_dirty()
             label = action.label(inverted)
             if label == self._last_label:
