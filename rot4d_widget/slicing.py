@@ -44,11 +44,13 @@ replaced it:
 
 The volume (divergence theorem over the outward triangles, about any point)
 and the per-cell polygons never relied on convexity: S may have several
-pieces and holes and tunnels.  Where H passes through a reflex vertex of P, S
-may not be a manifold there: two solids touching at that vertex.  The slice
-keeps it as ONE vertex shared by both; the surface is still closed (each edge
-in two polygons) and outward, the volume exact, but two fans of polygons meet
-at that vertex (so V - E + F counts it once: 3 for two balls touching).
+pieces and holes and tunnels.  Where H passes through a reflex vertex of P, or
+holds a reflex edge, S may not be a manifold there: two solids touching at that
+vertex, or along that edge.  The slice keeps the vertex (the edge) ONCE, shared
+by both: two fans of polygons meet at the vertex, four polygons at the edge
+(two of each solid, wound against each other).  The surface is still closed
+(every directed edge as often as its reverse) and outward, and the volume
+exact; V - E + F counts the shared part once (3 for two balls touching).
 
 S is solid (3-D) when some polygon comes out: some cell crosses H, or some
 2-face lying in H bounds a 3-D part (a cell lying in H, as the 8-cell at

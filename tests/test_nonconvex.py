@@ -22,7 +22,7 @@ from mesh_shapes import SHAPES, tesseract_union, tesseract_union_mesh
 from reference_geometry import random_rotation, rotation_with_w_row
 from rot4d_widget import Polytope, slice_polytope
 
-PROPS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+PROPS = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 shapes = st.sampled_from(sorted(SHAPES))
 seeds = st.integers(0, 2**32 - 1)
 
@@ -73,20 +73,25 @@ def pieces_components(shape, m, c0):
     return connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(len(cut), len(cut))), directed=False)[0]
 
 
-def check_closed(s):
-    """Every directed triangle edge once and its reverse once; every edge in exactly two polygons."""
+def check_closed(s, manifold=True):
+    """Every directed triangle edge once and its reverse once; every edge in exactly two polygons.
+
+    ``manifold=False`` (two solids touching along an edge in H): every directed edge as often
+    as its reverse, every edge in an even number of polygons (a closed surface, pinched)."""
     directed = Counter()
     for a, b, c in s.triangles.tolist():
         for e in ((a, b), (b, c), (c, a)):
             directed[e] += 1
-    assert set(directed.values()) == {1}
-    assert all(directed[(b, a)] == 1 for a, b in directed)
+    assert all(directed[(b, a)] == n for (a, b), n in directed.items())
     sides = Counter()
     for poly in s.polygons:
         cyc = poly.tolist()
         for a, b in zip(cyc, cyc[1:] + cyc[:1]):
             sides[frozenset((a, b))] += 1
-    assert set(sides.values()) == {2}
+    if manifold:
+        assert set(directed.values()) == {1} and set(sides.values()) == {2}
+    else:
+        assert all(n % 2 == 0 for n in sides.values())
     assert set(sides) == {frozenset(e) for e in s.edges.tolist()}
     assert len(s.edges) == len(sides)
     assert set(np.unique(s.polygon_indices).tolist()) == set(range(len(s.vertices)))
@@ -99,12 +104,13 @@ def signed_volume(s):
 
 def check_outward(shape, m, c0, s, eps=1e-7):
     """Just outside each polygon (along its normal from the winding) is outside every piece,
-    just inside is inside one: outward winding, checked locally, polygon by polygon."""
+    just inside is inside one (a closed box: S may lie in the boundary when cells lie in H):
+    outward winding, checked locally, polygon by polygon."""
     boxes = union(shape)[2]
 
     def inside(q3):
         x = m.T @ np.append(q3, c0)  # back to the polytope's own frame
-        return any(np.all((x > lo) & (x < hi)) for lo, hi in boxes)
+        return any(np.all((x >= lo - 1e-12) & (x <= hi + 1e-12)) for lo, hi in boxes)
 
     for poly in s.polygons:
         pts = s.vertices[poly]
@@ -281,6 +287,27 @@ def test_a_pinch_point_where_the_level_passes_through_a_reflex_vertex():
     assert len(s.vertices) - len(s.edges) + len(s.cell_ids) == 3
 
 
+def test_two_solids_touching_along_a_reflex_edge_in_h():
+    """2x2 minus one cut by x + y + z = 3, which holds its reflex edge (1, 1, 1, 0)-(1, 1, 1, 1):
+    S is two triangular prisms (in B and in C) touching along that edge.  The slicer keeps the
+    edge once, in four polygons (two of each prism, each pair wound against the other), and its
+    two ends once: closed and outward, exact volume, V - E + F = 3 = 2 + 2 - 1."""
+    p, pieces, boxes = union("2x2 minus one")
+    shift = -boxes[0][0]
+    m = rotation_with_w_row((1.0, 1.0, 1.0, 0.0))
+    c0 = float((np.array([1.0, 1, 1, 0]) - shift) @ m[3])
+    s = slice_polytope(p, m, c0)
+    assert s.volume == pytest.approx(2 * np.sqrt(3) / 2) == pytest.approx(pieces_volume("2x2 minus one", m, c0))
+    check_closed(s, manifold=False)
+    ends = [int(np.argmin(np.linalg.norm(s.vertices - (m @ (np.array([1.0, 1, 1, w]) - shift))[:3], axis=1)))
+            for w in (0.0, 1.0)]
+    on_edge = [k for k, poly in enumerate(s.polygons) if set(ends) <= set(poly.tolist())]
+    assert len(on_edge) == 4
+    assert signed_volume(s) == pytest.approx(s.volume)
+    check_outward("2x2 minus one", m, c0, s)
+    assert (len(s.vertices), len(s.edges), len(s.cell_ids)) == (10, 17, 10)
+
+
 def test_pieces_apart_on_both_sides_of_h_give_an_empty_slice():
     """Two tesseracts, one above and one below H: vertices on both sides, no cell crosses."""
     v, f, c, _ = tesseract_union_mesh([(0, 0, 0, 0), (0, 0, 0, 3)], centre=False)  # w in 0..1 and 3..4
@@ -289,3 +316,38 @@ def test_pieces_apart_on_both_sides_of_h_give_an_empty_slice():
         assert s.dim == -1 and s.volume == 0 and len(s.cell_ids) == 0
     s0, s1 = slice_polytope(p, np.eye(4), [0.2, 3.7])
     assert s0.volume == pytest.approx(1.0) and s1.volume == pytest.approx(1.0)
+
+
+SPECIAL = [(1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (1, 1, 0, 0), (1, -1, 0, 0), (1, 0, 1, 0),
+           (0, 1, 0, 1), (1, 1, 1, 0), (1, 1, 1, 1), (1, -1, 1, -1), (1, 2, 0, 0), (2, 1, 1, 0)]
+
+
+@PROPS
+@given(shape=shapes, direction=st.sampled_from(SPECIAL), which=st.integers(0, 10**6), spin=seeds)
+def test_levels_through_whole_faces_and_cells(shape, direction, which, spin):
+    """Hyperplanes along the grid (axes, diagonals) at vertex heights: faces, cells and flat
+    ridges lie in H.  S is the union of the pieces' slices: their sum, or along an axis the
+    distinct unit cubes lying in H."""
+    p, _, boxes = union(shape)
+    m = rotation_with_w_row(direction)
+    q, r = np.linalg.qr(np.random.default_rng(spin).normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r)) * (1 if np.linalg.det(q * np.sign(np.diag(r))) > 0 else -1)
+    m[:3] = q @ m[:3]  # any turn of H in itself
+    h = (p.vertices @ m.T)[:, 3]
+    c0 = float(h[which % len(h)])
+    s = slice_polytope(p, m, c0)
+    axis = [k for k in range(4) if direction[k]]
+    if len(axis) == 1:
+        k = axis[0]
+        cubes = {tuple(np.round(np.delete(lo, k), 9)) for (lo, hi) in boxes if lo[k] - 1e-9 <= c0 <= hi[k] + 1e-9}
+        expected = float(len(cubes))
+    else:
+        expected = pieces_volume(shape, m, c0)
+    assert s.volume == pytest.approx(expected, rel=1e-9, abs=1e-12)
+    if expected > 0:
+        assert s.dim == 3
+        check_closed(s, manifold=False)  # H may hold a reflex edge: two solids touching along it
+        assert signed_volume(s) == pytest.approx(s.volume, rel=1e-9)
+        check_outward(shape, m, c0, s)
+    else:
+        assert s.dim < 3 and len(s.cell_ids) == 0
