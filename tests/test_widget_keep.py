@@ -143,3 +143,23 @@ def test_render_and_render_animation(make, tmp_path):
     assert n == len(w.recording) + 1  # the start and one frame per step
     gif = Image.open(tmp_path / "keys.gif")
     assert gif.size == (160, 120) and gif.n_frames >= 2
+
+
+def test_the_readme_keep_what_you_see_block_runs(make, tmp_path, monkeypatch):
+    """The README's block, as written, on a widget made by the test (no page: no screenshot)."""
+    import pathlib
+    import re
+
+    readme = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Keep what you see", 1)[1]
+    block = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    w = make("24-cell")
+    w.press("4")
+    ns = {"w": w, "Rot4DWidget": lambda *a, **k: make(*a, **k)}
+    ns["Rot4DWidget"].from_state = lambda path: Rot4DWidget.from_state(path, _autotick=False)
+    exec(compile(block, "README.md", "exec"), ns)
+    for name in ("view.pdf", "slice.ply", "view.json", "keys.json", "turn.gif"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    np.testing.assert_array_equal(ns["w2"].state.matrix, w.state.matrix)
+    ns["w2"].close()
