@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import FakeClock
 from rot4d_widget import simple_rotation
 from test_widget import down, up
 from test_widget_scene import run_ticker
@@ -67,8 +66,8 @@ def test_a_click_is_one_step_and_shift_buttons_invert(make):
 
 
 @pytest.mark.parametrize("release", ["mouseup", "mouseleave"])
-def test_a_held_button_repeats_exactly_like_the_held_key(make, release):
-    ck, cp = FakeClock(), FakeClock()
+def test_a_held_button_repeats_exactly_like_the_held_key(make, clock, release):
+    ck, cp = clock, type(clock)(clock.t)  # two fake clocks, one per widget
     by_key = make("24-cell", _clock=ck)
     by_pad = make("24-cell", _clock=cp, keypad=True)
     down(by_key, "8")
