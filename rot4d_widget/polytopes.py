@@ -241,7 +241,8 @@ def _index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.
     bad = np.flatnonzero((flat < 0) | (flat >= n_max))
     if len(bad):
         i = int(np.searchsorted(_ptr(sizes), bad[0], side="right") - 1)
-        raise MeshError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}", item=("face" if what == "faces" else "cell", i))
+        raise MeshError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}",
+                        item=("face" if what == "faces" else "cell", i))
     return sizes, flat
 
 
@@ -424,13 +425,16 @@ class Polytope:
         face_ptr, cell_ptr = _ptr(face_sizes), _ptr(cell_sizes)
         small = np.flatnonzero(face_sizes < 3)
         if len(small):
-            raise MeshError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3", item=("face", int(small[0])))
+            raise MeshError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3",
+                            item=("face", int(small[0])))
         small = np.flatnonzero(cell_sizes < 4)
         if len(small):
-            raise MeshError(f"`cells[{small[0]}]` has {cell_sizes[small[0]]} faces; a cell needs at least 4", item=("cell", int(small[0])))
+            raise MeshError(f"`cells[{small[0]}]` has {cell_sizes[small[0]]} faces; a cell needs at least 4",
+                            item=("cell", int(small[0])))
         dup = _duplicate_in_rows(face_ptr, face_vidx, V)
         if dup:
-            raise MeshError(f"`faces[{dup[0]}]` has vertex {dup[1]} twice; a face is a cycle of distinct vertices", item=("face", dup[0]))
+            raise MeshError(f"`faces[{dup[0]}]` has vertex {dup[1]} twice; a face is a cycle of distinct vertices",
+                            item=("face", dup[0]))
         dup = _duplicate_in_rows(cell_ptr, cell_fidx, F)
         if dup:
             raise MeshError(f"`cells[{dup[0]}]` has face {dup[1]} twice", item=("cell", dup[0]))
@@ -440,10 +444,11 @@ class Polytope:
             f = int(bad[0])
             holders = _owner(cell_ptr)[cell_fidx == f].tolist()
             raise MeshError(f"face {f} is in {use[f]} cell(s) {holders}; every face must be in exactly two "
-                             f"cells (a closed boundary)", item=("face", f))
+                            f"cells (a closed boundary)", item=("face", f))
         unused = np.flatnonzero(np.bincount(face_vidx, minlength=V) == 0)
         if len(unused):
-            raise MeshError(f"vertex {unused[0]} is in no face; every vertex must be a corner of some face", item=("vertex", int(unused[0])))
+            raise MeshError(f"vertex {unused[0]} is in no face; every vertex must be a corner of some face",
+                            item=("vertex", int(unused[0])))
         self._set_combinatorics(face_ptr, face_vidx, cell_ptr, cell_fidx)
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
@@ -472,7 +477,8 @@ class Polytope:
         data = read_off(path_or_text)
         if name is None:
             is_path = isinstance(path_or_text, os.PathLike) or (
-                isinstance(path_or_text, str) and "\n" not in path_or_text and not path_or_text.lstrip().startswith("4OFF"))
+                isinstance(path_or_text, str) and "\n" not in path_or_text
+                and not path_or_text.lstrip().startswith("4OFF"))
             name = os.path.splitext(os.path.basename(os.fspath(path_or_text)))[0] if is_path else "4OFF"
         try:
             p = cls(data.vertices, data.faces, data.cells, name=name, validate=validate)
@@ -554,7 +560,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
         if len(bad):
             f = int(fs[bad[0]])
             raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]]:.3g} from its plane "
-                             f"(tolerance {tol:.3g})", item=("face", f))
+                            f"(tolerance {tol:.3g})", item=("face", f))
         e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
         e2 = np.roll(e, -1, axis=1)
         cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
@@ -568,8 +574,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
         if len(bad):
             f = int(fs[bad[0]])
             raise MeshError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
-                             f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
-                             f"strictly convex polygons with their vertices in cyclic order", item=("face", f))
+                            f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
+                            f"strictly convex polygons with their vertices in cyclic order", item=("face", f))
         face_c[fs] = c
         face_e[fs] = B
         face_area[fs] = 0.5 * np.abs((xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
@@ -595,10 +601,11 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
         if len(bad):
             c = int(cs[bad[0]])
             raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]]:.3g} from it "
-                             f"(tolerance {tol:.3g})", item=("cell", c))
+                            f"(tolerance {tol:.3g})", item=("cell", c))
         bad = np.flatnonzero(s[:, 2] <= tol)
         if len(bad):
-            raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D", item=("cell", int(cs[bad[0]])))
+            raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D",
+                            item=("cell", int(cs[bad[0]])))
         g[cs] = gc
         n[cs] = normal
     pc = _owner(cptr)  # the (cell, face) pairs, cell by cell
@@ -610,7 +617,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
     bad = np.flatnonzero(height <= tol)
     if len(bad):
         raise MeshError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
-                         f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
+                        f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
     m /= height[:, None]  # each face's outward normal within each of its cells
     if validate:
         _check_cells(p, v, tol, pc, pf, m, face_c)
@@ -628,7 +635,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
     bad = np.flatnonzero(lab[:C] == lab[C:])
     if len(bad):
         raise MeshError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
-                         f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
+                        f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
     s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
     ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
     vol3 = np.bincount(pc, weights=face_area[pf] * height, minlength=C) / 3.0
@@ -637,7 +644,7 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
     small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
     if len(small):
         raise MeshError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
-                         f"no 4-volume")
+                        f"no 4-volume")
     flip = vol4 < 0
     if ncomp > 1:
         flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
@@ -677,13 +684,14 @@ def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
             if out.any():
                 i, j2, k2 = np.argwhere(out)[0]
                 raise MeshError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
-                                 f"outside the plane of its face {int(pf[pairs[i, j2]])}", item=("cell", int(cs[i])))
+                                f"outside the plane of its face {int(pf[pairs[i, j2]])}", item=("cell", int(cs[i])))
             on = (D >= -tol).sum(axis=2)
             wrong = on != fsize[pf[pairs]]
             if wrong.any():
                 i, j2 = np.argwhere(wrong)[0]
                 raise MeshError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
-                                 f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)", item=("cell", int(cs[i])))
+                                f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)",
+                                 item=("cell", int(cs[i])))
 
 
 def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:
