@@ -728,11 +728,15 @@ def _named(canon: str) -> Polytope:
 
 
 def polytope(name) -> Polytope:
-    """One of the six regular polychora with edge 2, by name, alias or Schläfli symbol.
+    """A uniform polychoron with edge 2, centred on the origin, by name.
 
-    ``"5-cell"`` (pentachoron, ``"{3,3,3}"``), ``"8-cell"`` (tesseract),
-    ``"16-cell"``, ``"24-cell"``, ``"120-cell"``, ``"600-cell"``.  A `Polytope`
-    is returned as is.  The result is built once and cached.
+    The six regular ones by name, alias or Schläfli symbol: ``"5-cell"`` (pentachoron,
+    ``"{3,3,3}"``), ``"8-cell"`` (tesseract), ``"16-cell"``, ``"24-cell"``, ``"120-cell"``,
+    ``"600-cell"``; every other uniform one (`rot4d_widget.uniform`: the Wythoff families,
+    the snub 24-cell, the grand antiprism, prisms, duoprisms, antiprismatic prisms) by its
+    common name (``"rectified 5-cell"``, ``"5-7 duoprism"``) or linear Dynkin symbol
+    (``"o3x3o3o"``, ``"x5x3x3x"``); ``rot4d_widget.polytope_names()`` lists them.  A
+    `Polytope` is returned as is.  The result is built once and cached.
     """
     if isinstance(name, Polytope):
         return name
@@ -740,6 +744,11 @@ def polytope(name) -> Polytope:
         raise TypeError(f"Expected a polytope name (str) or a Polytope, got {type(name).__name__}")
     canon = _NAME_OF.get(_normalise_name(name))
     if canon is None:
+        from . import uniform  # imported here: uniform imports this module
+
+        if uniform.canonical_name(name) is not None:
+            return uniform.build(name)
         allowed = ", ".join(f"{n!r} ({', '.join(_ALIASES[n][1:3])}, {_ALIASES[n][-1]})" for n in POLYTOPE_NAMES)
-        raise ValueError(f"Unknown polytope {name!r}; expected one of {allowed}")
+        raise ValueError(f"Unknown polytope {name!r}; expected one of {allowed}, or a uniform polychoron by "
+                         "name or Dynkin symbol (rot4d_widget.polytope_names() lists them)")
     return _named(canon)
