@@ -648,6 +648,7 @@ def render_tomography(
     toff = np.asarray(ex["triangle_offsets"])
     soff = np.asarray(ex["segment_offsets"])
     # back to front by the depth of each slice's centre; zorders of slices never interleave
+    jobs = []  # labels, placed after every slice is drawn
     for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
         z_shift = 1e3 * rank
         ball = base_ball * scales[k] if ball_radius is None else ball_radius
@@ -675,7 +676,13 @@ def render_tomography(
                           (0.35 * look.default_bar_radius(ball) if bar_radius is None else bar_radius) if show_bars else 0.0,
                           show_faces=show_faces)
         if labels:
-            _label_slice(ax, centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift)
+            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift))
+    # labels that would overlap one already placed are left out: the highlighted slice's first,
+    # then the nearer (bigger) slices' (far, small slices of the oval crowd together)
+    placed: list = []
+    point = 2.0 * limit / (height * 72.0)  # data units per typographic point
+    for job in sorted(jobs, key=lambda j: (not j[3], -j[1] * perspective(np.asarray(j[0])[None, :])[1][0])):
+        _label_slice(ax, *job, point=point, placed=placed)
     ax.set_xlim(-limit * aspect, limit * aspect)
     ax.set_ylim(-limit, limit)
     if title:
@@ -688,15 +695,31 @@ def render_tomography(
     return fig
 
 
-def _label_slice(ax, centre, radius, w, highlighted, z_shift):
+def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
     """'w = ...' at the upper left of a slice's projected bounding circle (inside its square, like a
     CT film's corner text), painted with its slice (nearer slices cover it); the highlighted slice
-    ringed, its label bold."""
+    ringed, its label bold.  With ``point`` (data units per point) and ``placed`` (boxes of the
+    labels drawn so far), a label overlapping one of them is left out (not the highlighted one)."""
     (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
     r = radius * f
     fs = max(5.0, min(9.0, 30.0 * r))
     z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
-    ax.text(xy[0] - 0.98 * r, xy[1] + 0.98 * r, f"w = {w:.3g}", ha="left", va="top", fontsize=fs,
+    text = f"w = {w:.3g}"
+    x0, y1 = xy[0] - 0.98 * r, xy[1] + 0.98 * r
+    if point is not None and placed is not None:
+        # the upper left corner of the slice's square, else its upper right, else just above it
+        wd, ht = 0.62 * fs * point * len(text), 1.7 * fs * point  # a line and a gap
+        for cx, cy in ((x0, y1), (xy[0] + 0.98 * r - wd, y1), (xy[0] - wd / 2, y1 + ht)):
+            box = (cx, cy - ht, cx + wd, cy)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+                break
+        else:
+            if not highlighted:
+                return  # nowhere free: left out
+            cx, cy, box = x0, y1, (x0, y1 - ht, x0 + wd, y1)
+        placed.append(box)
+        x0, y1 = cx, cy
+    ax.text(x0, y1, text, ha="left", va="top", fontsize=fs,
             fontweight="bold" if highlighted else "normal", zorder=z, gid="label")
     if highlighted:
         ax.add_patch(Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",

@@ -16,10 +16,10 @@ default canvas aspect 600 / 500 -- and scaled to the source's units):
 
 ``"oval"``
     Kageyama's follow-up (J. Visualization 2016): the slice centres lie on the parabola
-    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, Y0 = -0.95,
+    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, Y0 = -0.65,
     |u| <= 2.0: it opens away from the eye and rises with depth, so its perspective image is
     an oval (the points at infinity would close it at the horizon y' = 5 C / B = 2).  The
-    central slice (w = c0) sits at the vertex P(0) = (0, -0.95, 0), nearest the eye and
+    central slice (w = c0) sits at the vertex P(0) = (0, -0.65, 0), nearest the eye and
     lowest; slices of higher w go right, lower w left.  World scales are
     ``s0 (1 - 0.4 tau^2) / max``, tau = (k - (N-1)/2) / ((N-1)/2), on top of perspective.
     Slices are laid along the parabola from the vertex at arc-length steps proportional to
@@ -27,8 +27,9 @@ default canvas aspect 600 / 500 -- and scaled to the source's units):
     used up; then the steps shrink.  ``s0`` is the largest scale, at most 0.6, for which
     every pair of bounding spheres (radius ``radius * scale``) is disjoint with a 5 % gap
     and every sphere's image lies in the 600 x 500 camera frame with a 3 % margin.  Why these
-    numbers: A, B, C make the oval's image span |x'| <= 1.68 and -0.95 ... 1.13 in y' (the
-    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0); u = 2 is past the widest point
+    numbers: A, B, C make the oval's image span |x'| <= 1.68 and -0.65 ... 1.22 in y' (the
+    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0; Y0 centres the picture: the big central
+    slice below and the far, small ones above leave about the same margin); u = 2 is past the widest point
     u* = sqrt(5 / B) = 1.29, so the ends curl back towards each other (an oval, not a U)
     while the farthest slice, 12 units deep, is still drawn at 29 % of its size.  With
     N = 16 every slice gets scale 0.56, with 64 about 0.2.
@@ -83,7 +84,7 @@ MAX_SLICES = 64
 COLOR_BY = ("w", "cell")
 
 #: The oval's parabola P(u) = (A u, Y0 + C u^2, -B u^2), |u| <= U_MAX, in displayed units.
-OVAL_PARABOLA = {"A": 2.6, "B": 3.0, "C": 1.2, "Y0": -0.95, "U_MAX": 2.0}
+OVAL_PARABOLA = {"A": 2.6, "B": 3.0, "C": 1.2, "Y0": -0.65, "U_MAX": 2.0}
 #: Largest world scale of an oval slice; relative shrink of the end slices (1 - 0.4 tau^2).
 OVAL_MAX_SCALE = 0.6
 OVAL_SHRINK = 0.4
