@@ -111,6 +111,48 @@ def tesseract_union_mesh(cubes, centre=True):
     return vertices - shift, faces, cells, pieces
 
 
+def stellated_tesseract_mesh(height: float):
+    """The tesseract [-1, 1]^4 with a 4-D pyramid of ``height`` on each of its 8 cubes.
+
+    Cells: over each cube, a square pyramid on each of its 6 squares (48 in all); faces: the
+    tesseract's 24 squares (each between the pyramids of its two cubes) and a triangle on each
+    cube edge and apex (96).  Height 1 gives the 24-cell (the two pyramids on a square make an
+    octahedron: flat ridges); above 1 the squares are reflex ridges.  Returns (vertices, faces,
+    cells, pieces): the pieces are the tesseract and the 8 pyramids, as point arrays.
+    """
+    cube_pts = np.array(list(itertools.product((-1.0, 1.0), repeat=4)))
+    apexes = [(k, s) for k in range(4) for s in (-1.0, 1.0)]
+    vertices = np.concatenate([cube_pts, [s * (1.0 + height) * np.eye(4)[k] for k, s in apexes]])
+    squares = {}  # frozenset of 4 vertex ids -> face id
+    faces, triangles, cells = [], {}, []
+    for a1, a2 in itertools.combinations(range(4), 2):
+        rest = [k for k in range(4) if k not in (a1, a2)]
+        for b1, b2 in itertools.product((-1.0, 1.0), repeat=2):
+            def vid(u, v):
+                x = np.zeros(4)
+                x[a1], x[a2], x[rest[0]], x[rest[1]] = u, v, b1, b2
+                return int(np.flatnonzero(np.all(cube_pts == x, axis=1))[0])
+            cyc = [vid(-1, -1), vid(1, -1), vid(1, 1), vid(-1, 1)]
+            squares[frozenset(cyc)] = len(faces)
+            faces.append(cyc)
+    pieces = [cube_pts]
+    for j, (k, s) in enumerate(apexes):
+        apex = 16 + j
+        in_cube = [f for f, cyc in enumerate(faces[:24]) if np.all(cube_pts[cyc, k] == s)]
+        for f in in_cube:
+            cyc = faces[f]
+            cell = [f]
+            for a, b in zip(cyc, cyc[1:] + cyc[:1]):
+                key = (frozenset((a, b)), apex)
+                if key not in triangles:
+                    triangles[key] = len(faces)
+                    faces.append([a, b, apex])
+                cell.append(triangles[key])
+            cells.append(cell)
+        pieces.append(np.concatenate([cube_pts[cube_pts[:, k] == s], vertices[apex : apex + 1]]))
+    return vertices, faces, cells, pieces
+
+
 #: unions of unit tesseracts, by their integer positions: in the xy-plane unless said
 SHAPES = {
     "L": [(0, 0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 0), (0, 1, 0, 0)],

@@ -18,57 +18,72 @@ from hypothesis import HealthCheck, assume, given, settings, strategies as st
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from mesh_shapes import SHAPES, tesseract_union, tesseract_union_mesh
+from mesh_shapes import SHAPES, stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
 from reference_geometry import random_rotation, rotation_with_w_row
 from rot4d_widget import Polytope, slice_polytope
 
 PROPS = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-shapes = st.sampled_from(sorted(SHAPES))
 seeds = st.integers(0, 2**32 - 1)
+
+
+#: a non-grid one: a tesseract with a tall pyramid on each cube (reflex ridges at its squares)
+STELLA = "stellated tesseract"
+ALL_SHAPES = sorted(SHAPES) + [STELLA]
+shapes = st.sampled_from(ALL_SHAPES)
 
 
 @functools.lru_cache(maxsize=None)
 def union(shape):
-    """(the union as a Polytope, its pieces as convex Polytopes, their boxes (lo, hi))."""
-    p, pieces = tesseract_union(shape)
-    return p, [Polytope(pc) for pc in pieces], [(pc.min(axis=0), pc.max(axis=0)) for pc in pieces]
+    """(the union as a Polytope, its pieces as convex Polytopes, each piece's corners as a set of
+    coordinate tuples).  Pieces meet in common faces: the intersection of any of them is the
+    convex hull of their common corners."""
+    if shape == STELLA:
+        v, f, c, pieces = stellated_tesseract_mesh(2.0)
+        p = Polytope(v, f, c, name=shape)
+    else:
+        p, pieces = tesseract_union(shape)
+    corners = [frozenset(map(tuple, np.round(pc, 9).tolist())) for pc in pieces]
+    return p, [Polytope(pc) for pc in pieces], corners
+
+
+def boxes(shape):
+    """The pieces of a union of tesseracts as (low, high) corners."""
+    return [(q.vertices.min(axis=0), q.vertices.max(axis=0)) for q in union(shape)[1]]
 
 
 def pieces_volume(shape, m, c0):
     return sum(slice_polytope(q, m, c0).volume for q in union(shape)[1])
 
 
+def _meets(common, m, c0):
+    """The convex hull of the corners ``common`` meets H strictly inside (general position)."""
+    if not common:
+        return False
+    h = (np.array(sorted(common)) @ m.T)[:, 3]
+    return h.min() < c0 < h.max()
+
+
 def euler_by_inclusion_exclusion(shape, m, c0):
-    """chi(S) of S = union of the pieces' slices: sum over sets of pieces whose boxes meet and
-    whose common box meets H, with sign (-1)^(k+1).  Levels must be away from vertex heights."""
-    boxes = union(shape)[2]
+    """chi(S) of S = union of the pieces' slices: sum over sets of pieces whose common face
+    meets H, with sign (-1)^(k+1) (each such intersection is convex: chi 1).  Levels must be
+    away from vertex heights."""
+    corners = union(shape)[2]
     chi = 0
-    for k in range(1, len(boxes) + 1):
-        for group in itertools.combinations(boxes, k):
-            lo = np.max([b[0] for b in group], axis=0)
-            hi = np.min([b[1] for b in group], axis=0)
-            if np.any(lo > hi + 1e-12):
-                continue
-            corners = np.array(list(itertools.product(*zip(lo, hi))))
-            h = (corners @ m.T)[:, 3]
-            if h.min() < c0 < h.max():
+    for k in range(1, len(corners) + 1):
+        for group in itertools.combinations(corners, k):
+            if _meets(frozenset.intersection(*group), m, c0):
                 chi += (-1) ** (k + 1)
     return chi
 
 
 def pieces_components(shape, m, c0):
     """Connected components of the union of the pieces' slices (pieces whose slices meet)."""
-    boxes = union(shape)[2]
+    corners = union(shape)[2]
     cut = [i for i, q in enumerate(union(shape)[1]) if slice_polytope(q, m, c0).dim == 3]
-    pairs = []
-    for i, j in itertools.combinations(cut, 2):
-        lo, hi = np.maximum(boxes[i][0], boxes[j][0]), np.minimum(boxes[i][1], boxes[j][1])
-        if np.all(lo <= hi + 1e-12):
-            h = (np.array(list(itertools.product(*zip(lo, hi)))) @ m.T)[:, 3]
-            if h.min() < c0 < h.max():
-                pairs.append((cut.index(i), cut.index(j)))
     if not cut:
         return 0
+    pairs = [(a, b) for a, b in itertools.combinations(range(len(cut)), 2)
+             if _meets(corners[cut[a]] & corners[cut[b]], m, c0)]
     a, b = zip(*pairs) if pairs else ((), ())
     return connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(len(cut), len(cut))), directed=False)[0]
 
@@ -106,11 +121,11 @@ def check_outward(shape, m, c0, s, eps=1e-7):
     """Just outside each polygon (along its normal from the winding) is outside every piece,
     just inside is inside one (a closed box: S may lie in the boundary when cells lie in H):
     outward winding, checked locally, polygon by polygon."""
-    boxes = union(shape)[2]
+    pieces = union(shape)[1]
 
     def inside(q3):
         x = m.T @ np.append(q3, c0)  # back to the polytope's own frame
-        return any(np.all((x >= lo - 1e-12) & (x <= hi + 1e-12)) for lo, hi in boxes)
+        return any(np.all(q.cell_normals @ x <= q.cell_offsets + 1e-12) for q in pieces)
 
     for poly in s.polygons:
         pts = s.vertices[poly]
@@ -215,7 +230,7 @@ def test_a_u_slices_into_two_pieces():
 # -- on-H cases that only a non-convex polytope has ---------------------------------------
 
 
-@pytest.mark.parametrize("shape", sorted(SHAPES))
+@pytest.mark.parametrize("shape", sorted(SHAPES))  # the grid ones
 @pytest.mark.parametrize("c0", [-0.5, -0.25, 0.0, 0.5])
 def test_cells_lying_in_h_side_by_side(shape, c0):
     """Identity orientation: at w = +-0.5 every piece has a cube in H, neighbours coplanar (flat
@@ -234,17 +249,16 @@ def test_cells_lying_in_h_side_by_side(shape, c0):
 def pieces_volume_union_in_h(shape, c0):
     """Volume of the union's slice at w = c0, identity orientation: the unit cubes of the pieces
     whose w-range holds c0 (a cube counted once where two pieces meet in H)."""
-    _, _, boxes = union(shape)
-    cubes = {tuple(np.round(lo[:3], 9)) for lo, hi in boxes if lo[3] - 1e-12 <= c0 <= hi[3] + 1e-12}
+    cubes = {tuple(np.round(lo[:3], 9)) for lo, hi in boxes(shape) if lo[3] - 1e-12 <= c0 <= hi[3] + 1e-12}
     return float(len(cubes))
 
 
 def test_a_face_inside_the_slice_at_a_reflex_ridge_gives_no_polygon():
     """2x2 minus one, cut by x + y = 2 through its reflex 2-face R (both cells of R rise above
     H, the polytope fills both sides of R in H): R is inside S, which is one box of volume 2√2."""
-    p, _, boxes = union("2x2 minus one")
+    p = union("2x2 minus one")[0]
     m = rotation_with_w_row((1.0, 1.0, 0.0, 0.0))
-    shift = -boxes[0][0]  # the mesh is centred: the first piece's low corner was the origin
+    shift = -boxes("2x2 minus one")[0][0]  # the mesh is centred; the first piece's low corner was 0
     c0 = float((np.array([1.0, 1.0, 0.0, 0.0]) - shift) @ m[3])
     s = slice_polytope(p, m, c0)
     assert s.volume == pytest.approx(2 * np.sqrt(2))
@@ -258,8 +272,8 @@ def test_a_pinch_point_where_the_level_passes_through_a_reflex_vertex():
     solids touching only at v.  The slicer keeps v as ONE vertex of the slice, shared by both:
     the surface is closed and wound outward and the volume is exact, but at v two fans of
     polygons meet (the link of v has two cycles) and V - E + F = 3 = 2 + 2 - 1."""
-    p, _, boxes = union("2x2 minus one")
-    shift = -boxes[0][0]
+    p = union("2x2 minus one")[0]
+    shift = -boxes("2x2 minus one")[0][0]
     iv = int(np.argmin(np.linalg.norm(p.vertices - (np.array([1.0, 1, 0, 0]) - shift), axis=1)))
     m = rotation_with_w_row((-1.0, -1.1, 1.2, 1.3))
     x = p.vertices @ m.T
@@ -292,8 +306,8 @@ def test_two_solids_touching_along_a_reflex_edge_in_h():
     S is two triangular prisms (in B and in C) touching along that edge.  The slicer keeps the
     edge once, in four polygons (two of each prism, each pair wound against the other), and its
     two ends once: closed and outward, exact volume, V - E + F = 3 = 2 + 2 - 1."""
-    p, pieces, boxes = union("2x2 minus one")
-    shift = -boxes[0][0]
+    p = union("2x2 minus one")[0]
+    shift = -boxes("2x2 minus one")[0][0]
     m = rotation_with_w_row((1.0, 1.0, 1.0, 0.0))
     c0 = float((np.array([1.0, 1, 1, 0]) - shift) @ m[3])
     s = slice_polytope(p, m, c0)
@@ -323,12 +337,13 @@ SPECIAL = [(1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (1, 1, 0, 0),
 
 
 @PROPS
-@given(shape=shapes, direction=st.sampled_from(SPECIAL), which=st.integers(0, 10**6), spin=seeds)
+@given(shape=st.sampled_from(sorted(SHAPES)), direction=st.sampled_from(SPECIAL), which=st.integers(0, 10**6),
+       spin=seeds)
 def test_levels_through_whole_faces_and_cells(shape, direction, which, spin):
     """Hyperplanes along the grid (axes, diagonals) at vertex heights: faces, cells and flat
     ridges lie in H.  S is the union of the pieces' slices: their sum, or along an axis the
     distinct unit cubes lying in H."""
-    p, _, boxes = union(shape)
+    p = union(shape)[0]
     m = rotation_with_w_row(direction)
     q, r = np.linalg.qr(np.random.default_rng(spin).normal(size=(3, 3)))
     q = q * np.sign(np.diag(r)) * (1 if np.linalg.det(q * np.sign(np.diag(r))) > 0 else -1)
@@ -339,7 +354,8 @@ def test_levels_through_whole_faces_and_cells(shape, direction, which, spin):
     axis = [k for k in range(4) if direction[k]]
     if len(axis) == 1:
         k = axis[0]
-        cubes = {tuple(np.round(np.delete(lo, k), 9)) for (lo, hi) in boxes if lo[k] - 1e-9 <= c0 <= hi[k] + 1e-9}
+        cubes = {tuple(np.round(np.delete(lo, k), 9)) for lo, hi in boxes(shape)
+                 if lo[k] - 1e-9 <= c0 <= hi[k] + 1e-9}
         expected = float(len(cubes))
     else:
         expected = pieces_volume(shape, m, c0)
@@ -351,3 +367,21 @@ def test_levels_through_whole_faces_and_cells(shape, direction, which, spin):
         check_outward(shape, m, c0, s)
     else:
         assert s.dim < 3 and len(s.cell_ids) == 0
+
+
+def test_the_24_cell_as_a_stellated_tesseract_with_flat_ridges():
+    """Pyramids of height 1 on the tesseract's cubes make the 24-cell, each octahedron split in
+    two square pyramids (flat ridges in every orientation): convex, and sliced as its hull."""
+    v, f, c, pieces = stellated_tesseract_mesh(1.0)
+    p, hull = Polytope(v, f, c), Polytope(v)
+    assert p.convex and p.counts == (24, 96, 120, 48) and hull.counts == (24, 96, 96, 24)
+    for seed in range(6):
+        m = random_rotation(seed)
+        for c0 in (0.0, 0.7, -1.3, float((v @ m.T)[seed, 3])):
+            a, b = slice_polytope(p, m, c0), slice_polytope(hull, m, c0)
+            assert a.volume == pytest.approx(b.volume, rel=1e-12, abs=1e-12)
+            if a.dim == 3:
+                check_closed(a)
+                assert len(a.vertices) == len(b.vertices)
+    tall = union(STELLA)[0]
+    assert not tall.convex
