@@ -206,7 +206,8 @@ def test_type_errors_name_what_is_allowed():
         Polytope(v, faces)
     with pytest.raises(TypeError, match="pass the name as name="):
         Polytope(v, "box")
-    with pytest.raises(TypeError, match=r"`faces` to be a sequence of sequences of vertex indices \(integers 0 to 15\)"):
+    with pytest.raises(TypeError,
+                       match=r"`faces` to be a sequence of sequences of vertex indices \(integers 0 to 15\)"):
         Polytope(v, 5, cells)
 
 
@@ -379,7 +380,8 @@ def test_round_trip_of_a_non_convex_mesh(shape):
 
 
 def test_comments_blank_lines_and_counts_on_the_header_line():
-    text = "# a comment first\n4OFF 16 24 0 8\n" + TESSERACT_4OFF.split("16 24 32 8\n", 1)[1].replace("\n\n", "\n\n# more\n\n")
+    body = TESSERACT_4OFF.split("16 24 32 8\n", 1)[1].replace("\n\n", "\n\n# more\n\n")
+    text = "# a comment first\n4OFF 16 24 0 8\n" + body
     assert Polytope.from_off(text).counts == (16, 32, 24, 8)
 
 
@@ -445,7 +447,8 @@ def edit(lineno, new):
         # the Polytope's own checks, mapped to the line of the face, cell or vertex
         (edit(26, "4 12 13 14 15"), r"line 26 \(face 3\): face 3 .* is not a convex polygon"),
         (edit(8, "1 1 -1 -1.5"), r"line \d+ \(face \d+\): face \d+ is not planar"),
-        (edit(49, "6 12 13 16 17 20 22"), r"line \d+ \((face \d+\): face \d+ is in [13] cell|cell \d+\): cell \d+ is not closed)"),
+        (edit(49, "6 12 13 16 17 20 22"),
+         r"line \d+ \((face \d+\): face \d+ is in [13] cell|cell \d+\): cell \d+ is not closed)"),
     ],
 )
 def test_bad_4off_files_name_the_line(text, match):
