@@ -16,10 +16,12 @@ default canvas aspect 600 / 500 -- and scaled to the source's units):
 
 ``"oval"``
     Kageyama's follow-up (J. Visualization 2016): the slice centres lie on the parabola
-    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, Y0 = -0.65,
-    |u| <= 2.0: it opens away from the eye and rises with depth, so its perspective image is
+    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, |u| <= 2.0 and Y0
+    chosen for each N so that the picture is centred in the frame (the slices' bounding spheres
+    reach as far above the frame's middle as below it: -0.05 for N = 5, -0.49 for N = 12, -0.95
+    for N = 64): it opens away from the eye and rises with depth, so its perspective image is
     an oval (the points at infinity would close it at the horizon y' = 5 C / B = 2).  The
-    central slice (w = c0) sits at the vertex P(0) = (0, -0.65, 0), nearest the eye and
+    central slice (w = c0) sits at the vertex P(0) = (0, Y0, 0), nearest the eye and
     lowest; slices of higher w go right, lower w left.  World scales are
     ``s0 (1 - 0.4 tau^2) / max``, tau = (k - (N-1)/2) / ((N-1)/2), on top of perspective.
     Slices are laid along the parabola from the vertex at arc-length steps proportional to
@@ -28,8 +30,7 @@ default canvas aspect 600 / 500 -- and scaled to the source's units):
     every pair of bounding spheres (radius ``radius * scale``) is disjoint with a 5 % gap
     and every sphere's image lies in the 600 x 500 camera frame with a 3 % margin.  Why these
     numbers: A, B, C make the oval's image span |x'| <= 1.68 and -0.65 ... 1.22 in y' (the
-    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0; Y0 centres the picture: the big central
-    slice below and the far, small ones above leave about the same margin); u = 2 is past the widest point
+    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0, with Y0 = -0.65); u = 2 is past the widest point
     u* = sqrt(5 / B) = 1.29, so the ends curl back towards each other (an oval, not a U)
     while the farthest slice, 12 units deep, is still drawn at 29 % of its size.  With
     N = 16 every slice gets scale 0.56, with 64 about 0.2.
@@ -83,7 +84,8 @@ ARRANGEMENTS = ("oval", "grid", "stack")
 MAX_SLICES = 64
 COLOR_BY = ("w", "cell")
 
-#: The oval's parabola P(u) = (A u, Y0 + C u^2, -B u^2), |u| <= U_MAX, in displayed units.
+#: The oval's parabola P(u) = (A u, Y0 + C u^2, -B u^2), |u| <= U_MAX, in displayed units; Y0 is
+#: where the layout starts: it is then shifted so that the picture is centred in the frame.
 OVAL_PARABOLA = {"A": 2.6, "B": 3.0, "C": 1.2, "Y0": -0.65, "U_MAX": 2.0}
 #: Largest world scale of an oval slice; relative shrink of the end slices (1 - 0.4 tau^2).
 OVAL_MAX_SCALE = 0.6
@@ -175,8 +177,29 @@ def _oval(n: int):
     diff = np.linalg.norm(centres[:, None, :] - centres[None, :, :], axis=2)
     iu = np.triu_indices(n, 1)
     s_sep = float((diff[iu] / (R * (g[:, None] + g[None, :])[iu] * (1.0 + GAP))).min())
+    # centred in the frame (few slices use only the bottom of the oval), then fitted to it
+    centres[:, 1] += _vertical_centring(centres, R * min(OVAL_MAX_SCALE, s_sep) * g)
     s_fit = _frame_fit(centres[:, 0], centres[:, 1], centres[:, 2], R * g)
-    return centres, min(OVAL_MAX_SCALE, s_sep, s_fit) * g
+    scales = min(OVAL_MAX_SCALE, s_sep, s_fit) * g
+    centres[:, 1] += _vertical_centring(centres, R * scales)
+    s_fit = _frame_fit(centres[:, 0], centres[:, 1], centres[:, 2], R * g)
+    return centres, np.minimum(scales, s_fit * g)
+
+
+def _vertical_centring(centres, radii) -> float:
+    """The world-y shift after which the spheres' images reach as far above the frame's middle
+    as below it (their top and bottom, ``(y +- r) D / (D - z)``, balance)."""
+    f = _D / (_D - centres[:, 2])
+    y, r = centres[:, 1], radii
+
+    def imbalance(dy):
+        return float(((y + dy + r) * f).max() + ((y + dy - r) * f).min())
+
+    lo, hi = -20.0, 20.0  # imbalance rises with dy
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if imbalance(mid) < 0 else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def _rows(n: int, cols: int):

@@ -349,10 +349,15 @@ def test_one_slice_is_the_identity_layout(name):
 
 @pytest.mark.parametrize("n", [2, 3, 5, 8, 12, 16, 33, 64])
 def test_oval_centres_on_the_documented_parabola(n):
-    A, B, C, Y0 = (OVAL_PARABOLA[k] for k in ("A", "B", "C", "Y0"))
+    A, B, C = (OVAL_PARABOLA[k] for k in ("A", "B", "C"))
     centres, scales = arrangement_layout("oval", n)
     u = centres[:, 0] / A
-    np.testing.assert_allclose(centres[:, 1], Y0 + C * u * u, atol=1e-12)
+    y0 = centres[:, 1] - C * u * u  # one Y0 for every slice: they lie on one parabola
+    np.testing.assert_allclose(y0, y0[0], atol=1e-12)
+    # centred: the spheres' images reach as far above the frame's middle as below it
+    f = look.CAMERA_POSITION[2] / (look.CAMERA_POSITION[2] - centres[:, 2])
+    r = R_D * scales
+    assert ((centres[:, 1] + r) * f).max() == pytest.approx(-((centres[:, 1] - r) * f).min(), abs=1e-9)
     np.testing.assert_allclose(centres[:, 2], -B * u * u, atol=1e-12)
     assert np.all(np.abs(u) <= OVAL_PARABOLA["U_MAX"] + 1e-12)
     assert np.all(np.diff(u) > 0)  # higher w to the right
