@@ -286,9 +286,13 @@ class Polytope:
     Two cells sharing a face may lie in one hyperplane (a flat ridge, as where two
     cubes of glued tesseracts meet side by side): that is allowed, and the slicer
     gives their slices as two polygons.  Not checked: that the boundary does not
-    intersect itself.  ``validate=False`` skips the per-cell convexity and closedness
-    checks (the costly part for big meshes; for combinatorics known to be right, e.g.
-    from a Wythoff construction); the orientation is still derived and checked.
+    intersect itself, or is a manifold at its vertices and edges (two pieces may touch
+    there).  Everything is vectorised: a 120x120 duoprism (14400 vertices, 14640 faces)
+    or the omnitruncated 120-cell (17040 faces, 2640 cells) builds in about 0.3-0.5 s,
+    of which the cell checks are about a third.  ``validate=False`` skips the per-cell
+    closedness and convexity checks (for combinatorics known to be right, e.g. from a
+    Wythoff construction); the faces' geometry and the orientation are still derived
+    and checked, and a non-convex cell then gives wrong normals or an orientation error.
 
     Attributes
     ----------
