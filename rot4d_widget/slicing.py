@@ -652,7 +652,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         ).sum()
     ) / 6.0
     if len(on_idx):
-        vertices, edges, flat, triangles = _boundary_only(vertices, edges, flat, offsets, triangles, n_e)
+        vertices, edges, flat, triangles = _boundary_only(vertices, edges, flat, offsets, triangles)
     return Slice(vertices, edges, flat, offsets, cell_ids, triangles, triangle_cells, volume, 3)
 
 
@@ -708,7 +708,7 @@ def _faces_in_h(t: _Tables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, 
     return plus != minus, minus
 
 
-def _boundary_only(vertices, edges, flat, offsets, triangles, n_e):
+def _boundary_only(vertices, edges, flat, offsets, triangles):
     """Drop the on-H vertices and in-H edges that no polygon uses (a solid slice of a non-convex
     polytope is given by its boundary: a face inside S, or P touching H away from S, adds none).
 
