@@ -228,7 +228,7 @@ class PolytopeSlice(SliceData):
 
 
 class PolytopeSource:
-    """A convex 4-polytope as a source: groups are its cells, the slice is exact."""
+    """A 4-polytope (convex or not) as a source: groups are its cells, the slice is exact."""
 
     def __init__(self, polytope):
         from .polytopes import polytope as get_polytope
@@ -269,7 +269,7 @@ class PolytopeSource:
             normals=None,
             volume=float(s.volume),
             readout=(("slice", census_text(s)),),
-            convex=True,
+            convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
             extra={"slice": s},
         )
 

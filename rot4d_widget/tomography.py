@@ -427,8 +427,8 @@ class StackSource:
             from .slicing import slice_polytope
 
             if len(levels) == 1:  # today's single slice, bit for bit
-                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])))]
-            return [_PolytopePiece(s) for s in slice_polytope(self._polytope, matrix, levels)]
+                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])), self._polytope.convex)]
+            return [_PolytopePiece(s, self._polytope.convex) for s in slice_polytope(self._polytope, matrix, levels)]
         if coarse:
             return [self.source.slice(matrix, float(w), coarse=True) for w in levels]
         return [self.source.slice(matrix, float(w)) for w in levels]
@@ -510,10 +510,11 @@ class StackSource:
 class _PolytopePiece:
     """A polytope `Slice` seen as slice data (what `PolytopeSource.slice` would give)."""
 
-    __slots__ = ("slice",)
+    __slots__ = ("slice", "convex")
 
-    def __init__(self, s):
+    def __init__(self, s, convex: bool = True):
         self.slice = s
+        self.convex = bool(convex)  # a convex polytope's slice is convex; a non-convex one's may not be
 
     points = property(lambda self: self.slice.vertices)
     segments = property(lambda self: self.slice.edges)
@@ -522,7 +523,6 @@ class _PolytopePiece:
     normals = None
     volume = property(lambda self: float(self.slice.volume))
     readout = property(lambda self: (("slice", census_text(self.slice)),))
-    convex = True
     show_points = True
     data = property(lambda self: self.slice)
 
