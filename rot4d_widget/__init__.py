@@ -23,6 +23,7 @@ _LAZY = {
     "DEFAULT_KEYMAP": "keymap",
     "Keymap": "keymap",
     "Polytope": "polytopes",
+    "MeshError": "polytopes",
     "pentachoron": "polytopes",
     "polytope": "polytopes",
     "double_rotation": "rotation",
