@@ -1,14 +1,22 @@
-"""The Binder configuration builds what Binder would build, and the notebooks run there.
+"""The Binder configuration builds what Binder would build, and the built wheel installs and runs there.
 
 No Docker engine is needed: repo2docker's Python build pack creates one environment with
 JupyterLab 4 / Notebook 7 / ipywidgets 8 and then, because ``binder/requirements.txt`` names a
 local path, copies the whole repository and runs ``pip install -r binder/requirements.txt`` with
-the repository root as working directory.  The slow test does the same in a fresh venv, then
-checks the lab extensions and runs the notebooks with nbval against the *installed* package.
+the repository root as working directory: ``.[notebooks]``, the package built from the source
+tree with its ``notebooks`` extra.
 
-Deselect it locally with ``-m "not slow"``; the default test command (and CI) runs it.
+The slow tests share one fresh venv (module-scoped: built once): Binder's base image, then the
+wheel that ``python -m build --no-isolation`` made from this repository (tests/test_wheel.py)
+with the extra that ``binder/requirements.txt`` names -- the same install as Binder's, but from
+the release artefact, so the wheel is proven to install and work away from the source tree.
+Then: the package is imported from the venv, its server extension is enabled, the lab extensions
+are there, and every notebook runs with nbval (from a copy outside the repository).
+
+Deselect them locally with ``-m "not slow"``; the default test command (and CI) runs them.
 """
 
+import json
 import os
 import re
 import shutil
@@ -16,8 +24,11 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
+
+from test_wheel import build_dists
 
 ROOT = Path(__file__).resolve().parents[1]
 BINDER = ROOT / "binder"
@@ -96,26 +107,70 @@ def _run(cmd, *, env, cwd, timeout=1200):
     return proc
 
 
-@pytest.mark.slow
-def test_binder_environment_has_the_extensions_and_runs_the_notebooks(tmp_path):
-    venv = tmp_path / "binder-venv"
+def _venv_binder_line() -> str:
+    """The line of binder/requirements.txt that installs this package ('.[notebooks]')."""
+    return next(line for line in _requirement_lines() if line.lstrip("-e ").startswith("."))
+
+
+@pytest.fixture(scope="module")
+def binder_venv(tmp_path_factory):
+    """A fresh venv as Binder builds it, with the built wheel in place of the source tree."""
+    t0 = time.monotonic()
+    tmp = tmp_path_factory.mktemp("binder")
+    _, wheel = build_dists(tmp / "dist")
+    venv = tmp / "binder-venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300)
     py = str(venv / "bin" / "python")
-    env = _clean_env(tmp_path, venv)
+    env = _clean_env(tmp, venv)
     pip = [py, "-m", "pip", "install", "--quiet"]
 
-    # 1. Binder's base image, 2. binder/requirements.txt from the repository root (as repo2docker)
-    _run([*pip, "--upgrade", "pip"], env=env, cwd=tmp_path)
-    _run([*pip, *BASE_IMAGE], env=env, cwd=tmp_path)
-    _run([*pip, "-r", str(REQUIREMENTS.relative_to(ROOT))], env=env, cwd=ROOT)
-    _run([py, "-m", "pip", "check"], env=env, cwd=tmp_path)
+    # 1. Binder's base image, 2. what binder/requirements.txt names: this package with its extra,
+    # here the built wheel ('.[notebooks]' -> '<wheel>[notebooks]'), installed from outside the repo
+    extra = _venv_binder_line().lstrip("-e ")[1:]
+    _run([*pip, "--upgrade", "pip"], env=env, cwd=tmp)
+    _run([*pip, *BASE_IMAGE], env=env, cwd=tmp)
+    _run([*pip, f"{wheel}{extra}"], env=env, cwd=tmp)
+    _run([py, "-m", "pip", "check"], env=env, cwd=tmp)
+    # only to run the notebooks here; not part of the Binder image
+    _run([*pip, *TEST_TOOLS], env=env, cwd=tmp)
+    print(f"[{time.monotonic() - t0:6.1f} s] venv ready")
+    return SimpleNamespace(venv=venv, py=py, env=env, tmp=tmp, wheel=wheel)
 
-    # the kernel imports the installed package, not the source tree
-    where = _run([py, "-c", "import rot4d_widget; print(rot4d_widget.__file__)"], env=env, cwd=tmp_path)
-    assert Path(where.stdout.strip()).is_relative_to(venv), where.stdout
 
+@pytest.mark.slow
+def test_the_venv_runs_the_installed_wheel_not_the_source_tree(binder_venv):
+    b = binder_venv
+    code = ("import json, pathlib, importlib.metadata as m, rot4d_widget as r;"
+            "d = m.distribution('rot4d_widget');"
+            "print(json.dumps([r.__file__, r.__version__, d.read_text('direct_url.json')]))")
+    where, version, direct_url = json.loads(_run([b.py, "-c", code], env=b.env, cwd=b.tmp).stdout)
+    assert Path(where).is_relative_to(b.venv), where
+    assert version == b.wheel.name.split("-")[1]
+    assert '"editable": true' not in (direct_url or "") and b.wheel.name in (direct_url or ""), direct_url
+    pkg = Path(where).parent
+    assert (pkg / "companion.js").is_file() and list((pkg / "glsl").glob("*.vert"))
+    assert (b.venv / "etc" / "jupyter" / "jupyter_server_config.d" / "rot4d_widget.json").is_file()
+
+
+@pytest.mark.slow
+def test_the_server_extension_is_enabled(binder_venv):
+    b = binder_venv
+    proc = _run([str(b.venv / "bin" / "jupyter"), "server", "extension", "list"], env=b.env, cwd=b.tmp)
+    listing = ANSI.sub("", proc.stdout + proc.stderr)
+    print(listing)
+    # enabled by the config the wheel installed into the venv (sys-prefix), and it loads
+    section = listing.split(f"Config dir: {b.venv / 'etc' / 'jupyter'}", 1)
+    assert len(section) == 2, f"no config dir in the venv:\n{listing}"
+    section = section[1].split("Config dir:", 1)[0]
+    assert re.search(r"^\s*rot4d_widget\._server\s+enabled\s*$", section, re.MULTILINE), listing
+    assert re.search(r"^\s*rot4d_widget\._server\s+(\S+\s+)?OK\s*$", section, re.MULTILINE), listing
+
+
+@pytest.mark.slow
+def test_binder_environment_has_the_lab_extensions(binder_venv):
+    b = binder_venv
     # the browser side: prebuilt lab extensions, enabled and OK
-    proc = _run([str(venv / "bin" / "jupyter"), "labextension", "list"], env=env, cwd=tmp_path)
+    proc = _run([str(b.venv / "bin" / "jupyter"), "labextension", "list"], env=b.env, cwd=b.tmp)
     listing = ANSI.sub("", proc.stdout + proc.stderr)
     print(listing)
     for name in LAB_EXTENSIONS:
@@ -124,14 +179,18 @@ def test_binder_environment_has_the_extensions_and_runs_the_notebooks(tmp_path):
         status = line.group(1).split()
         assert status[:2] == ["enabled", "OK"], f"{name}: {line.group(0).strip()}\n{listing}"
 
-    # the notebooks, run by nbval in that environment (a copy, away from the repository's config)
-    _run([*pip, *TEST_TOOLS], env=env, cwd=tmp_path)
-    work = tmp_path / "run"
+
+@pytest.mark.slow
+def test_binder_environment_runs_the_notebooks(binder_venv):
+    b = binder_venv
+    # the notebooks, run by nbval in that environment (a copy, away from the repository's config
+    # and source tree: the kernel can only import the installed wheel)
+    work = b.tmp / "run"
     shutil.copytree(ROOT / "notebooks", work / "notebooks", ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
     (work / "pytest.ini").write_text("[pytest]\n")
     proc = _run(
-        [py, "-m", "pytest", "-p", "no:cacheprovider", "--nbval-lax", "--nbval-current-env", "-q", "notebooks"],
-        env=env, cwd=work,
+        [b.py, "-m", "pytest", "-p", "no:cacheprovider", "--nbval-lax", "--nbval-current-env", "-q", "notebooks"],
+        env=b.env, cwd=work,
     )
     summary = proc.stdout.strip().splitlines()[-1]
     assert "failed" not in summary and "error" not in summary, proc.stdout[-3000:]
@@ -144,3 +203,4 @@ def test_binder_environment_has_the_extensions_and_runs_the_notebooks(tmp_path):
     )
     passed = re.search(r"(\d+) passed", summary)
     assert passed and int(passed.group(1)) == n_cells, f"expected {n_cells} cells to pass: {summary}"
+    assert (ROOT / NOTEBOOK).is_file() and (work / NOTEBOOK).is_file()
