@@ -470,13 +470,19 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     toff = np.zeros(G + 1, dtype=np.intp)
     np.cumsum(np.bincount(t_level, minlength=G), out=toff[1:])
     out = []
+    new = object.__new__
     for g in range(G):
         p0, p1, t0, t1 = poff[g], poff[g + 1], toff[g], toff[g + 1]
-        o = offsets[p0 : p1 + 1] - offsets[p0]
-        out.append(Slice(
-            vertices[voff[g] : voff[g + 1]], edges[eoff[g] : eoff[g + 1]], flat[offsets[p0] : offsets[p1]],
-            o, cell_ids[p0:p1], triangles[t0:t1], triangle_cells[t0:t1], float(volumes[g]), 3,
-        ))
+        # every array a view of a sealed one (read-only already) or sealed here: the fields are set
+        # directly, without the frozen dataclass's per-field __setattr__ and __post_init__
+        sl = new(Slice)
+        sl.__dict__.update(
+            vertices=vertices[voff[g] : voff[g + 1]], edges=edges[eoff[g] : eoff[g + 1]],
+            polygon_indices=flat[offsets[p0] : offsets[p1]], polygon_offsets=_seal(offsets[p0 : p1 + 1] - offsets[p0]),
+            cell_ids=cell_ids[p0:p1], triangles=triangles[t0:t1], triangle_cells=triangle_cells[t0:t1],
+            volume=float(volumes[g]), dim=3,
+        )
+        out.append(sl)
     return out
 
 
