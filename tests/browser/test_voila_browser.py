@@ -171,7 +171,10 @@ def _wait(predicate, timeout, interval=0.1):
 def test_notebook_01_in_voila_offline_turns_with_keys(voila_server, offline_page, artifacts):
     page = offline_page
     t0 = time.monotonic()
+    # Voila streams the page while the kernel runs the cells, one after the other, and shows the
+    # outputs (#rendered_cells) once the last has run: then nothing but keys changes the view
     page.goto(voila_server.render_url(NOTEBOOK), timeout=300_000)
+    page.wait_for_selector("#rendered_cells", state="visible", timeout=300_000)
     # the first live widget (cell "widget"): pythreejs's renderer div carries the scene's classes
     sel = ".rot4d-canvas canvas"
     page.wait_for_selector(sel, timeout=300_000)
@@ -194,10 +197,12 @@ def test_notebook_01_in_voila_offline_turns_with_keys(voila_server, offline_page
 
     widget = page.locator(sel).first
     widget.scroll_into_view_if_needed()
-    time.sleep(0.5)
     readout = page.locator(".rot4d-readout").first
+    # settled: the same picture twice, half a second apart
+    before = _wait(lambda: (a := _stats(page, sel), time.sleep(0.5), b := _stats(page, sel))
+                   and a["hash"] == b["hash"] and b, timeout=30)
+    assert before, "the canvas kept changing before any key"
     readout_before = readout.inner_text()
-    before = _stats(page, sel)
     page.evaluate(_RECORD_KEYS)
 
     box = widget.bounding_box()
@@ -212,7 +217,8 @@ def test_notebook_01_in_voila_offline_turns_with_keys(voila_server, offline_page
     assert after["count"] > 50, after
     assert _wait(lambda: readout.inner_text() != readout_before, timeout=20), readout_before
     readout_after = readout.inner_text()
-    assert "R_xw" in readout_after, readout_after
+    steps = re.search(r"R_xw\s*[x\u00d7]\s*(\d+)", readout_after)
+    assert steps and int(steps.group(1)) >= 2, f"a held 4 should have turned several steps: {readout_after}"
 
     # the shortcut guard (for Notebook 7) marked the key as handled, and ipyevents still forwarded it
     keys = page.evaluate("() => window.__keys")
