@@ -534,18 +534,9 @@ class Rot4DWidget(widgets.HBox):
                 with self._pump.lock:
                     if self._closed or key_id in self._repeater.held_keys:
                         return  # a touch's emulated mousedown: one press only
-                    now = self._pump.clock()
-                    if action.kind == "help":
-                        self.help_visible = not self.help_visible
-                        return
-                    self._step(action, inverted)
-                    if action.kind in REPEATING_KINDS or (action.kind == "custom" and self._custom[action.name][1]):
-                        self._repeater.press(key_id, action, inverted, now)
-                    self._pump.flush(now)
+                    self._press(key_id, action, inverted)
             elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):
-                with self._pump.lock:
-                    self._repeater.release(key_id)
-                    self._settle()
+                self._release(key_id)
         except Exception as exc:  # shown, never lost, never raised into the kernel
             self._report_error(exc)
 
@@ -615,7 +606,7 @@ class Rot4DWidget(widgets.HBox):
 
         rec = self.recording if recording is None else recording
         kwargs = {**settings_of(self), **options}
-        return render_animation(rec, None, self._source_for_pictures(), path, fps=fps, per=per, **kwargs)
+        return render_animation(rec, None, self._level_source, path, fps=fps, per=per, **kwargs)
 
     def render(self, path=None, *, size=None, dpi: float = 100, **options):
         """The view as a static matplotlib figure (no browser): the current state, source and
@@ -629,11 +620,7 @@ class Rot4DWidget(widgets.HBox):
             state = self.state.copy()
             kwargs = {**settings_of(self), **options}
         size = (self.scene.width, self.scene.height) if size is None else size
-        return render_state(state, self._source_for_pictures(), path, size=size, dpi=dpi, **kwargs)
-
-    def _source_for_pictures(self):
-        """The inner source for `render_state` (which stacks it again from the `slices` setting)."""
-        return self._level_source
+        return render_state(state, self._level_source, path, size=size, dpi=dpi, **kwargs)
 
     def slice_mesh(self, **options):
         """What the view shows as one `trimesh.Trimesh`: every face of the slice (all levels of a
@@ -693,24 +680,17 @@ class Rot4DWidget(widgets.HBox):
         return w
 
     def _apply_loaded(self, state, settings) -> None:
+        from .export import SETTING_NAMES
         from .state import without_source_keys
 
-        keymap = without_source_keys(state.keymap)
-        actions = _source_actions(self.source)
-        if actions:
-            keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
         d = state.to_dict()
         d.pop("keymap")
         with self._pump.lock:
             if self._closed:
                 raise RuntimeError("This Rot4DWidget is closed")
             self.state.restore(d)  # the loaded state becomes what r resets to
-            self.state.keymap = keymap
-            self.help_panel.value = ro.help_html(_help_groups(keymap), self._repeater.hold_delay,
-                                                 self._repeater.tick_rate)
-            self._recorder.restart(self.state)
-        for name in ("slices", "arrangement", "spacing", "levels", "color_by", "face_opacity", "ball_radius",
-                     "bar_radius", "background", "show_balls", "show_bars", "show_faces"):
+            self._use_keymap(without_source_keys(state.keymap), self.source)
+        for name in SETTING_NAMES:  # slices before spacing and arrangement
             value = settings.get(name)
             if value is None or not self.has_trait(name):
                 continue
@@ -882,15 +862,20 @@ class Rot4DWidget(widgets.HBox):
         from .tomography import StackSource
 
         stack = StackSource(self.source, slices=slices)
-        actions = _source_actions(stack)
-        self.state.keymap = self.state.keymap.extended({k: a for k, (a, _, _) in actions.items()})
-        self._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
+        self._use_keymap(self.state.keymap, stack)
         self.source = stack
-        self.help_panel.value = ro.help_html(_help_groups(self.state.keymap), self._repeater.hold_delay,
-                                             self._repeater.tick_rate)
         self._source_version += 1
         self._slice_cache = None
         self._sync_stack()
+
+    def _use_keymap(self, keymap, source) -> None:
+        """Bind ``keymap`` plus ``source``'s own keys (its actions runnable), and show them in the help."""
+        actions = _source_actions(source)
+        if actions:
+            keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
+        self._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
+        self.state.keymap = keymap
+        self.help_panel.value = ro.help_html(_help_groups(keymap), self._repeater.hold_delay, self._repeater.tick_rate)
 
     def _sync_levels(self) -> None:
         """Copy the source's iso levels (if it has any) into the `levels` trait."""
@@ -938,9 +923,7 @@ class Rot4DWidget(widgets.HBox):
             elif etype == "keyup":
                 key_id = _key_id(event)
                 if key_id is not None:
-                    with self._pump.lock:
-                        self._repeater.release(key_id)
-                        self._settle()
+                    self._release(key_id)
             elif etype == "mouseleave":
                 self.release_keys()
         except Exception as exc:  # shown, never lost, never raised into the kernel
@@ -999,15 +982,25 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             if self._closed:
                 return
-            if action.kind == "help":
-                self.help_visible = not self.help_visible
-                return
-            now = self._pump.clock()
             self._repeater.release(key_id)
-            self._step(action, inverted)
-            if action.kind in REPEATING_KINDS or (action.kind == "custom" and self._custom[action.name][1]):
-                self._repeater.press(key_id, action, inverted, now)
-            self._pump.flush(now)
+            self._press(key_id, action, inverted)
+
+    def _press(self, key_id, action: Action, inverted: bool) -> None:
+        """Key (or key pad button) ``key_id`` went down: one step now, repeats while held (lock held)."""
+        if action.kind == "help":
+            self.help_visible = not self.help_visible
+            return
+        now = self._pump.clock()
+        self._step(action, inverted)
+        if action.kind in REPEATING_KINDS or (action.kind == "custom" and self._custom[action.name][1]):
+            self._repeater.press(key_id, action, inverted, now)
+        self._pump.flush(now)
+
+    def _release(self, key_id) -> None:
+        """Key (or key pad button) ``key_id`` went up: no more repeats; at rest, settle."""
+        with self._pump.lock:
+            self._repeater.release(key_id)
+            self._settle()
 
     # ------------------------------------------------------------ stepping
     def _tick(self, now: float) -> None:
@@ -1023,21 +1016,23 @@ class Rot4DWidget(widgets.HBox):
             run[0](-1 if inverted else 1)
             self._source_version += 1
             changed = True
+            self._recorder.record(None, False, action, inverted)
             self._sync_levels()
             self._sync_stack()
         elif action.kind == "screenshot":
             self._screenshot_key()
             return False
         elif action.kind == "slices" and not _is_stack(self.source):
-            # n on a single slice: the first added slice makes the view a stack of two
+            # n on a single slice: the first added slice makes the view a stack of two (not a
+            # step a recording can replay: the stack's own keys are, from here on)
             changed = (-1 if inverted else 1) * action.sign > 0
             if changed:
                 self._wrap_in_stack(2)
         else:
             changed = self.state.apply(action, inverted)
-        if changed:
-            if action.kind != "slices" or _is_stack(self.source):  # not n wrapping a single view
+            if changed:
                 self._recorder.record(None, False, action, inverted)
+        if changed:
             self._pump.mark_dirty()
             label = action.label(inverted)
             if label == self._last_label:

@@ -67,6 +67,9 @@ def test_a_single_view_becomes_parallel_slices_when_asked(make):
     assert pressed.press("n")
     assert isinstance(pressed.source, StackSource) and pressed.slices == 2
     _same_picture(pressed, make("5-cell", slices=2))
+    assert len(pressed.recording) == 0  # the wrap is not a step a recording could replay
+    pressed.press("n")  # the stack's own key from here on: recorded
+    assert [e.action.name for e in pressed.recording.events] == ["slice +"]
 
 
 def test_one_slice_is_today_s_view(make):
