@@ -8,7 +8,7 @@ For each polychoron, a fresh Python process (``subprocess``) imports the package
 * **slice**: ``slice_polytope(p, matrix, 0.0)`` at ``--steps`` random orientations (fixed
   seed), hyperplane through the centre; the median.
 
-    python benchmarks/uniform_build.py [--steps N] [--repeats R] [--names all|non-prismatic|big] [--markdown]
+    python benchmarks/uniform_build.py [--steps N] [--repeats R] [--names all|non-prismatic|big]
 
 The regular six are the core's objects (``polytope(name)``, built from their hull as before);
 their row is what ``build`` costs for them.  Target (issue 11): the 14400-vertex omnitruncated

@@ -256,6 +256,15 @@ def _duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
     return None
 
 
+def order_cycle(points: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """The vertices ``idx`` of a planar convex polygon (points in any dimension) ordered as a cycle (intp)."""
+    p = points[idx]
+    c = p.mean(axis=0)
+    _, _, vt = np.linalg.svd(p - c)
+    xy = (p - c) @ vt[:2].T
+    return idx[np.argsort(np.arctan2(xy[:, 1], xy[:, 0]))].astype(np.intp)
+
+
 class Polytope:
     """A 4-polytope: vertices, edges, 2-faces and cells.
 
@@ -287,9 +296,8 @@ class Polytope:
     cubes of glued tesseracts meet side by side): that is allowed, and the slicer
     gives their slices as two polygons.  Not checked: that the boundary does not
     intersect itself, or is a manifold at its vertices and edges (two pieces may touch
-    there).  Everything is vectorised: a 120x120 duoprism (14400 vertices, 14640 faces)
-    or the omnitruncated 120-cell (17040 faces, 2640 cells) builds in about 0.3-0.5 s,
-    of which the cell checks are about a third.  ``validate=False`` skips the per-cell
+    there).  Everything is vectorised, no loop over pairs (build times of the biggest,
+    the omnitruncated 120-cell: docs/uniform.md).  ``validate=False`` skips the per-cell
     closedness and convexity checks (for combinatorics known to be right, e.g. from a
     Wythoff construction); the faces' geometry and the orientation are still derived
     and checked, and a non-convex cell then gives wrong normals or an orientation error.
@@ -357,7 +365,7 @@ class Polytope:
         shared = cell_vertices.astype(np.int32) @ cell_vertices.T.astype(np.int32)
         ci, cj = np.nonzero(np.triu(shared >= 3, k=1))
         face_sets = cell_vertices[ci] & cell_vertices[cj]  # (F, V)
-        faces = [self._order_cycle(np.flatnonzero(row)) for row in face_sets]
+        faces = [order_cycle(v, np.flatnonzero(row)) for row in face_sets]
         face_sizes = np.array([len(f) for f in faces], dtype=np.intp)
         # each cell's faces in ascending order: face f is in cells ci[f] < cj[f]
         both = np.concatenate([ci, cj])
@@ -370,13 +378,6 @@ class Polytope:
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
         self.convex = True
 
-    def _order_cycle(self, idx: np.ndarray) -> np.ndarray:
-        """Order the vertices of a planar convex polygon in 4-D as a cycle."""
-        p = self.vertices[idx]
-        c = p.mean(axis=0)
-        _, _, vt = np.linalg.svd(p - c)
-        xy = (p - c) @ vt[:2].T
-        return idx[np.argsort(np.arctan2(xy[:, 1], xy[:, 0]))].astype(np.intp)
 
     def _set_combinatorics(self, face_ptr, face_vidx, cell_ptr, cell_fidx) -> None:
         """Edges, faces, cells and the flat incidence tables (also used by the slicer).
@@ -388,7 +389,7 @@ class Polytope:
         number of the cell's faces that have each.
         """
         V = len(self.vertices)
-        F, C = len(face_ptr) - 1, len(cell_ptr) - 1
+        C = len(cell_ptr) - 1
         nxt = np.arange(1, len(face_vidx) + 1, dtype=np.intp)
         nxt[face_ptr[1:] - 1] = face_ptr[:-1]
         a, b = face_vidx, face_vidx[nxt]

@@ -351,15 +351,6 @@ def _cell_name(labels, rings, K) -> str:
 # ---------------------------------------------------------------------------------------------
 
 
-def _order_cycle(points: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """The vertices ``idx`` of a planar convex polygon (any dimension) ordered as a cycle."""
-    p = points[idx]
-    c = p.mean(axis=0)
-    _, _, vt = np.linalg.svd(p - c)
-    xy = (p - c) @ vt[:2].T
-    return idx[np.argsort(np.arctan2(xy[:, 1], xy[:, 0]))]
-
-
 def _hull_facets(points: np.ndarray):
     """Facets of the convex hull of ``points`` (every point a corner): (list of vertex-index arrays, normals, offsets).
 
@@ -382,7 +373,7 @@ def _hull_combinatorics(points: np.ndarray, cell_namer=None) -> Combinatorics:
     incT = inc.T.astype(np.int32)
     shared = incT @ incT.T
     ci, cj = np.nonzero(np.triu(shared >= 3, k=1))
-    faces = [_order_cycle(points, np.flatnonzero(inc[:, a] & inc[:, b])) for a, b in zip(ci, cj)]
+    faces = [_polytopes.order_cycle(points, np.flatnonzero(inc[:, a] & inc[:, b])) for a, b in zip(ci, cj)]
     cells = [[] for _ in cells_v]
     for f, (a, b) in enumerate(zip(ci, cj)):
         cells[a].append(f)
@@ -484,7 +475,7 @@ def _snub_polyhedron(labels) -> Combinatorics:
     even = np.linalg.det(g.mats) > 0
     pts = g.mats[even] @ p
     faces, _ = _hull_facets(pts)
-    faces = [_order_cycle(pts, f) for f in faces]
+    faces = [_polytopes.order_cycle(pts, f) for f in faces]
     return Combinatorics(pts, _edges_of(faces), faces, [])
 
 
@@ -766,8 +757,8 @@ def _as_polytope(comb: Combinatorics, name: str):
     """A core `Polytope` from explicit combinatorics (``Polytope(vertices, faces, cells)``).
 
     Validated even though the construction is exact: the constructor's checks (planar convex
-    faces, closed convex cells, orientable boundary) cost ~0.1 s for the 14400-vertex
-    omnitruncated 120-cell, within the noise of this machine.
+    faces, closed convex cells, orientable boundary) are part of the build times in
+    docs/uniform.md (`benchmarks/uniform_build.py`).
     """
     return _polytopes.Polytope(comb.vertices, comb.faces, comb.cells, name=name)
 

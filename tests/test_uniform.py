@@ -6,7 +6,6 @@ Published (V, E, F, C) are from the English Wikipedia articles on the uniform 4-
 polychora"); see docs/uniform.md.
 """
 
-import inspect
 import itertools
 
 import numpy as np
@@ -97,14 +96,6 @@ PRISMATIC_SAMPLE = [
     "3-3 duoprism", "3-4 duoprism", "5-7 duoprism", "3-32 duoprism", "32-32 duoprism",
     "4-antiprismatic prism", "7-antiprismatic prism", "32-antiprismatic prism",
 ]
-
-
-def _has_explicit_constructor() -> bool:
-    return "faces" in inspect.signature(Polytope.__init__).parameters
-
-
-explicit = pytest.mark.skipif(not _has_explicit_constructor(),
-                              reason="Polytope(vertices, faces=, cells=) has not landed in polytopes.py yet")
 
 
 def test_forty_seven_non_prismatic():
@@ -364,17 +355,12 @@ def test_prismatic_counts():
     assert sum(len(v) for k, v in uniform.polytope_names().items() if k.startswith("duoprisms")) == 30 * 31 // 2 - 1
 
 
-def test_build_is_cached_and_fast_enough():
-    import time
-
-    t = time.perf_counter()
-    c = uniform.combinatorics("x5x3x3x")
+def test_build_is_cached():
+    c = uniform.combinatorics("x5x3x3x")  # its build time: benchmarks/uniform_build.py
     assert c.counts == (14400, 28800, 17040, 2640)
     assert uniform.combinatorics("omnitruncated 120-cell") is c
-    assert time.perf_counter() - t < 20  # generous: ~0.3 s here; the benchmark measures it
 
 
-@explicit
 @pytest.mark.parametrize("name", ["rectified 5-cell", "truncated tesseract", "snub 24-cell", "grand antiprism",
                                   "5-7 duoprism", "truncated cubic prism", "7-antiprismatic prism",
                                   "runcinated 24-cell"])
@@ -411,7 +397,6 @@ def _check_slice(p, m, c0):
     return s
 
 
-@explicit
 @pytest.mark.parametrize("name", SLICE_SAMPLE)
 @pytest.mark.parametrize("seed", range(3))
 def test_slices_against_halfspaces_and_hull(name, seed):
@@ -422,7 +407,6 @@ def test_slices_against_halfspaces_and_hull(name, seed):
     _check_slice(p, m, c0)
 
 
-@explicit
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["omnitruncated 120-cell", "runcitruncated 600-cell", "cantellated 120-cell"])
 def test_big_slices_against_halfspaces_and_hull(name):
@@ -430,7 +414,6 @@ def test_big_slices_against_halfspaces_and_hull(name):
     _check_slice(p, random_rotation(5), 0.0)
 
 
-@explicit
 @pytest.mark.parametrize("name", ["rectified 5-cell", "truncated tesseract", "snub 24-cell", "grand antiprism",
                                   "5-7 duoprism", "truncated cubic prism", "7-antiprismatic prism"])
 def test_cavalieri_integral_of_slice_volumes_is_the_4_volume(name):
@@ -448,16 +431,14 @@ def test_cavalieri_integral_of_slice_volumes_is_the_4_volume(name):
     assert total == pytest.approx(ConvexHull(p.vertices).volume, rel=1e-9)
 
 
-@explicit
 def test_widest_slice_census_of_the_omnitruncated_120_cell():
-    """Cut through the centre along a coordinate axis of the group frame: every polygon is a
+    """Cut through the centre at a random orientation: every polygon is a
     slice of a cell, their number is the number of cells crossed."""
     p = uniform.build("x5x3x3x")
     s = slice_polytope(p, random_rotation(3), 0.0)
     assert s.dim == 3 and s.volume > 0
     w = p.vertices @ random_rotation(3)[3]
-    crossed = sum(1 for cell in p.cells
-                  if (lambda ws: ws.min() < 0 < ws.max())(w[np.unique(np.concatenate([p.faces[f] for f in cell]))]))
+    crossed = sum(1 for c in range(len(p.cells)) if w[p.cell_vertices(c)].min() < 0 < w[p.cell_vertices(c)].max())
     assert len(s.cell_ids) == crossed
 
 
@@ -468,7 +449,6 @@ def test_cached_combinatorics_are_read_only():
             a[0] = a[0]
 
 
-@explicit
 @pytest.mark.parametrize("name", ["truncated tesseract", "runcinated 24-cell", "grand antiprism", "5-7 duoprism",
                                   "snub cubic prism"])
 def test_hyperplane_through_a_cell_gives_that_cell(name):
@@ -481,7 +461,7 @@ def test_hyperplane_through_a_cell_gives_that_cell(name):
     for k in np.unique(c.cell_types, return_index=True)[1]:
         m = rotation_with_w_row(p.cell_normals[k])
         s = slice_polytope(p, m, float(p.cell_offsets[k]))
-        pts = p.vertices[np.unique(np.concatenate([p.faces[f] for f in p.cells[k]]))] @ m.T
+        pts = p.vertices[p.cell_vertices(k)] @ m.T
         assert s.dim == 3
         assert s.volume == pytest.approx(ConvexHull(pts[:, :3]).volume, rel=1e-9)
         assert len(s.cell_ids) == len(p.cells[k])
