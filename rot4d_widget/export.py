@@ -33,7 +33,7 @@ import math
 import os
 import tempfile
 import warnings
-from typing import Mapping, NamedTuple, Sequence
+from typing import Mapping, NamedTuple
 
 import numpy as np
 
@@ -160,12 +160,8 @@ def _one_mesh_arrays(data, color_by, group_colors):
         toff = np.asarray(ex["triangle_offsets"])
         attrs["slice"] = np.repeat(np.arange(len(toff) - 1), np.diff(toff))
         scales = np.asarray(ex["scales"], dtype=np.float64)
-        vols = ex.get("volumes", ())
-        n = len(scales)
-        if n == 1:
-            volume = None if vols[0] is None else float(vols[0])
-        else:
-            volume = None if any(v is None for v in vols) else float(sum(s**3 * v for s, v in zip(scales, vols)))
+        vols = ex.get("volumes", ())  # each slice drawn scaled by scales[k] (1 for a single slice)
+        volume = None if any(v is None for v in vols) else float(sum(s**3 * v for s, v in zip(scales, vols)))
         kind = "stack"
     elif _is_field_data(data):
         volume = float(sum(s.volume for s in data.extra["levels"]))

@@ -659,7 +659,7 @@ def render_tomography(
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
                            s.volume, s.dim)
             if palette is not None:
-                cmap = ListedColormap(palette[[0]] if len(palette) == 1 else palette)
+                cmap = ListedColormap(palette)
             else:
                 cmap = None if group_rgb is None else ListedColormap([group_rgb[k]])
             if not show_faces:
@@ -671,10 +671,9 @@ def render_tomography(
             for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
                 a.set_zorder(a.get_zorder() + z_shift)
         else:
+            bar_width = (0.35 * bar if bar_radius is None else bar) if show_bars else 0.0  # a field's box: thin
             _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
-                          src.source, face_alpha, z_shift,
-                          (0.35 * look.default_bar_radius(ball) if bar_radius is None else bar_radius) if show_bars else 0.0,
-                          show_faces=show_faces)
+                          src.source, face_alpha, z_shift, bar_width, show_faces=show_faces)
         if labels:
             jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift))
     # labels that would overlap one already placed are left out: the highlighted slice's first,
@@ -839,7 +838,7 @@ def render_state(
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
     `look.level_colors`; a stack coloured by w: its levels' colormap).  It does not follow a
     camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
-    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels.
+    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels (plus the title's strip when ``title`` is given).
     Returns the Figure.
     """
     if not isinstance(state, RotationState):

@@ -30,7 +30,6 @@ escape into the event loop.
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from dataclasses import dataclass

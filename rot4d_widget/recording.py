@@ -368,7 +368,7 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
             _apply(state, e, src)
             yield e.t, state, src
         return
-    n = int(math.ceil(recording.duration * fps - 1e-9)) + 1
+    n = _frame_count(recording, "time", fps)
     i = 0
     for k in range(1, n):
         t = k / fps
@@ -376,6 +376,13 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
             _apply(state, events[i], src)
             i += 1
         yield t, state, src
+
+
+def _frame_count(recording, per: str, fps: float) -> int:
+    """Frames of an animation: the start and one per step, or one per 1/fps s of recorded time."""
+    if per == "step":
+        return len(recording.events) + 1
+    return int(math.ceil(recording.duration * fps - 1e-9)) + 1
 
 
 def _positive(name, value) -> float:
@@ -403,7 +410,7 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     from .figures import render_state
 
     fps = _positive("fps", fps)
-    n = len(recording.events) + 1 if per == "step" else int(math.ceil(recording.duration * fps - 1e-9)) + 1
+    n = _frame_count(recording, per, fps)
     if n > max_frames:
         raise ValueError(f"The animation would have {n} frames, more than max_frames = {max_frames}; "
                          "lower fps, use per='step', or raise max_frames")
@@ -489,7 +496,7 @@ def paper_animation(figure: int, path, *, frames: int = 16, fps: float = 4.0, si
     import string
 
     rec, src = paper_recording(figure, frames, fps)
-    key = "4" if figure == 3 else "z"
+    key = rec.events[0].key
 
     def title(k, t, state):
         letter = f"({string.ascii_lowercase[k]})" if k < 26 else f"({k + 1})"

@@ -30,7 +30,6 @@ import numpy as np
 
 from .keymap import DEFAULT_KEYMAP, Action, Keymap
 from .rotation import (
-    ORTHOGONALITY_TOLERANCE,
     as_rotation_matrix,
     double_rotation,
     reorthonormalize,
@@ -55,7 +54,7 @@ __all__ = [
 #: The version of `RotationState.to_dict`'s layout (``d["format"]``).
 STATE_FORMAT = 1
 #: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
-#: further off, up to `ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
+#: further off, up to `rotation.ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
 _EXACT_ENOUGH = 1e-14
 
 DEFAULT_THETA0 = math.pi / 64
@@ -338,25 +337,14 @@ _ACTION_FIELDS = ("kind", "planes", "sign", "name", "text")
 def _loaded_rotation(value, name: str) -> np.ndarray:
     """A stored orientation: exact if orthogonal to rounding, re-orthonormalised within 1e-6, else refused."""
     try:
-        m = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"Expected `{name}` to be a 4 x 4 list of numbers") from None
-    if m.shape != (4, 4):
-        raise ValueError(f"Expected `{name}` to have shape (4, 4), got {m.shape}")
-    if not np.all(np.isfinite(m)):
-        raise ValueError(f"Expected `{name}` to be finite, got non-finite entries")
-    err = float(np.abs(m @ m.T - np.eye(4)).max())
-    if err > ORTHOGONALITY_TOLERANCE:
-        raise ValueError(
-            f"`{name}` is not a rotation: |M M^T - I| = {err:.3g} > {ORTHOGONALITY_TOLERANCE:g} "
-            "(only a matrix within that of orthogonal is re-orthonormalised)"
-        )
+        m = as_rotation_matrix(value, name)  # (4, 4), finite, within 1e-6 of orthogonal, det +1, a fresh copy
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None  # from_dict refuses bad data with ValueError
     for _ in range(4):  # Newton-Schulz squares the error: 1e-6 -> 1e-12 -> rounding
-        if err <= _EXACT_ENOUGH:
+        if float(np.abs(m @ m.T - np.eye(4)).max()) <= _EXACT_ENOUGH:
             break
         m = reorthonormalize(m)
-        err = float(np.abs(m @ m.T - np.eye(4)).max())
-    return as_rotation_matrix(m, name)  # det +1, fresh copy
+    return m
 
 
 def action_to_data(action: Action):

@@ -358,10 +358,10 @@ def test_from_dict_reorthonormalises_a_nearly_orthogonal_orientation():
 
 
 @pytest.mark.parametrize("orientation, match", [
-    ((np.eye(4) + 1e-5 * np.arange(16).reshape(4, 4) / 16).tolist(), r"not a rotation: \|M M\^T - I\| = "),
+    ((np.eye(4) + 1e-5 * np.arange(16).reshape(4, 4) / 16).tolist(), r"to be orthogonal .*deviation "),
     (np.diag([1.0, 1.0, 1.0, -1.0]).tolist(), "reflection"),
     (np.eye(3).tolist(), r"shape \(4, 4\)"),
-    ("identity", "4 x 4 list"),
+    ("identity", r"\(4, 4\) array of real numbers"),
 ])
 def test_from_dict_refuses_what_is_not_a_rotation(orientation, match):
     d = RotationState().to_dict()
