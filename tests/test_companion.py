@@ -11,6 +11,7 @@ report; it needs Chromium.)
 from __future__ import annotations
 
 import json
+import os
 import pathlib
 import shutil
 import subprocess
@@ -316,9 +317,20 @@ console.log(JSON.stringify(out));
 """
 
 
+def _apt_install_node():
+    """As root with apt (CI, a fresh machine): install Debian's nodejs, like the browser tests' Chromium."""
+    if not (hasattr(os, "geteuid") and os.geteuid() == 0 and shutil.which("apt-get")):
+        return None
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    subprocess.run(["apt-get", "update", "-qq"], env=env, check=False, capture_output=True, timeout=600)
+    subprocess.run(["apt-get", "install", "-y", "-qq", "nodejs"], env=env, check=False, capture_output=True,
+                   timeout=900)
+    return shutil.which("node") or shutil.which("nodejs")
+
+
 @pytest.fixture(scope="module")
 def js_run(tmp_path_factory):
-    node = shutil.which("node") or shutil.which("nodejs")
+    node = shutil.which("node") or shutil.which("nodejs") or _apt_install_node()
     if node is None:
         pytest.skip("Node.js is not installed: companion.js unit test not run (apt-get install nodejs)")
     d = tmp_path_factory.mktemp("companion")

@@ -14,7 +14,10 @@ import subprocess
 import sys
 import tarfile
 import time
-import tomllib
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10: the test extra brings tomli
+    import tomli as tomllib
 import zipfile
 from pathlib import Path
 
