@@ -108,10 +108,13 @@ def test_phase_separation_field_held_key_then_full_resolution(jupyter_server, pa
     before = _state(jp)
 
     # 3. hold 4 (time into x): the picture changes while held, from coarse slices
+    # long enough for several pictures at this run's own pace (a tap's round trip each, at least)
     page.keyboard.down("4")
-    time.sleep(1.2)
+    time.sleep(max(1.2, 4 * sorted(taps)[len(taps) // 2]))
     page.keyboard.up("4")
-    down = jp.key_stamps("keydown", "Digit4")[-1]
+    downs = jp.key_stamps("keydown", "Digit4")
+    assert downs, "the page saw no keydown of 4"
+    down = downs[-1]
     up = jp.wait_for(lambda: jp.key_stamps("keyup", "Digit4"), timeout=5)[-1]
     held_changes = [t for t in jp.pixel_changes(down) if t <= up]
     assert len(held_changes) >= 3, f"{len(held_changes)} pictures while 4 was held for {(up - down) / 1000:.2f} s"

@@ -7,7 +7,6 @@ matches the one read from the canvas in the page, and the count of such pixels a
 
 from __future__ import annotations
 
-import time
 
 from jupyter_page import JupyterPage, write_notebook
 from test_widget_browser import _bad_console, _canvas, _hover
@@ -35,7 +34,8 @@ def test_screenshot_and_key_p_give_the_view_as_a_png(jupyter_server, page, artif
     jp.run_all(timeout=300)
     sel = _canvas(jp)
     page.mouse.move(5, 300)  # off the canvas: nothing changes the view meanwhile
-    time.sleep(0.3)
+    jp.watch_pixels(sel)
+    assert jp.wait_quiet(0.5), "the view kept changing"
     canvas = jp.canvas_stats(sel)
 
     # 1. from code: returns at once; the PNG arrives after the cell

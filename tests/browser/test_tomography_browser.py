@@ -94,9 +94,10 @@ def test_oval_view_draws_every_slice_in_its_place_and_they_turn_together(jupyter
     page.keyboard.down("4")
     time.sleep(1.0)
     page.keyboard.up("4")
-    jp.wait_for(lambda: jp.kernel_json("len(w.held_keys)") == 0, timeout=10)
-    time.sleep(0.5)
-    after = per_box()
+    assert jp.wait_for(lambda: jp.kernel_json("len(w.held_keys)") == 0, timeout=10)
+    # the updates still on their way land within a few round trips; wait for them, not a fixed time
+    after = jp.wait_for(lambda: (r := per_box()) and all(a["h"] != b["h"] for a, b in zip(r, before)) and r,
+                        timeout=10) or per_box()
     changed = [a["h"] != b["h"] for a, b in zip(after, before)]
     assert all(changed), f"pixels unchanged in boxes {[i for i, c in enumerate(changed) if not c]}"
     assert all(a["n"] > 0 for a in after)
@@ -106,8 +107,7 @@ def test_oval_view_draws_every_slice_in_its_place_and_they_turn_together(jupyter
     h0 = per_box()
     page.keyboard.press("n")
     assert jp.wait_for(lambda: jp.kernel_json("w.slices") == n0 + 1, timeout=10)
-    time.sleep(0.5)
-    assert per_box() != h0
+    assert jp.wait_for(lambda: per_box() != h0, timeout=10), "the picture did not change after n"
     page.keyboard.press("b")
     page.keyboard.press("b")
     assert jp.wait_for(lambda: jp.kernel_json("[w.slices, w.source.slices]") == [n0 - 1, n0 - 1], timeout=10)
