@@ -32,7 +32,17 @@
 //     `mouseleave` on the canvas element: ipyevents' own handler then removes
 //     its document listener.  The guard needs no companion view: it stays
 //     with the canvas element and goes when the canvas goes.
-// All listeners are removed when the view is removed.
+//  6. rows drawn without instancing: just before each render the companion copies the rows
+//     in use of the shared row buffer into one plain (non-instanced) geometry per layer
+//     (a row becomes its template's 6 or 3 vertices, each carrying the row's columns) and
+//     draws that instead of the instanced geometry.  Software WebGL (SwiftShader, what a
+//     machine without a GPU runs) pays a fixed cost for every instance of an instanced draw
+//     call; figures and command in docs/design.md.  The shaders are unchanged: an attribute
+//     reads the same columns, per vertex instead of per instance.  Filled in the scene's
+//     `beforeRender` from the array three.js holds at that moment, so a frame draws one
+//     whole update, and the drawn acknowledgement (job 1) stays exact.
+// All listeners are removed when the view is removed (and each layer gets its instanced
+// geometry back).
 
 const GUARD_TAG = "rot4d-leave-guard";
 
@@ -63,6 +73,70 @@ function defineLeaveGuard() {
 // starts far above any pythreejs value and only rises.
 let surfaceVersion = 2 ** 30;
 const nextSurfaceVersion = () => ++surfaceVersion;
+
+// 6. Plain geometries drawn in place of the instanced ones, shared by every companion view
+// of one scene (keyed by the layer's three.js instanced geometry).
+const expansions = new WeakMap();
+
+// THREE.BufferGeometry without importing three.js: the instanced geometry's parent class.
+function plainGeometryClass(inst) {
+  const parent = inst && Object.getPrototypeOf(inst.constructor.prototype);
+  const C = parent && parent.constructor;
+  return typeof C === "function" && C !== Object && !C.prototype.isInstancedBufferGeometry ? C : null;
+}
+
+// The layer's template (`position`, V vertices) and the row columns its attributes read;
+// null if the geometry is not one this module knows how to expand.
+function layerLayout(inst) {
+  const attrs = inst && inst.attributes;
+  const tmpl = attrs && attrs.position;
+  if (!tmpl || !tmpl.array || tmpl.itemSize !== 3 || !plainGeometryClass(inst)) return null;
+  const columns = [];
+  for (const [name, a] of Object.entries(attrs)) {
+    if (name === "position") continue;
+    if (!a || !a.isInterleavedBufferAttribute || !Number.isInteger(a.offset) || !Number.isInteger(a.itemSize)) return null;
+    columns.push({ name, offset: a.offset, size: a.itemSize });
+  }
+  return columns.length ? { template: tmpl.array, Attribute: tmpl.constructor, columns } : null;
+}
+
+// A plain geometry for `capacity` rows of the layer: the template repeated per row and one
+// attribute per column (Float32, filled by fillExpansion).
+function makeExpansion(inst, layout, capacity) {
+  const Geometry = plainGeometryClass(inst);
+  const g = new Geometry();
+  const add = (name, attr) => (g.addAttribute ? g.addAttribute(name, attr) : g.setAttribute(name, attr));
+  const V = layout.template.length / 3;
+  const position = new Float32Array(capacity * V * 3);
+  for (let i = 0; i < capacity; i++) position.set(layout.template, i * V * 3);
+  add("position", new layout.Attribute(position, 3));
+  const columns = layout.columns.map((c) => {
+    const attr = new layout.Attribute(new Float32Array(capacity * V * c.size), c.size);
+    add(c.name, attr);
+    return { ...c, attr };
+  });
+  g.setDrawRange(0, 0);
+  return { inst, layout, geometry: g, capacity, V, columns, rows: null, version: null, count: -1, users: 0 };
+}
+
+// Copy rows [0, count) of the interleaved `rows` (stride floats per row) into the expansion.
+function fillExpansion(e, rows, stride, count) {
+  const n = Math.max(0, Math.min(count, e.capacity, Math.floor(rows.length / stride)));
+  const V = e.V;
+  for (const c of e.columns) {
+    const dst = c.attr.array;
+    const size = c.size;
+    for (let i = 0; i < n; i++) {
+      const src = i * stride + c.offset;
+      for (let k = 0, o = i * V * size; k < V; k++, o += size) {
+        for (let j = 0; j < size; j++) dst[o + j] = rows[src + j];
+      }
+    }
+    if (n > 0) c.attr.needsUpdate = true;
+  }
+  e.geometry.setDrawRange(0, n * V);
+  return n;
+}
 
 function modelId(ref) {
   return typeof ref === "string" && ref.startsWith("IPY_MODEL_") ? ref.slice(10) : ref;
@@ -247,6 +321,58 @@ async function render({ model, el }) {
         // one opaque surface writes depth; nested translucent ones (sorted back to front) do not
         if (mesh.obj.material) mesh.obj.material.depthWrite = !(s.opacity < 1);
       };
+      // 6. rows drawn without instancing: geometries[i] is meshes[i]'s (balls, bars, faces)
+      const layers = geometries.slice(0, 3).map((model, i) => ({ model, mesh: meshes[i], e: null }));
+      const release = (layer) => {
+        const e = layer.e;
+        layer.e = null;
+        if (!e) return;
+        const mesh = layer.mesh && layer.mesh.obj;
+        if (mesh && mesh.geometry === e.geometry) mesh.geometry = e.inst;
+        if (--e.users > 0) return;
+        expansions.delete(e.inst);
+        if (e.geometry.dispose) e.geometry.dispose();
+      };
+      cleanups.push(() => layers.forEach(release));
+      const expand = () => {
+        const obj = buffer.obj;
+        if (!obj || !obj.array || !(obj.stride > 0)) return;
+        const held = Math.floor(obj.array.length / obj.stride);
+        const counts = buffer.get("_rot4d_counts") || [];
+        layers.forEach((layer, i) => {
+          const inst = layer.model.obj;
+          const mesh = layer.mesh && layer.mesh.obj;
+          if (!inst || !mesh) return;
+          if (layer.e && layer.e.inst !== inst) release(layer); // pythreejs rebuilt the geometry
+          if (!layer.e) {
+            let shared = expansions.get(inst);
+            if (!shared) {
+              const layout = layerLayout(inst);
+              if (!layout) return; // not a layer this module knows: it stays instanced
+              shared = makeExpansion(inst, layout, Math.max(held, 1));
+              expansions.set(inst, shared);
+            }
+            shared.users++;
+            layer.e = shared;
+          }
+          const e = layer.e;
+          if (e.capacity < held) {
+            // the capacity grew: a new geometry (a GL buffer cannot take a longer array in place)
+            const old = e.geometry;
+            const fresh = makeExpansion(inst, e.layout, held);
+            Object.assign(e, { geometry: fresh.geometry, capacity: held, columns: fresh.columns, rows: null });
+            if (old.dispose) old.dispose();
+          }
+          const count = Number.isInteger(counts[i]) ? counts[i] : held;
+          if (e.rows !== obj.array || e.version !== obj.version || e.count !== count) {
+            fillExpansion(e, obj.array, obj.stride, count);
+            e.rows = obj.array;
+            e.version = obj.version;
+            e.count = count;
+          }
+          if (mesh.geometry !== e.geometry) mesh.geometry = e.geometry;
+        });
+      };
       if (geometries.length) applyCounts();
       if (meshes.length) applyTurn();
       if (meshes.length) applySurface();
@@ -318,6 +444,13 @@ async function render({ model, el }) {
       }
       scene.on("afterRender", onRendered);
       cleanups.push(() => scene.off("afterRender", onRendered));
+      // the frame about to be drawn takes the update's counts and turn, and its rows unpacked
+      const beforeRender = () => {
+        settle();
+        expand();
+      };
+      scene.on("beforeRender", beforeRender);
+      cleanups.push(() => scene.off("beforeRender", beforeRender));
 
       // 5. screenshot: {event: "screenshot", id} from the kernel -> the canvas as a PNG data URL.
       // Read in the task that rendered (after a render asked for here): only then is the

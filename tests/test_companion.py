@@ -416,3 +416,181 @@ def test_js_cleanup_removes_every_listener(js_run):
     assert js_run["left"] == {"window": 0, "document": 0, "buffer": 1, "scene": 1}
     assert js_run["afterCleanupPrevented"] is False
     assert js_run["afterCleanup"] == []
+
+
+# ------------------------------------------------ rows drawn without instancing (job 6)
+EXPAND_DRIVER = r"""
+import { pathToFileURL } from "node:url";
+const out = {};
+const target = () => ({ addEventListener() {}, removeEventListener() {} });
+globalThis.window = target();
+globalThis.document = Object.assign(target(), { visibilityState: "visible", querySelector: () => null,
+  getElementsByClassName: () => [] });
+let raf = [];
+globalThis.requestAnimationFrame = (f) => raf.push(f);
+const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
+function backbone(attrs) {
+  const L = {};
+  return {
+    attrs, get: (k) => attrs[k],
+    setState(state) { Object.assign(attrs, state); for (const k of Object.keys(state)) (L["change:" + k] || []).slice().forEach((f) => f()); (L.change || []).slice().forEach((f) => f()); },
+    on(t, f) { (L[t] ||= []).push(f); }, off(t, f) { L[t] = (L[t] || []).filter((g) => g !== f); },
+    trigger(t) { (L[t] || []).slice().forEach((f) => f()); },
+  };
+}
+// three.js r97 in miniature: the classes the companion finds through the objects it is given
+class BufferGeometry {
+  constructor() { this.attributes = {}; this.drawRange = { start: 0, count: Infinity }; this.disposed = false; }
+  addAttribute(name, a) { this.attributes[name] = a; return this; }
+  setDrawRange(start, count) { this.drawRange = { start, count }; }
+  dispose() { this.disposed = true; }
+}
+class InstancedBufferGeometry extends BufferGeometry {}
+InstancedBufferGeometry.prototype.isInstancedBufferGeometry = true;
+class BufferAttribute {
+  constructor(array, itemSize) { this.array = array; this.itemSize = itemSize; this.version = 0; }
+  set needsUpdate(v) { if (v) this.version++; }
+}
+// rows of 6 floats: [ball x y z flag | bar_a x y z]... as in buffers.COLUMNS, smaller
+const STRIDE = 6;
+const rowsOf = (n, base) => Float32Array.from({ length: n * STRIDE }, (_, i) => base + i);
+const buffer = backbone({ _rot4d_seq: 0, array: { data: rowsOf(4, 0) }, _rot4d_counts: [4, 4, 4] });
+buffer.save_changes = () => {};
+buffer.obj = { array: buffer.attrs.array.data, version: 1, stride: STRIDE };
+buffer.on("change", () => { buffer.obj.array = buffer.attrs.array.data; buffer.obj.version++; });
+const col = (offset, itemSize) => ({ isInterleavedBufferAttribute: true, offset, itemSize, data: buffer.obj });
+const quad = new Float32Array([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0]);
+const inst = (columns, template) => {
+  const g = new InstancedBufferGeometry();
+  g.addAttribute("position", new BufferAttribute(template, 3));
+  for (const [name, [o, s]] of Object.entries(columns)) g.addAttribute(name, col(o, s));
+  g.maxInstancedCount = 4;
+  return g;
+};
+const geometries = [
+  { obj: inst({ ball: [0, 4] }, quad) },
+  { obj: inst({ bar_a: [1, 3], bar_b: [3, 3] }, quad) },
+  { obj: inst({ tri_a: [0, 3], tri_rgb: [5, 1] }, new Float32Array([1, 0, 0, 0, 1, 0, 0, 0, 1])) },
+];
+const meshes = geometries.map((g) => ({ obj: { geometry: g.obj, matrix: { elements: [] }, quaternion: { setFromRotationMatrix() {} } } }));
+const scene = backbone({});
+const sent = [];
+const ids = { buf: buffer, scn: scene, g0: geometries[0], g1: geometries[1], g2: geometries[2], m0: meshes[0], m1: meshes[1], m2: meshes[2] };
+const model = () => ({
+  get: (k) => ({ buffer_model_id: "buf", scene_model_id: "scn", canvas_class: "c", geometry_model_ids: ["g0", "g1", "g2"],
+                 mesh_model_ids: ["m0", "m1", "m2"] })[k],
+  send: (m) => sent.push(m), on() {}, off() {},
+  widget_manager: { async get_model(id) { return ids[id]; } },
+});
+const mod = await import(pathToFileURL(process.argv[2]).href);
+const cleanup = await mod.default.render({ model: model(), el: { style: {} } });
+
+// what a frame draws: per layer, the vertices in the draw range with their attributes
+const drawn = () => meshes.map((m) => {
+  const g = m.obj.geometry;
+  if (g.isInstancedBufferGeometry) return { instanced: true };
+  const n = g.drawRange.count;
+  const attrs = {};
+  for (const [name, a] of Object.entries(g.attributes)) attrs[name] = Array.from(a.array.slice(0, n * a.itemSize));
+  return { n, attrs, versions: Object.values(g.attributes).map((a) => a.version) };
+});
+const draw = () => { scene.trigger("beforeRender"); const d = drawn(); scene.trigger("afterRender"); frame(); return d; };
+
+buffer.setState({ _rot4d_seq: 1, array: { data: rowsOf(4, 100) }, _rot4d_counts: [2, 3, 1] });
+out.first = draw();
+out.firstAck = sent.splice(0);
+out.unchanged = draw();  // nothing new: nothing re-uploaded
+buffer.setState({ _rot4d_seq: 2, array: { data: rowsOf(4, 200) }, _rot4d_counts: [1, 1, 2] });
+out.second = draw();
+out.secondAck = sent.splice(0);
+const before = meshes.map((m) => m.obj.geometry);
+buffer.setState({ _rot4d_seq: 3, array: { data: rowsOf(9, 300) }, _rot4d_counts: [9, 7, 8] });  // capacity grew
+out.grown = draw();
+out.grownAck = sent.splice(0);
+out.oldDisposed = before.map((g) => g.disposed);
+// pythreejs rebuilds a geometry's three.js object: the new one is expanded, the old expansion released
+const rebuilt = inst({ ball: [0, 4] }, quad);
+geometries[0].obj = rebuilt;
+meshes[0].obj.geometry = rebuilt;
+out.rebuilt = draw()[0].n;
+// a second view of the same companion shares the expansions; removing it keeps them
+const cleanup2 = await mod.default.render({ model: model(), el: { style: {} } });
+const shared = meshes.map((m) => m.obj.geometry);
+draw();
+out.sharedSame = meshes.map((m, i) => m.obj.geometry === shared[i]);
+cleanup2();
+draw();
+out.afterOneCleanup = meshes.map((m, i) => m.obj.geometry === shared[i] && !shared[i].disposed);
+cleanup();
+out.restored = meshes.map((m, i) => m.obj.geometry === geometries[i].obj);
+out.disposedAtEnd = shared.map((g) => g.disposed);
+console.log(JSON.stringify(out));
+"""
+
+
+@pytest.fixture(scope="module")
+def js_expand(tmp_path_factory):
+    node = shutil.which("node") or shutil.which("nodejs") or _apt_install_node()
+    if node is None:
+        pytest.skip("Node.js is not installed: companion.js unit test not run (apt-get install nodejs)")
+    d = tmp_path_factory.mktemp("companion_expand")
+    driver = d / "driver.mjs"
+    driver.write_text(EXPAND_DRIVER)
+    proc = subprocess.run([node, str(driver), str(JS)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _expected(rows, count, columns, template):
+    """Independent unpacking: each of `count` rows becomes the template's vertices carrying its columns."""
+    stride = 6
+    V = len(template) // 3
+    attrs = {"position": [float(x) for _ in range(count) for x in template]}
+    for name, (offset, size) in columns.items():
+        attrs[name] = [float(rows[i * stride + offset + j]) for i in range(count) for _ in range(V) for j in range(size)]
+    return {"n": count * V, "attrs": attrs}
+
+
+QUAD = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, -1, 0, 1, 1, 0, -1, 1, 0]
+TRI = [1, 0, 0, 0, 1, 0, 0, 0, 1]
+LAYERS = [({"ball": (0, 4)}, QUAD), ({"bar_a": (1, 3), "bar_b": (3, 3)}, QUAD), ({"tri_a": (0, 3), "tri_rgb": (5, 1)}, TRI)]
+
+
+def _rows(n, base):
+    return [base + i for i in range(n * 6)]
+
+
+def _check(frame, rows, counts):
+    for layer, (columns, template), count in zip(frame, LAYERS, counts):
+        want = _expected(rows, count, columns, template)
+        assert layer["n"] == want["n"]
+        assert layer["attrs"] == want["attrs"]
+
+
+def test_js_each_frame_draws_the_rows_of_its_update_without_instancing(js_expand):
+    # the frame right after an update draws that update's rows, as plain vertices (no instancing)
+    _check(js_expand["first"], _rows(4, 100), [2, 3, 1])
+    _check(js_expand["second"], _rows(4, 200), [1, 1, 2])
+    assert js_expand["firstAck"] == [{"event": "drawn", "seq": 1}]
+    assert js_expand["secondAck"] == [{"event": "drawn", "seq": 2}]
+
+
+def test_js_unchanged_rows_are_not_uploaded_again(js_expand):
+    assert [layer["versions"] for layer in js_expand["unchanged"]] == [layer["versions"] for layer in js_expand["first"]]
+    # a new update re-uploads every column
+    for a, b in zip(js_expand["first"], js_expand["second"]):
+        assert all(y > x for x, y in zip(a["versions"][1:], b["versions"][1:]))
+
+
+def test_js_a_grown_capacity_gets_new_geometries(js_expand):
+    _check(js_expand["grown"], _rows(9, 300), [9, 7, 8])
+    assert js_expand["grownAck"] == [{"event": "drawn", "seq": 3}]
+    assert js_expand["oldDisposed"] == [True, True, True]  # a GL buffer cannot take a longer array in place
+    assert js_expand["rebuilt"] == 9 * 6  # a geometry pythreejs rebuilt is expanded too
+
+
+def test_js_views_share_the_expansions_and_the_last_one_gives_the_instanced_geometry_back(js_expand):
+    assert js_expand["sharedSame"] == [True, True, True]
+    assert js_expand["afterOneCleanup"] == [True, True, True]
+    assert js_expand["restored"] == [True, True, True]
+    assert js_expand["disposedAtEnd"] == [True, True, True]
