@@ -2,10 +2,13 @@
 
 After an update is sent the pump may send the next one, computed from the
 latest state at that moment, while fewer than ``max_in_flight`` updates await
-the page's "drawn" acknowledgement.  With two in flight the kernel computes
-and sends the next picture while the page draws the previous one, so the
-round trip to the kernel is no longer in series with the page's frames; the
-page always draws the newest picture it holds.  Nothing queues beyond that
+the page's "drawn" acknowledgement.  With more than one in flight the kernel
+computes and sends the next picture while the page draws the previous one, so
+the round trip to the kernel is no longer in series with the page's frames;
+the page always draws the newest picture it holds.  Three, not two: the
+page's acknowledgement comes one frame after the draw (so it follows what
+the renderer really finished), and with two the held key waited on it; the
+measurements behind the bound are in docs/design.md.  Nothing queues beyond that
 bound, so the view never falls behind and settles as soon as the state stops
 changing.  An acknowledgement names an update and retires it and every older
 one (the page acknowledges only the newest of several arriving before a frame).
@@ -38,7 +41,7 @@ __all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_IN_FLIGHT"]
 
 ACK_TIMEOUT = 0.5
 #: Updates allowed in flight at once (1: strictly one at a time).
-MAX_IN_FLIGHT = 2
+MAX_IN_FLIGHT = 3
 #: Recent acknowledgement times the adaptive timeout looks at.
 _ACK_WINDOW = 8
 

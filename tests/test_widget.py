@@ -382,33 +382,34 @@ def test_parameter_keys_repeat_but_step_angle_keys_do_not(make, clock):
     assert w.state.theta0 == pytest.approx(theta0 * math.sqrt(2))
 
 
-def test_at_most_two_updates_in_flight_and_the_next_is_the_latest_state(make, clock):
+def test_at_most_three_updates_in_flight_and_the_next_is_the_latest_state(make, clock):
     w = make()
     t0 = clock.t
     down(w, "4")
     first = w.scene.update_id
     assert len(w.scene.shown) == 2 and w.in_flight
-    run_ticker(w, clock, t0 + 0.45)  # the second goes out with the first tick, then nothing without an ack
-    assert xw_steps(w) > 3
-    assert len(w.scene.shown) == 3 and wmod.MAX_IN_FLIGHT == 2
+    run_ticker(w, clock, t0 + 0.45)  # the second and third go out with the ticks, then nothing without an ack
+    assert xw_steps(w) > 4
+    assert len(w.scene.shown) == 4 and wmod.MAX_IN_FLIGHT == 3
     w.companion.drawn(first)  # the oldest drawn: the latest state goes out
-    assert len(w.scene.shown) == 4 and w.in_flight
+    assert len(w.scene.shown) == 5 and w.in_flight
     latest = slice_polytope(w.polytope, w.state.matrix, w.state.c0)
     assert np.allclose(w.scene.shown[-1].vertices, latest.vertices)
     w.companion.drawn()  # the newest drawn (and so every older one): nothing changed since
     w.companion.drawn()
-    assert len(w.scene.shown) == 4 and not w.in_flight
+    assert len(w.scene.shown) == 5 and not w.in_flight
 
 
 def test_an_acknowledgement_retires_every_older_update(make, clock):
     w = make()
     w.press("4")
     w.press("4")
-    assert len(w.scene.shown) == 3 and w.stats.updates == 3
-    w.press("4")  # two in flight: pending
-    assert len(w.scene.shown) == 3
-    w.companion.drawn()  # the page drew the newest (it skipped the older one): both retired
-    assert len(w.scene.shown) == 4 and w.stats.acks == 1
+    w.press("4")
+    assert len(w.scene.shown) == 4 and w.stats.updates == 4
+    w.press("4")  # three in flight: pending
+    assert len(w.scene.shown) == 4
+    w.companion.drawn()  # the page drew the newest (it skipped the older ones): all retired
+    assert len(w.scene.shown) == 5 and w.stats.acks == 1
     w.companion.drawn()
     assert not w.in_flight
 
@@ -417,20 +418,21 @@ def test_duplicate_acknowledgements_release_nothing_extra(make, clock):
     w = make()
     w.press("4")
     w.press("4")
-    assert w.in_flight and len(w.scene.shown) == 3
-    w.press("4")  # a third step while two are in flight: pending
-    assert len(w.scene.shown) == 3
-    first = w.scene.update_id - 1
-    w.companion.drawn(first)  # view A acknowledges the older update -> the third goes out
-    assert len(w.scene.shown) == 4 and w.scene.update_id == first + 2
+    w.press("4")
+    assert w.in_flight and len(w.scene.shown) == 4
+    w.press("4")  # a fourth step while three are in flight: pending
+    assert len(w.scene.shown) == 4
+    first = w.scene.update_id - 2
+    w.companion.drawn(first)  # view A acknowledges the oldest update -> the fourth goes out
+    assert len(w.scene.shown) == 5 and w.scene.update_id == first + 3
     w.companion.drawn(first)  # view B's late acknowledgement of it: ignored
     w.press("4")
-    assert len(w.scene.shown) == 4  # still two in flight
+    assert len(w.scene.shown) == 5  # still three in flight
     assert w.stats.acks == 1
-    w.companion.drawn(first + 7)  # an update that was never sent: ignored
+    w.companion.drawn(first + 9)  # an update that was never sent: ignored
     assert w.in_flight and w.stats.acks == 1
     w.companion.drawn(first + 1)
-    assert len(w.scene.shown) == 5
+    assert len(w.scene.shown) == 6
 
 
 def test_after_release_the_view_settles_at_once(make, clock):
@@ -475,15 +477,16 @@ def test_scripting_press_redraws_and_respects_flow_control(make, clock):
     w = make()
     assert w.press("4") is True
     assert w.press("C") is True  # R_zw inverted: the second update in flight
-    assert len(w.scene.shown) == 3
-    assert w.press("c", shift=True) is True  # pending while two are in flight
-    expected = simple_rotation("zw", -2 * w.state.theta0) @ simple_rotation("xw", w.state.theta0)
+    assert w.press("C") is True  # the third
+    assert len(w.scene.shown) == 4
+    assert w.press("c", shift=True) is True  # pending while three are in flight
+    expected = simple_rotation("zw", -3 * w.state.theta0) @ simple_rotation("xw", w.state.theta0)
     assert np.allclose(w.state.matrix, expected)
     assert np.allclose(w.slice.vertices, slice_polytope(w.polytope, expected, 0.0).vertices)
-    assert len(w.scene.shown) == 3
+    assert len(w.scene.shown) == 4
     clock.t += w.ack_timeout  # no view (nbval): the timeout sends the latest
     service(w)
-    assert len(w.scene.shown) == 4 and w.scene.shown[-1] is w.slice
+    assert len(w.scene.shown) == 5 and w.scene.shown[-1] is w.slice
     assert w.press("q") is False
     with pytest.raises(TypeError, match="key"):
         w.press(4)

@@ -146,7 +146,7 @@ def _front_facing(rows, eye):
 
 def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_control(make, recording_comms):
     w = make("24-cell")
-    for _ in range(2):  # two updates in flight (the most allowed)
+    for _ in range(3):  # three updates in flight (the most allowed)
         down(w, "z")
         up(w, "z")
     before = w.scene.rows
@@ -155,7 +155,7 @@ def test_an_orbit_re_sends_the_faces_ordered_for_the_new_eye_through_flow_contro
     eye = (3.0, -4.0, 1.0)
     orbit_ends_at(w, eye)
     assert w.scene.eye == eye
-    assert w.stats.updates == n_updates  # two updates in flight: this one waits for an ack
+    assert w.stats.updates == n_updates  # three updates in flight: this one waits for an ack
     drawn(w)
     assert w.stats.updates == n_updates + 1 and w.scene.rows is not before
     facing = _front_facing(w.scene.rows, eye)
@@ -203,13 +203,13 @@ def test_the_companion_acknowledgement_releases_the_next_update(make, clock, rec
     down(w, "4")
     first = w.scene.update_id
     run_ticker(w, clock, t0 + 0.45)
-    # the initial picture, the first step, the first repeat; then two are in flight
-    assert len(buffer_messages(w, recording_comms)) == 3
+    # the initial picture, the first step, two repeats; then three are in flight
+    assert len(buffer_messages(w, recording_comms)) == 4
     acks = w.stats.acks
     drawn(w, first - 1)  # an acknowledgement of an older update: ignored
-    assert w.scene.update_id == first + 1 and w.stats.acks == acks
+    assert w.scene.update_id == first + 2 and w.stats.acks == acks
     drawn(w, first)
-    assert w.scene.update_id == first + 2 and w.in_flight and w.stats.acks == acks + 1
+    assert w.scene.update_id == first + 3 and w.in_flight and w.stats.acks == acks + 1
     assert np.allclose(
         w.scene.rows[: len(w.slice.points), 0:3],
         scaled_points(w, w.source.slice(w.state.matrix, 0.0)),
