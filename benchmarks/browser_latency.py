@@ -430,11 +430,14 @@ CELLS = [
     "from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({name!r}))\nw",
 ]
 READ = {BASE: "bench.read_baseline()", WIDGET: "bench.read_widget(w)"}
-#: Frames drawn after a key's release that still count as settling at once: the updates the
-#: widget may have in flight at keyup (its pump's bound, read from the widget measured), plus the
-#: latest state (rows re-sent at rest).
-def after_frames_allowed(h: dict) -> int:
-    return int(h.get("max_in_flight") or 2) + 1
+def release_ok(h: dict) -> bool:
+    """The view settled at once after the key's release: the state did not move, at most the
+    updates the widget may have had in flight at keyup (its pump's bound, read from the widget
+    measured) plus the latest state (rows re-sent at rest) were drawn, the last within 0.5 s."""
+    allowed = int(h.get("max_in_flight") or 2) + 1
+    return (not h["moved_after_up"]) and h["after_frames"] <= allowed and h["settle_ms"] <= 500
+
+
 #: Targets, per ``--targets``: (excess key->pixel in frames, held fps) for the small four and for
 #: the 600-/120-cell; held fps is absolute ("issue4") or a ratio of the same run's baseline.
 TARGETS = {
@@ -1063,7 +1066,7 @@ def report(results: dict, meta: dict) -> str:
         h = w["hold"]
         lat_ok = excess <= lat_target and not w["misses"]
         fps_ok = h["fps"] >= fps_target
-        rel_ok = (not h["moved_after_up"]) and h["after_frames"] <= after_frames_allowed(h) and h["settle_ms"] <= 500
+        rel_ok = release_ok(h)
         after = f"{h['after_frames']}, {fmt(h['settle_ms'])} ms" + (", state moved after keyup" if h["moved_after_up"] else "")
         std = statistics.stdev(lat) if len(lat) > 1 else math.nan
         lines.append(
@@ -1194,7 +1197,7 @@ def verdicts(case: str, r: dict) -> dict:
         "misses": w["misses"],
         "fps": h["fps"],
         "base_fps": r.get("base_fps", math.nan),
-        "release_ok": (not h["moved_after_up"]) and h["after_frames"] <= after_frames_allowed(h) and h["settle_ms"] <= 500,
+        "release_ok": release_ok(h),
     }
 
 

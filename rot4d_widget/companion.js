@@ -102,10 +102,10 @@ function layerLayout(inst) {
 
 // A plain geometry for `capacity` rows of the layer: the template repeated per row and one
 // attribute per column (Float32, filled by fillExpansion).
-function makeExpansion(inst, layout, capacity) {
+function buildGeometry(inst, layout, capacity) {
   const Geometry = plainGeometryClass(inst);
-  const g = new Geometry();
-  const add = (name, attr) => (g.addAttribute ? g.addAttribute(name, attr) : g.setAttribute(name, attr));
+  const geometry = new Geometry();
+  const add = (name, attr) => (geometry.addAttribute ? geometry.addAttribute(name, attr) : geometry.setAttribute(name, attr));
   const V = layout.template.length / 3;
   const position = new Float32Array(capacity * V * 3);
   for (let i = 0; i < capacity; i++) position.set(layout.template, i * V * 3);
@@ -115,8 +115,13 @@ function makeExpansion(inst, layout, capacity) {
     add(c.name, attr);
     return { ...c, attr };
   });
-  g.setDrawRange(0, 0);
-  return { inst, layout, geometry: g, capacity, V, columns, rows: null, version: null, count: -1, users: 0 };
+  geometry.setDrawRange(0, 0);
+  return { geometry, columns, capacity, rows: null };
+}
+
+function makeExpansion(inst, layout, capacity) {
+  const V = layout.template.length / 3;
+  return { inst, layout, V, version: null, count: -1, users: 0, ...buildGeometry(inst, layout, capacity) };
 }
 
 // Copy rows [0, count) of the interleaved `rows` (stride floats per row) into the expansion.
@@ -359,8 +364,7 @@ async function render({ model, el }) {
           if (e.capacity < held) {
             // the capacity grew: a new geometry (a GL buffer cannot take a longer array in place)
             const old = e.geometry;
-            const fresh = makeExpansion(inst, e.layout, held);
-            Object.assign(e, { geometry: fresh.geometry, capacity: held, columns: fresh.columns, rows: null });
+            Object.assign(e, buildGeometry(inst, e.layout, held));
             if (old.dispose) old.dispose();
           }
           const count = Number.isInteger(counts[i]) ? counts[i] : held;

@@ -328,17 +328,21 @@ def _apt_install_node():
     return shutil.which("node") or shutil.which("nodejs")
 
 
-@pytest.fixture(scope="module")
-def js_run(tmp_path_factory):
+def _run_driver(tmp_path_factory, name, driver_text):
+    """Run a Node driver script against the shipped companion.js; its last stdout line is JSON."""
     node = shutil.which("node") or shutil.which("nodejs") or _apt_install_node()
     if node is None:
         pytest.skip("Node.js is not installed: companion.js unit test not run (apt-get install nodejs)")
-    d = tmp_path_factory.mktemp("companion")
-    driver = d / "driver.mjs"
-    driver.write_text(DRIVER)
+    driver = tmp_path_factory.mktemp(name) / "driver.mjs"
+    driver.write_text(driver_text)
     proc = subprocess.run([node, str(driver), str(JS)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="module")
+def js_run(tmp_path_factory):
+    return _run_driver(tmp_path_factory, "companion", DRIVER)
 
 
 def test_js_the_surface_is_uploaded_even_after_pythreejs_resets_its_versions(js_run):
@@ -530,15 +534,7 @@ console.log(JSON.stringify(out));
 
 @pytest.fixture(scope="module")
 def js_expand(tmp_path_factory):
-    node = shutil.which("node") or shutil.which("nodejs") or _apt_install_node()
-    if node is None:
-        pytest.skip("Node.js is not installed: companion.js unit test not run (apt-get install nodejs)")
-    d = tmp_path_factory.mktemp("companion_expand")
-    driver = d / "driver.mjs"
-    driver.write_text(EXPAND_DRIVER)
-    proc = subprocess.run([node, str(driver), str(JS)], capture_output=True, text=True, timeout=60)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return _run_driver(tmp_path_factory, "companion_expand", EXPAND_DRIVER)
 
 
 def _expected(rows, count, columns, template):
