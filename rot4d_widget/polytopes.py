@@ -40,7 +40,8 @@ import numpy as np
 from ._arrays import sealed as _sealed
 from scipy.spatial import ConvexHull
 
-__all__ = ["Polytope", "MeshError", "polytope", "pentachoron", "POLYTOPE_NAMES", "MESH_TOLERANCE"]
+__all__ = ["Polytope", "MeshError", "polytope", "pentachoron", "POLYTOPE_NAMES", "MESH_TOLERANCE",
+           "COORDINATE_RANGE"]
 
 PHI = (1.0 + math.sqrt(5.0)) / 2.0
 
@@ -168,6 +169,29 @@ _BUILDERS = {
 MESH_TOLERANCE = 1e-6
 
 
+#: The scale of an object (a polytope's largest absolute coordinate, a field box's half widths and
+#: the ends of its extent) must lie in this range: (smallest, largest).  Within it the square of
+#: every coordinate, distance or dot product is a normal float64 (1e-300 to 1e300), so any code
+#: that measures lengths stays exact to rounding; outside it a ValueError names the range.  Each
+#: object is normalised by a power of two (exact) before the hull, the checks and the slicer, and
+#: every tolerance is relative to its scale, so the results are the unit object's, scaled.
+COORDINATE_RANGE = (1e-150, 1e150)
+
+
+def check_scale(scale: float, what: str) -> None:
+    """ValueError unless ``COORDINATE_RANGE[0] <= scale <= COORDINATE_RANGE[1]`` (``what`` names it)."""
+    lo, hi = COORDINATE_RANGE
+    if not lo <= scale <= hi:
+        raise ValueError(f"{what} is {scale:.3g}; expected {lo:g} to {hi:g} (rot4d_widget.polytopes.COORDINATE_RANGE: "
+                         f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
+                         f"other units)")
+
+
+def _power_of_two_unit(amax: float) -> float:
+    """The power of two 2**k with ``1 <= amax / 2**k < 2`` (dividing by it is exact)."""
+    return math.ldexp(1.0, math.frexp(amax)[1] - 1)
+
+
 class MeshError(ValueError):
     """An explicit mesh given to `Polytope` is not a valid 4-polytope.
 
@@ -292,6 +316,12 @@ class Polytope:
       encloses positive 4-volume, and a component inside another (a cavity, found by
       casting a ray) the other way.
 
+    Scale: the largest absolute coordinate must lie in `COORDINATE_RANGE` (1e-150 to 1e150; else
+    a ValueError naming the range).  Within it any scale works alike: the vertices are divided by
+    a power of two (exactly) before qhull, the checks and the slicer, and every tolerance is
+    relative, so ``Polytope(s * v)`` has the combinatorics of ``Polytope(v)``, its offsets and
+    circumradius times ``s``, and its slices are those of ``Polytope(v)`` (at ``c0 / s``) times ``s``.
+
     Two cells sharing a face may lie in one hyperplane (a flat ridge, as where two
     cubes of glued tesseracts meet side by side): that is allowed, and the slicer
     gives their slices as two polygons.  Not checked: that the boundary does not
@@ -334,9 +364,19 @@ class Polytope:
             raise ValueError("Expected `vertices` to be finite")
         if (faces is None) != (cells is None):
             raise TypeError("Expected both `faces` and `cells`, or neither (then the convex hull of the vertices)")
+        amax = float(np.abs(v).max())
+        if amax == 0:
+            raise ValueError("`vertices` are all the origin: they do not span a 4-D convex polytope" if faces is None
+                             else "`vertices` are all the same point")
+        check_scale(amax, "The largest absolute coordinate of `vertices`")
         self.name = str(name)
         self.vertices = _sealed(v)
-        self.circumradius = float(np.sqrt((v * v).sum(axis=1)).max())
+        # the vertices divided by a power of two (exactly) so that the largest |coordinate| is in
+        # [1, 2): the hull, the mesh checks and the slicer work on these, at any scale
+        self._unit = _power_of_two_unit(amax)
+        vn = v / self._unit
+        self._unit_vertices = _sealed(vn)
+        self.circumradius = float(np.sqrt((vn * vn).sum(axis=1)).max()) * self._unit
         if faces is None:
             self._build_hull()
         else:
@@ -344,18 +384,17 @@ class Polytope:
 
     # -- construction ------------------------------------------------------
     def _build_hull(self) -> None:
-        v = self.vertices
-        scale = float(np.abs(v).max())
-        tol = 1e-9 * scale
+        v = self._unit_vertices  # largest |coordinate| in [1, 2): qhull and the tolerances see one scale
+        tol = 1e-9 * float(np.abs(v).max())
         try:
             hull = ConvexHull(v)
         except Exception as exc:  # qhull: flat or degenerate input
             raise ValueError(f"`vertices` do not span a 4-D convex polytope: {exc}") from None
         if len(hull.vertices) != len(v):
             raise ValueError("Every vertex must be a corner of the convex hull (found interior or repeated points)")
-        # cells: distinct facet hyperplanes of the hull
+        # cells: distinct facet hyperplanes of the hull (unit normals, offsets of order 1)
         eq = hull.equations
-        key = np.round(eq / scale * np.array([1, 1, 1, 1, scale]), 7)
+        key = np.round(eq, 7)
         _, first = np.unique(key, axis=0, return_index=True)
         first = np.sort(first)
         normals, offsets = eq[first, :4], -eq[first, 4]
@@ -374,7 +413,7 @@ class Polytope:
         cell_sizes = np.bincount(both, minlength=len(first))
         self._set_combinatorics(_ptr(face_sizes), np.concatenate(faces), _ptr(cell_sizes), cell_fidx)
         self.cell_normals = _sealed(np.ascontiguousarray(normals))
-        self.cell_offsets = _sealed(np.ascontiguousarray(offsets))
+        self.cell_offsets = _sealed(np.ascontiguousarray(offsets) * self._unit)
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
         self.convex = True
 
@@ -458,9 +497,9 @@ class Polytope:
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
         self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
-        normals, offsets, centres, ncomp, tol = _mesh_geometry(self, validate)
+        normals, offsets, centres, ncomp, tol = _mesh_geometry(self, validate)  # in the unit vertices' scale
         self.cell_normals = _sealed(normals)
-        self.cell_offsets = _sealed(offsets)
+        self.cell_offsets = _sealed(offsets * self._unit)
         c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
         self.convex = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
                            and np.all(np.einsum("fd,fd->f", normals[c2], centres[c1]) <= offsets[c2] + tol))
@@ -535,8 +574,8 @@ class Polytope:
 
 def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
     """Check an explicit mesh's geometry: (outward cell normals, offsets, cell centres, number of
-    boundary components, the tolerance used)."""
-    v = p.vertices
+    boundary components, the tolerance used); lengths in the scale of ``p._unit_vertices``."""
+    v = p._unit_vertices
     V, F, C = len(v), len(p._face_ptr) - 1, len(p._cell_ptr) - 1
     tol = MESH_TOLERANCE * float(np.ptp(v, axis=0).max())
     if tol == 0:
@@ -564,8 +603,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
         bad = np.flatnonzero(off > tol)
         if len(bad):
             f = int(fs[bad[0]])
-            raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]]:.3g} from its plane "
-                            f"(tolerance {tol:.3g})", item=("face", f))
+            raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]] * p._unit:.3g} from its plane "
+                            f"(tolerance {tol * p._unit:.3g})", item=("face", f))
         e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
         e2 = np.roll(e, -1, axis=1)
         cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
@@ -605,8 +644,8 @@ def _mesh_geometry(p: Polytope, validate: bool) -> tuple:
         bad = np.flatnonzero(off > tol)
         if len(bad):
             c = int(cs[bad[0]])
-            raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]]:.3g} from it "
-                            f"(tolerance {tol:.3g})", item=("cell", c))
+            raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]] * p._unit:.3g} "
+                            f"from it (tolerance {tol * p._unit:.3g})", item=("cell", c))
         bad = np.flatnonzero(s[:, 2] <= tol)
         if len(bad):
             raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D",

@@ -64,6 +64,15 @@ H if there is one, otherwise the lower-numbered of its two cells.
 Everything per step is vectorised over precomputed incidence tables (built
 once per polytope): no Python loop over edges, faces or cells.
 
+Scale: the slicer cuts the polytope's *unit vertices* (its vertices divided by
+a power of two, so the largest |coordinate| is in [1, 2); exact) at
+``c0 / unit`` and multiplies the slice's vertices by ``unit`` (exact) and its
+volume by ``unit**3``: a polytope scaled by ``s`` (any scale in
+`rot4d_widget.polytopes.COORDINATE_RANGE`, 1e-150 to 1e150) has the slices
+of the unscaled one at ``c0 / s``, scaled by ``s``.  Only the volume can leave
+float64's range (coordinates beyond about 5e102 give ``inf``, below about
+2e-103 it underflows towards 0; ``dim`` still says the slice is solid).
+
 Many levels at once (a stack of parallel slices): ``slice_polytope(p, m, c0s)``
 with a 1-D array of levels rotates once, classifies every vertex against every
 level in one (L, V) comparison, finds the crossing faces and cells of all
@@ -121,10 +130,15 @@ class _Tables:
         self.cell_normals = np.ascontiguousarray(p.cell_normals)
         # each cell's vertex mean (a point inside the convex cell), for 2-faces lying in H
         nv = np.diff(np.append(self.c_starts, len(self.cv_vert)))
-        self.cell_centres = np.stack([np.bincount(self.cv_cell, weights=p.vertices[self.cv_vert, k], minlength=C)
+        # everything here is in the scale of the polytope's unit vertices (its vertices divided by
+        # the power of two `unit`, largest |coordinate| in [1, 2)): a slice is cut there and its
+        # vertices and volume are scaled back (`_scaled`), so any scale in COORDINATE_RANGE slices alike
+        self.unit = float(p._unit)
+        self.vertices = p._unit_vertices
+        self.radius = p.circumradius / self.unit
+        self.cell_centres = np.stack([np.bincount(self.cv_cell, weights=self.vertices[self.cv_vert, k], minlength=C)
                                       for k in range(4)], axis=1) / nv[:, None]
-        self.vertices = p.vertices
-        self.tol = TOLERANCE * p.circumradius
+        self.tol = TOLERANCE * self.radius
         # fixed-width rows for many levels at once: each face's / cell's edges, padded with the
         # index E (a column that never crosses)
         self.fe_pad = _padded(self.fe_face, self.fe_edge, F, len(self.ea))
@@ -174,7 +188,8 @@ class Slice:
     triangles : (k, 3) intp -- the polygons fanned into a closed surface, CCW
         seen from outside
     triangle_cells : (k,) intp -- the 4-D cell of each triangle
-    volume : float -- the 3-volume (0 unless the slice is solid)
+    volume : float -- the 3-volume (0 unless the slice is solid; inf, or 0, when it is
+        beyond float64's range: coordinates above ~5e102 or below ~2e-103)
     dim : int -- 3 solid, 2/1/0 when H only touches a face/edge/vertex, -1 empty
 
     Every array is read-only (a missed slice shares its empty arrays with
@@ -252,10 +267,13 @@ def slice_polytope(polytope, matrix, c0=0.0):
     m = as_rotation_matrix(matrix)
     levels, many = _as_levels(c0)
     t = _tables(p)
-    x = p.vertices @ m.T
+    x = t.vertices @ m.T  # the unit vertices: c0 and the results are scaled by t.unit (exact, a power of 2)
+    if t.unit != 1.0:
+        with np.errstate(over="ignore"):  # a level beyond float64 in the unit scale is inf: H misses
+            levels = levels / t.unit
     if not many:
-        return _slice_level(t, x, m, float(levels[0]), p.circumradius)
-    return _slice_many(t, x, m, levels, p.circumradius)
+        return _slice_level(t, x, m, float(levels[0]), t.radius)
+    return _slice_many(t, x, m, levels, t.radius)
 
 
 def _as_levels(c0):
@@ -326,6 +344,21 @@ def _slice_many(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, ra
     for i in (~generic).nonzero()[0]:
         out[i] = _slice_level(t, x, m, float(levels[i]), radius)
     return tuple(out)
+
+
+def _scaled(t: _Tables, vertices: np.ndarray) -> np.ndarray:
+    """Slice vertices from the unit vertices' scale back to the polytope's (exact: a power of 2)."""
+    return vertices if t.unit == 1.0 else vertices * t.unit
+
+
+def _scaled_volume(t: _Tables, volume):
+    """A volume from the unit vertices' scale back to the polytope's: times unit**3, one factor at
+    a time (a volume beyond float64's range becomes inf, or 0 below it; never nan)."""
+    if t.unit == 1.0:
+        return volume
+    u = t.unit
+    with np.errstate(over="ignore", under="ignore"):
+        return volume * u * u * u
 
 
 def _seal(a: np.ndarray) -> np.ndarray:
@@ -469,6 +502,9 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     np.cumsum(np.bincount(p_level, minlength=G), out=poff[1:])
     toff = np.zeros(G + 1, dtype=np.intp)
     np.cumsum(np.bincount(t_level, minlength=G), out=toff[1:])
+    if t.unit != 1.0:
+        vertices = _seal(_scaled(t, vertices))
+        volumes = _scaled_volume(t, volumes)
     out = []
     new = object.__new__
     for g in range(G):
@@ -659,7 +695,8 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     ) / 6.0
     if len(on_idx):
         vertices, edges, flat, triangles = _boundary_only(vertices, edges, flat, offsets, triangles)
-    return Slice(vertices, edges, flat, offsets, cell_ids, triangles, triangle_cells, volume, 3)
+    return Slice(_scaled(t, vertices), edges, flat, offsets, cell_ids, triangles, triangle_cells,
+                 _scaled_volume(t, volume), 3)
 
 
 def _touching(t: _Tables, vertices, edges, on_idx, f_on) -> Slice:
@@ -668,7 +705,7 @@ def _touching(t: _Tables, vertices, edges, on_idx, f_on) -> Slice:
         dim = -1
     else:
         dim = 2 if f_on.any() else (1 if len(edges) else 0)
-    return Slice(vertices, edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
+    return Slice(_scaled(t, vertices), edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
 
 
 def _faces_in_h(t: _Tables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, fn: np.ndarray, c_on: np.ndarray):
