@@ -22,6 +22,13 @@ State files
     written into the file: saving says so (`SourceNotRebuildable` warning) and loading then
     needs the source passed in (``load_state(path, source=field)``).
 
+    A state file is data, never code: loading one imports no module and calls nothing the file
+    names.  A field made from a function is described by the function's name
+    (``"module:qualname"``); `load_state` refuses to import it (`CodeNotAllowed`, a ValueError
+    saying how to allow it) unless asked: ``load_state(path, allow_code=True)`` for a file you
+    trust, ``load_state(path, function=f)`` to give the function yourself, or
+    ``load_state(path, source=field)``.
+
 numpy, trimesh (and xarray for `open_field`); nothing here knows about widgets.
 """
 
@@ -45,6 +52,7 @@ __all__ = [
     "STATE_FILE_FORMAT",
     "STATE_FILE_VERSION",
     "SourceNotRebuildable",
+    "CodeNotAllowed",
     "LoadedState",
     "slice_mesh",
     "face_colors",
@@ -82,6 +90,12 @@ STATE_FILE_VERSION = 1
 class SourceNotRebuildable(UserWarning):
     """A source that a state file describes but cannot rebuild (an in-memory array, a lambda,
     a user's own source): loading the file needs the source passed in."""
+
+
+class CodeNotAllowed(ValueError):
+    """A state file names code (a field's ``"module:qualname"`` function) and the caller did not
+    allow importing it: pass ``allow_code=True`` (a file you trust), the function
+    (``function=f``) or the source (``source=...``)."""
 
 
 class _CannotRebuild(ValueError):
@@ -341,12 +355,18 @@ def describe_source(source) -> dict:
     return _jsonable(d, "source.describe()")
 
 
-def rebuild_source(description: Mapping):
+def rebuild_source(description: Mapping, *, allow_code: bool = False, function=None):
     """The source a `describe_source` dict describes.
 
     ``ValueError`` says why it cannot be rebuilt and what to do (pass the source to
     `load_state`), or what is wrong with the description (an unknown polytope name ...).
+    A field described by a function's name (``"module:qualname"``) is rebuilt with ``function``
+    if given (a callable ``f(x, y, z, w)``), else by importing the name only when
+    ``allow_code`` is True; otherwise `CodeNotAllowed` (a ValueError) says how to allow it.
+    Nothing else in a description is ever imported or called.
     """
+    if function is not None and not callable(function):
+        raise TypeError(f"Expected `function` to be a callable f(x, y, z, w), got {type(function).__name__}")
     if not isinstance(description, Mapping) or "kind" not in description:
         raise ValueError(f"Expected a source description with a 'kind', got {description!r}")
     kind = description["kind"]
@@ -365,7 +385,7 @@ def rebuild_source(description: Mapping):
     if kind == "stack":
         from .tomography import StackSource
 
-        inner = rebuild_source(description["source"])
+        inner = rebuild_source(description["source"], allow_code=allow_code, function=function)
         return StackSource(inner, slices=description["slices"], spacing=description.get("spacing"),
                            arrangement=description.get("arrangement", "oval"),
                            color_by=description.get("color_by", "w"))
@@ -373,11 +393,11 @@ def rebuild_source(description: Mapping):
         raise _CannotRebuild(f"The state file's source cannot be rebuilt: {why}. "
                          "Pass it in: load_state(path, source=...)")
     if kind == "field":
-        return _rebuild_field(description)
+        return _rebuild_field(description, allow_code, function)
     raise _CannotRebuild(f"Unknown source kind {kind!r}; pass the source in: load_state(path, source=...)")
 
 
-def _rebuild_field(d):
+def _rebuild_field(d, allow_code=False, function=None):
     from .fields import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
@@ -388,8 +408,19 @@ def _rebuild_field(d):
         field = open_field(origin.pop("path"), origin.pop("variable", None), engine=origin.pop("engine", None),
                            **origin.pop("kwargs", {}))
         field.w_per_unit = d["w_per_unit"]
+    elif function is not None:
+        field = Field4D.from_function(function, d["extent"], **common)
     else:
-        spec = d.get("function") or ""
+        spec = d.get("function")
+        if not spec or not isinstance(spec, str):
+            raise ValueError(f"Expected a field described by a file ('origin') or by a function's name "
+                             f"('function': 'module:qualname'), got 'function': {spec!r}")
+        if not allow_code:
+            raise CodeNotAllowed(
+                f"The state file's field is made by the Python function {spec!r}: loading it would import "
+                "and run that code, which a state file does not do unless asked. If you trust the file, "
+                "pass allow_code=True (load_state(path, allow_code=True)); or pass the function, "
+                "load_state(path, function=f), or the source, load_state(path, source=...)")
         module, _, qual = spec.partition(":")
         try:
             obj = importlib.import_module(module)
@@ -434,6 +465,13 @@ def open_field(path, variable=None, *, engine=None, **from_xarray_kwargs):
     field.origin = {"kind": "xarray", "path": p, "variable": variable, "engine": engine,
                     "kwargs": _jsonable(dict(from_xarray_kwargs), "from_xarray keywords")}
     return field
+
+
+def _made_by_function(d) -> bool:
+    """Whether a source description is (a stack of) a field made by a function."""
+    while isinstance(d, Mapping) and d.get("kind") == "stack":
+        d = d.get("source")
+    return isinstance(d, Mapping) and d.get("kind") == "field" and "origin" not in d and bool(d.get("function"))
 
 
 def _inner_identity(d):
@@ -539,7 +577,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     return doc
 
 
-def load_state(path, source=None) -> LoadedState:
+def load_state(path, source=None, *, allow_code: bool = False, function=None) -> LoadedState:
     """Read a `save_state` file: ``(state, source, settings)``.
 
     The state is validated (`RotationState.from_dict`: an orientation within 1e-6 of orthogonal
@@ -548,7 +586,16 @@ def load_state(path, source=None) -> LoadedState:
     polytope of the same name), else ``ValueError`` -- or rebuilt from the file; when it cannot
     be (an in-memory array), the source is None and a `SourceNotRebuildable` warning says why.
     ``ValueError`` names what is wrong with a file that is not a state file, or a newer one.
+
+    A state file is data: loading it imports no module and calls no code it names.  A field
+    the file describes by a function's name (``"module:qualname"``) is rebuilt with
+    ``function`` (a callable ``f(x, y, z, w)``) if given, or by importing that name only when
+    ``allow_code=True`` (for a file you trust: importing runs the module's code); otherwise
+    `CodeNotAllowed` (a ValueError) says so and how to allow it.
     """
+    if source is not None and function is not None:
+        raise TypeError("Expected `source` or `function`, not both (the source already has its function)")
+    allow_code = bool(allow_code)
     path = os.fspath(path)
     try:
         with open(path, encoding="utf-8") as fh:
@@ -585,10 +632,15 @@ def load_state(path, source=None) -> LoadedState:
                                  f"{'' if want[1] is None else f' ({want[1]})'}, got {got[0]!r}"
                                  f"{'' if got[1] is None else f' ({got[1]})'}")
         return LoadedState(state, source, settings)
+    if function is not None and not _made_by_function(desc):
+        raise ValueError(f"{path!r}: `function` rebuilds a field the file describes by a function's name; "
+                         f"its source is {_inner_identity(desc or {})[0]!r}")
     if desc is None:
         return LoadedState(state, None, settings)
     try:
-        rebuilt = rebuild_source(desc)
+        rebuilt = rebuild_source(desc, allow_code=allow_code, function=function)
+    except CodeNotAllowed as exc:
+        raise CodeNotAllowed(f"{path!r}: {exc}") from None
     except _CannotRebuild as exc:
         warnings.warn(str(exc), SourceNotRebuildable, stacklevel=2)
         rebuilt = None

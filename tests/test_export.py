@@ -11,6 +11,7 @@ trimesh = pytest.importorskip("trimesh")
 
 from rot4d_widget import Field4D, RotationState, look  # noqa: E402
 from rot4d_widget.export import (  # noqa: E402
+    CodeNotAllowed,
     SourceNotRebuildable,
     describe_source,
     face_colors,
@@ -267,9 +268,14 @@ def test_stack_state_file_rebuilds_the_stack(tmp_path):
 def test_function_field_state_file_rebuilds_the_field(tmp_path):
     f = _field(levels=(0.4,))
     save_state(tmp_path / "f.json", _state(), f)
-    _, back, _ = load_state(tmp_path / "f.json")
+    with pytest.raises(CodeNotAllowed, match="allow_code=True"):  # a state file runs no code unasked
+        load_state(tmp_path / "f.json")
+    _, back, _ = load_state(tmp_path / "f.json", allow_code=True)
     assert isinstance(back, Field4D) and back.levels == (0.4,) and back.resolution == 24
     assert back.slice(M, 0.1).volume == f.slice(M, 0.1).volume
+    _, given, _ = load_state(tmp_path / "f.json", function=ball_minus_w)  # the function passed in
+    assert isinstance(given, Field4D) and given.levels == (0.4,) and given.resolution == 24
+    assert given.slice(M, 0.1).volume == f.slice(M, 0.1).volume
 
 
 def test_file_field_state_file_reopens_the_file(tmp_path):
