@@ -38,7 +38,8 @@ import importlib
 import json
 import math
 import os
-import tempfile
+import secrets
+import stat
 import warnings
 from typing import Mapping, NamedTuple
 
@@ -563,18 +564,40 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
 
     doc["rot4d_widget"] = __version__
     text = json.dumps(doc, indent=1, allow_nan=False)
-    path = os.fspath(path)
+    _write_atomically(os.fspath(path), text + "\n")
+    return doc
+
+
+def _write_atomically(path: str, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file beside it and `os.replace`.
+
+    The file gets the mode ``open(path, "w")`` would leave: a replaced file keeps its own; a new
+    one gets 0o666 less the umask (the temporary file is created with mode 0o666, so the
+    kernel applies the umask, and default ACLs, itself -- never read or changed here)."""
     folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".rot4d-state-", suffix=".json", dir=folder)
+    try:
+        keep = stat.S_IMODE(os.stat(path).st_mode)
+    except FileNotFoundError:
+        keep = None
+    for _ in range(100):
+        tmp = os.path.join(folder, f".rot4d-state-{secrets.token_hex(8)}.json")
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+            break
+        except FileExistsError:
+            continue
+    else:
+        raise FileExistsError(f"Could not create a temporary file in {folder!r}")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text + "\n")
+            if keep is not None:
+                os.chmod(tmp, keep)
+            fh.write(text)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-    return doc
 
 
 def load_state(path, source=None, *, allow_code: bool = False, function=None) -> LoadedState:

@@ -2,6 +2,8 @@
 
 import json
 import math
+import os
+import stat
 import warnings
 
 import numpy as np
@@ -419,3 +421,26 @@ def test_a_non_convex_polytope_keeps_its_faces_and_cells(tmp_path):
     assert b.volume == pytest.approx(a.volume, rel=1e-12) and a.volume > 0
     with pytest.raises(ValueError, match="convex hull"):  # the vertices alone would not rebuild it
         type(p)(p.vertices)
+
+
+@pytest.mark.skipif(not hasattr(os, "fchmod"), reason="POSIX file modes")
+@pytest.mark.parametrize("umask", [0o022, 0o077, 0o002], ids=["022", "077", "002"])
+def test_save_state_leaves_the_mode_open_would(tmp_path, umask):
+    """A replaced file keeps its mode; a new one gets what ``open(path, "w")`` gives under the umask."""
+    old = os.umask(umask)
+    try:
+        with open(tmp_path / "reference.json", "w"):
+            pass
+        save_state(tmp_path / "new.json", RotationState(), "5-cell")
+        for mode in (0o644, 0o640, 0o664, 0o600):
+            path = tmp_path / f"kept-{mode:o}.json"
+            path.write_text("{}")
+            os.chmod(path, mode)
+            save_state(path, _state(), "5-cell")
+            assert stat.S_IMODE(os.stat(path).st_mode) == mode, f"{mode:o}"
+            assert load_state(path).source.name == "5-cell"  # replaced, not appended to
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(tmp_path / "new.json").st_mode) == stat.S_IMODE(
+        os.stat(tmp_path / "reference.json").st_mode) == 0o666 & ~umask
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary file left
