@@ -38,6 +38,15 @@ every chunk is read) for the held-key steps and for the data range.
 
 Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
+
+Scale: the box's half widths (slice units) and the ends of ``extent`` must lie
+in `rot4d_widget.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
+ValueError naming it).  Within it a field scaled by ``s`` (extent times s, the
+same samples) slices as the unscaled one at ``c0 / s``, its surfaces scaled by
+s: the box cut is the exact slicer's (normalised), the resampling works in
+index units, and marching cubes runs with unit spacing, its vertices, volume
+and area scaled afterwards in float64.  Only a volume or area beyond float64
+itself becomes inf (or 0); `Field4D.slice` then gives the widget no volume.
 """
 
 from __future__ import annotations
@@ -53,6 +62,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import sealed as _sealed
+from .polytopes import COORDINATE_RANGE, check_scale
 from .rotation import as_rotation_matrix
 from .source import SliceData
 
@@ -269,6 +279,13 @@ def _check_extent(extent) -> tuple:
     bad = [_AXES[d] for d in range(4) if not e[d, 0] < e[d, 1]]
     if bad:
         raise ValueError(f"Expected min < max in `extent` for every axis; not so for {', '.join(bad)}: {e.tolist()}")
+    lo, hi = COORDINATE_RANGE
+    for d in range(4):
+        end = float(np.abs(e[d]).max())
+        if end > hi:
+            raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} "
+                             f"(rot4d_widget.polytopes.COORDINATE_RANGE; rescale the coordinates, e.g. to other units)")
+        check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")
     return tuple((float(a), float(b)) for a, b in e)
 
 
@@ -288,8 +305,9 @@ class FieldSlice:
     triangles : (k, 3) intp -- counter-clockwise seen from where f < level
         (outward from {f >= level}); the surface is closed, capped on the box's faces
     normals : (n, 3) float64 -- unit, outward
-    volume : float -- 3-volume of {f >= level} in the slice
-    area : float -- area of the surface
+    volume : float -- 3-volume of {f >= level} in the slice (inf, or 0, when beyond float64's
+        range: slice coordinates above about 5e102 or below about 2e-103)
+    area : float -- area of the surface (likewise beyond about 1e154 and 1e-154)
     level : float
     spacing : float -- the sample spacing of the step (slice units); 0 when nothing was sampled
     """
@@ -605,10 +623,13 @@ class Field4D:
 
     @w_per_unit.setter
     def w_per_unit(self, value) -> None:
-        self._w_per_unit = _check_positive(value, "w_per_unit")
+        wpu = _check_positive(value, "w_per_unit")
         e = np.array(self.extent)
-        self._unit = np.array([1.0, 1.0, 1.0, self._w_per_unit])  # data units per slice unit
-        self._hw = (e[:, 1] - e[:, 0]) / 2 / self._unit
+        unit = np.array([1.0, 1.0, 1.0, wpu])  # data units per slice unit
+        with np.errstate(over="ignore", under="ignore"):
+            hw = (e[:, 1] - e[:, 0]) / 2 / unit
+        check_scale(float(hw[3]), f"With `w_per_unit` = {wpu:.3g}, the box's half width along w in slice units")
+        self._w_per_unit, self._unit, self._hw = wpu, unit, hw
         self.half_widths = tuple(float(v) for v in self._hw)
         self._stats = None  # K is per slice unit
         if self._coarse is not None and self._coarse is not self:
@@ -732,7 +753,7 @@ class Field4D:
         return FieldSliceData.build(
             points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
             groups=np.concatenate(groups), normals=np.concatenate(nrm),
-            volume=float(slices[0].volume) if len(slices) == 1 else None,
+            volume=_representable(slices[0]) if len(slices) == 1 else None,
             readout=readout, convex=False, show_points=False,
             extra={"levels": slices, "box": box},
         )
@@ -887,6 +908,15 @@ class Field4D:
     def __repr__(self) -> str:
         what = "function" if self._kind == "function" else f"{self._kind} {tuple(self._values.shape)}"
         return f"Field4D({self.name or ''!s}{' ' if self.name else ''}{what}, axes={self.axes!r}, extent={self.extent})"
+
+
+def _representable(s: FieldSlice):
+    """The slice's volume, or None when it left float64's range (inf, or a non-empty surface whose
+    volume underflowed: coordinates beyond about 1e102 or below about 1e-102)."""
+    v = float(s.volume)
+    if not math.isfinite(v) or (not s.empty and abs(v) < sys.float_info.min):
+        return None
+    return v
 
 
 def _turned_slice(s: FieldSlice, t: np.ndarray) -> FieldSlice:
@@ -1122,10 +1152,13 @@ def _surface(s: _Samples, level: float) -> FieldSlice:
         v = np.minimum(v, s.k * s.g).astype(np.float32)
     if not v.max() > 0:
         return _empty_slice(level, d)
-    verts, faces, normals, _ = marching_cubes(v, 0.0, spacing=(d, d, d), method="lewiner")
+    # in index space (spacing 1): skimage scales in float32, which overflows beyond ~3e38; the
+    # vertices, volume and area are scaled here in float64, so any field scale works alike
+    verts, faces, normals, _ = marching_cubes(v, 0.0, method="lewiner")
     if len(faces) == 0:
         return _empty_slice(level, d)
-    vertices = verts.astype(np.float64) + s.origin
+    iv = verts.astype(np.float64)  # index coordinates
+    vertices = iv * d + s.origin
     tri = faces.astype(np.intp)
     # skimage (gradient 'descent') winds faces clockwise seen from the low side: flip to CCW
     tri = tri[:, ::-1].copy()
@@ -1133,8 +1166,8 @@ def _surface(s: _Samples, level: float) -> FieldSlice:
     ln = np.linalg.norm(nrm, axis=1)
     bad = ~(ln > 1e-12)
     if bad.any():
-        fn = np.cross(vertices[tri[:, 1]] - vertices[tri[:, 0]], vertices[tri[:, 2]] - vertices[tri[:, 0]])
-        acc = np.zeros_like(vertices)
+        fn = np.cross(iv[tri[:, 1]] - iv[tri[:, 0]], iv[tri[:, 2]] - iv[tri[:, 0]])
+        acc = np.zeros_like(iv)
         for c in range(3):
             for axis in range(3):
                 acc[:, axis] += np.bincount(tri[:, c], weights=fn[:, axis], minlength=len(vertices))
@@ -1144,11 +1177,13 @@ def _surface(s: _Samples, level: float) -> FieldSlice:
         nrm[still] = (0.0, 0.0, 1.0)
         ln[still] = 1.0
     nrm /= ln[:, None]
-    c = vertices.mean(axis=0)
-    A, B, C = (vertices - c)[tri[:, 0]], (vertices - c)[tri[:, 1]], (vertices - c)[tri[:, 2]]
+    # volume and area in index units (of order resolution**3 and **2), then times d**3 and d**2:
+    # only a result beyond float64's range over- or underflows (inf, 0), never the products
+    c = iv.mean(axis=0)
+    A, B, C = (iv - c)[tri[:, 0]], (iv - c)[tri[:, 1]], (iv - c)[tri[:, 2]]
     cr = np.cross(B - A, C - A)
-    volume = float(np.einsum("ij,ij->", A, np.cross(B, C))) / 6.0
-    area = float(np.linalg.norm(cr, axis=1).sum()) / 2.0
+    volume = float(np.einsum("ij,ij->", A, np.cross(B, C))) / 6.0 * d * d * d
+    area = float(np.linalg.norm(cr, axis=1).sum()) / 2.0 * d * d
     return FieldSlice(_sealed(vertices), _sealed(tri), _sealed(nrm), volume, area, level, d)
 
 
