@@ -3,18 +3,26 @@
 A `Recorder` is the widget's hook: created with the `RotationState` as it is when recording
 starts, it is told every action the widget applies (``recorder.record(key, shift, action,
 inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
-(``recorder.record_set("c0", 0.3)``, a slider), with a time stamp.  It keeps at most
+(``recorder.record_set("c0", 0.3)``, a slider) and every setting of the source
+(``recorder.record_source("levels", (2.0, 3.0))``: ``levels``, ``slices``, ``spacing``,
+``arrangement``), with a time stamp.  It keeps at most
 ``max_events``; older events are folded into the starting state, so a recording always replays
 to the live state.  ``recorder.recording()`` is an immutable `Recording`:
 
 * ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
   so a recorded ``r`` resets where the live one did);
-* ``events``: `Step` (t, key, shift, action, inverted, label) and `Setting` (t, name, value);
+* ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value) and
+  `SourceSetting` (t, name, value);
 * ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
+
+A recording is data: loading one imports nothing and runs nothing it names (a source's own
+action is looked up by name among the actions of the source the caller passes).
 
 Replaying applies the same floating-point operations in the same order, so the final state is
 the recorded one bit for bit (tested).  A source's own actions (a field's level keys, a stack's
-slice keys) are replayed on a source when one is given (`Recording.replay`), else skipped.
+slice keys) and the source's settings are replayed on a source when one is given
+(`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
+view into a stack replaces its source), else skipped.
 
 `render_animation` draws a recording with `rot4d_widget.figures.render_state` -- one frame
 per step, or one per 1/fps seconds of the recorded time -- into an animated GIF (Pillow) or an
@@ -33,7 +41,7 @@ import os
 import threading
 import time
 from dataclasses import dataclass
-from numbers import Real
+from numbers import Integral, Real
 from typing import Iterator, Mapping
 
 import numpy as np
@@ -48,6 +56,8 @@ __all__ = [
     "ANIMATION_FORMATS",
     "Step",
     "Setting",
+    "SourceSetting",
+    "SOURCE_SETTINGS",
     "Recording",
     "Recorder",
     "animation_states",
@@ -58,13 +68,19 @@ __all__ = [
 ]
 
 RECORDING_FORMAT = "rot4d_widget recording"
-RECORDING_VERSION = 1
+#: Version 2 adds `SourceSetting` events; a recording without them is written as version 1
+#: (so that an older rot4d_widget still reads it).
+RECORDING_VERSION = 2
 #: Default bound of a `Recorder`: 100 000 events is about 55 minutes of a key held at 30 Hz
 #: (some 10 MB of JSON).
 MAX_EVENTS = 100_000
 ANIMATION_FORMATS = (".gif", ".mp4")
 #: What `Recorder.record_set` accepts: the state's settable parameters.
 SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
+#: What `Recorder.record_source` accepts: the source's settings the widget has as traits.
+SOURCE_SETTINGS = ("levels", "slices", "spacing", "arrangement")
+#: The settings that need parallel slices (a `StackSource`).
+_STACK_SETTINGS = ("slices", "spacing", "arrangement")
 
 
 # ============================================================================ events
@@ -106,6 +122,25 @@ class Setting:
         return {"t": self.t, "set": self.name, "value": self.value}
 
 
+@dataclass(frozen=True)
+class SourceSetting:
+    """A setting of the source (the widget's traits): ``name`` in `SOURCE_SETTINGS` and its
+    ``value`` -- ``levels`` a list of floats (a field's iso levels; a stack's inner source's),
+    ``slices`` an int >= 1, ``spacing`` a number > 0 or None (the default), ``arrangement``
+    ``"oval"``, ``"grid"`` or ``"stack"``."""
+
+    t: float
+    name: str
+    value: object
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} set"
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, "source": self.name, "value": self.value}
+
+
 def _time(t) -> float:
     if isinstance(t, bool) or not isinstance(t, Real) or not math.isfinite(t) or t < 0:
         raise ValueError(f"Expected a time stamp >= 0 (seconds), got {t!r}")
@@ -124,14 +159,46 @@ def _check_setting(name, value):
     return float(value)
 
 
+def _check_source_setting(name, value):
+    """``value`` as a `SourceSetting` holds it (JSON-able); ValueError naming what is allowed."""
+    if name not in SOURCE_SETTINGS:
+        raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
+    if name == "levels":
+        values = [value] if isinstance(value, Real) else value
+        ok = isinstance(values, (list, tuple, np.ndarray)) and len(values) > 0 and all(
+            isinstance(v, Real) and not isinstance(v, bool) and math.isfinite(v) for v in values)
+        if not ok:
+            raise ValueError(f"Expected 'levels' to be set to a finite number or a non-empty sequence of them, "
+                             f"got {value!r}")
+        return [float(v) for v in values]
+    if name == "slices":
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral) or value < 1:
+            raise ValueError(f"Expected 'slices' to be set to an int >= 1, got {value!r}")
+        return int(value)
+    if name == "spacing":
+        if value is None:
+            return None
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):
+            raise ValueError(f"Expected 'spacing' to be set to a finite number > 0 or None (the default), got {value!r}")
+        return float(value)
+    from .tomography import ARRANGEMENTS
+
+    if value not in ARRANGEMENTS:
+        raise ValueError(f"Expected 'arrangement' to be set to one of {', '.join(map(repr, ARRANGEMENTS))}, "
+                         f"got {value!r}")
+    return str(value)
+
+
 def _event_from_dict(d):
     if not isinstance(d, Mapping) or "t" not in d:
         raise ValueError(f"Expected a recorded event with a time 't', got {d!r}")
     t = _time(d["t"])
     if "set" in d:
         return Setting(t, d["set"], _check_setting(d["set"], d.get("value")))
+    if "source" in d:
+        return SourceSetting(t, d["source"], _check_source_setting(d["source"], d.get("value")))
     if "action" not in d:
-        raise ValueError(f"Expected a recorded event with an 'action' or a 'set', got {dict(d)!r}")
+        raise ValueError(f"Expected a recorded event with an 'action', a 'set' or a 'source', got {dict(d)!r}")
     key = d.get("key")
     if key is not None and not isinstance(key, str):
         raise ValueError(f"Expected an event's 'key' to be a string or null, got {key!r}")
@@ -150,8 +217,51 @@ def _source_action(source, name: str):
     return None
 
 
-def _apply(state: RotationState, event, source=None) -> bool:
-    """Apply one event to ``state`` (and a source's own action to ``source``); True if applied."""
+def _is_stack(source) -> bool:
+    from .tomography import StackSource
+
+    return isinstance(source, StackSource)
+
+
+def _set_on_source(source, name: str, value) -> None:
+    """Set a source setting on ``source`` in place: ``levels`` on a field (a stack's inner one),
+    the others on a stack.  ValueError if ``source`` has no such setting."""
+    if name == "levels":
+        target = source.source if _is_stack(source) else source
+        if not hasattr(target, "levels"):
+            raise ValueError(f"A recorded 'levels' applies to a source with iso levels (a field), not "
+                             f"{type(target).__name__}")
+        target.levels = tuple(value)
+        return
+    if not _is_stack(source):
+        raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a single "
+                         "view: replay with set_source= (Rot4DWidget.replay turns its view into a stack), or "
+                         "on a StackSource")
+    setattr(source, name, value)
+
+
+def _with_source_setting(source, name: str, value):
+    """``source`` with a source setting applied: in place, or (``slices`` of a single view) a new
+    `StackSource` around it, as the widget does."""
+    if name == "slices" and not _is_stack(source):
+        from .tomography import StackSource
+
+        return StackSource(source, slices=value)
+    _set_on_source(source, name, value)
+    return source
+
+
+def _apply(state: RotationState, event, source=None, set_source=None) -> bool:
+    """Apply one event to ``state`` (a source's own action and a source setting to ``source``, or
+    a source setting through ``set_source(name, value)``); True if applied."""
+    if isinstance(event, SourceSetting):
+        if set_source is not None:
+            set_source(event.name, event.value)
+            return True
+        if source is None:
+            return False
+        _set_on_source(source, event.name, event.value)
+        return True
     if isinstance(event, Setting):
         setattr(state, event.name, np.asarray(event.value) if event.name == "matrix" else event.value)
         return True
@@ -175,8 +285,11 @@ class Recording:
         self._initial = json.loads(json.dumps(dict(initial)))  # a private, JSON-clean copy
         self.events = tuple(events)
         for e in self.events:
-            if not isinstance(e, (Step, Setting)):
-                raise TypeError(f"Expected Step or Setting events, got {type(e).__name__}")
+            if not isinstance(e, (Step, Setting, SourceSetting)):
+                raise TypeError(f"Expected Step, Setting or SourceSetting events, got {type(e).__name__}")
+        if isinstance(dropped, (bool, np.bool_)) or not isinstance(dropped, Integral) or dropped < 0:
+            raise ValueError("Expected `dropped` (how many events were folded into the starting state) to be an "
+                             f"int >= 0, got {dropped!r}")
         self.dropped = int(dropped)
 
     @property
@@ -201,7 +314,9 @@ class Recording:
 
     # -- data ------------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {"format": RECORDING_FORMAT, "version": RECORDING_VERSION, "initial": self.initial,
+        # version 1 unless a source setting needs 2: older readers keep reading what they can
+        version = 2 if any(isinstance(e, SourceSetting) for e in self.events) else 1
+        return {"format": RECORDING_FORMAT, "version": version, "initial": self.initial,
                 "dropped": self.dropped, "events": [e.to_dict() for e in self.events]}
 
     @classmethod
@@ -235,14 +350,26 @@ class Recording:
         return cls.from_dict(d)
 
     # -- replay ----------------------------------------------------------------------------
-    def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True) -> RotationState:
+    def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True,
+               set_source=None) -> RotationState:
         """Apply the events to ``state`` (in place; default a fresh state) and return it.
 
         ``restart``: set ``state`` to the recording's starting state first (its orientation,
         parameters and reset point; its keymap is kept).  ``source``: a source whose own actions
         (``source.actions``, matched by name) are replayed on it, changing it; without one they
         are skipped.  The result equals the recorded final state bit for bit.
+
+        Source settings (`SourceSetting`: ``levels``, ``slices``, ``spacing``, ``arrangement``)
+        are applied by calling ``set_source(name, value)`` when given (the widget's own setter:
+        setting ``slices`` on a single view replaces its source with a stack, which only the
+        widget can do), else set on ``source`` in place (``levels`` on a stack's inner source);
+        a single-view ``source`` given a stack setting is refused (``ValueError``) before
+        anything changes.  Without ``source`` or ``set_source`` they are skipped.
         """
+        if set_source is not None and not callable(set_source):
+            raise TypeError(f"Expected `set_source` to be a callable (name, value), got {type(set_source).__name__}")
+        if set_source is None and source is not None:
+            self._check_source_settings(source)
         if state is None:
             state = self.initial_state()
         elif not isinstance(state, RotationState):
@@ -252,8 +379,21 @@ class Recording:
             d.pop("keymap", None)
             state.restore(d)  # with the recorded reset point ("initial")
         for e in self.events:
-            _apply(state, e, source)
+            _apply(state, e, source, set_source)
         return state
+
+    def _check_source_settings(self, source) -> None:
+        """ValueError now if ``source`` cannot take the recording's source settings in place."""
+        names = {e.name for e in self.events if isinstance(e, SourceSetting)}
+        inner = source.source if _is_stack(source) else source
+        if "levels" in names and not hasattr(inner, "levels"):
+            raise ValueError(f"The recording sets 'levels', which applies to a source with iso levels (a field), "
+                             f"not {type(inner).__name__}")
+        stack_names = sorted(names & set(_STACK_SETTINGS))
+        if stack_names and not _is_stack(source):
+            raise ValueError(f"The recording sets {', '.join(map(repr, stack_names))}, which apply to parallel "
+                             f"slices, and {type(source).__name__} is a single view: replay with set_source= "
+                             "(Rot4DWidget.replay turns its view into a stack), or on a StackSource")
 
 
 class Recorder:
@@ -265,7 +405,9 @@ class Recorder:
     made (``clock``, default `time.monotonic`).  Thread-safe (the widget's ticker thread records
     while the kernel's thread may read).  Past ``max_events`` the oldest event is folded into
     the starting state, so `recording` always replays to the live state (custom source actions
-    that fall out are lost: count in ``dropped``).
+    that fall out are lost: count in ``dropped``; the last value of each source setting that
+    falls out is kept, at the start of the recording).  ``record_source(name, value)`` records
+    a source setting (``levels``, ``slices``, ``spacing``, ``arrangement``).
     """
 
     def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic):
@@ -284,6 +426,7 @@ class Recorder:
         self._t0 = self._clock()
         self._shadow = state.copy()  # the state before the oldest kept event
         self._events = collections.deque()
+        self._folded_source = {}  # name -> the last SourceSetting folded out of the events
         self.dropped = 0
 
     def restart(self, state: RotationState) -> None:
@@ -300,7 +443,12 @@ class Recorder:
                 event = dataclasses.replace(event, t=self._events[-1].t)
             self._events.append(event)
             while len(self._events) > self.max_events:
-                _apply(self._shadow, self._events.popleft())
+                old = self._events.popleft()
+                if isinstance(old, SourceSetting):  # no source here: keep its last value instead
+                    self._folded_source.pop(old.name, None)
+                    self._folded_source[old.name] = old
+                else:
+                    _apply(self._shadow, old)
                 self.dropped += 1
 
     def record(self, key, shift, action, inverted: bool | None = None, t=None) -> Step:
@@ -321,10 +469,18 @@ class Recorder:
         self._push(setting)
         return setting
 
+    def record_source(self, name: str, value, t=None) -> SourceSetting:
+        """A source setting (``"levels"``, ``"slices"``, ``"spacing"``, ``"arrangement"``) set to
+        ``value`` -- what the widget calls after its trait changed the source."""
+        setting = SourceSetting(self._stamp(t), name, _check_source_setting(name, value))
+        self._push(setting)
+        return setting
+
     def recording(self) -> Recording:
         """The events so far as an immutable `Recording`."""
         with self._lock:
-            return Recording(self._shadow.to_dict(initial=True), tuple(self._events), dropped=self.dropped)
+            events = tuple(self._folded_source.values()) + tuple(self._events)
+            return Recording(self._shadow.to_dict(initial=True), events, dropped=self.dropped)
 
     def __len__(self) -> int:
         return len(self._events)
@@ -348,9 +504,11 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
                      per: str = "step", fps: float = 10.0) -> Iterator[tuple]:
     """``(t, state, source)`` for each frame: after each step (``per="step"``, the first frame the
     starting state) or at t = k / fps over the recorded time (``per="time"``: the state after every
-    event up to t).  ``state`` and ``source`` are the same objects every time, changed in place:
-    draw them before taking the next.  ``initial_state``: start there instead of the recording's
-    starting state (its copy is used).  ``source`` is copied before its own actions change it."""
+    event up to t).  ``state`` and ``source`` are the same objects every time, changed in place
+    (but a recorded ``slices`` on a single view makes the source a new `StackSource` around it,
+    as the widget does): draw them before taking the next.  ``initial_state``: start there
+    instead of the recording's starting state (its copy is used).  ``source`` is copied before
+    its own actions and the recorded source settings change it."""
     if per not in ("step", "time"):
         raise ValueError(f"Expected `per` to be 'step' or 'time', got {per!r}")
     fps = _positive("fps", fps)
@@ -361,11 +519,17 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
     else:
         raise TypeError(f"Expected `initial_state` to be a RotationState or None, got {type(initial_state).__name__}")
     src = None if source is None else _own_copy(source)
+
+    def set_source(name, value):  # the copy is ours: replace it where the widget would
+        nonlocal src
+        src = _with_source_setting(src, name, value)
+
+    setter = None if src is None else set_source
     events = recording.events
     yield 0.0, state, src
     if per == "step":
         for e in events:
-            _apply(state, e, src)
+            _apply(state, e, src, setter)
             yield e.t, state, src
         return
     n = _frame_count(recording, "time", fps)
@@ -373,7 +537,7 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
     for k in range(1, n):
         t = k / fps
         while i < len(events) and events[i].t <= t + 1e-9:
-            _apply(state, events[i], src)
+            _apply(state, events[i], src, setter)
             i += 1
         yield t, state, src
 
@@ -406,14 +570,21 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     ``settings`` go to `rot4d_widget.figures.render_state` (``size``, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...).  ``titles``: a callable ``(k, t, state) -> str`` giving each
     frame a title, or None.  More than ``max_frames`` frames raises ``ValueError`` before any is drawn.
+    When the recording sets source settings (``levels``, ``slices``, ``spacing``,
+    ``arrangement``), those keywords are the source's settings at the start, and each frame
+    shows them as recorded up to it.
     """
-    from .figures import render_state
+    from .figures import render_state, state_source
 
     fps = _positive("fps", fps)
     n = _frame_count(recording, per, fps)
     if n > max_frames:
         raise ValueError(f"The animation would have {n} frames, more than max_frames = {max_frames}; "
                          "lower fps, use per='step', or raise max_frames")
+    if any(isinstance(e, SourceSetting) for e in recording.events):
+        # the settings given are where the source starts; the recorded ones change it from there
+        start = {k: settings.pop(k) for k in SOURCE_SETTINGS if k in settings}
+        source = state_source(source, **start)
     for k, (t, state, src) in enumerate(animation_states(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
         fig = render_state(state, src if src is not None else "5-cell", title=title, **settings)

@@ -10,6 +10,7 @@ from rot4d_widget.recording import (
     Recorder,
     Recording,
     Setting,
+    SourceSetting,
     Step,
     animation_states,
     paper_animation,
@@ -201,7 +202,7 @@ def test_bad_input_is_named(tmp_path):
         Recording.load(tmp_path / "bad.json")
     d = rec.recording().to_dict()
     for change, match in (({"format": "x"}, "Not a rot4d_widget recording"), ({"version": 5}, "version 5"),
-                          ({"events": [{"t": 1.0}]}, "an 'action' or a 'set'"),
+                          ({"events": [{"t": 1.0}]}, "an 'action', a 'set' or a 'source'"),
                           ({"events": [{"t": -1, "action": "xw"}]}, "time stamp >= 0"),
                           ({"events": [{"t": 2.0, "action": "xw"}, {"t": 1.0, "action": "xw"}]}, "time order")):
         with pytest.raises(ValueError, match=match):
@@ -217,3 +218,198 @@ def test_events_are_steps_and_settings():
     assert isinstance(rec.record_set("alpha", 0.01, t=2.0), Setting)
     assert [e["label"] if "label" in e else e["set"] for e in rec.recording().to_dict()["events"]] == \
         ["R_zw\u207b\u00b9", "c0+", "alpha"]
+
+
+# -------------------------------------------------------------------- dropped, validated
+@pytest.mark.parametrize("dropped", [-5, "x", 1.5, True, None, "3"])
+def test_dropped_must_be_an_int_at_least_zero(dropped):
+    initial = RotationState().to_dict(initial=True)
+    with pytest.raises(ValueError, match=r"`dropped` .* to be an int >= 0, got"):
+        Recording(initial, (), dropped=dropped)
+    d = Recording(initial).to_dict()
+    with pytest.raises(ValueError, match=r"`dropped` .* to be an int >= 0"):
+        Recording.from_dict({**d, "dropped": dropped})
+    assert Recording(initial, (), dropped=np.int64(3)).dropped == 3 and Recording(initial).dropped == 0
+
+
+# -------------------------------------------------------------------- source settings
+def ball(x, y, z, w):
+    return 4.0 - (x * x + y * y + z * z) - 0.5 * w
+
+
+def _ball_field():
+    from rot4d_widget import Field4D
+
+    return Field4D.from_function(ball, [(-2, 2)] * 4, resolution=10, coarse_resolution=8)
+
+
+def _source_recording():
+    """The issue's steps: levels, then parallel slices, their spacing and arrangement, keys between."""
+    clock = Clock()
+    st = RotationState()
+    rec = Recorder(st, clock=clock)
+    for key, (name, value) in zip("4z8", [("levels", (2.0, 3.0)), ("slices", 3), ("spacing", 0.3)]):
+        clock.now += 0.1
+        rec.record_source(name, value)
+        clock.now += 0.1
+        st.press(key)
+        rec.record(key, False, *st.keymap.resolve(key))
+    clock.now += 0.1
+    rec.record_source("arrangement", "grid")
+    rec.record_source("levels", 2.5)
+    return rec.recording(), st
+
+
+def test_source_settings_are_recorded_saved_and_loaded(tmp_path):
+    r, st = _source_recording()
+    kinds = [type(e).__name__ for e in r.events]
+    assert kinds == ["SourceSetting", "Step"] * 3 + ["SourceSetting"] * 2
+    assert [(e.name, e.value) for e in r.events if isinstance(e, SourceSetting)] == [
+        ("levels", [2.0, 3.0]), ("slices", 3), ("spacing", 0.3), ("arrangement", "grid"), ("levels", [2.5])]
+    assert r.events[0].label == "levels set" and r.events[0].t == pytest.approx(0.1)
+    d = r.to_dict()
+    assert d["version"] == 2 and d["events"][0] == {"t": r.events[0].t, "source": "levels", "value": [2.0, 3.0]}
+    r.save(tmp_path / "keys.json")
+    back = Recording.load(tmp_path / "keys.json")
+    assert back.to_dict() == d and back.events == r.events
+    # a recording without source settings is still written as version 1 (older readers read it)
+    plain = Recorder(RotationState(), clock=Clock())
+    plain.record("4", False, "xw")
+    assert plain.recording().to_dict()["version"] == 1
+    old = {**plain.recording().to_dict(), "version": 1}
+    assert len(Recording.from_dict(old)) == 1
+
+
+def test_replay_sets_the_source_settings_on_a_stack_and_its_inner_field():
+    from rot4d_widget.tomography import StackSource
+
+    r, st = _source_recording()
+    field = _ball_field()
+    stack = StackSource(field, slices=2)
+    assert field.levels != (2.5,)
+    got = r.replay(None, stack)
+    assert field.levels == (2.5,)  # `levels` on the stack's inner source
+    assert (stack.slices, stack.spacing, stack.arrangement) == (3, 0.3, "grid")
+    assert np.array_equal(got.matrix, st.matrix)
+    # the issue's case: `w.levels = (2.0, 3.0)` replayed ends at (2.0, 3.0), not the field's default
+    rec = Recorder(RotationState(), clock=Clock())
+    rec.record_source("levels", (2.0, 3.0))
+    fresh = _ball_field()
+    rec.recording().replay(None, fresh)
+    assert fresh.levels == (2.0, 3.0)
+    rec.record_source("spacing", 0.3)
+    one = StackSource(_ball_field(), slices=4)
+    rec.recording().replay(None, one)
+    assert one.spacing == 0.3 and one.source.levels == (2.0, 3.0)
+
+
+def test_replay_calls_set_source_in_order_with_the_steps():
+    r, st = _source_recording()
+    calls = []
+    state = RotationState()
+    got = r.replay(state, "anything: set_source applies the settings",
+                   set_source=lambda name, value: calls.append((name, value, state.matrix.copy())))
+    assert [(n, v) for n, v, _ in calls] == [("levels", [2.0, 3.0]), ("slices", 3), ("spacing", 0.3),
+                                              ("arrangement", "grid"), ("levels", [2.5])]
+    # each call came between the steps it was recorded between
+    assert np.array_equal(calls[0][2], np.eye(4)) and not np.array_equal(calls[1][2], np.eye(4))
+    assert np.array_equal(calls[-1][2], st.matrix) and got is state
+    with pytest.raises(TypeError, match="`set_source` to be a callable"):
+        r.replay(None, None, set_source="levels")
+
+
+def test_a_single_view_given_stack_settings_is_refused_before_any_change():
+    r, _ = _source_recording()
+    field = _ball_field()
+    before = field.levels
+    state = RotationState()
+    with pytest.raises(ValueError, match=r"sets 'arrangement', 'slices', 'spacing'.*single view.*set_source="):
+        r.replay(state, field)
+    assert field.levels == before and np.array_equal(state.matrix, np.eye(4))
+    with pytest.raises(ValueError, match="sets 'levels'.*iso levels"):
+        r.replay(None, __import__("rot4d_widget.tomography").tomography.StackSource("5-cell", slices=2))
+    assert np.array_equal(r.replay().matrix, r.replay(None, None).matrix)  # skipped without a source
+
+
+def test_animations_follow_the_source_settings_on_their_copy():
+    from rot4d_widget.tomography import StackSource
+
+    r, st = _source_recording()
+    field = _ball_field()
+    before = field.levels
+    seen = [(type(src).__name__, tuple(getattr(src, "source", src).levels), getattr(src, "slices", None),
+             getattr(src, "spacing", None) if isinstance(src, StackSource) and not src.spacing_is_default else None,
+             getattr(src, "arrangement", None)) for _, _, src in animation_states(r, None, field)]
+    assert seen[0] == ("Field4D", before, None, None, None)
+    assert seen[1] == ("Field4D", (2.0, 3.0), None, None, None)  # after levels set
+    assert seen[3][:3] == ("StackSource", (2.0, 3.0), 3)  # slices made a stack of the copy, as the widget
+    assert seen[5][3] == 0.3 and seen[-2][4] == "grid" and seen[-1][1] == (2.5,)
+    assert field.levels == before  # the source given is left alone
+
+
+def test_render_frames_follow_the_source_settings(monkeypatch):
+    """Each frame is drawn with the settings recorded up to it; the keywords given are the start."""
+    from rot4d_widget import figures
+    from rot4d_widget.recording import render_frames
+
+    drawn = []
+
+    def fake_render_state(state, source, **kwargs):
+        stack = figures.state_source(source, **{k: kwargs.get(k) for k in
+                                                ("levels", "slices", "spacing", "arrangement")})
+        drawn.append((stack.source.levels, stack.slices, stack.spacing, stack.arrangement))
+        import matplotlib.figure
+
+        return matplotlib.figure.Figure(figsize=(0.2, 0.2), dpi=10)
+
+    monkeypatch.setattr(figures, "render_state", fake_render_state)
+    r, _ = _source_recording()
+    field = _ball_field()
+    frames = list(render_frames(r, None, field, levels=(1.0,), slices=None, spacing=None, arrangement="oval"))
+    assert len(frames) == len(r) + 1
+    assert drawn[0][0] == (1.0,) and drawn[0][1] == 1  # the start: the keywords given
+    assert drawn[1][0] == (2.0, 3.0)  # the recorded levels, not the keyword's
+    assert drawn[3][1] == 3 and drawn[5][2] == 0.3 and drawn[-2][3] == "grid" and drawn[-1][0] == (2.5,)
+    assert field.levels != (1.0,)
+
+
+def test_a_bounded_recorder_keeps_the_last_source_settings_folded_out():
+    from rot4d_widget.tomography import StackSource
+
+    clock = Clock()
+    st = RotationState()
+    rec = Recorder(st, max_events=3, clock=clock)
+    for v in (1.0, 2.0, 3.0):
+        clock.now += 0.1
+        rec.record_source("levels", v)
+    rec.record_source("spacing", 0.4)
+    for _ in range(5):
+        clock.now += 0.1
+        st.press("4")
+        rec.record("4", False, "xw")
+    r = rec.recording()
+    assert r.dropped == 6 and [type(e).__name__ for e in r.events] == ["SourceSetting"] * 2 + ["Step"] * 3
+    assert [(e.name, e.value) for e in r.events[:2]] == [("levels", [3.0]), ("spacing", 0.4)]
+    stack = StackSource(_ball_field(), slices=2)
+    got = r.replay(None, stack)
+    assert stack.source.levels == (3.0,) and stack.spacing == 0.4 and np.array_equal(got.matrix, st.matrix)
+
+
+@pytest.mark.parametrize("name, value, match", [
+    ("colour", 1, "a source setting among 'levels', 'slices', 'spacing', 'arrangement'"),
+    ("levels", (), "non-empty sequence"),
+    ("levels", ("a",), "finite number or a non-empty sequence"),
+    ("levels", float("nan"), "finite number"),
+    ("slices", 0, "'slices' to be set to an int >= 1"),
+    ("slices", 2.0, "an int >= 1"),
+    ("spacing", -1.0, "finite number > 0 or None"),
+    ("arrangement", "circle", "one of 'oval', 'grid', 'stack'"),
+])
+def test_record_source_names_what_is_allowed(name, value, match):
+    rec = Recorder(RotationState(), clock=Clock())
+    with pytest.raises(ValueError, match=match):
+        rec.record_source(name, value)
+    d = Recording(RotationState().to_dict(initial=True)).to_dict()
+    with pytest.raises(ValueError, match=match):
+        Recording.from_dict({**d, "version": 2, "events": [{"t": 0.0, "source": name, "value": value}]})
+    assert rec.record_source("spacing", None).value is None
