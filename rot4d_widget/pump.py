@@ -29,17 +29,45 @@ own clock.  Every entry point runs under one re-entrant lock, shared with the
 owner (``pump.lock``), so comm handlers and the ticker thread interleave
 safely.  Exceptions raised by ``tick``/``send`` go to ``on_error`` and never
 escape into the event loop.
+
+The rules that keep a slow kernel from freezing the keys:
+
+* **The lock is released between ticks whatever a tick costs.**  The thread
+  takes the lock for one ``service`` and gives it up before the next (it
+  always waits at least `MIN_WAIT`), so a keyup waiting on the lock is
+  handled after at most one tick.  A tick that overruns drops the ticks it
+  missed (the owner's ``tick`` reschedules them; see
+  `rot4d_widget.keyhold.KeyRepeater.drop_missed`).
+* **Expensive work runs outside the lock.**  ``send`` may be a generator: it
+  yields a callable (the slow part: slicing) after reading the state under
+  the lock; the thread runs that callable with the lock released and sends
+  its result back into the generator under the lock again, which returns the
+  update's id.  Meanwhile keys change the state freely.
+* **Queued changes coalesce.**  With ``autotick``, `flush` only wakes the
+  thread: the thread alone sends, always the latest state, so ten taps that
+  arrive while a slow slice is computed make one more picture, not ten.
+  Without ``autotick`` (scripts, tests) `flush` sends at once.
+* **A failed send is not lost.**  When ``send`` raises (a comm that fails, a
+  bad slice) the state stays dirty: the next acknowledgement, key or
+  `flush` tries again.
+* **The adaptive timeout is capped** at `MAX_ACK_TIMEOUT`, so one very late
+  acknowledgement cannot silence a page that then stops answering.
 """
 
 from __future__ import annotations
 
+import inspect
 import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_IN_FLIGHT"]
+__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_ACK_TIMEOUT", "MAX_IN_FLIGHT"]
 
 ACK_TIMEOUT = 0.5
+#: The adaptive acknowledgement timeout never exceeds this (s).
+MAX_ACK_TIMEOUT = 5.0
+#: The ticker thread always waits at least this long between services (s): the lock is free then.
+MIN_WAIT = 0.001
 #: Updates allowed in flight at once (1: strictly one at a time).
 MAX_IN_FLIGHT = 3
 #: Recent acknowledgement times the adaptive timeout looks at.
@@ -71,10 +99,12 @@ class UpdatePump:
 
     Parameters
     ----------
-    send : callable () -> int or None
+    send : callable () -> int or None, or a generator function
         Compute and send the latest state; return the update's id when an
         update left (an acknowledgement is then awaited), None when nothing
-        changed on screen.
+        changed on screen.  A generator yields once a callable (the slow
+        part, run without the lock on the ticker thread), receives its result
+        and returns the id (see the module docs).
     tick : callable (now) -> None, optional
         Advance time-driven state (held keys) to ``now``.
     deadline : callable () -> float or None, optional
@@ -109,6 +139,8 @@ class UpdatePump:
         self._ack_times = []  # recent send -> acknowledgement durations
         self._thread = None
         self._closed = False
+        self._sending = False  # a send is being computed outside the lock (ticker thread)
+        self._failed = False  # the last send raised: retried on the next ack, key or flush, not at once
 
     # -- state ----------------------------------------------------------------
     @property
@@ -124,8 +156,8 @@ class UpdatePump:
     def timeout(self) -> float:
         """The acknowledgement timeout in force: ``ack_timeout``, or 4 x the recent median if larger."""
         times = sorted(self._ack_times)
-        recent = 4.0 * times[len(times) // 2] if times else 0.0
-        return max(self.ack_timeout, recent)
+        recent = 4.0 * times[(len(times) - 1) // 2] if times else 0.0  # the lower median
+        return max(self.ack_timeout, min(recent, MAX_ACK_TIMEOUT))
 
     @property
     def dirty(self) -> bool:
@@ -135,33 +167,88 @@ class UpdatePump:
     def mark_dirty(self) -> None:
         """The state changed: send it as soon as flow control allows (call ``flush``)."""
         self._dirty = True
+        self._failed = False
 
     # -- entry points -----------------------------------------------------------
     def flush(self, now=None) -> None:
-        """Send the latest state unless ``max_in_flight`` updates are in flight (and none timed out)."""
+        """Send the latest state unless ``max_in_flight`` updates are in flight (and none timed out).
+
+        With ``autotick`` the ticker thread sends (this wakes it); otherwise it sends here."""
         with self.lock:
             if self._closed or not self._dirty:
                 return
-            now = self.clock() if now is None else now
-            if len(self._flight) >= self.max_in_flight:
-                oldest, sent = next(iter(self._flight.items()))
-                if now - sent < self.timeout:
-                    self.wake()
-                    return
-                del self._flight[oldest]  # the page does not answer: stop waiting for the oldest
-                self.stats.timeouts += 1
-            self.send_now(now, expect_ack=True)
-            self.wake()
+            self._failed = False
+            if self.autotick and threading.current_thread() is not self._thread:
+                self.wake()
+                return
+            self._flush(self.clock() if now is None else now)
 
-    def send_now(self, now=None, *, expect_ack=True) -> None:
-        """Compute and send the latest state now, whatever is in flight (the initial picture)."""
+    def _may_send(self, now) -> bool:
+        """Flow control: True if an update may leave now (gives up the oldest after the timeout)."""
+        if self._sending:
+            return False
+        if len(self._flight) >= self.max_in_flight:
+            oldest, sent = next(iter(self._flight.items()))
+            if now - sent < self.timeout:
+                return False
+            del self._flight[oldest]  # the page does not answer: stop waiting for the oldest
+            self.stats.timeouts += 1
+        return True
+
+    def _flush(self, now, *, unlocked: bool = False) -> None:
+        if self._dirty and self._may_send(now):
+            self._send_locked(now, True, unlocked)
+        self.wake()
+
+    def send_now(self, now=None, *, expect_ack=True, unlocked: bool = False) -> None:
+        """Compute and send the latest state now, whatever is in flight (the initial picture).
+
+        ``unlocked``: run a generator ``send``'s slow part with the lock released (the
+        ticker thread, which holds the lock exactly once).  If ``send`` raises, the state
+        stays dirty (the picture is not lost) and the exception propagates."""
         with self.lock:
-            self._dirty = False
+            self._send_locked(now, expect_ack, unlocked)
+
+    def _send_locked(self, now, expect_ack, unlocked) -> None:
+        """`send_now` with the lock held once (it may be let go for a two-phase send's slow part)."""
+        self._dirty = False
+        self._sending = True
+        try:
             seq = self._send()
-            if seq is not None:
-                self.stats.updates += 1
-                if expect_ack:
-                    self._flight[seq] = self.clock() if now is None else now
+            if inspect.isgenerator(seq):
+                seq = self._run_generator(seq, unlocked)
+        except BaseException:
+            self._dirty = self._failed = True
+            raise
+        finally:
+            self._sending = False
+        if seq is not None:
+            self.stats.updates += 1
+            if expect_ack:
+                self._flight[seq] = self.clock() if now is None else now
+
+    def _run_generator(self, gen, unlocked: bool):
+        """Drive a two-phase ``send``: its yielded callable runs without the lock if ``unlocked``."""
+        try:
+            work = next(gen)
+        except StopIteration as stop:
+            return stop.value
+        if unlocked:
+            self.lock.release()
+            try:
+                result = work()
+            except BaseException as exc:
+                self.lock.acquire()
+                gen.close()
+                raise exc
+            self.lock.acquire()
+        else:
+            result = work()
+        try:
+            gen.send(result)
+        except StopIteration as stop:
+            return stop.value
+        raise RuntimeError("a two-phase send must yield exactly once")
 
     def acknowledge(self, seq) -> bool:
         """The page drew update ``seq`` (and so every older one); True if it was awaited."""
@@ -174,13 +261,16 @@ class UpdatePump:
             for k in [k for k in self._flight if k <= seq]:
                 del self._flight[k]
                 self.stats.acknowledged += 1
-            self._ack_times = (self._ack_times + [max(0.0, self.clock() - sent)])[-_ACK_WINDOW:]
+            self._ack_times = (self._ack_times + [min(max(0.0, self.clock() - sent), MAX_ACK_TIMEOUT)])[-_ACK_WINDOW:]
             self.stats.acks += 1
+            self._failed = False
             self.flush()
             return True
 
-    def service(self, now=None):
-        """Run due ticks, honour the timeout, send if allowed; the clock time to run next (or None)."""
+    def service(self, now=None, *, unlocked: bool = False):
+        """Run due ticks, honour the timeout, send if allowed; the clock time to run next (or None).
+
+        ``unlocked`` (the ticker thread): a two-phase send's slow part runs without the lock."""
         with self.lock:
             if self._closed:
                 return None
@@ -188,9 +278,11 @@ class UpdatePump:
             try:
                 if self._tick is not None:
                     self._tick(now)
-                self.flush(now)
             except Exception as exc:
-                self._dirty = False
+                self._report(exc)
+            try:
+                self._flush(now, unlocked=unlocked)
+            except Exception as exc:  # the state stays dirty: the next ack, key or flush retries
                 self._report(exc)
             return self.next_deadline()
 
@@ -202,6 +294,8 @@ class UpdatePump:
                 deadlines.append(d)
         if self._dirty and len(self._flight) >= self.max_in_flight:
             deadlines.append(next(iter(self._flight.values())) + self.timeout)
+        elif self._dirty and self.autotick and not self._sending and not self._failed:
+            deadlines.append(self.clock())  # a flush woke the thread: send now
         return min(deadlines) if deadlines else None
 
     # -- the thread -------------------------------------------------------------
@@ -218,17 +312,18 @@ class UpdatePump:
             self._wakeup.notify_all()
 
     def _run(self) -> None:
-        with self.lock:
-            while not self._closed:
-                deadline = self.service()
+        """The ticker: one `service` per turn under the lock, then a wait (at least `MIN_WAIT`)
+        that releases it, so other threads always get the lock between ticks."""
+        while True:
+            self.service(unlocked=True)  # takes the lock once, so its slow part can release it
+            with self.lock:
                 if self._closed:
-                    break
+                    return
+                deadline = self.next_deadline()  # again: a flush may have come in meanwhile
                 if deadline is None:
                     self._wakeup.wait()
                 else:
-                    timeout = deadline - self.clock()
-                    if timeout > 0:
-                        self._wakeup.wait(timeout)
+                    self._wakeup.wait(max(deadline - self.clock(), MIN_WAIT))
 
     @property
     def thread_alive(self) -> bool:

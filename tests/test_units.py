@@ -123,23 +123,131 @@ def test_a_slow_page_stretches_the_timeout_to_four_times_its_median_ack():
     assert pump.stats.timeouts == 1
 
 
-def test_errors_go_to_on_error_and_the_pump_goes_on():
+def test_errors_go_to_on_error_and_the_failed_picture_is_sent_on_the_next_ack_or_flush():
+    # issue 18 item 7: the pump used to clear its dirty flag before a send that raised,
+    # so the page never got that picture, not after acks nor a flush
     seen = []
     boom = {"on": True}
+    sent = []
 
     def send():
         if boom["on"]:
             raise RuntimeError("boom")
-        return 1
+        sent.append(len(sent) + 1)
+        return sent[-1]
 
     pump = UpdatePump(send, clock=lambda: 0.0, autotick=False, on_error=seen.append)
     pump.mark_dirty()
     pump.service(0.0)
-    assert [type(e) for e in seen] == [RuntimeError] and not pump.dirty
+    assert [type(e) for e in seen] == [RuntimeError] and pump.dirty  # the picture is still owed
+    assert pump.next_deadline() is None  # and not retried in a busy loop
     boom["on"] = False
+    pump.flush(0.0)  # no new change: the owed picture goes out
+    assert sent == [1] and pump.stats.updates == 1 and not pump.dirty
+    boom["on"] = True
     pump.mark_dirty()
     pump.service(0.0)
-    assert pump.stats.updates == 1
+    boom["on"] = False
+    assert pump.acknowledge(1) is True and sent == [1, 2]  # an ack retries it too
+
+
+def test_one_very_late_ack_does_not_set_a_huge_timeout():
+    # issue 18 item 10: one ack 600 s late among the first two set the timeout to 2,400 s
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=0.5, max_in_flight=1)
+    page.changes += 1
+    pump.mark_dirty()
+    pump.flush()
+    t[0] = 600.0
+    assert pump.acknowledge(1)
+    assert pump.timeout <= 5.0
+    page.changes += 1
+    pump.mark_dirty()
+    pump.flush()
+    t[0] += 0.1
+    assert pump.acknowledge(2)
+    assert pump.timeout == 0.5  # the lower median of (600 capped, 0.1): the page is fast again
+
+
+def test_a_slow_tick_releases_the_lock_between_ticks():
+    # issue 18 item 1: a tick longer than the period kept the ticker's lock for good (its
+    # release happened only inside a wait() that was skipped when the timeout was <= 0)
+    import threading
+    import time
+
+    period = 0.01
+    due = {"t": time.monotonic()}
+    ticks = []
+
+    def tick(now):  # every tick takes 5 periods (a slow observer)
+        if due["t"] is not None and due["t"] <= now:
+            time.sleep(5 * period)
+            ticks.append(now)
+            due["t"] = time.monotonic()  # already due again: it overran
+
+    pump = UpdatePump(lambda: None, tick=tick, deadline=lambda: due["t"])
+    pump.wake()
+    try:
+        limit = time.monotonic() + 10
+        while len(ticks) < 2 and time.monotonic() < limit:
+            time.sleep(period)
+        got = []
+        for _ in range(5):
+            t0 = time.monotonic()
+            assert pump.lock.acquire(timeout=2.0), "the ticker kept the lock"  # what a keyup handler does
+            got.append(time.monotonic() - t0)
+            pump.lock.release()
+            time.sleep(period)
+        longest_tick = 5 * period
+        assert max(got) < 10 * longest_tick, got  # within about one tick, not never
+    finally:
+        due["t"] = None
+        if pump.lock.acquire(timeout=2.0):
+            pump.lock.release()
+            pump.close()
+
+
+
+def test_the_thread_slices_without_the_lock_and_coalesces_changes():
+    """A two-phase send: the slow part runs with the lock free; ten changes meanwhile make one picture."""
+    import threading
+    import time
+
+    state = {"v": 0}
+    shown = []
+    started = threading.Event()
+
+    def send():
+        v = state["v"]  # read under the lock
+        def slow():
+            started.set()
+            time.sleep(0.2)
+            return v
+        result = yield slow
+        shown.append(result)
+        return len(shown)
+
+    pump = UpdatePump(send, ack_timeout=0.05)
+    try:
+        with pump.lock:
+            state["v"] += 1
+            pump.mark_dirty()
+            pump.flush()
+        assert started.wait(5)
+        for _ in range(10):  # taps while the slice is computed: the lock is free
+            t0 = time.monotonic()
+            with pump.lock:
+                assert time.monotonic() - t0 < 0.15
+                state["v"] += 1
+                pump.mark_dirty()
+                pump.flush()
+        deadline = time.monotonic() + 10
+        while (not shown or shown[-1] != 11) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert shown[-1] == 11 and len(shown) == 2, shown  # the first picture, then only the latest
+    finally:
+        pump.close()
 
 
 def test_the_thread_runs_ticks_in_real_time_and_stops_on_close():
