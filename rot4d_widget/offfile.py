@@ -20,20 +20,32 @@ prefixes (``ST``, ``C``, ``N``, ``n``: ``C4OFF``, ``4nOFF``, ...), or the
 counts line has three numbers (Geomview's ``V F E``) instead of four, or it
 declares no cells.
 
-Every error is a ValueError that names the line (1-based) it is about.
+Every error is a ValueError that names the line (1-based) it is about (and the file, when
+read from one).  A file is read one line at a time and never trusted for sizes: a line longer
+than `MAX_LINE_CHARS`, bytes that are not UTF-8 text, and counts that the rest of the file
+cannot hold (or above `MAX_COUNT`) are refused before anything is allocated for them.  The
+reader only parses numbers: nothing in a file is imported or evaluated.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["OffData", "read_off", "write_off", "parse_off"]
+__all__ = ["OffData", "read_off", "write_off", "parse_off", "MAX_LINE_CHARS", "MAX_COUNT"]
 
 _GEOMVIEW_HEADER = re.compile(r"^(ST|S|T)?C?N?4?n?OFF$")
+#: The longest line read (a face of 100 000 corners fits); a longer one is refused when that much is read.
+MAX_LINE_CHARS = 1 << 20
+#: The most vertices, faces, edges or cells a file may declare (each is also checked against the
+#: bytes the file has left, when its size is known).
+MAX_COUNT = 100_000_000
+#: Bytes that were not UTF-8, as ``errors="surrogateescape"`` decodes them.
+_UNDECODED = re.compile("[\udc80-\udcff]")
 
 
 @dataclass(frozen=True)
@@ -62,12 +74,50 @@ class OffData:
     counts_line: int
 
 
-def _lines(text: str):
-    """(line number, tokens) of every line with content, comments removed."""
-    for no, line in enumerate(text.splitlines(), start=1):
-        content = line.split("#", 1)[0].split()
-        if content:
-            yield no, content
+class _Lines:
+    """``(line number, tokens)`` of every line with content, comments removed, read one line at a
+    time from ``stream`` (a text stream: ``readline(limit)`` returning str).
+
+    A line longer than `MAX_LINE_CHARS` is refused as soon as that much is read; so is a NUL
+    character (a binary file) and, when ``decoded`` (the text was decoded from bytes with
+    ``errors="surrogateescape"``), a byte that is not UTF-8.  ``consumed`` counts the characters
+    read so far, ``last`` is the number of the last line with content.
+    """
+
+    def __init__(self, stream, decoded: bool = False):
+        self._readline = stream.readline
+        self._decoded = decoded
+        self.no = 0
+        self.last = 0
+        self.consumed = 0
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        while True:
+            line = self._readline(MAX_LINE_CHARS + 1)
+            if not line:
+                raise StopIteration
+            self.no += 1
+            self.consumed += len(line)
+            if len(line) > MAX_LINE_CHARS and not line.endswith("\n"):
+                raise ValueError(f"line {self.no}: longer than {MAX_LINE_CHARS} characters; a 4OFF line holds one "
+                                 f"count line, vertex, face or cell (is this a 4OFF file?)")
+            if self._decoded:
+                bad = _UNDECODED.search(line)
+                if bad:
+                    raise ValueError(f"line {self.no}: not UTF-8 text (byte 0x{ord(bad.group()) - 0xDC00:02x} at "
+                                     f"column {bad.start() + 1}): a 4OFF file is text")
+            if "\x00" in line:
+                raise ValueError(f"line {self.no}: a NUL byte at column {line.index(chr(0)) + 1}: a binary file, "
+                                 f"not 4OFF text")
+            if self.no == 1 and line.startswith("\ufeff"):  # a byte order mark
+                line = line[1:]
+            content = line.split("#", 1)[0].split()
+            if content:
+                self.last = self.no
+                return self.no, content
 
 
 def _colour(tokens, no: int, what: str) -> np.ndarray:
@@ -115,10 +165,16 @@ def parse_off(text: str) -> OffData:
     """Parse the text of a Stella4D 4OFF file (see the module docstring)."""
     if not isinstance(text, str):
         raise TypeError(f"Expected the 4OFF text as str, got {type(text).__name__}")
-    lines = list(_lines(text))
-    if not lines:
+    return _parse(_Lines(io.StringIO(text, newline=None)), len(text))
+
+
+def _parse(lines: _Lines, size: int | None) -> OffData:
+    """Parse what ``lines`` reads; ``size``: an upper bound of the characters (bytes) of the
+    whole input, or None if unknown, to refuse counts that cannot fit before allocating."""
+    first = next(lines, None)
+    if first is None:
         raise ValueError("line 1: empty file; expected the header 4OFF")
-    no, head = lines[0]
+    no, head = first
     word = head[0]
     if word != "4OFF":
         if _GEOMVIEW_HEADER.match(word) and word != "OFF":
@@ -126,12 +182,11 @@ def parse_off(text: str) -> OffData:
                              f"coordinates of a surface, no cells); expected Stella4D's 4OFF with cells")
         raise ValueError(f"line {no}: expected the header 4OFF (Stella4D), got {word!r}")
     rest = head[1:]
-    it = iter(lines[1:])
     if rest:  # counts on the header line
         counts_no, counts = no, rest
     else:
         try:
-            counts_no, counts = next(it)
+            counts_no, counts = next(lines)
         except StopIteration:
             raise ValueError(f"line {no + 1}: missing the counts line V F E C") from None
     if len(counts) == 3:
@@ -149,22 +204,32 @@ def parse_off(text: str) -> OffData:
     if nc == 0:
         raise ValueError(f"line {counts_no}: no cells (C = 0): a 4OFF without cells is a surface (Geomview's "
                          f"meaning?), not a 4-polytope; Stella4D's 4OFF lists the cells")
+    # every vertex line is at least "x y z w\n" (8 characters), a face or cell line "n i\n" (4):
+    # counts the rest of the file cannot hold are refused before anything is allocated
+    need = 8 * nv + 4 * nf + 4 * nc - 1
+    left = None if size is None else size - lines.consumed
+    if left is not None and need > left:
+        raise ValueError(f"line {counts_no}: the counts {' '.join(counts)!r} declare {nv} vertices, {nf} faces and "
+                         f"{nc} cells, which take at least {need} more bytes, but the file has {max(left, 0)} left: "
+                         f"the counts are wrong or the file is cut short")
+    if max(nv, nf, ne, nc) > MAX_COUNT:
+        raise ValueError(f"line {counts_no}: counts {' '.join(counts)!r} above {MAX_COUNT:,}; this reader takes at "
+                         f"most {MAX_COUNT:,} of each")
 
     def take(n: int, what: str):
-        out = []
         for k in range(n):
             try:
-                out.append(next(it))
+                yield k, next(lines)
             except StopIteration:
-                last = lines[-1][0]
-                raise ValueError(f"line {last + 1}: file ends after {k} of {n} {what} lines") from None
-        return out
+                raise ValueError(f"line {lines.last + 1}: file ends after {k} of {n} {what} lines") from None
 
-    vertices = np.empty((nv, 4))
+    vertices = np.empty((nv if left is not None else min(nv, 1 << 16), 4))  # grown below if the size is unknown
     vertex_lines = []
-    for k, (no, tok) in enumerate(take(nv, "vertex")):
+    for k, (no, tok) in take(nv, "vertex"):
         if len(tok) != 4:
             raise ValueError(f"line {no}: vertex {k} has {len(tok)} numbers; expected 4 coordinates x y z w")
+        if k == len(vertices):
+            vertices = np.concatenate([vertices, np.empty((min(len(vertices), nv - k), 4))])
         try:
             vertices[k] = [float(t) for t in tok]
         except ValueError:
@@ -172,19 +237,20 @@ def parse_off(text: str) -> OffData:
         if not np.all(np.isfinite(vertices[k])):
             raise ValueError(f"line {no}: vertex {k} is not finite: {' '.join(tok)!r}")
         vertex_lines.append(no)
+    vertices = vertices[:nv]
     faces, face_lines, fcol = [], [], []
-    for k, (no, tok) in enumerate(take(nf, "face")):
+    for k, (no, tok) in take(nf, "face"):
         idx, col = _indices(tok, no, f"face {k}", "vertex", nv)
         faces.append(idx)
         face_lines.append(no)
         fcol.append(col)
     cells, cell_lines, ccol = [], [], []
-    for k, (no, tok) in enumerate(take(nc, "cell")):
+    for k, (no, tok) in take(nc, "cell"):
         idx, col = _indices(tok, no, f"cell {k}", "face", nf)
         cells.append(idx)
         cell_lines.append(no)
         ccol.append(col)
-    extra = next(it, None)
+    extra = next(lines, None)
     if extra is not None:
         raise ValueError(f"line {extra[0]}: unexpected content after the {nc} cells: {' '.join(extra[1])!r}")
 
@@ -197,16 +263,54 @@ def parse_off(text: str) -> OffData:
                    ne, counts_no)
 
 
+def _stream_size(fh) -> int | None:
+    """Bytes from ``fh``'s position to its end, if it is a seekable file; else None."""
+    try:
+        return os.fstat(fh.fileno()).st_size - fh.tell()
+    except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+        return None
+
+
 def read_off(path_or_text) -> OffData:
-    """Parse a 4OFF file given as a path (str or path-like) or as its text (a str containing
-    a line break, or starting with ``4OFF``)."""
+    """Parse a 4OFF file given as a path (str or path-like), as its text (a str containing a line
+    break, or starting with ``4OFF``), as bytes, or as an open file (binary or text).
+
+    The file is read one line at a time: an over-long line (`MAX_LINE_CHARS`), bytes that are
+    not UTF-8 or counts the file's size cannot hold are refused at once, as a ValueError that
+    names the file and the line.
+    """
     if isinstance(path_or_text, (bytes, bytearray)):
-        return parse_off(path_or_text.decode("utf-8"))
+        data = bytes(path_or_text)
+        text = io.TextIOWrapper(io.BytesIO(data), encoding="utf-8", errors="surrogateescape", newline=None)
+        return _parse(_Lines(text, decoded=True), len(data))
     if isinstance(path_or_text, str) and ("\n" in path_or_text or path_or_text.lstrip().startswith("4OFF")):
         return parse_off(path_or_text)
     if isinstance(path_or_text, (str, os.PathLike)):
-        with open(path_or_text, encoding="utf-8") as fh:
-            return parse_off(fh.read())
+        path = os.fspath(path_or_text)
+        with open(path, encoding="utf-8", errors="surrogateescape", newline=None) as fh:
+            size = os.fstat(fh.fileno()).st_size
+            try:
+                return _parse(_Lines(fh, decoded=True), size)
+            except ValueError as exc:
+                raise ValueError(f"{path!r}, {exc}") from None
+    if hasattr(path_or_text, "readline") and hasattr(path_or_text, "read"):
+        fh = path_or_text
+        name = getattr(fh, "name", None)
+        if isinstance(fh.read(0), str):
+            lines, size, wrapper = _Lines(fh), None, None
+        else:
+            size = _stream_size(fh)
+            wrapper = io.TextIOWrapper(fh, encoding="utf-8", errors="surrogateescape", newline=None)
+            lines = _Lines(wrapper, decoded=True)
+        try:
+            return _parse(lines, size)
+        except ValueError as exc:
+            if isinstance(name, str):
+                raise ValueError(f"{name!r}, {exc}") from None
+            raise
+        finally:
+            if wrapper is not None:
+                wrapper.detach()  # the caller's file stays open
     raise TypeError(f"Expected a path or the text of a 4OFF file, got {type(path_or_text).__name__}")
 
 
