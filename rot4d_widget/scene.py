@@ -65,6 +65,7 @@ import pathlib
 import re
 import uuid
 
+import ipywidgets as widgets
 import numpy as np
 import pythreejs as p3
 from traitlets import CFloat, CInt, Dict, List
@@ -231,6 +232,7 @@ class Scene:
         if not isinstance(antialias, bool):
             raise TypeError(f"Expected `antialias` to be True or False, got {antialias!r}")
         self.group_rgb = _group_colors(group_colors, int(n_groups))
+        self._user_rgb = None if group_colors is None else self.group_rgb
         if isinstance(capacity, bool) or not isinstance(capacity, (int, np.integer)) or capacity < 1:
             raise ValueError(f"Expected `capacity` to be an int >= 1, got {capacity!r}")
         self.capacity = int(capacity)
@@ -486,6 +488,17 @@ class Scene:
                     self._meshes["surface"].visible = value
             self._display[name] = value
 
+    def palette(self, n_groups: int) -> np.ndarray:
+        """(n, 3) colours for ``n_groups`` groups: the ``group_colors`` given, followed where they
+        run out by `rot4d_widget.look.group_palette` (a source's group count may change at run
+        time: a stack taken down to one slice shows its inner source's cells)."""
+        n = max(int(n_groups), 1)
+        if self._user_rgb is None:
+            return look.group_palette(n) if n != len(self.group_rgb) else self.group_rgb
+        if len(self._user_rgb) >= n:
+            return self._user_rgb
+        return np.concatenate([self._user_rgb, np.asarray(look.group_palette(n), dtype=np.float32)[len(self._user_rgb):]])
+
     # -- the update --------------------------------------------------------
     def show(self, data, *, single_rgb=None, group_rgb=None, force=False) -> bool:
         """Show a slice (`rot4d_widget.source.SliceData`); True if an update was sent.
@@ -599,8 +612,12 @@ class Scene:
             self._camera.unobserve(self._camera_moved, names="position")
         except ValueError:
             pass
-        for w in self._widgets:
+        for w in self._widgets:  # with the Layout / Style / shadow map each one made for itself
+            subs = [getattr(w, name, None) for name in ("layout", "style", "shadowMap")]
             w.close()
+            for sub in subs:
+                if isinstance(sub, widgets.Widget):
+                    sub.close()
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"

@@ -9,11 +9,17 @@ Defaults (documented in the README):
   pi*sqrt(2)/(8*sqrt(3))``: the ratio of the paper's Fig. 4 (alpha/theta0
   irrational, so a held double rotation never returns).  ``beta = theta0 - alpha``.
 * "k"/"j" change alpha by ``theta0 * ALPHA_STEP_FRACTION`` (1/32) keeping
-  alpha + beta = theta0; nothing clamps alpha or beta (both may go negative).
+  alpha + beta = theta0; both may go negative.
 * "l"/"h" change c0 by ``c0_step`` (default 0.02; the widget uses 1/64 of the
   polytope's circumradius).
-* "+"/"-" multiply/divide theta0 by ``THETA0_FACTOR`` (sqrt 2), keeping alpha/theta0;
-  theta0 stays within (0, pi].
+* "+"/"-" multiply/divide theta0 by ``THETA0_FACTOR`` (sqrt 2), keeping alpha/theta0.
+
+**Bounds of the repeating keys.**  A key step that would leave its range is refused
+(``apply`` returns False, nothing changes), never clamped, so the opposite key always
+undoes a step that was made: theta0 stays in [`THETA0_MIN`, `THETA0_MAX`] = [pi/2^20, pi];
+alpha and beta in [-pi, pi] (`ALPHA_MAX`); c0 in [-c0_limit, c0_limit] (``c0_limit``,
+default infinite; the widget sets twice the source's size), where a c0 set outside by hand
+may still step back towards the range.
 
 ``to_dict()`` / ``from_dict(d)`` turn a state into JSON-able data and back, exactly (floats
 are written with Python's shortest round-tripping repr): the orientation, theta0, alpha, c0,
@@ -43,6 +49,9 @@ __all__ = [
     "ALPHA_STEP_FRACTION",
     "DEFAULT_C0_STEP",
     "THETA0_FACTOR",
+    "THETA0_MIN",
+    "THETA0_MAX",
+    "ALPHA_MAX",
     "STATE_FORMAT",
     "action_to_data",
     "action_from_data",
@@ -63,6 +72,10 @@ ALPHA_STEP_FRACTION = 1.0 / 32.0
 DEFAULT_C0_STEP = 0.02
 THETA0_FACTOR = math.sqrt(2.0)
 THETA0_MAX = math.pi
+#: The smallest theta0 the "-" key reaches (pi / 2**20 rad): far below what a person sees.
+THETA0_MIN = math.pi / 2**20
+#: k / j keep |alpha| and |beta| within this (radians).
+ALPHA_MAX = math.pi
 
 
 def _finite(name: str, value) -> float:
@@ -114,6 +127,7 @@ class RotationState:
         keymap: Keymap = DEFAULT_KEYMAP,
         c0_step: float = DEFAULT_C0_STEP,
         matrix=None,
+        c0_limit: float = math.inf,
     ):
         if not isinstance(keymap, Keymap):
             raise TypeError(f"Expected `keymap` to be a rot4d_widget.Keymap, got {type(keymap).__name__}")
@@ -122,6 +136,7 @@ class RotationState:
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else _finite("alpha", alpha)
         self._c0 = _finite("c0", c0)
         self.c0_step = c0_step
+        self.c0_limit = c0_limit
         self._matrix = _read_only(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
         self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
         self._steps: dict = {}
@@ -184,6 +199,20 @@ class RotationState:
         self._c0_step = value
 
     @property
+    def c0_limit(self) -> float:
+        """The l / h keys keep |c0| within this (inf: no limit); setting c0 directly is not limited."""
+        return self._c0_limit
+
+    @c0_limit.setter
+    def c0_limit(self, value) -> None:
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+            raise TypeError(f"Expected `c0_limit` to be a number > 0 (or inf), got {type(value).__name__}")
+        value = float(value)
+        if not value > 0:
+            raise ValueError(f"Expected `c0_limit` > 0 (or inf), got {value}")
+        self._c0_limit = value
+
+    @property
     def alpha_step(self) -> float:
         """How much "k"/"j" change alpha: ``theta0 * ALPHA_STEP_FRACTION``."""
         return self._theta0 * ALPHA_STEP_FRACTION
@@ -209,13 +238,20 @@ class RotationState:
             # a new array each step: arrays handed out before are never edited
             self._matrix = _read_only(reorthonormalize(self.step_matrix(action, inverted) @ self._matrix))
         elif kind == "alpha":
-            self.alpha = self._alpha + action.sign * self.alpha_step
+            new = self._alpha + action.sign * self.alpha_step
+            if not (abs(new) <= ALPHA_MAX and abs(self._theta0 - new) <= ALPHA_MAX):
+                return False  # refused, not clamped: the opposite key undoes every step made
+            self.alpha = new
         elif kind == "c0":
-            self.c0 = self._c0 + action.sign * self._c0_step
+            new = self._c0 + action.sign * self._c0_step
+            if abs(new) > self._c0_limit and abs(new) >= abs(self._c0):
+                return False
+            self.c0 = new
         elif kind == "theta0":
             new = self._theta0 * THETA0_FACTOR if action.sign > 0 else self._theta0 / THETA0_FACTOR
-            new = min(new, THETA0_MAX)
-            if new == self._theta0:
+            ratio = self._alpha / self._theta0
+            if not (THETA0_MIN <= new <= THETA0_MAX and abs(ratio * new) <= ALPHA_MAX
+                    and abs((1.0 - ratio) * new) <= ALPHA_MAX):
                 return False
             self.theta0 = new
         elif kind == "reset":
@@ -320,7 +356,9 @@ class RotationState:
 
     def copy(self) -> "RotationState":
         """An independent state with the same values, keymap and reset point."""
-        return type(self).from_dict(self.to_dict(initial=True), keymap=self.keymap)
+        new = type(self).from_dict(self.to_dict(initial=True), keymap=self.keymap)
+        new.c0_limit = self._c0_limit
+        return new
 
     def __repr__(self) -> str:
         return (

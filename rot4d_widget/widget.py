@@ -36,8 +36,12 @@ import html
 import inspect
 import logging
 import math
+import os
+import threading
 import traceback
+import warnings
 from collections.abc import Mapping
+import dataclasses
 
 import ipywidgets as widgets
 import numpy as np
@@ -49,7 +53,7 @@ from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
-from .source import as_source
+from .source import as_source, check_slice
 from .state import DEFAULT_THETA0, RotationState, _finite, _theta0
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
@@ -63,6 +67,12 @@ C0_STEP_FRACTION = 1.0 / 64.0
 READOUT_PERIOD = 0.25
 #: How many error reports the ``errors`` area keeps.
 MAX_ERRORS_SHOWN = 5
+#: Screenshot requests no view answered are dropped after this many seconds ...
+SCREENSHOT_TIMEOUT = 10.0
+#: ... and at most this many wait at once (the oldest is dropped).
+MAX_PENDING_SCREENSHOTS = 8
+#: The l / h keys keep |c0| within this many times the source's size (`RotationState.c0_limit`).
+C0_LIMIT_SIZES = 2.0
 
 _WATCHED_EVENTS = ["keydown", "keyup", "mouseleave"]
 _DISPLAY_TRAITS = ("ball_radius", "bar_radius", "face_opacity", "background", "show_balls", "show_bars", "show_faces")
@@ -226,7 +236,8 @@ class Rot4DWidget(widgets.HBox):
             keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
         if c0_step is None:
             c0_step = float(src.size) * C0_STEP_FRACTION
-        state = RotationState(theta0, alpha, c0, keymap=keymap, c0_step=c0_step)
+        state = RotationState(theta0, alpha, c0, keymap=keymap, c0_step=c0_step,
+                              c0_limit=C0_LIMIT_SIZES * float(src.size))
         color_by = _check_color_by(color_by)
         scale = look.REFERENCE_RADIUS / float(src.size)
         if ball_radius is None:
@@ -258,8 +269,11 @@ class Rot4DWidget(widgets.HBox):
         self._note = None  # one line for the readout: what a screenshot did
         self._pad = None  # the key pad's box, built when first shown
         self._pad_events = []
-        self._screenshots = {}  # request id -> (path, callback): asked, not answered yet
+        self._screenshots = {}  # request id -> (path, callback, time asked): asked, not answered yet
         self._screenshot_seq = 0
+        self._shot_number = 1  # key p's next file number (rot4d-001.png ...)
+        self._source_lock = threading.RLock()  # source.slice and source changes (never the pump lock inside)
+        self._update_errors = ()  # error reports of failed updates: cleared by the next good one
         #: The PNG of the view the page sent last (`screenshot`, key p), or None.
         self.last_screenshot = None
         self._pump = UpdatePump(
@@ -325,6 +339,14 @@ class Rot4DWidget(widgets.HBox):
             **display,
             color_by=color_by,
         )
+        try:
+            self._wire(keypad)
+        except BaseException:
+            self.close()  # a source failing here must not leave the widget models behind
+            raise
+
+    def _wire(self, keypad) -> None:
+        """Connect the parts and send the initial picture (the last step of construction)."""
         self._sync_traits()
         self._sync_levels()
         self._sync_stack()
@@ -433,15 +455,25 @@ class Rot4DWidget(widgets.HBox):
             return self._ask_screenshot(path, callback)
 
     def _ask_screenshot(self, path, callback):
-        # asked in any case: a front end that does not count views (count 0) may still answer
+        # asked in any case: a front end that does not count views (count 0) may still answer,
+        # but such a request is not kept (an answer to it is dropped), so none piles up
+        now = self._pump.clock()
+        for old in [k for k, v in self._screenshots.items() if now - v[2] > SCREENSHOT_TIMEOUT]:
+            del self._screenshots[old]  # nobody answered: dropped
+        while len(self._screenshots) >= MAX_PENDING_SCREENSHOTS:
+            del self._screenshots[next(iter(self._screenshots))]
         self._screenshot_seq += 1
         rid = self._screenshot_seq
-        self._screenshots[rid] = (path, callback)
+        self._screenshots[rid] = (path, callback, now)
         self.companion.request_screenshot(rid)
         if self.scene.view_count == 0:
-            self._set_note("no view is displayed to answer: no screenshot (display the widget first)")
+            del self._screenshots[rid]  # no view to answer (a front end that counts none: see below)
+            text = "no view is displayed to answer: no screenshot (display the widget first)"
+            self._set_note(text)
+            warnings.warn(f"Rot4DWidget.screenshot: {text}", stacklevel=3)
             return None
-        self._set_note(f"screenshot asked{' for ' + str(path) if path is not None else ''}\u2026")
+        shown = "rot4d-NNN.png" if path is _KEY_P else path
+        self._set_note(f"screenshot asked{' for ' + str(shown) if shown is not None else ''}\u2026")
         return rid
 
     def _on_screenshot(self, rid, png, error) -> None:
@@ -450,7 +482,7 @@ class Rot4DWidget(widgets.HBox):
             asked = self._screenshots.pop(rid, None)
             if asked is None or self._closed:
                 return
-            path, callback = asked
+            path, callback, _ = asked
             if png is None:
                 self._set_note(f"screenshot failed: {error}")
                 return
@@ -458,8 +490,10 @@ class Rot4DWidget(widgets.HBox):
             where = "kept as last_screenshot"
             if path is not None:
                 try:
-                    with open(path, "wb") as f:
-                        f.write(png)
+                    if path is _KEY_P:
+                        path, self._shot_number = _write_numbered_png(png, self._shot_number)
+                    else:
+                        path = _write_png(path, png)
                 except OSError as exc:
                     self._set_note(f"screenshot not saved: {exc}")
                     return
@@ -472,14 +506,9 @@ class Rot4DWidget(widgets.HBox):
                 self._report_error(exc)
 
     def _screenshot_key(self) -> None:
-        """Key p: a numbered PNG in the current directory (rot4d-001.png, ...), never overwriting."""
-        import pathlib
-
-        n = 1
-        while pathlib.Path(f"rot4d-{n:03d}.png").exists() or any(
-                str(p) == f"rot4d-{n:03d}.png" for p, _ in self._screenshots.values()):
-            n += 1
-        self._ask_screenshot(f"rot4d-{n:03d}.png", None)
+        """Key p: a numbered PNG in the current directory (rot4d-001.png, ...), never overwriting
+        and never through a link; the number is chosen when the picture arrives."""
+        self._ask_screenshot(_KEY_P, None)
 
     # ------------------------------------------------------------ key pad
     def _on_keypad(self, change) -> None:
@@ -534,9 +563,9 @@ class Rot4DWidget(widgets.HBox):
                 with self._pump.lock:
                     if self._closed or key_id in self._repeater.held_keys:
                         return  # a touch's emulated mousedown: one press only
-                    self._press(key_id, action, inverted)
+                    self._press(key_id, action, inverted, _page_time(event))
             elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):
-                self._release(key_id)
+                self._release(key_id, _page_time(event))
         except Exception as exc:  # shown, never lost, never raised into the kernel
             self._report_error(exc)
 
@@ -586,7 +615,7 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             if self._closed:
                 raise RuntimeError("This Rot4DWidget is closed")
-            recording.replay(self.state, self.source)
+            recording.replay(self.state, _LiveSource(self), set_source=self._set_source_setting)
             self._source_version += 1
             self._sync_levels()
             self._sync_stack()
@@ -594,6 +623,12 @@ class Rot4DWidget(widgets.HBox):
             self._sync_traits()
             self._pump.mark_dirty()
             self._pump.flush()
+
+    def _set_source_setting(self, name, value) -> None:
+        """A recorded source setting, applied as its trait would be (a stack made if needed)."""
+        if isinstance(value, list):
+            value = tuple(value)
+        setattr(self, name, value)
 
     def render_animation(self, path, *, recording=None, fps: float = 10.0, per: str = "step", **options) -> int:
         """Draw `recording` (default: this widget's) without a browser into an animated GIF
@@ -702,19 +737,24 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             self._recorder.restart(self.state)
 
-    def release_keys(self) -> None:
-        """Forget every held key (what mouseleave and focus loss do)."""
+    def release_keys(self, page_time=None) -> None:
+        """Release every held key (what mouseleave and focus loss do); ``page_time``: the page's
+        time of the event in seconds, if known (each key's steps are then corrected to it)."""
         with self._pump.lock:
-            self._repeater.clear()
+            for action, inverted, correction in self._repeater.release_all(page_time):
+                self._correct(action, inverted, correction)
             self._settle()
 
     def _settle(self) -> None:
-        """At rest (no key held): bring the readout up to date and the rows into the turned frame."""
+        """At rest (no key held): bring the readout up to date and the rows into the turned frame,
+        and send a picture still owed (one whose send failed)."""
         turned = self._shown is not None and self._shown is not self._rows_key
         coarse = self._shown is not None and self._shown[5]
-        if (self._readout_stale or turned or coarse) and not len(self._repeater) and not self._closed:
+        if self._closed or len(self._repeater):
+            return
+        if self._readout_stale or turned or coarse:
             self._pump.mark_dirty()
-            self._pump.flush()
+        self._pump.flush()
 
     def close(self) -> None:
         """Stop the ticker thread, drop the listeners, close every child widget."""
@@ -827,11 +867,13 @@ class Rot4DWidget(widgets.HBox):
             try:
                 if target is None:
                     raise TypeError(why_not)
-                setattr(target, change["name"], change["new"])
+                with self._source_lock:
+                    setattr(target, change["name"], change["new"])
             except Exception:
                 self._set_quietly(change["name"], change["old"])
                 raise
             self._source_version += 1
+            self._recorder.record_source(change["name"], change["new"])
             self._sync_levels()
             self._sync_stack()
             self._pump.mark_dirty()
@@ -846,6 +888,7 @@ class Rot4DWidget(widgets.HBox):
                 except Exception:
                     self._set_quietly("slices", change["old"])
                     raise
+                self._recorder.record_source("slices", change["new"])
                 self._pump.mark_dirty()
                 self._pump.flush()
             return
@@ -863,7 +906,8 @@ class Rot4DWidget(widgets.HBox):
 
         stack = StackSource(self.source, slices=slices)
         self._use_keymap(self.state.keymap, stack)
-        self.source = stack
+        with self._source_lock:
+            self.source = stack
         self._source_version += 1
         self._slice_cache = None
         self._sync_stack()
@@ -923,9 +967,9 @@ class Rot4DWidget(widgets.HBox):
             elif etype == "keyup":
                 key_id = _key_id(event)
                 if key_id is not None:
-                    self._release(key_id)
+                    self._release(key_id, _page_time(event))
             elif etype == "mouseleave":
-                self.release_keys()
+                self.release_keys(_page_time(event))
         except Exception as exc:  # shown, never lost, never raised into the kernel
             self._report_error(exc)
 
@@ -983,37 +1027,66 @@ class Rot4DWidget(widgets.HBox):
             if self._closed:
                 return
             self._repeater.release(key_id)
-            self._press(key_id, action, inverted)
+            self._press(key_id, action, inverted, _page_time(event))
 
-    def _press(self, key_id, action: Action, inverted: bool) -> None:
-        """Key (or key pad button) ``key_id`` went down: one step now, repeats while held (lock held)."""
+    def _press(self, key_id, action: Action, inverted: bool, page_time=None) -> None:
+        """Key (or key pad button) ``key_id`` went down: one step now, repeats while held (lock held).
+
+        ``page_time``: the page's time of the keydown (s), against which the keyup's corrects
+        the number of steps (`rot4d_widget.keyhold`)."""
         if action.kind == "help":
             self.help_visible = not self.help_visible
             return
         now = self._pump.clock()
-        self._step(action, inverted)
+        changed = self._step(action, inverted)
         if action.kind in REPEATING_KINDS or (action.kind == "custom" and self._custom[action.name][1]):
-            self._repeater.press(key_id, action, inverted, now)
+            self._repeater.press(key_id, action, inverted, now, page_time=page_time, applied=changed)
         self._pump.flush(now)
 
-    def _release(self, key_id) -> None:
-        """Key (or key pad button) ``key_id`` went up: no more repeats; at rest, settle."""
+    def _release(self, key_id, page_time=None) -> None:
+        """Key (or key pad button) ``key_id`` went up at the page's ``page_time`` (s): no more
+        repeats, its steps corrected to what the page says the hold was; at rest, settle."""
         with self._pump.lock:
-            self._repeater.release(key_id)
+            held = self._repeater.held(key_id)
+            correction = self._repeater.release(key_id, page_time)
+            if held is not None:
+                self._correct(*held, correction)
             self._settle()
+
+    def _correct(self, action: Action, inverted: bool, correction: int) -> None:
+        """Take back (``correction`` < 0) or add (> 0) steps of a released key (lock held).
+
+        A late keyup lets the ticker repeat a key the user had already released; the page's
+        timestamps say how many steps the hold made, and this makes the state agree.  Each
+        step taken back is the opposite step, recorded like any other."""
+        if correction < 0:
+            opposite = _opposite(action, inverted)
+            for _ in range(-correction):
+                self._step(*opposite)
+        for _ in range(max(correction, 0)):
+            self._step(action, inverted)
 
     # ------------------------------------------------------------ stepping
     def _tick(self, now: float) -> None:
-        """Pump callback: the held keys' steps due by ``now``."""
-        for action, inverted in self._repeater.due(now):
-            self._step(action, inverted)
+        """Pump callback: the held keys' steps due by ``now``; a tick that overran (slow
+        observers, a loaded machine) drops the ticks it missed instead of bursting."""
+        rep = self._repeater
+        for key_id, action, inverted in rep.due_keys(now):
+            if self._step(action, inverted):
+                rep.note_applied(key_id)
+        after = self._pump.clock()
+        if after - now > rep.period:
+            rep.drop_missed(after)
 
     def _step(self, action: Action, inverted: bool) -> bool:
         if action.kind == "custom":
             run = self._custom.get(action.name)
             if run is None:
                 return False
-            run[0](-1 if inverted else 1)
+            with self._source_lock:
+                result = run[0](-1 if inverted else 1)
+            if result is False:  # refused (at a bound): nothing changed, nothing recorded
+                return False
             self._source_version += 1
             changed = True
             self._recorder.record(None, False, action, inverted)
@@ -1028,6 +1101,7 @@ class Rot4DWidget(widgets.HBox):
             changed = (-1 if inverted else 1) * action.sign > 0
             if changed:
                 self._wrap_in_stack(2)
+                self._recorder.record_source("slices", 2)
         else:
             changed = self.state.apply(action, inverted)
             if changed:
@@ -1046,12 +1120,18 @@ class Rot4DWidget(widgets.HBox):
         st = self.state
         m, c0, version = st.matrix, st.c0, self._source_version
         coarse = bool(coarse and self._coarse_ok)
+        cached = self._cached_slice(m, c0, version, coarse)
+        if cached is not None:
+            return cached
+        data = _checked_slice(self.source, m, c0, coarse, self._source_lock)
+        self._slice_cache = (m, c0, version, coarse, data)
+        return data
+
+    def _cached_slice(self, m, c0, version, coarse):
         cache = self._slice_cache
         if cache is not None and cache[0] is m and cache[1] == c0 and cache[2] == version and cache[3] == coarse:
             return cache[4]
-        data = self.source.slice(m, c0, coarse=True) if coarse else self.source.slice(m, c0)
-        self._slice_cache = (m, c0, version, coarse, data)
-        return data
+        return None
 
     def _send(self):
         """Pump callback: show the latest state; the update's id, or None if nothing was sent.
@@ -1082,15 +1162,30 @@ class Rot4DWidget(widgets.HBox):
                     and _leaves_w_alone(key[0], rows[0])):
                 # the same cut turned in 3-D: turn the full-resolution slice shown, no resampling
                 t = (np.asarray(key[0]) @ np.asarray(rows[0]).T)[:3, :3]
-                self._rows_data = self._rows_data.turned(t)
+                data = self._rows_data.turned(t)
             else:
-                self._rows_data = self._current_slice(coarse)
+                m, c0, version, coarse_ = key[0], key[1], key[3], bool(coarse and self._coarse_ok)
+                data = self._cached_slice(m, c0, version, coarse_)
+                if data is None:
+                    source, lock = self.source, self._source_lock
+                    # the slow part: on the ticker thread it runs with the pump's lock free, so
+                    # keys go on changing the state meanwhile (the next picture takes the latest)
+                    data = yield (lambda: _checked_slice(source, m, c0, coarse_, lock))
+                    if self._closed:
+                        return None
+                    if self._source_version != version or self.source is not source:
+                        self._pump.mark_dirty()  # the source changed meanwhile: never show the old one
+                        return None
+                    self._slice_cache = (m, c0, version, coarse_, data)
             colors = self._group_colors()
             extra = {} if colors is None else {"group_rgb": colors}
-            if scene.show(self._rows_data, single_rgb=single, **extra):
+            if scene.show(data, single_rgb=single, **extra):
                 sent = scene.update_id
+            self._rows_data = data
             self._shown = self._rows_key = key
         now = self._pump.clock()
+        if self._update_errors:  # a good picture: the widget has recovered
+            self._clear_update_errors()
         if not len(self._repeater) or now - self._readout_at >= READOUT_PERIOD:
             self.readout.value = self._readout_html()
             self._readout_at, self._readout_stale = now, False
@@ -1117,12 +1212,8 @@ class Rot4DWidget(widgets.HBox):
             ("last", last),
         ]
         rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
-        colors = self._group_colors()
-        if colors is not None and self.color_by == "group":  # the legend: what each colour is
-            if _is_stack(self.source):
-                labels = [f"w {w:.3g}" for w in self.source.levels_at(st.c0)]
-            else:
-                labels = [f"{lv:.4g}" for lv in self.source.levels]
+        colors, labels = self._colours()
+        if labels is not None and self.color_by == "group":  # the legend: what each colour is
             rows.append(("colours", " ".join(
                 f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
                 f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
@@ -1135,27 +1226,122 @@ class Rot4DWidget(widgets.HBox):
         return ro.readout_html(_title(self.source), rows, gizmo=ro.gizmo_svg(st.matrix))
 
     def _group_colors(self):
-        """Colours the source asks for (a stack's colours by w, a field's by level), or None."""
-        if _is_stack(self.source):
-            return self.source.group_colors()
-        return _level_colors(self.source) if self._coarse_ok else None
+        """The colour of every group of the source as it is now (`_colours`)."""
+        return self._colours()[0]
+
+    def _colours(self):
+        """``(rgb (G, 3), labels or None)``: a stack's colours by w, else a field's by level (also
+        inside a stack of one slice), else the scene's palette sized to the source's groups
+        now (labels None: cells need no legend).  Follows the source when it changes."""
+        src = self.source
+        if _is_stack(src):
+            rgb = src.group_colors()
+            if rgb is not None:
+                return rgb, [f"w {w:.3g}" for w in src.levels_at(self.state.c0)]
+            src = src.source
+        rgb = _level_colors(src)
+        if rgb is not None:
+            return rgb, [f"{lv:.4g}" for lv in src.levels]
+        return self.scene.palette(int(self.source.n_groups)), None
 
     def _report_error(self, exc: BaseException) -> None:
-        """Show an exception in the ``errors`` area (and the log); never raises."""
+        """Show an exception in the ``errors`` area (and the log); never raises.
+
+        The area shows what went wrong since the last good picture: the next update that
+        is sent clears it (the widget has recovered)."""
         try:
             text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
             log.error("Rot4DWidget: error while handling a key\n%s", text)
             self._repeater.clear()
             item = {"output_type": "stream", "name": "stderr", "text": text}
             self.errors.outputs = tuple(self.errors.outputs[-(MAX_ERRORS_SHOWN - 1):]) + (item,)
+            self._update_errors = self.errors.outputs
         except Exception:
             log.exception("Rot4DWidget: could not report an error")
+
+    def _clear_update_errors(self) -> None:
+        shown, self._update_errors = self._update_errors, ()
+        if tuple(self.errors.outputs) == tuple(shown):
+            self.errors.outputs = ()
 
 
 # ------------------------------------------------------------------ helpers
 def _is_stack(source) -> bool:
     """True for parallel slices (`rot4d_widget.tomography.StackSource`) without importing it."""
     return type(source).__name__ == "StackSource" and hasattr(source, "levels_at")
+
+
+class _LiveSource:
+    """The widget's source as it is at each moment (a replay may turn it into a stack midway)."""
+
+    def __init__(self, widget):
+        self._widget = widget
+
+    def __getattr__(self, name):
+        return getattr(self._widget.source, name)
+
+
+def _checked_slice(source, matrix, c0, coarse, lock):
+    """``source.slice`` validated once (`rot4d_widget.source.check_slice`): a bad slice (None,
+    non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
+    or TypeError naming the source and the member that is wrong, and is never drawn."""
+    with lock:
+        data = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
+        n_groups = int(source.n_groups)
+    try:
+        check_slice(data, n_groups)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{_title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
+    return data
+
+
+def _opposite(action: Action, inverted: bool):
+    """``(action, inverted)`` of the step that undoes one step of ``action``."""
+    if action.is_rotation or action.kind == "custom":
+        return action, not inverted
+    return dataclasses.replace(action, sign=-action.sign), inverted
+
+
+def _page_time(event) -> float | None:
+    """The page's time of an ipyevents event in seconds (its ``timeStamp``, ms), or None."""
+    t = event.get("timeStamp") if isinstance(event, Mapping) else None
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        return None
+    return float(t) / 1000.0
+
+
+#: Key p's request: a numbered file in the current directory, named when the picture arrives.
+_KEY_P = object()
+
+
+_PNG_FLAGS = os.O_WRONLY | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_BINARY", 0)
+
+
+def _write_png(path, png: bytes) -> str:
+    """Write ``png`` to ``path`` (replacing a file) but never through a link at that name."""
+    name = os.fspath(path)
+    if os.path.islink(name):
+        raise OSError(f"{name} is a link: a screenshot is never written through one")
+    with os.fdopen(os.open(name, _PNG_FLAGS | os.O_TRUNC, 0o666), "wb") as f:
+        f.write(png)
+    return name
+
+
+def _write_numbered_png(png: bytes, start: int) -> tuple:
+    """Key p: write ``png`` as the first free ``rot4d-NNN.png`` (N >= ``start``) in the current
+    directory, never overwriting anything, not even a dangling link.  Returns (name, next N)."""
+    for n in range(max(int(start), 1), max(int(start), 1) + 100000):
+        name = f"rot4d-{n:03d}.png"
+        if os.path.lexists(name):
+            continue
+        try:
+            fd = os.open(name, _PNG_FLAGS | os.O_EXCL, 0o666)
+        except FileExistsError:
+            continue
+        with os.fdopen(fd, "wb") as f:
+            f.write(png)
+        return name, n + 1
+    raise OSError("no free rot4d-NNN.png name in the current directory")
 
 
 def _takes_coarse(source) -> bool:
@@ -1208,7 +1394,7 @@ def _default_ball_radius(source, scale, state) -> float:
     """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment."""
     edge = getattr(source, "edge_length", None)
     if edge is None:
-        data = source.slice(state.matrix, state.c0)
+        data = _checked_slice(source, state.matrix, state.c0, False, threading.RLock())
         seg = np.asarray(data.segments)
         if len(seg):
             p = np.asarray(data.points, dtype=np.float64)

@@ -92,6 +92,12 @@ class FakeScene:
     def set_display(self, **options):
         self.display.update(self.check_display(options))
 
+    @staticmethod
+    def palette(n_groups):
+        from rot4d_widget import look
+
+        return look.group_palette(max(int(n_groups), 1))
+
     def show(self, s, single_rgb=None, group_rgb=None):
         """Like Scene.show: True if sent, False (and no new update_id) if the picture is unchanged."""
         if self.shown and np.array_equal(self.shown[-1].points, s.points) and self.single[-1] == single_rgb:
@@ -152,15 +158,18 @@ def fake_rendering(monkeypatch):
 _CODES = {"?": "Slash", "@": "Digit2", "+": "Equal", "-": "Minus"}
 
 
-def key_event(kind, key, code=None, shift=False, repeat=False, t=0.0, **extra):
-    """The dict ipyevents 2.0.4 sends for a key event."""
+def key_event(kind, key, code=None, shift=False, repeat=False, t=None, **extra):
+    """The dict ipyevents 2.0.4 sends for a key event; ``t``: the page's time in seconds (its
+    ``timeStamp``), left out when None so that the kernel's clock alone decides the steps."""
     if code is None:
         code = _CODES.get(key) or (f"Digit{key}" if key.isdigit() else f"Key{key.upper()}")
     ev = {
         "type": kind, "event": kind, "key": key, "code": code, "shiftKey": shift,
         "altKey": False, "ctrlKey": False, "metaKey": False, "repeat": repeat,
-        "timeStamp": t * 1000.0, "location": 0, "target": {},
+        "location": 0, "target": {},
     }
+    if t is not None:
+        ev["timeStamp"] = t * 1000.0
     ev.update(extra)
     return ev
 
@@ -610,7 +619,7 @@ def test_malformed_events_are_ignored(make, event):
 def test_errors_in_key_handling_are_shown_not_lost(make, clock):
     w = make()
 
-    def broken(s, single_rgb=None):
+    def broken(s, single_rgb=None, group_rgb=None):
         raise RuntimeError("scene exploded")
 
     w.scene.show = broken
@@ -628,7 +637,7 @@ def test_errors_in_the_ticker_are_shown_and_stop_the_hold(make, clock):
     w = make()
     down(w, "4")
     w.companion.drawn()
-    w.scene.show = lambda s, single_rgb=None: 1 / 0
+    w.scene.show = lambda s, single_rgb=None, group_rgb=None: 1 / 0
     run_ticker(w, clock, clock.t + 1.0)
     assert any("ZeroDivisionError" in o["text"] for o in w.errors.outputs)
     assert w.held_keys == ()
@@ -690,12 +699,19 @@ def test_the_ticker_thread_rotates_in_real_time_and_stops_on_keyup():
         w.close()
 
 
-def test_no_thread_until_needed_and_none_for_a_scripting_widget_at_rest():
+def test_no_thread_until_a_change_then_the_thread_sends_it():
+    # the ticker thread alone sends (so changes queued behind a slow slice coalesce): a widget
+    # that nothing changed has none; the first change starts it and it sends the new picture
     w = Rot4DWidget()
     try:
         assert not w._pump.thread_alive
-        w.press("k")  # readout only: nothing in flight, nothing to wait for
-        assert not w._pump.thread_alive
+        before = w.scene.update_id
+        w.press("4")
+        assert w._pump.thread_alive
+        limit = time.monotonic() + 30
+        while w.scene.update_id == before and time.monotonic() < limit:
+            time.sleep(0.01)
+        assert w.scene.update_id > before
     finally:
         w.close()
 

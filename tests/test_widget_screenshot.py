@@ -49,7 +49,8 @@ def test_png_data_urls_are_checked():
 
 def test_no_view_no_screenshot_and_the_readout_says_so(make, recording_comms):
     w = make()
-    assert w.screenshot() is None
+    with pytest.warns(UserWarning, match="no view is displayed"):
+        assert w.screenshot() is None
     assert "no view is displayed" in w.readout.value
     assert w.last_screenshot is None
     assert len(_asked(recording_comms, w)) == 1  # asked anyway: a front end may not count views

@@ -67,9 +67,14 @@ def test_a_single_view_becomes_parallel_slices_when_asked(make):
     assert pressed.press("n")
     assert isinstance(pressed.source, StackSource) and pressed.slices == 2
     _same_picture(pressed, make("5-cell", slices=2))
-    assert len(pressed.recording) == 0  # the wrap is not a step a recording could replay
-    pressed.press("n")  # the stack's own key from here on: recorded
-    assert [e.action.name for e in pressed.recording.events] == ["slice +"]
+    # the wrap is recorded as the source setting it is (issue 18 item 9: replay ends where you ended)
+    [wrap] = pressed.recording.events
+    assert (wrap.name, wrap.value) == ("slices", 2)
+    pressed.press("n")  # the stack's own key from here on: recorded as a step
+    assert pressed.recording.events[-1].action.name == "slice +"
+    again = make("5-cell")
+    again.replay(pressed.recording)
+    assert isinstance(again.source, StackSource) and again.slices == 3
 
 
 def test_one_slice_is_today_s_view(make):
