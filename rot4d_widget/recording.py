@@ -11,6 +11,8 @@ to the live state.  ``recorder.recording()`` is an immutable `Recording`:
 
 * ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
   so a recorded ``r`` resets where the live one did);
+* ``initial_source``: the source settings the events start from (``{"levels": [...], ...}``, those
+  the recorder was told with ``source_settings=``, and those folded in), possibly empty;
 * ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value) and
   `SourceSetting` (t, name, value);
 * ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
@@ -189,6 +191,18 @@ def _check_source_setting(name, value):
     return str(value)
 
 
+def _check_source_settings(settings) -> dict:
+    """A ``{name: value}`` of source settings, checked (`_check_source_setting`), in `SOURCE_SETTINGS` order."""
+    if settings is None:
+        return {}
+    if not isinstance(settings, Mapping):
+        raise ValueError(f"Expected the source settings as a dict {{name: value}}, got {settings!r}")
+    for name in settings:
+        if name not in SOURCE_SETTINGS:
+            raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
+    return {name: _check_source_setting(name, settings[name]) for name in SOURCE_SETTINGS if name in settings}
+
+
 def _event_from_dict(d):
     if not isinstance(d, Mapping) or "t" not in d:
         raise ValueError(f"Expected a recorded event with a time 't', got {d!r}")
@@ -280,8 +294,9 @@ def _apply(state: RotationState, event, source=None, set_source=None) -> bool:
 class Recording:
     """A starting state and the events applied to it (immutable; see the module docstring)."""
 
-    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0):
+    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0, initial_source: Mapping | None = None):
         RotationState.from_dict(initial)  # validates
+        self._initial_source = _check_source_settings(initial_source)
         self._initial = json.loads(json.dumps(dict(initial)))  # a private, JSON-clean copy
         self.events = tuple(events)
         for e in self.events:
@@ -291,6 +306,11 @@ class Recording:
             raise ValueError("Expected `dropped` (how many events were folded into the starting state) to be an "
                              f"int >= 0, got {dropped!r}")
         self.dropped = int(dropped)
+
+    @property
+    def initial_source(self) -> dict:
+        """The source settings at the start (``{name: value}`` of `SOURCE_SETTINGS`; a copy)."""
+        return json.loads(json.dumps(self._initial_source))
 
     @property
     def initial(self) -> dict:
@@ -315,9 +335,12 @@ class Recording:
     # -- data ------------------------------------------------------------------------------
     def to_dict(self) -> dict:
         # version 1 unless a source setting needs 2: older readers keep reading what they can
-        version = 2 if any(isinstance(e, SourceSetting) for e in self.events) else 1
-        return {"format": RECORDING_FORMAT, "version": version, "initial": self.initial,
-                "dropped": self.dropped, "events": [e.to_dict() for e in self.events]}
+        version = 2 if self._initial_source or any(isinstance(e, SourceSetting) for e in self.events) else 1
+        d = {"format": RECORDING_FORMAT, "version": version, "initial": self.initial}
+        if self._initial_source:
+            d["initial_source"] = self.initial_source
+        d.update(dropped=self.dropped, events=[e.to_dict() for e in self.events])
+        return d
 
     @classmethod
     def from_dict(cls, d) -> "Recording":
@@ -331,7 +354,7 @@ class Recording:
         events = [_event_from_dict(e) for e in d["events"]]
         if any(b.t < a.t for a, b in zip(events, events[1:])):
             raise ValueError("Expected a recording's events in time order")
-        return cls(d["initial"], events, dropped=d.get("dropped", 0))
+        return cls(d["initial"], events, dropped=d.get("dropped", 0), initial_source=d.get("initial_source"))
 
     def save(self, path) -> None:
         """Write the recording as JSON to ``path``."""
@@ -355,7 +378,8 @@ class Recording:
         """Apply the events to ``state`` (in place; default a fresh state) and return it.
 
         ``restart``: set ``state`` to the recording's starting state first (its orientation,
-        parameters and reset point; its keymap is kept).  ``source``: a source whose own actions
+        parameters and reset point; its keymap is kept) and the source to its `initial_source`
+        settings.  ``source``: a source whose own actions
         (``source.actions``, matched by name) are replayed on it, changing it; without one they
         are skipped.  The result equals the recorded final state bit for bit.
 
@@ -369,7 +393,7 @@ class Recording:
         if set_source is not None and not callable(set_source):
             raise TypeError(f"Expected `set_source` to be a callable (name, value), got {type(set_source).__name__}")
         if set_source is None and source is not None:
-            self._check_source_settings(source)
+            self._check_source_settings(source, restart)
         if state is None:
             state = self.initial_state()
         elif not isinstance(state, RotationState):
@@ -378,13 +402,22 @@ class Recording:
             d = dict(self._initial)
             d.pop("keymap", None)
             state.restore(d)  # with the recorded reset point ("initial")
+        if restart:
+            for e in self._start_settings():
+                _apply(state, e, source, set_source)
         for e in self.events:
             _apply(state, e, source, set_source)
         return state
 
-    def _check_source_settings(self, source) -> None:
+    def _start_settings(self) -> list:
+        """`initial_source` as `SourceSetting` events at t = 0."""
+        return [SourceSetting(0.0, name, value) for name, value in self.initial_source.items()]
+
+    def _check_source_settings(self, source, restart: bool = True) -> None:
         """ValueError now if ``source`` cannot take the recording's source settings in place."""
         names = {e.name for e in self.events if isinstance(e, SourceSetting)}
+        if restart:
+            names |= set(self._initial_source)
         inner = source.source if _is_stack(source) else source
         if "levels" in names and not hasattr(inner, "levels"):
             raise ValueError(f"The recording sets 'levels', which applies to a source with iso levels (a field), "
@@ -405,12 +438,14 @@ class Recorder:
     made (``clock``, default `time.monotonic`).  Thread-safe (the widget's ticker thread records
     while the kernel's thread may read).  Past ``max_events`` the oldest event is folded into
     the starting state, so `recording` always replays to the live state (custom source actions
-    that fall out are lost: count in ``dropped``; the last value of each source setting that
-    falls out is kept, at the start of the recording).  ``record_source(name, value)`` records
-    a source setting (``levels``, ``slices``, ``spacing``, ``arrangement``).
+    that fall out are lost: count in ``dropped``; a source setting that falls out becomes the
+    recording's `Recording.initial_source`).  ``record_source(name, value)`` records a source
+    setting (``levels``, ``slices``, ``spacing``, ``arrangement``); ``source_settings`` (here and
+    in `restart`) are the source's settings when recording starts, ``{name: value}``.
     """
 
-    def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic):
+    def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic,
+                 source_settings: Mapping | None = None):
         if not isinstance(state, RotationState):
             raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
         if isinstance(max_events, bool) or not isinstance(max_events, int) or max_events < 1:
@@ -420,19 +455,20 @@ class Recorder:
         self.max_events = max_events
         self._clock = clock
         self._lock = threading.Lock()
-        self._start(state)
+        self._start(state, source_settings)
 
-    def _start(self, state):
+    def _start(self, state, source_settings=None):
+        settings = _check_source_settings(source_settings)
         self._t0 = self._clock()
         self._shadow = state.copy()  # the state before the oldest kept event
+        self._shadow_source = settings  # the source settings before the oldest kept event
         self._events = collections.deque()
-        self._folded_source = {}  # name -> the last SourceSetting folded out of the events
         self.dropped = 0
 
-    def restart(self, state: RotationState) -> None:
-        """Forget everything; record from ``state`` as it is now."""
+    def restart(self, state: RotationState, source_settings: Mapping | None = None) -> None:
+        """Forget everything; record from ``state`` (and the source's ``source_settings``) as they are now."""
         with self._lock:
-            self._start(state)
+            self._start(state, source_settings)
 
     def _stamp(self, t):
         return max(0.0, self._clock() - self._t0) if t is None else _time(t)
@@ -444,9 +480,8 @@ class Recorder:
             self._events.append(event)
             while len(self._events) > self.max_events:
                 old = self._events.popleft()
-                if isinstance(old, SourceSetting):  # no source here: keep its last value instead
-                    self._folded_source.pop(old.name, None)
-                    self._folded_source[old.name] = old
+                if isinstance(old, SourceSetting):  # folded into the starting source settings
+                    self._shadow_source[old.name] = old.value
                 else:
                     _apply(self._shadow, old)
                 self.dropped += 1
@@ -479,8 +514,8 @@ class Recorder:
     def recording(self) -> Recording:
         """The events so far as an immutable `Recording`."""
         with self._lock:
-            events = tuple(self._folded_source.values()) + tuple(self._events)
-            return Recording(self._shadow.to_dict(initial=True), events, dropped=self.dropped)
+            return Recording(self._shadow.to_dict(initial=True), tuple(self._events), dropped=self.dropped,
+                             initial_source=self._shadow_source)
 
     def __len__(self) -> int:
         return len(self._events)
@@ -525,6 +560,9 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
         src = _with_source_setting(src, name, value)
 
     setter = None if src is None else set_source
+    if src is not None:
+        for e in recording._start_settings():
+            set_source(e.name, e.value)
     events = recording.events
     yield 0.0, state, src
     if per == "step":
@@ -570,9 +608,10 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     ``settings`` go to `rot4d_widget.figures.render_state` (``size``, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...).  ``titles``: a callable ``(k, t, state) -> str`` giving each
     frame a title, or None.  More than ``max_frames`` frames raises ``ValueError`` before any is drawn.
-    When the recording sets source settings (``levels``, ``slices``, ``spacing``,
-    ``arrangement``), those keywords are the source's settings at the start, and each frame
-    shows them as recorded up to it.
+    When the recording has source settings (``levels``, ``slices``, ``spacing``,
+    ``arrangement``: its `Recording.initial_source` or recorded ones), those keywords are the
+    source's settings at the start unless ``initial_source`` has them, and each frame shows them
+    as recorded up to it.
     """
     from .figures import render_state, state_source
 
@@ -581,7 +620,7 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     if n > max_frames:
         raise ValueError(f"The animation would have {n} frames, more than max_frames = {max_frames}; "
                          "lower fps, use per='step', or raise max_frames")
-    if any(isinstance(e, SourceSetting) for e in recording.events):
+    if recording.initial_source or any(isinstance(e, SourceSetting) for e in recording.events):
         # the settings given are where the source starts; the recorded ones change it from there
         start = {k: settings.pop(k) for k in SOURCE_SETTINGS if k in settings}
         source = state_source(source, **start)

@@ -373,12 +373,12 @@ def test_render_frames_follow_the_source_settings(monkeypatch):
     assert field.levels != (1.0,)
 
 
-def test_a_bounded_recorder_keeps_the_last_source_settings_folded_out():
+def test_a_bounded_recorder_folds_source_settings_into_the_starting_ones():
     from rot4d_widget.tomography import StackSource
 
     clock = Clock()
     st = RotationState()
-    rec = Recorder(st, max_events=3, clock=clock)
+    rec = Recorder(st, max_events=3, clock=clock, source_settings={"arrangement": "stack"})
     for v in (1.0, 2.0, 3.0):
         clock.now += 0.1
         rec.record_source("levels", v)
@@ -388,11 +388,46 @@ def test_a_bounded_recorder_keeps_the_last_source_settings_folded_out():
         st.press("4")
         rec.record("4", False, "xw")
     r = rec.recording()
-    assert r.dropped == 6 and [type(e).__name__ for e in r.events] == ["SourceSetting"] * 2 + ["Step"] * 3
-    assert [(e.name, e.value) for e in r.events[:2]] == [("levels", [3.0]), ("spacing", 0.4)]
+    assert r.dropped == 6 and [type(e).__name__ for e in r.events] == ["Step"] * 3
+    assert r.initial_source == {"levels": [3.0], "spacing": 0.4, "arrangement": "stack"}
     stack = StackSource(_ball_field(), slices=2)
     got = r.replay(None, stack)
-    assert stack.source.levels == (3.0,) and stack.spacing == 0.4 and np.array_equal(got.matrix, st.matrix)
+    assert stack.source.levels == (3.0,) and stack.spacing == 0.4 and stack.arrangement == "stack"
+    assert np.array_equal(got.matrix, st.matrix)
+
+
+def test_the_source_settings_at_the_start_are_kept_and_replayed_first(tmp_path):
+    from rot4d_widget.tomography import StackSource
+
+    st = RotationState()
+    rec = Recorder(st, clock=Clock(), source_settings={"slices": 4, "levels": (1.5,)})
+    st.press("4")
+    rec.record("4", False, "xw")
+    rec.record_source("levels", (2.0,), t=1.0)
+    r = rec.recording()
+    assert r.initial_source == {"levels": [1.5], "slices": 4}
+    d = r.to_dict()
+    assert d["version"] == 2 and d["initial_source"] == {"levels": [1.5], "slices": 4}
+    r.save(tmp_path / "keys.json")
+    assert Recording.load(tmp_path / "keys.json").initial_source == r.initial_source
+    calls = []
+    r.replay(None, None, set_source=lambda name, value: calls.append((name, value)))
+    assert calls == [("levels", [1.5]), ("slices", 4), ("levels", [2.0])]
+    calls.clear()
+    r.replay(None, None, restart=False, set_source=lambda name, value: calls.append((name, value)))
+    assert calls == [("levels", [2.0])]  # not restarted: the start settings are not applied
+    stack = StackSource(_ball_field(), slices=2)
+    r.replay(None, stack)
+    assert stack.slices == 4 and stack.source.levels == (2.0,)
+    frames = [(type(src).__name__, getattr(src, "slices", None), getattr(src, "source", src).levels)
+              for _, _, src in animation_states(r, None, _ball_field())]
+    assert frames == [("StackSource", 4, (1.5,)), ("StackSource", 4, (1.5,)), ("StackSource", 4, (2.0,))]
+    rec.restart(st, {"spacing": None})
+    assert rec.recording().initial_source == {"spacing": None} and len(rec.recording()) == 0
+    with pytest.raises(ValueError, match="a source setting among"):
+        Recorder(st, source_settings={"colour": 1})
+    with pytest.raises(ValueError, match="as a dict"):
+        Recording(st.to_dict(initial=True), initial_source=[("levels", 1.0)])
 
 
 @pytest.mark.parametrize("name, value, match", [
