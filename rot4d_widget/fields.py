@@ -62,7 +62,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import sealed as _sealed
-from .polytopes import COORDINATE_RANGE, check_scale
+from .polytopes import COORDINATE_RANGE, _power_of_two_unit, check_scale
 from .rotation import as_rotation_matrix
 from .source import SliceData
 
@@ -283,8 +283,9 @@ def _check_extent(extent) -> tuple:
     for d in range(4):
         end = float(np.abs(e[d]).max())
         if end > hi:
-            raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} "
-                             f"(rot4d_widget.polytopes.COORDINATE_RANGE; rescale the coordinates, e.g. to other units)")
+            raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
+                             f"{lo:g} to {hi:g} (rot4d_widget.polytopes.COORDINATE_RANGE; rescale the coordinates, "
+                             f"e.g. to other units)")
         check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")
     return tuple((float(a), float(b)) for a, b in e)
 
@@ -861,11 +862,14 @@ class Field4D:
         else:
             rng = (math.nan, math.nan)
         with np.errstate(invalid="ignore"):
-            grads = np.gradient(a, *spacing)
+            # spacings in units of the box's size (a power of two: exact), so a float32 gradient
+            # neither overflows nor underflows at any scale; K is scaled back below
+            u = _power_of_two_unit(self.size)
+            grads = np.gradient(a, *[sp / u for sp in spacing])
             gm = np.sqrt(sum(g * g for g in grads))
         ok = np.isfinite(gm) & (gm > 0)
         if ok.any():
-            k = float(np.percentile(gm[ok], 95))  # steep places: a phase field's plateaus must not set it
+            k = float(np.percentile(gm[ok], 95)) / u  # steep places: a phase field's plateaus must not set it
         else:
             span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
             k = max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * self.size)
