@@ -82,6 +82,7 @@ _DESCRIPTIONS = {
 #: to the same action is not shown ("=" next to "+", "_" next to "-").
 _HELP_TWINS = {"=": "+", "_": "-"}
 _CODE_RE = re.compile(r"^[A-Z][A-Za-z0-9]+$")
+_LETTER_CODE_RE = re.compile(r"^Key([A-Z])$")
 _DIGIT_CODE_RE = re.compile(r"^(?:Digit|Numpad)([0-9])$")
 
 _SUPERSCRIPT_MINUS_ONE = "\u207b\u00b9"
@@ -193,6 +194,12 @@ class Keymap(Mapping):
         if not isinstance(bindings, Mapping):
             raise TypeError(f"Keymap expects a mapping of key -> action, got {type(bindings).__name__}")
         self._bindings = {_check_key_name(k): Action.parse(v) for k, v in bindings.items()}
+        for k, a in self._bindings.items():  # one physical key, two names: which would win is not ours to guess
+            m = _LETTER_CODE_RE.match(k) or _DIGIT_CODE_RE.match(k)
+            twin = m.group(1).lower() if m else None
+            if twin is not None and twin in self._bindings and self._bindings[twin] != a:
+                raise ValueError(f"Keymap binds both {twin!r} and {k!r} (the same key) to different actions: "
+                                 f"bind one of them")
 
     def __getitem__(self, key: str) -> Action:
         return self._bindings[key]

@@ -592,12 +592,14 @@ class Scene:
 
     def _grow(self, capacity):
         """Grow the row capacity; every intermediate frame shows one whole picture."""
+        capacity = max(int(capacity), len(self._rows))
         padded = np.zeros((capacity, bf.ROW_FLOATS), dtype=np.float32)
-        padded[: self.capacity] = self._rows
+        padded[: len(self._rows)] = self._rows  # the rows assigned last (a failed send may have left them longer)
         self._assign(padded, self.update_id, self._buffer._rot4d_counts)  # (a) same picture, more (hidden) rows
+        self.capacity = capacity  # the rows are that long now, whatever (b) does
         for g in self._geometries.values():  # (b) draw them
             g.maxInstancedCount = capacity
-        self.capacity = capacity  # (c) is the caller's normal update
+        # (c) is the caller's normal update
 
     # -- teardown ----------------------------------------------------------
     def close(self) -> None:

@@ -36,6 +36,7 @@ That is geometry, not a promise a source has to make.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 
@@ -71,8 +72,10 @@ class SourceAction:
     """An extra key action a source brings.
 
     ``run(sign)`` changes the source (+1 for the key, -1 for Shift+key when
-    ``invertible``); the widget then re-slices.  ``repeat``: the action
-    repeats while the key is held, like a rotation.
+    ``invertible``); the widget then re-slices.  ``run`` returns False when it
+    changed nothing (a bound reached: the widget records no step and the key's
+    opposite still undoes every step made).  ``repeat``: the action repeats
+    while the key is held, like a rotation.
     """
 
     name: str
@@ -192,6 +195,15 @@ _POLYGON_NAMES = {
 }
 
 
+def _volume_or_none(s):
+    """A polytope slice's volume, or None where it left float64's range (inf beyond coordinates of
+    about 1e102, or a solid slice's volume underflowed below about 1e-102)."""
+    v = float(s.volume)
+    if not math.isfinite(v) or (s.dim == 3 and abs(v) < sys.float_info.min):
+        return None
+    return v
+
+
 def census_text(s) -> str:
     """A polytope slice's faces in words: ``"8 triangles, 6 quadrilaterals"``."""
     if s.dim < 0:
@@ -267,7 +279,7 @@ class PolytopeSource:
             triangles=s.triangles,
             groups=s.triangle_cells,
             normals=None,
-            volume=float(s.volume),
+            volume=_volume_or_none(s),
             readout=(("slice", census_text(s)),),
             convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
             extra={"slice": s},

@@ -98,6 +98,11 @@ FRAME_MARGIN = 0.97
 VIEW_ASPECT = 600.0 / 500.0
 #: g / f multiply / divide the spacing by this (Shift inverts).
 SPACING_FACTOR = 2.0 ** 0.25
+#: Δ stays within [SPACING_MIN, SPACING_MAX] times the source's size: g / f refuse a step
+#: beyond (so the opposite key always undoes one), and setting Δ outside is a ValueError.
+#: 2^-12 size: slices closer than that look the same; 4 size: every slice but one misses.
+SPACING_MIN = 2.0 ** -12
+SPACING_MAX = 4.0
 
 _D = float(look.CAMERA_POSITION[2])
 _HALF_H = _D * math.tan(math.radians(look.CAMERA_FOV) / 2.0)  # frame half-height at z = 0
@@ -323,7 +328,18 @@ class StackSource:
 
     @spacing.setter
     def spacing(self, value) -> None:
-        self._spacing = _check_spacing(value)
+        d = _check_spacing(value)
+        if d is not None:
+            lo, hi = self.spacing_range
+            if not lo <= d <= hi:
+                raise ValueError(f"Expected `spacing` in [{lo:.4g}, {hi:.4g}] ({SPACING_MIN:g} \u2026 {SPACING_MAX:g} "
+                                 f"times the source's size {self.size:.4g}) or None, got {d!r}")
+        self._spacing = d
+
+    @property
+    def spacing_range(self) -> tuple:
+        """(lowest, highest) Δ allowed: `SPACING_MIN` and `SPACING_MAX` times the source's size."""
+        return SPACING_MIN * self.size, SPACING_MAX * self.size
 
     @property
     def spacing_is_default(self) -> bool:
@@ -393,8 +409,11 @@ class StackSource:
 
     @property
     def actions(self) -> dict:
-        """n / b: one slice more / fewer; g / f: Δ times / divided by 2^(1/4) (Shift inverts each)."""
+        """n / b: one slice more / fewer; g / f: Δ times / divided by 2^(1/4) (Shift inverts each);
+        and the inner source's own keys (a field's o / i), which act on every slice."""
+        inner = getattr(self.source, "actions", None) or {}
         return {
+            **inner,
             "n": SourceAction("slice +", "add a parallel slice", lambda sign=1: self.step_slices(sign), repeat=False),
             "b": SourceAction("slice \u2212", "remove a parallel slice", lambda sign=1: self.step_slices(-sign),
                               repeat=False),
@@ -404,15 +423,23 @@ class StackSource:
                               lambda sign=1: self.step_spacing(-sign)),
         }
 
-    def step_slices(self, sign: int) -> int:
-        """One slice more (sign > 0) or fewer, kept in 1 ... 64; returns N."""
-        self._slices = min(MAX_SLICES, max(1, self._slices + (1 if sign > 0 else -1)))
-        return self._slices
+    def step_slices(self, sign: int):
+        """One slice more (sign > 0) or fewer; returns N, or False (no change) beyond 1 ... 64."""
+        n = self._slices + (1 if sign > 0 else -1)
+        if not 1 <= n <= MAX_SLICES:
+            return False
+        self._slices = n
+        return n
 
-    def step_spacing(self, sign: int) -> float:
-        """Δ times (sign > 0) or divided by `SPACING_FACTOR`; returns Δ (now explicit)."""
-        self._spacing = self.spacing * (SPACING_FACTOR if sign > 0 else 1.0 / SPACING_FACTOR)
-        return self._spacing
+    def step_spacing(self, sign: int):
+        """Δ times (sign > 0) or divided by `SPACING_FACTOR`; returns Δ (now explicit), or False
+        (no change) when that would leave `spacing_range`."""
+        d = self.spacing * (SPACING_FACTOR if sign > 0 else 1.0 / SPACING_FACTOR)
+        lo, hi = self.spacing_range
+        if not lo <= d <= hi:
+            return False
+        self._spacing = d
+        return d
 
     def slice(self, matrix, c0, coarse: bool = False) -> StackSliceData:
         """The N slices at `levels_at` (``c0``), placed by the arrangement, as one `StackSliceData`."""

@@ -54,7 +54,7 @@ from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .source import as_source, check_slice
-from .state import DEFAULT_THETA0, RotationState, _finite, _theta0
+from .state import DEFAULT_THETA0, RotationState, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
 
@@ -284,7 +284,7 @@ class Rot4DWidget(widgets.HBox):
         from .recording import Recorder
 
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
-        self._recorder = Recorder(state, clock=self._pump.clock)
+        self._recorder = Recorder(state, clock=self._pump.clock, source_settings=_source_settings(src))
 
         # -- widgets ------------------------------------------------------------
         Scene, Companion = _scene_classes()
@@ -452,9 +452,9 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             if self._closed:
                 raise RuntimeError("This Rot4DWidget is closed")
-            return self._ask_screenshot(path, callback)
+            return self._ask_screenshot(path, callback, warn=True)
 
-    def _ask_screenshot(self, path, callback):
+    def _ask_screenshot(self, path, callback, warn=False):
         # asked in any case: a front end that does not count views (count 0) may still answer,
         # but such a request is not kept (an answer to it is dropped), so none piles up
         now = self._pump.clock()
@@ -470,7 +470,8 @@ class Rot4DWidget(widgets.HBox):
             del self._screenshots[rid]  # no view to answer (a front end that counts none: see below)
             text = "no view is displayed to answer: no screenshot (display the widget first)"
             self._set_note(text)
-            warnings.warn(f"Rot4DWidget.screenshot: {text}", stacklevel=3)
+            if warn:  # from code: say it where the code runs (key p: the readout says it)
+                warnings.warn(f"Rot4DWidget.screenshot: {text}", stacklevel=3)
             return None
         shown = "rot4d-NNN.png" if path is _KEY_P else path
         self._set_note(f"screenshot asked{' for ' + str(shown) if shown is not None else ''}\u2026")
@@ -522,7 +523,21 @@ class Rot4DWidget(widgets.HBox):
 
     def _build_keypad(self):
         """Rows of buttons, one per bound action in `_PAD_ROWS`; each button's presses feed the
-        same repeater as keys (ipyevents mouse and touch events on the button)."""
+        same repeater as keys (ipyevents mouse and touch events on the button).  If building
+        fails halfway (a comm that raises), every widget made for it is closed again."""
+        from ipywidgets.widgets.widget import _instances
+
+        before = set(_instances)
+        try:
+            return self._make_keypad()
+        except BaseException:
+            made = [w for k, w in list(_instances.items()) if k not in before]
+            self._pad_events = [ev for ev in self._pad_events if ev not in made]
+            for w in made:
+                _close_quietly(w)
+            raise
+
+    def _make_keypad(self):
         rows = []
         for title, row in _PAD_ROWS:
             buttons = []
@@ -598,7 +613,7 @@ class Rot4DWidget(widgets.HBox):
     def start_recording(self) -> None:
         """Forget what was recorded; record from the current state on."""
         with self._pump.lock:
-            self._recorder.restart(self.state)
+            self._recorder.restart(self.state, _source_settings(self.source))
 
     def replay(self, recording) -> None:
         """Apply a `Recording` (or a path to a saved one) to this widget: its starting state,
@@ -619,7 +634,7 @@ class Rot4DWidget(widgets.HBox):
             self._source_version += 1
             self._sync_levels()
             self._sync_stack()
-            self._recorder.restart(self.state)
+            self._recorder.restart(self.state, _source_settings(self.source))
             self._sync_traits()
             self._pump.mark_dirty()
             self._pump.flush()
@@ -695,12 +710,15 @@ class Rot4DWidget(widgets.HBox):
         self._apply_loaded(loaded.state, loaded.settings)
 
     @classmethod
-    def from_state(cls, path, source=None, **kwargs) -> "Rot4DWidget":
+    def from_state(cls, path, source=None, *, allow_code: bool = False, **kwargs) -> "Rot4DWidget":
         """A widget for a `save_state` file: its source rebuilt from the file (or ``source``,
-        needed when the file says it cannot be rebuilt), its settings, its state."""
+        needed when the file says it cannot be rebuilt), its settings, its state.
+
+        A file is data: a field made from a function is refused unless ``allow_code=True``
+        (then the module the file names is imported) or the source is passed in."""
         from .export import load_state
 
-        loaded = load_state(path, source=source)
+        loaded = load_state(path, source=source, allow_code=allow_code)
         if loaded.source is None:
             raise ValueError(f"{path!r} does not say how to rebuild its source: pass it, "
                              "Rot4DWidget.from_state(path, source=...)")
@@ -735,7 +753,7 @@ class Rot4DWidget(widgets.HBox):
                 setattr(self, name, value)
         self.refresh()
         with self._pump.lock:
-            self._recorder.restart(self.state)
+            self._recorder.restart(self.state, _source_settings(self.source))
 
     def release_keys(self, page_time=None) -> None:
         """Release every held key (what mouseleave and focus loss do); ``page_time``: the page's
@@ -819,6 +837,13 @@ class Rot4DWidget(widgets.HBox):
     def _valid_display(self, proposal):
         name = proposal["trait"].name
         return self.scene.check_display({name: proposal["value"]})[name]
+
+    @traitlets.validate("slices")
+    def _valid_slices(self, proposal):
+        value = proposal["value"]
+        if value is not None and (isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer))):
+            raise TypeError(f"Expected `slices` to be an int in 1 \u2026 64 or None, got {value!r}")
+        return value
 
     @traitlets.validate("color_by")
     def _valid_color_by(self, proposal):
@@ -905,7 +930,8 @@ class Rot4DWidget(widgets.HBox):
         from .tomography import StackSource
 
         stack = StackSource(self.source, slices=slices)
-        self._use_keymap(self.state.keymap, stack)
+        # the stack brings the inner source's keys too: rebind them from the reserved ones
+        self._use_keymap(without_source_keys(self.state.keymap), stack)
         with self._source_lock:
             self.source = stack
         self._source_version += 1
@@ -1063,7 +1089,11 @@ class Rot4DWidget(widgets.HBox):
             opposite = _opposite(action, inverted)
             for _ in range(-correction):
                 self._step(*opposite)
-        for _ in range(max(correction, 0)):
+        clock = self._pump.clock
+        start = clock()
+        for _ in range(max(correction, 0)):  # missing steps: within one tick's time, like a tick
+            if clock() - start > self._repeater.period:
+                break
             self._step(action, inverted)
 
     # ------------------------------------------------------------ stepping
@@ -1071,10 +1101,13 @@ class Rot4DWidget(widgets.HBox):
         """Pump callback: the held keys' steps due by ``now``; a tick that overran (slow
         observers, a loaded machine) drops the ticks it missed instead of bursting."""
         rep = self._repeater
+        clock = self._pump.clock
         for key_id, action, inverted in rep.due_keys(now):
             if self._step(action, inverted):
                 rep.note_applied(key_id)
-        after = self._pump.clock()
+            if clock() - now > rep.period:
+                break  # over budget: the rest of this catch-up is dropped, the lock let go
+        after = clock()
         if after - now > rep.period:
             rep.drop_missed(after)
 
@@ -1219,8 +1252,9 @@ class Rot4DWidget(widgets.HBox):
                 f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
                 for t, rgb in zip(labels, colors))))
         volume = getattr(data, "volume", None)
-        if volume is not None:
-            rows.append(("volume", f"{volume * self._scale ** 3:.4f} as drawn"))
+        drawn = None if volume is None else float(volume) * self._scale * self._scale * self._scale
+        if drawn is not None and math.isfinite(drawn):  # a factor at a time: no overflow at any scale
+            rows.append(("volume", f"{drawn:.4f} as drawn"))
         if self._note:
             rows.append(("picture", html.escape(self._note)))
         return ro.readout_html(_title(self.source), rows, gizmo=ro.gizmo_svg(st.matrix))
@@ -1269,6 +1303,22 @@ class Rot4DWidget(widgets.HBox):
 def _is_stack(source) -> bool:
     """True for parallel slices (`rot4d_widget.tomography.StackSource`) without importing it."""
     return type(source).__name__ == "StackSource" and hasattr(source, "levels_at")
+
+
+def _source_settings(source) -> dict:
+    """The settings a recording starts from: a source's iso levels, a stack's N, Δ (None while
+    it follows N) and arrangement (`rot4d_widget.recording.Recorder`'s ``source_settings``)."""
+    out = {}
+    stack = _is_stack(source)
+    inner = source.source if stack else source
+    levels = getattr(inner, "levels", None)
+    if levels is not None:
+        out["levels"] = tuple(float(v) for v in levels)
+    if stack:
+        out["slices"] = int(source.slices)
+        out["spacing"] = None if source.spacing_is_default else float(source.spacing)
+        out["arrangement"] = source.arrangement
+    return out
 
 
 class _LiveSource:

@@ -1,0 +1,377 @@
+"""Hostile use (issue 18): what broke when the widget was driven as a hostile user would.
+
+Each test names the item it covers; each failed on the code before the fix (7ba6e62).
+The widgets here are real (real Scene and companion, no browser), on the fake clock without a
+ticker thread unless the test is about the thread.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+import time
+
+import ipywidgets
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rot4d_widget import Rot4DWidget, SliceData
+from rot4d_widget.fields import Field4D
+from rot4d_widget.keyhold import steps_for
+from rot4d_widget.keymap import DEFAULT_KEYMAP
+from rot4d_widget.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
+from rot4d_widget.tomography import SPACING_MAX, SPACING_MIN
+from test_widget import down, up, xw_steps
+from widget_time import service
+
+pytestmark = pytest.mark.usefixtures("recording_comms")
+
+
+def run_ticker(w, clock, until):
+    """What the ticker thread does, on the fake clock, up to ``until`` (the kernel's time)."""
+    while True:
+        deadline = service(w)
+        if deadline is None or deadline > until:
+            clock.t = until
+            service(w)
+            return
+        clock.t = max(clock.t, deadline)
+
+
+def ball_field():
+    return Field4D.from_function(lambda x, y, z, w: 1.0 - (x * x + y * y + z * z + w * w),
+                                 extent=[(-1.5, 1.5)] * 4, levels=0.0, resolution=16)
+
+
+def c0_steps(w, start=0.0):
+    return round((w.state.c0 - start) / w.state.c0_step)
+
+
+# ------------------------------------------------------- item 0: keys by the page's clock
+def test_a_tap_whose_keyup_the_kernel_handles_late_is_one_step(make, clock):
+    """The kernel, busy, handles the keyup 1 s after the keydown; the page says it was a tap."""
+    w = make()
+    page = 5000.0  # the page's clock has nothing to do with the kernel's
+    down(w, "4", t=page)
+    run_ticker(w, clock, clock.t + 1.0)  # meanwhile the ticker repeats: 1 + 23 steps
+    assert xw_steps(w) > 1
+    up(w, "4", t=page + 0.06)
+    assert xw_steps(w) == 1
+    # the steps taken back are in the recording: a replay ends where the view ended
+    again = make()
+    again.replay(w.recording)
+    np.testing.assert_allclose(again.state.matrix, w.state.matrix, atol=1e-12)
+
+
+@pytest.mark.parametrize("held, kernel_late", [(0.6, 0.9), (1.0, 0.4), (0.25, 0.5), (2.0, 0.0)])
+def test_a_hold_makes_the_steps_the_page_s_duration_gives(make, clock, held, kernel_late):
+    w = make()
+    t0 = clock.t
+    down(w, "4", t=77.0)
+    run_ticker(w, clock, t0 + held + kernel_late)
+    up(w, "4", t=77.0 + held)
+    assert xw_steps(w) == steps_for(held, w.hold_delay, w.tick_rate)
+
+
+def test_a_kernel_behind_adds_at_most_max_lag_of_missing_steps(make, clock):
+    w = make()
+    down(w, "4", t=0.0)  # the ticker never ran: the kernel was busy the whole hold
+    up(w, "4", t=2.0)
+    want = steps_for(2.0, w.hold_delay, w.tick_rate)
+    assert 1 + w._repeater.max_steps == xw_steps(w) < want  # dropped beyond the max lag
+
+
+def test_a_late_keyup_of_l_takes_back_the_c0_steps_and_mouseleave_corrects_too(make, clock):
+    w = make()
+    down(w, "l", t=10.0)
+    run_ticker(w, clock, clock.t + 0.8)
+    up(w, "l", t=10.1)
+    assert c0_steps(w) == 1
+    down(w, "4", t=20.0)
+    run_ticker(w, clock, clock.t + 0.8)
+    from test_widget import deliver
+
+    deliver(w, {"type": "mouseleave", "event": "mouseleave", "timeStamp": 20.1e3})
+    assert xw_steps(w) == 1 and w.held_keys == ()
+
+
+def test_a_key_pad_click_the_kernel_sees_late_is_one_step(make, clock):
+    w = make(keypad=True)
+    [button_4] = [ev for ev in w._pad_events if ev.source.description == "R_xw"]
+
+    def send(event):  # as the front end does: a custom message on the button's Event comm
+        button_4.comm.handler({"content": {"data": {"method": "custom", "content": event}}, "buffers": []})
+
+    send({"event": "mousedown", "type": "mousedown", "button": 0, "timeStamp": 1e3})
+    run_ticker(w, clock, clock.t + 1.0)
+    send({"event": "mouseup", "type": "mouseup", "button": 0, "timeStamp": 1.05e3})
+    assert xw_steps(w) == 1
+
+
+def test_a_slow_observer_does_not_freeze_the_keyup():
+    """Item 1: an observer slower than the tick period kept the ticker's lock for good."""
+    w = Rot4DWidget("5-cell", hold_delay=0.01, tick_rate=240, ack_timeout=0.01)
+    cost = []
+
+    def slow(change):
+        t = time.monotonic()
+        time.sleep(0.05)
+        cost.append(time.monotonic() - t)
+
+    try:
+        w.observe(slow, names="orientation")
+        now_ms = time.monotonic() * 1e3
+        down(w, "4", t=now_ms / 1e3)
+        time.sleep(0.5)
+        done = threading.Event()
+        took = []
+
+        def keyup():
+            t = time.monotonic()
+            up(w, "4", t=time.monotonic())
+            took.append(time.monotonic() - t)
+            done.set()
+
+        threading.Thread(target=keyup, daemon=True).start()
+        tick = max(cost)  # what one tick cost in this run
+        assert done.wait(60 * tick + 5), "the keyup was not handled: the ticker kept the lock"
+        # handled within about one tick (plus the steps the keyup corrects, each one tick)
+        assert took[0] < (w._repeater.max_steps + 4) * tick + 1.0, (took, tick)
+        assert w.held_keys == ()
+        m = w.state.matrix
+        time.sleep(10 * tick)
+        assert w.state.matrix is m  # nothing turns after the keyup
+    finally:
+        if w._pump.lock.acquire(timeout=5):  # (before the fix the ticker never let it go)
+            w._pump.lock.release()
+            w.close()
+
+
+def test_taps_queued_behind_a_slow_source_coalesce():
+    """Item 0: ten taps while a 0.3 s slice is computed draw two pictures, not ten."""
+    class Slow:
+        def __init__(self):
+            self.inner = ball_field()
+            self.calls = 0
+
+        def __getattr__(self, name):
+            return getattr(self.inner, name)
+
+        def slice(self, matrix, c0, coarse=False):
+            self.calls += 1
+            time.sleep(0.3)
+            return self.inner.slice(matrix, c0, coarse=coarse)
+
+    src = Slow()
+    w = Rot4DWidget(src, ack_timeout=0.05)
+    try:
+        calls = src.calls
+        for i in range(10):
+            w.press("l")
+        limit = time.monotonic() + 60
+        while (w._pump.dirty or w._pump._sending or w.stats.updates < 1) and time.monotonic() < limit:
+            time.sleep(0.05)
+        assert c0_steps(w) == 10
+        assert src.calls - calls <= 3, src.calls - calls  # the first, then the latest (not all ten)
+        np.testing.assert_allclose(w._rows_data.points, w.slice.points)  # what is shown is the latest
+    finally:
+        w.close()
+
+
+# ------------------------------------------------------- item 2: the palette follows the source
+def test_a_stack_taken_down_to_one_slice_keeps_working(make):
+    w = make("24-cell", slices=5)
+    for _ in range(4):
+        assert w.press("b")
+    assert w.slices == 1 and w.errors.outputs == ()
+    assert w.press("4") and w.errors.outputs == ()
+    w.slices = 5
+    w.slices = 1
+    w.press("8")
+    w.release_keys()
+    assert w.errors.outputs == ()
+    groups = int(np.max(w.slice.groups)) + 1
+    assert len(w._group_colors()) >= groups  # a colour for each of the 24-cell's cells
+
+
+def test_a_field_stack_down_to_one_slice_takes_new_levels_and_keeps_its_colours(make):
+    w = make(ball_field(), levels=(0.0, 0.3))
+    colours = w._group_colors().copy()
+    w.press("n")
+    w.press("b")
+    w.levels = (0.2, 0.4, 0.6)
+    assert w.levels == (0.2, 0.4, 0.6) and w.source.source.levels == (0.2, 0.4, 0.6)
+    assert w.errors.outputs == ()
+    w.levels = (0.0, 0.3)
+    np.testing.assert_allclose(w._group_colors(), colours)  # level colours, not the cells' cyan
+    assert "colours" in w.readout.value  # the legend is still there
+
+
+# ------------------------------------------------------- item 5: p with no view
+def test_p_with_no_view_does_not_pile_up(make, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    w = make()
+    for _ in range(1000):
+        down(w, "p", code="KeyP")
+        up(w, "p", code="KeyP")
+    assert len(w._screenshots) <= 8
+    assert os.listdir(tmp_path) == []
+
+
+# ------------------------------------------------------- item 6 and the bounds: finite, undone
+def test_g_held_stays_finite_and_f_brings_it_back(make):
+    w = make("24-cell", slices=3)
+    start = w.spacing
+    made = sum(bool(w.press("g")) for _ in range(5000))
+    size = w.source.size
+    assert math.isfinite(w.spacing) and w.spacing <= SPACING_MAX * size
+    for _ in range(made):
+        assert w.press("f")
+    assert w.spacing == pytest.approx(start, rel=1e-9)
+    made = sum(bool(w.press("f")) for _ in range(5000))
+    assert w.spacing >= SPACING_MIN * size
+    w.press("4")
+    assert w.errors.outputs == ()
+    with pytest.raises(ValueError, match="spacing"):
+        w.spacing = 1e300
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.sampled_from("+-kjlh"), min_size=1, max_size=400))
+def test_parameter_keys_stay_bounded_and_the_opposite_key_undoes_each_step(keys):
+    opposite = {"+": "-", "-": "+", "k": "j", "j": "k", "l": "h", "h": "l"}
+    s = RotationState(c0_limit=1.0)
+    start = (s.theta0, s.alpha, s.c0)
+    made = []
+    for k in keys:
+        if s.press(k):
+            made.append(k)
+        assert THETA0_MIN <= s.theta0 <= THETA0_MAX
+        assert abs(s.alpha) <= ALPHA_MAX and abs(s.beta) <= ALPHA_MAX
+        assert abs(s.c0) <= 1.0
+    for k in reversed(made):
+        assert s.press(opposite[k]), k
+    np.testing.assert_allclose((s.theta0, s.alpha, s.c0), start, rtol=1e-9, atol=1e-12)
+
+
+def test_minus_held_for_ever_keeps_theta0_positive():
+    s = RotationState()
+    for _ in range(5000):
+        s.press("-")
+    assert s.theta0 >= THETA0_MIN and s.press("+")
+
+
+# ------------------------------------------------------- item 8: leaks
+def _models():
+    from ipywidgets.widgets.widget import _instances
+
+    return len(_instances)
+
+
+def test_a_source_failing_in_construction_leaves_no_models():
+    class Fails:
+        size = 1.0
+        n_groups = 1
+
+        def slice(self, matrix, c0):
+            raise RuntimeError("no data")
+
+        def describe(self):
+            return {"kind": "fails"}
+
+    before = _models()
+    with pytest.raises(RuntimeError, match="no data"):
+        Rot4DWidget(Fails(), _autotick=False, ball_radius=0.05)
+    assert _models() == before
+
+
+def test_create_and_close_leaves_no_models():
+    Rot4DWidget(_autotick=False).close()  # warm-up (module-level widgets)
+    before = _models()
+    for _ in range(5):
+        Rot4DWidget(_autotick=False, keypad=True).close()
+    assert _models() == before
+
+
+# ------------------------------------------------------- item 11: a user source's bad slice
+class Flaky:
+    """A user source that returns NaN points, None or a good slice, as told."""
+
+    size = 1.0
+    n_groups = 2
+
+    def __init__(self):
+        self.mode = "good"
+
+    def slice(self, matrix, c0):
+        if self.mode == "nan":
+            return SliceData(np.array([[0.0, np.nan, 0.0]]), np.zeros((0, 2), int), np.zeros((0, 3), int),
+                             np.zeros(0, int))
+        if self.mode == "none":
+            return None
+        if self.mode == "group":
+            return SliceData.build(np.eye(3), triangles=[[0, 1, 2]], groups=[5])
+        return SliceData.build(np.eye(3) * (1 + c0), segments=[[0, 1]])
+
+    def describe(self):
+        return {"kind": "flaky"}
+
+
+@pytest.mark.parametrize("mode, field", [("nan", "points"), ("none", "points"), ("group", "groups")])
+def test_a_bad_user_slice_is_named_and_the_widget_recovers(make, mode, field):
+    src = Flaky()
+    w = make(src, ball_radius=0.05)
+    src.mode = mode
+    rows = w.scene._rows
+    with pytest.raises((TypeError, ValueError), match=f"Flaky.slice.*`{field}`"):
+        w.press("l")  # from code the error is raised; from a key it is shown (below)
+    down(w, "l", code="KeyL")
+    up(w, "l", code="KeyL")
+    assert w.errors.outputs, "the bad slice went through silently"
+    text = w.errors.outputs[-1]["text"]
+    assert "Flaky.slice" in text and f"`{field}`" in text
+    assert w.scene._rows is rows  # nothing of it reached the page
+    src.mode = "good"
+    down(w, "l", code="KeyL")
+    up(w, "l", code="KeyL")
+    assert w.errors.outputs == ()  # recovered: the error is cleared
+
+
+# ------------------------------------------------------- item 13: smaller ones
+def test_p_never_writes_through_a_dangling_link_and_screenshot_refuses_a_link(make, tmp_path, monkeypatch):
+    from test_widget_screenshot import _answer, _asked, _data_url, _png
+
+    monkeypatch.chdir(tmp_path)
+    target = tmp_path / "elsewhere.png"
+    os.symlink(target, tmp_path / "rot4d-001.png")
+    from test_widget import front_end_view_count
+
+    w = make()
+    front_end_view_count(w, 1)
+    down(w, "p", code="KeyP")
+    up(w, "p", code="KeyP")
+    rid = w._screenshot_seq
+    _answer(w, rid, png=_data_url(_png()))
+    assert not target.exists()
+    assert (tmp_path / "rot4d-002.png").is_file()
+    link = tmp_path / "link.png"
+    os.symlink(target, link)
+    rid = w.screenshot(str(link))
+    _answer(w, rid, png=_data_url(_png()))
+    assert not target.exists() and "not saved" in w.readout.value
+
+
+def test_a_field_stacked_at_construction_keeps_its_level_keys(make):
+    w = make(ball_field(), slices=3)
+    before = w.levels
+    assert w.press("o") and w.levels != before
+    assert "level up" in w.help_panel.value
+
+
+def test_a_keymap_binding_c_and_keyc_differently_is_refused():
+    with pytest.raises(ValueError, match="'c' and 'KeyC'"):
+        DEFAULT_KEYMAP.replace(KeyC="xy")
+    assert DEFAULT_KEYMAP.replace(KeyC="zw")["KeyC"] == DEFAULT_KEYMAP["c"]  # the same action: fine
