@@ -695,17 +695,23 @@ class Field4D:
         span = hi - lo
         return span / 50 if span > 0 else max(abs(hi), 1.0) / 50
 
-    def step_levels(self, sign: int) -> tuple:
-        """Move every level by ``sign * level_step``, kept within one step beyond the data range."""
+    def step_levels(self, sign: int):
+        """Move every level by ``sign * level_step``; returns the levels, or False (no change) when
+        a level would leave the data range widened by one step (refused, not clamped, so the
+        opposite key undoes every step made)."""
         step = self.level_step
         lo, hi = self.data_range
-        new = []
-        for v in self.levels:
-            v = v + (1 if sign > 0 else -1) * step
-            if math.isfinite(lo) and math.isfinite(hi):
-                v = min(max(v, lo - step), hi + step)
-            new.append(v)
-        self._levels = tuple(new)
+        new = tuple(v + (1 if sign > 0 else -1) * step for v in self.levels)
+        if math.isfinite(lo) and math.isfinite(hi):
+            def outside(v):  # how far beyond the widened range (0 inside)
+                return max(lo - step - v, v - hi - step, 0.0)
+
+            # a level set outside by hand may still step back towards the range
+            if any(outside(v) > 0 and outside(v) >= outside(u) for u, v in zip(self.levels, new)):
+                return False
+        elif not all(math.isfinite(v) for v in new):
+            return False
+        self._levels = new
         return self._levels
 
     @property

@@ -375,3 +375,16 @@ def test_a_keymap_binding_c_and_keyc_differently_is_refused():
     with pytest.raises(ValueError, match="'c' and 'KeyC'"):
         DEFAULT_KEYMAP.replace(KeyC="xy")
     assert DEFAULT_KEYMAP.replace(KeyC="zw")["KeyC"] == DEFAULT_KEYMAP["c"]  # the same action: fine
+
+
+def test_o_held_stays_in_the_data_range_and_i_undoes_each_step(make):
+    w = make(ball_field(), levels=0.0)
+    lo, hi = w.source.data_range
+    step = w.source.level_step
+    made = sum(bool(w.press("o")) for _ in range(500))
+    assert w.levels[0] <= hi + step
+    for _ in range(made):
+        assert w.press("i")
+    assert w.levels[0] == pytest.approx(0.0, abs=1e-9)
+    w.levels = (hi + 10 * step,)  # set outside by hand: i still steps back towards the range
+    assert not w.press("o") and w.press("i")
