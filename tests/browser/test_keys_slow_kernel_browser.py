@@ -345,7 +345,11 @@ def test_quick_taps_on_a_slow_source_are_exact_and_coalesced(jupyter_server, pag
     jp, sel = _shown(page, jupyter_server, "taps-slow.ipynb", 1, SLOW_SINGLE)
     jp.kernel(f"slow.delay = {SLOW_TAPS}")  # (built with the shorter delay: construction slices ~8 times)
     taps = jp.tap_round_trips(["l", "h", "l"])
-    bound = _timing_bound(taps, 8, 2.0)
+    # coalesced, the view settles at most ~2 round trips after the last tap (the slice under
+    # way when it came, then the latest state's); 3 allows for a loaded machine.  Each round
+    # trip here is mostly the store's 1 s, the same on a loaded machine.  Slicing every state
+    # the flow control lets through takes ~4.
+    bound = _timing_bound(taps, 3, 2.0)
     before = _settled(jp)
     n0 = len(_keylog(jp, "KeyL"))
     for _ in range(10):
