@@ -850,8 +850,9 @@ class Soak:
         w, rng = self.w, self.rng
         size = float(w.source.size)
         vals = {
-            "theta0": lambda: rng.uniform(1e-3, math.pi),
-            "alpha": lambda: rng.uniform(-1.0, 1.0),
+            # alpha keeps its ratio to theta0, and alpha and beta stay within [-pi, pi]
+            "theta0": lambda: rng.uniform(1e-3, self.theta0_max()),
+            "alpha": lambda: rng.uniform(max(-1.0, w.theta0 - math.pi), min(1.0, math.pi)),
             "c0": lambda: rng.uniform(-size, size),
             "color_by": lambda: rng.choice(["group", "#ff8800", "#0af", (0.2, 0.4, 0.6)]),
             "ball_radius": lambda: rng.uniform(0.01, 0.2),
@@ -874,12 +875,17 @@ class Soak:
             vals["arrangement"] = lambda: rng.choice(["oval", "grid", "stack"])
         return vals
 
+    def theta0_max(self) -> float:
+        """The largest theta0 a set may take now: alpha/theta0 is kept and |alpha|, |beta| <= pi."""
+        ratio = self.w.alpha / self.w.theta0
+        return min(math.pi, *(math.pi / abs(r) for r in (ratio, 1.0 - ratio) if r != 0.0))
+
     def invalid_values(self):
         w = self.w
         bad_num = [float("nan"), float("inf"), "x", None, True, [1.0]]
         vals = {
             "theta0": [0.0, -0.1, 4.0] + bad_num,
-            "alpha": bad_num,
+            "alpha": [4.0, -3.5] + bad_num,
             "c0": bad_num,
             "color_by": ["nope", (2.0, 0.0, 0.0), 5, None],
             "ball_radius": [0.0, -1.0, 11.0] + bad_num,

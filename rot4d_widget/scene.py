@@ -59,6 +59,7 @@ kernel does not echo it back again.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import pathlib
@@ -237,6 +238,7 @@ class Scene:
             raise ValueError(f"Expected `capacity` to be an int >= 1, got {capacity!r}")
         self.capacity = int(capacity)
         self.update_id = 0
+        self._unsent = False  # a send of the buffer failed and none succeeded since
         self.canvas_class = f"rot4d-canvas-{uuid.uuid4().hex[:12]}"
         self._closed = False
         self._display = {}
@@ -530,7 +532,7 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
             capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
-        if (not force and surface is None and np.array_equal(rows, self._rows)
+        if (not force and not self._unsent and surface is None and np.array_equal(rows, self._rows)
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
@@ -558,13 +560,26 @@ class Scene:
         m4 = np.eye(4)
         m4[:3, :3] = r
         turn = [float(x) for x in m4.flatten(order="F")]
-        if turn == self._buffer._rot4d_turn:
+        if turn == self._buffer._rot4d_turn and not self._unsent:
             return False
         self.update_id += 1
-        with self._buffer.hold_sync():
+        with self._sending():
             self._buffer._rot4d_turn = turn
             self._buffer._rot4d_seq = self.update_id
         return True
+
+    @contextlib.contextmanager
+    def _sending(self):
+        """The buffer's ``hold_sync``, remembering a failed send: until one succeeds, `show` and
+        `turn` never take "unchanged" for an answer (the kernel's copy of the traits is ahead of
+        the page's, and ipywidgets sends what it still owes with the next message)."""
+        try:
+            with self._buffer.hold_sync():
+                yield
+        except BaseException:
+            self._unsent = True
+            raise
+        self._unsent = False
 
     @property
     def counts(self) -> list:
@@ -578,7 +593,7 @@ class Scene:
 
     def _assign(self, rows, seq, counts=None, surface=None):
         buf = self._buffer
-        with buf.hold_sync():
+        with self._sending():
             if surface is not None:
                 buf._rot4d_surface = surface
                 self._surface_shown = bool(surface)

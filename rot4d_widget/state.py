@@ -98,6 +98,13 @@ def _read_only(m: np.ndarray) -> np.ndarray:
     return v
 
 
+def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
+    """ValueError unless |alpha| and |beta| = |theta0 - alpha| are within `ALPHA_MAX`."""
+    if not (abs(alpha) <= ALPHA_MAX and abs(theta0 - alpha) <= ALPHA_MAX):
+        raise ValueError(f"{what} gives alpha = {alpha:.6g}, beta = {theta0 - alpha:.6g}: expected both "
+                         f"in [-pi, pi] radians")
+
+
 def _theta0(value) -> float:
     value = _finite("theta0", value)
     if not 0.0 < value <= THETA0_MAX:
@@ -134,6 +141,7 @@ class RotationState:
         self.keymap = keymap
         self._theta0 = _theta0(theta0)
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else _finite("alpha", alpha)
+        _check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
         self._c0 = _finite("c0", c0)
         self.c0_step = c0_step
         self.c0_limit = c0_limit
@@ -161,7 +169,9 @@ class RotationState:
     @theta0.setter
     def theta0(self, value) -> None:
         value = _theta0(value)
-        self._alpha *= value / self._theta0  # keep alpha/theta0
+        alpha = self._alpha * (value / self._theta0)  # keep alpha/theta0
+        _check_alpha_beta(alpha, value, f"theta0 = {value:.6g} (alpha keeps its ratio to theta0)")
+        self._alpha = alpha
         self._theta0 = value
         self._steps.clear()
 
@@ -171,7 +181,9 @@ class RotationState:
 
     @alpha.setter
     def alpha(self, value) -> None:
-        self._alpha = _finite("alpha", value)
+        value = _finite("alpha", value)
+        _check_alpha_beta(value, self._theta0, f"alpha = {value:.6g}")
+        self._alpha = value
         self._steps.clear()
 
     @property

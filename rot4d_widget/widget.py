@@ -54,7 +54,7 @@ from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .source import as_source, check_slice
-from .state import DEFAULT_THETA0, RotationState, _finite, _theta0, without_source_keys
+from .state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
 
@@ -643,6 +643,8 @@ class Rot4DWidget(widgets.HBox):
         """A recorded source setting, applied as its trait would be (a stack made if needed)."""
         if isinstance(value, list):
             value = tuple(value)
+        self._sync_stack()  # the replay's steps changed the source: the traits must say what it is
+        self._sync_levels()
         setattr(self, name, value)
 
     def render_animation(self, path, *, recording=None, fps: float = 10.0, per: str = "step", **options) -> int:
@@ -827,11 +829,18 @@ class Rot4DWidget(widgets.HBox):
     # --------------------------------------------------------------- traits
     @traitlets.validate("theta0")
     def _valid_theta0(self, proposal):
-        return _theta0(proposal["value"])
+        value = _theta0(proposal["value"])
+        if not self._syncing:  # alpha keeps its ratio: refused here, before the trait changes
+            st = self.state
+            _check_alpha_beta(st.alpha * (value / st.theta0), value, f"theta0 = {value:.6g} (alpha keeps its ratio)")
+        return value
 
     @traitlets.validate("alpha", "c0")
     def _valid_real(self, proposal):
-        return _finite(proposal["trait"].name, proposal["value"])
+        value = _finite(proposal["trait"].name, proposal["value"])
+        if proposal["trait"].name == "alpha" and not self._syncing:
+            _check_alpha_beta(value, self.state.theta0, f"alpha = {value:.6g}")
+        return value
 
     @traitlets.validate("ball_radius", "bar_radius", "face_opacity", "background", "show_balls", "show_bars", "show_faces")
     def _valid_display(self, proposal):

@@ -388,3 +388,14 @@ def test_o_held_stays_in_the_data_range_and_i_undoes_each_step(make):
     assert w.levels[0] == pytest.approx(0.0, abs=1e-9)
     w.levels = (hi + 10 * step,)  # set outside by hand: i still steps back towards the range
     assert not w.press("o") and w.press("i")
+
+
+def test_a_replay_sets_a_stack_setting_the_keys_had_changed_since_it_was_last_set(make):
+    w = make("5-cell")
+    w.slices = 4
+    w.press("b")  # 3 (a step: the trait follows, the recording has the step)
+    w.slices = 4  # set again: a change from 3
+    w.press("b")
+    again = make("5-cell")
+    again.replay(w.recording)
+    assert again.slices == w.slices == 3
