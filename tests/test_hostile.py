@@ -257,6 +257,20 @@ def test_parameter_keys_stay_bounded_and_the_opposite_key_undoes_each_step(keys)
     np.testing.assert_allclose((s.theta0, s.alpha, s.c0), start, rtol=1e-9, atol=1e-12)
 
 
+def test_plus_held_stops_below_pi_and_minus_undoes_it_and_k_l_stay_bounded():
+    s = RotationState(c0_limit=1.0)
+    start = (s.theta0, s.alpha)
+    made = sum(bool(s.press("+")) for _ in range(40))
+    assert s.theta0 <= THETA0_MAX and not s.press("+")
+    for _ in range(made):
+        assert s.press("-")
+    np.testing.assert_allclose((s.theta0, s.alpha), start, rtol=1e-12)
+    for _ in range(20000):
+        s.press("k")
+        s.press("l")
+    assert abs(s.alpha) <= ALPHA_MAX and abs(s.beta) <= ALPHA_MAX and abs(s.c0) <= 1.0
+
+
 def test_minus_held_for_ever_keeps_theta0_positive():
     s = RotationState()
     for _ in range(5000):
@@ -273,11 +287,17 @@ def _models():
 
 def test_a_source_failing_in_construction_leaves_no_models():
     class Fails:
+        """Slices while the widget sizes its buffers, then fails (the first picture)."""
+
         size = 1.0
         n_groups = 1
+        calls = 0
 
         def slice(self, matrix, c0):
-            raise RuntimeError("no data")
+            self.calls += 1
+            if self.calls > 6:
+                raise RuntimeError("no data")
+            return SliceData.build(np.eye(3), segments=[[0, 1]])
 
         def describe(self):
             return {"kind": "fails"}
