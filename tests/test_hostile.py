@@ -24,21 +24,9 @@ from rot4d_widget.keyhold import steps_for
 from rot4d_widget.keymap import DEFAULT_KEYMAP
 from rot4d_widget.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
 from rot4d_widget.tomography import SPACING_MAX, SPACING_MIN
-from test_widget import down, up, xw_steps
-from widget_time import service
+from test_widget import down, run_ticker, up, xw_steps
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
-
-
-def run_ticker(w, clock, until):
-    """What the ticker thread does, on the fake clock, up to ``until`` (the kernel's time)."""
-    while True:
-        deadline = service(w)
-        if deadline is None or deadline > until:
-            clock.t = until
-            service(w)
-            return
-        clock.t = max(clock.t, deadline)
 
 
 def ball_field():
