@@ -407,3 +407,19 @@ def test_a_replay_sets_a_stack_setting_the_keys_had_changed_since_it_was_last_se
     again = make("5-cell")
     again.replay(w.recording)
     assert again.slices == w.slices == 3
+
+
+def test_a_replay_ends_at_the_levels_and_spacing_set_as_traits(make):
+    """Item 9: after `w.levels = (...)` / `w.spacing = 0.3` a replay ended at the old values."""
+    w = make(ball_field())
+    w.levels = (0.2, 0.5)
+    w.press("4")
+    again = make(ball_field())
+    again.replay(w.recording)
+    assert again.levels == (0.2, 0.5)
+    s = make("24-cell", slices=3)
+    s.spacing = 0.3
+    s.press("g")
+    again = make("24-cell")
+    again.replay(s.recording)
+    assert again.slices == 3 and again.spacing == pytest.approx(s.spacing)
