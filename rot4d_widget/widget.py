@@ -854,6 +854,20 @@ class Rot4DWidget(widgets.HBox):
             raise TypeError(f"Expected `slices` to be an int in 1 \u2026 64 or None, got {value!r}")
         return value
 
+    @traitlets.validate("spacing")
+    def _valid_spacing(self, proposal):
+        value = proposal["value"]  # checked here too: True == 1.0 would pass the observer unseen
+        if value is not None and (isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number))):
+            raise TypeError(f"Expected `spacing` to be a finite number > 0 or None, got {value!r}")
+        return value
+
+    @traitlets.validate("arrangement")
+    def _valid_arrangement(self, proposal):
+        value = proposal["value"]
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"Expected `arrangement` to be 'oval', 'grid' or 'stack', got {value!r}")
+        return value
+
     @traitlets.validate("color_by")
     def _valid_color_by(self, proposal):
         return _check_color_by(proposal["value"])

@@ -423,3 +423,12 @@ def test_a_replay_ends_at_the_levels_and_spacing_set_as_traits(make):
     again = make("24-cell")
     again.replay(s.recording)
     assert again.slices == 3 and again.spacing == pytest.approx(s.spacing)
+
+
+def test_a_bool_is_not_a_slice_count_or_a_spacing_even_when_it_equals_the_value(make):
+    w = make("5-cell", slices=1, spacing=1.0)
+    with pytest.raises(TypeError, match="slices"):
+        w.slices = True  # True == 1: traitlets would see no change and keep True
+    with pytest.raises(TypeError, match="spacing"):
+        w.spacing = True
+    assert w.slices == 1 and type(w.slices) is int and w.spacing == 1.0 and type(w.spacing) is float
