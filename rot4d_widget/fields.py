@@ -409,6 +409,54 @@ class _ChunkReader:
             self._cached = 0
 
 
+class _LazyXarray:
+    """A DataArray whose data are neither dask nor loaded (an xarray backend's lazily indexed
+    array: netCDF or zarr opened without chunks), seen as a plain sliceable array.
+
+    Slicing reads only that block (``variable[key].values``) and returns a numpy array, so the
+    chunk reader and dask's ``from_array`` never see a DataArray (inside dask a DataArray chunk
+    aligns by its labels -- two takes of neighbouring samples shrink to their common ones -- and
+    pulls in dask.dataframe, which needs pyarrow).  ``chunks``: the store's own chunk shape when
+    the encoding gives one (zarr), else None (the reader then reads 16-sample blocks).
+    """
+
+    def __init__(self, da):
+        self._variable = da.variable
+        self.shape = tuple(int(n) for n in da.shape)
+        self.ndim = len(self.shape)
+        self.dtype = np.dtype(da.dtype)
+        enc = getattr(da, "encoding", None) or {}
+        pref = enc.get("preferred_chunks")
+        ch = None
+        if isinstance(pref, dict) and all(d in pref for d in da.dims):
+            ch = tuple(int(pref[d]) for d in da.dims)
+        elif isinstance(enc.get("chunks"), (tuple, list)) and len(enc["chunks"]) == self.ndim:
+            ch = tuple(int(c) for c in enc["chunks"])
+        self.chunks = ch if ch is not None and all(c > 0 for c in ch) else None
+        self.name = da.name
+
+    def __getitem__(self, key):
+        return np.asarray(self._variable[key].values)
+
+    def __array__(self, dtype=None, copy=None):
+        a = self[(slice(None),) * self.ndim]
+        return a if dtype is None else a.astype(dtype, copy=False)
+
+
+def _xarray_values(da):
+    """The array behind a DataArray for `Field4D`: dask stays dask, loaded data become numpy,
+    a lazily indexed backend array becomes `_LazyXarray` (never the DataArray itself)."""
+    if da.chunks is not None:
+        return da.data
+    if getattr(da.variable, "_in_memory", True):
+        return np.asarray(da.values)
+    return _LazyXarray(da)
+
+
+def _is_xarray(obj, what: str) -> bool:
+    return type(obj).__name__ == what and (type(obj).__module__ or "").startswith("xarray")
+
+
 def _array_kind(values) -> str:
     if isinstance(values, np.ndarray):
         return "numpy"
@@ -607,8 +655,7 @@ class Field4D:
         if w_per_unit is None:
             sp = np.mean([(b - a) / (int(da.sizes[chosen[k]]) - 1) for k, (a, b) in zip("xyz", extent)])
             w_per_unit = ((extent[3][1] - extent[3][0]) / (int(da.sizes[chosen["w"]]) - 1)) / sp
-        values = da.data if da.chunks is not None else (
-            da.values if getattr(da.variable, "_in_memory", True) else da)
+        values = _xarray_values(da)
         units = da.attrs.get("units")
         w_units = kwargs.pop("w_units", da.coords[chosen["w"]].attrs.get("units") if chosen["w"] in da.coords else None)
         if w_units is None and chosen["w"] in da.coords and np.issubdtype(da.coords[chosen["w"]].dtype, np.datetime64):

@@ -1,0 +1,129 @@
+"""The scientist's path into Field4D: files opened every way xarray opens them, the axis order
+named (never guessed silently), bad input named, non-finite data reported.
+
+Each xarray test writes its own small files (tmp_path): 60 times (more than COARSE_SAMPLES, so
+the coarse copy resamples time) on an 8 x 8 x 8 grid, and compares every way of opening them with
+the same numbers given as a numpy array.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+from rot4d_widget.fields import COARSE_SAMPLES, Field4D, slice_field
+from rot4d_widget.rotation import random_rotation
+
+NT = 60
+assert NT > COARSE_SAMPLES
+
+
+def tzyx_array():
+    """f[t, z, y, x]: a ball whose radius grows with t, plus a little noise."""
+    t = np.linspace(0.0, 1.0, NT)[:, None, None, None]
+    g = np.linspace(-1.0, 1.0, 8)
+    r2 = g[None, None, None, :] ** 2 + g[None, None, :, None] ** 2 + g[None, :, None, None] ** 2
+    noise = np.random.default_rng(0).normal(0.0, 0.01, (NT, 8, 8, 8))
+    return (0.2 + 0.6 * t - r2 + noise).astype(np.float64)
+
+
+def dataset(xr):
+    a = tzyx_array()
+    g = np.linspace(-1.0, 1.0, 8)
+    return xr.Dataset({"T": (("time", "z", "y", "x"), a, {"units": "K"})},
+                      coords={"time": np.linspace(0.0, 5.9, NT), "z": g, "y": g, "x": g})
+
+
+OPENINGS = {
+    "netcdf open_dataset": lambda xr, d: xr.open_dataset(d / "run.nc", engine="scipy"),
+    "netcdf open_dataset chunks={}": lambda xr, d: xr.open_dataset(d / "run.nc", engine="scipy", chunks={}),
+    "netcdf load": lambda xr, d: xr.open_dataset(d / "run.nc", engine="scipy").load(),
+    "zarr open_zarr": lambda xr, d: xr.open_zarr(d / "run.zarr"),
+    "zarr open_zarr chunks=None": lambda xr, d: xr.open_zarr(d / "run.zarr", chunks=None),
+    "zarr open_dataset engine=zarr": lambda xr, d: xr.open_dataset(d / "run.zarr", engine="zarr"),
+    "zarr open_dataset engine=zarr load": lambda xr, d: xr.open_dataset(d / "run.zarr", engine="zarr").load(),
+}
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    xr = pytest.importorskip("xarray")
+    d = tmp_path_factory.mktemp("run")
+    ds = dataset(xr)
+    pytest.importorskip("scipy")
+    ds.to_netcdf(d / "run.nc", engine="scipy")  # netCDF3
+    if _has("zarr"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # zarr 3: consolidated metadata is not in the spec
+            ds.to_zarr(d / "run.zarr", mode="w")
+    return d
+
+
+def _has(module):
+    try:
+        __import__(module)
+    except ImportError:
+        return False
+    return True
+
+
+def _same_slices(a, b, tol=1e-9):
+    assert len(a.vertices) == len(b.vertices) and len(a.triangles) == len(b.triangles)
+    assert np.allclose(a.vertices, b.vertices, atol=tol * 10, rtol=0)
+    assert a.volume == pytest.approx(b.volume, rel=tol, abs=tol)
+
+
+@pytest.mark.parametrize("how", list(OPENINGS))
+def test_the_readme_xarray_line_works_however_the_file_is_opened(files, how):
+    """`Field4D.from_xarray(open(...)["T"], w="time")` for netCDF3 and zarr, chunked or not, lazy or
+    loaded: the same slices (full and coarse, at a turned matrix) as the numpy array.  Before, a
+    lazily indexed backend array went into dask as a DataArray: without pyarrow a
+    ModuleNotFoundError from dask.dataframe, with it a ValueError from np.gradient (the coarse copy's
+    neighbouring takes aligned by label and lost samples)."""
+    xr = pytest.importorskip("xarray")
+    if "zarr" in how and not _has("zarr"):
+        pytest.skip("zarr is not installed")
+    if "chunks={}" in how or how == "zarr open_zarr":
+        pytest.importorskip("dask")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", category=FutureWarning)
+        ds = OPENINGS[how](xr, files)
+    field = Field4D.from_xarray(ds["T"], w="time")
+    assert field.axes == "wzyx" and field.shape == (8, 8, 8, NT) and field.units == "K"
+    ref = Field4D(tzyx_array(), axes="wzyx", extent=field.extent, w_per_unit=field.w_per_unit)
+    assert field.data_range == pytest.approx(ref.data_range)
+    level = 0.25
+    rng = np.random.default_rng(3)
+    for c0 in (0.0, 0.2):
+        m = random_rotation(rng)
+        for coarse in (False, True):
+            _same_slices(slice_field(field, m, c0, level, 24, coarse=coarse),
+                         slice_field(ref, m, c0, level, 24, coarse=coarse))
+        d = field.slice(m, c0)
+        assert len(d.triangles) > 0
+    ds.close()
+
+
+def test_a_lazily_opened_file_never_reaches_dask_dataframe(files):
+    """The netCDF file opened without chunks goes through every step (coarse copy, statistics, a
+    full step) without importing dask.dataframe -- the module that needs pyarrow -- so the line
+    works with and without pyarrow installed (a fresh interpreter: nothing imported it before)."""
+    pytest.importorskip("xarray")
+    code = f"""
+import sys, numpy as np, xarray as xr
+from rot4d_widget import Field4D
+f = Field4D.from_xarray(xr.open_dataset({str(files / "run.nc")!r}, engine="scipy")["T"], w="time")
+m = np.linalg.qr(np.random.default_rng(1).normal(size=(4, 4)))[0]
+m = m if np.linalg.det(m) > 0 else m[:, [1, 0, 2, 3]]
+f.slice(m, 0.0, coarse=True); f.slice(m, 0.0)
+assert f._kind == "lazy", f._kind
+print("dask.dataframe" in sys.modules)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "False"
