@@ -1108,10 +1108,13 @@ class Rot4DWidget(widgets.HBox):
         A late keyup lets the ticker repeat a key the user had already released; the page's
         timestamps say how many steps the hold made, and this makes the state agree.  Each
         step taken back is the opposite step, recorded like any other."""
-        if correction < 0:
+        if correction < 0:  # however many (a keyup 80 s late): the traits are synced once
             opposite = _opposite(action, inverted)
-            for _ in range(-correction):
-                self._step(*opposite)
+            undone = sum(self._apply_step(*opposite) for _ in range(-correction))
+            if undone:
+                if self._last_label == action.label(inverted):
+                    self._last_count = max(self._last_count - undone, 1)
+                self._after_steps(action)
         clock = self._pump.clock
         start = clock()
         for _ in range(max(correction, 0)):  # missing steps: within one tick's time, like a tick
@@ -1135,6 +1138,19 @@ class Rot4DWidget(widgets.HBox):
             rep.drop_missed(after)
 
     def _step(self, action: Action, inverted: bool) -> bool:
+        """One step of ``action``: applied, recorded, counted in the readout, traits synced."""
+        changed = self._apply_step(action, inverted)
+        if changed:
+            label = action.label(inverted)
+            if label == self._last_label:
+                self._last_count += 1
+            else:
+                self._last_label, self._last_count = label, 1
+            self._after_steps(action)
+        return changed
+
+    def _apply_step(self, action: Action, inverted: bool) -> bool:
+        """Apply and record one step (no trait sync: `_after_steps` does it once); True if it changed."""
         if action.kind == "custom":
             run = self._custom.get(action.name)
             if run is None:
@@ -1144,33 +1160,31 @@ class Rot4DWidget(widgets.HBox):
             if result is False:  # refused (at a bound): nothing changed, nothing recorded
                 return False
             self._source_version += 1
-            changed = True
             self._recorder.record(None, False, action, inverted)
-            self._sync_levels()
-            self._sync_stack()
-        elif action.kind == "screenshot":
+            return True
+        if action.kind == "screenshot":
             self._screenshot_key()
             return False
-        elif action.kind == "slices" and not _is_stack(self.source):
-            # n on a single slice: the first added slice makes the view a stack of two (not a
-            # step a recording can replay: the stack's own keys are, from here on)
-            changed = (-1 if inverted else 1) * action.sign > 0
-            if changed:
-                self._wrap_in_stack(2)
-                self._recorder.record_source("slices", 2)
-        else:
-            changed = self.state.apply(action, inverted)
-            if changed:
-                self._recorder.record(None, False, action, inverted)
+        if action.kind == "slices" and not _is_stack(self.source):
+            # n on a single slice: the first added slice makes the view a stack of two (recorded
+            # as the source setting it is; the stack's own keys are steps from here on)
+            if (-1 if inverted else 1) * action.sign <= 0:
+                return False
+            self._wrap_in_stack(2)
+            self._recorder.record_source("slices", 2)
+            return True
+        changed = self.state.apply(action, inverted)
         if changed:
-            self._pump.mark_dirty()
-            label = action.label(inverted)
-            if label == self._last_label:
-                self._last_count += 1
-            else:
-                self._last_label, self._last_count = label, 1
-            self._sync_traits()
+            self._recorder.record(None, False, action, inverted)
         return changed
+
+    def _after_steps(self, action: Action) -> None:
+        """After steps of ``action`` changed something: redraw, and the traits say what it is."""
+        self._pump.mark_dirty()
+        if action.kind in ("custom", "slices"):
+            self._sync_levels()
+            self._sync_stack()
+        self._sync_traits()
 
     def _current_slice(self, coarse: bool = False):
         st = self.state

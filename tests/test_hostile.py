@@ -432,3 +432,26 @@ def test_a_bool_is_not_a_slice_count_or_a_spacing_even_when_it_equals_the_value(
     with pytest.raises(TypeError, match="spacing"):
         w.spacing = True
     assert w.slices == 1 and type(w.slices) is int and w.spacing == 1.0 and type(w.spacing) is float
+
+
+def test_a_keyup_80_s_late_takes_back_every_step_with_one_observer_call(make, clock):
+    """Item 0: a released key kept turning for 82 s; the take-back must not cost a step's
+    observers per step taken back (2,400 calls of a slow observer would freeze the keyup)."""
+    w = make()
+    down(w, "4", t=0.0)
+    run_ticker(w, clock, clock.t + 80.0)
+    assert xw_steps(w) != 1 and len(w.recording.events) > 2000
+    calls = []
+    w.observe(lambda change: calls.append(1), names="orientation")
+    up(w, "4", t=0.05)
+    assert len(calls) == 1
+    m = w.state.matrix
+    expected = np.eye(4)
+    c, s = math.cos(w.state.theta0), math.sin(w.state.theta0)
+    expected[0, 0] = expected[3, 3] = c
+    expected[3, 0], expected[0, 3] = s, -s
+    np.testing.assert_allclose(m, expected, atol=1e-9)
+    from test_widget_scene import drawn
+
+    drawn(w)  # the page drew what is in flight: the readout catches up
+    assert "<td>last</td><td>R_xw</td>" in w.readout.value  # one step, not "R_xw ×2400"
