@@ -38,11 +38,13 @@ The rules that keep a slow kernel from freezing the keys:
   handled after at most one tick.  A tick that overruns drops the ticks it
   missed (the owner's ``tick`` reschedules them; see
   `rot4d_widget.keyhold.KeyRepeater.drop_missed`).
-* **Expensive work runs outside the lock.**  ``send`` may be a generator: it
-  yields a callable (the slow part: slicing) after reading the state under
-  the lock; the thread runs that callable with the lock released and sends
-  its result back into the generator under the lock again, which returns the
-  update's id.  Meanwhile keys change the state freely.
+* **Expensive work runs outside the lock, and ticks go on meanwhile.**  ``send``
+  may be a generator: it yields a callable (the slow part: slicing) after
+  reading the state under the lock; with the ticker running, a worker thread
+  runs that callable without the lock and sends its result back into the
+  generator under the lock again, which returns the update's id.  Meanwhile
+  keys change the state and held keys keep ticking on time (a slow slice does
+  not eat their steps); one send at a time.
 * **Queued changes coalesce.**  With ``autotick``, `flush` only wakes the
   thread: the thread alone sends, always the latest state, so ten taps that
   arrive while a slow slice is computed make one more picture, not ten.
@@ -72,6 +74,15 @@ MIN_WAIT = 0.001
 MAX_IN_FLIGHT = 3
 #: Recent acknowledgement times the adaptive timeout looks at.
 _ACK_WINDOW = 8
+
+
+def _complete(gen, result):
+    """Send ``result`` into a two-phase send's generator; the update id it returns."""
+    try:
+        gen.send(result)
+    except StopIteration as stop:
+        return stop.value
+    raise RuntimeError("a two-phase send must yield exactly once")
 
 
 @dataclass
@@ -210,45 +221,55 @@ class UpdatePump:
             self._send_locked(now, expect_ack, unlocked)
 
     def _send_locked(self, now, expect_ack, unlocked) -> None:
-        """`send_now` with the lock held once (it may be let go for a two-phase send's slow part)."""
+        """`send_now` with the lock held once.  ``unlocked`` (the ticker thread): a two-phase
+        send's slow part goes to a worker thread, so ticks go on meanwhile; the worker finishes
+        the send under the lock (`_finish`)."""
         self._dirty = False
         self._sending = True
         try:
             seq = self._send()
             if inspect.isgenerator(seq):
-                seq = self._run_generator(seq, unlocked)
+                try:
+                    work = next(seq)
+                except StopIteration as stop:
+                    seq = stop.value
+                else:
+                    if unlocked:
+                        threading.Thread(target=self._work, args=(seq, work, now, expect_ack),
+                                         name=f"{self._name}-slice", daemon=True).start()
+                        return  # still sending: `_finish` ends it
+                    seq = _complete(seq, work())
         except BaseException:
+            self._sending = False
             self._dirty = self._failed = True
             raise
-        finally:
-            self._sending = False
+        self._sending = False
+        self._sent(seq, now, expect_ack)
+
+    def _sent(self, seq, now, expect_ack) -> None:
         if seq is not None:
             self.stats.updates += 1
             if expect_ack:
                 self._flight[seq] = self.clock() if now is None else now
 
-    def _run_generator(self, gen, unlocked: bool):
-        """Drive a two-phase ``send``: its yielded callable runs without the lock if ``unlocked``."""
+    def _work(self, gen, work, now, expect_ack) -> None:
+        """The worker: the slow part without the lock, then the rest of the send under it."""
         try:
-            work = next(gen)
-        except StopIteration as stop:
-            return stop.value
-        if unlocked:
-            self.lock.release()
+            result, error = work(), None
+        except BaseException as exc:  # reported under the lock, like any failed send
+            result, error = None, exc
+        with self.lock:
             try:
-                result = work()
-            except BaseException as exc:
-                self.lock.acquire()
-                gen.close()
-                raise exc
-            self.lock.acquire()
-        else:
-            result = work()
-        try:
-            gen.send(result)
-        except StopIteration as stop:
-            return stop.value
-        raise RuntimeError("a two-phase send must yield exactly once")
+                if error is not None:
+                    gen.close()
+                    raise error
+                self._sent(_complete(gen, result), self.clock() if now is None else now, expect_ack)
+            except Exception as exc:
+                self._dirty = self._failed = True
+                self._report(exc)
+            finally:
+                self._sending = False
+                self.wake()  # the latest state may be waiting
 
     def acknowledge(self, seq) -> bool:
         """The page drew update ``seq`` (and so every older one); True if it was awaited."""
