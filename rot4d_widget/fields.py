@@ -57,6 +57,7 @@ import math
 import numbers
 import sys
 import threading
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,7 +67,8 @@ from .polytopes import COORDINATE_RANGE, _power_of_two_unit, check_scale
 from .rotation import as_rotation_matrix
 from .source import SliceData
 
-__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "AxesWarning", "NonFiniteWarning",
+           "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
 
 #: Nodes per axis, at most, of the in-memory coarse copy (`Field4D.coarse`).
 COARSE_SAMPLES = 48
@@ -77,6 +79,27 @@ BYTES_PER_SAMPLE = 24
 #: Nodes per axis of the grid a function field is sampled on for its range.
 _FUNCTION_PROBE = 21
 _AXES = "xyzw"
+
+
+class AxesWarning(UserWarning):
+    """`Field4D(array)` without ``axes=``: the array's axes were taken as f[x, y, z, w]."""
+
+
+class NonFiniteWarning(RuntimeWarning):
+    """The data hold +inf or -inf samples (reported once per field; NaN is allowed and silent)."""
+
+
+def _axes_text(axes: str) -> str:
+    """'wzyx' -> 'f[w, z, y, x]': which of x, y, z, w each array axis is."""
+    return "f[" + ", ".join(axes) + "]"
+
+
+def _dataset_error(ds) -> TypeError:
+    names = [str(k) for k in getattr(ds, "data_vars", {})]
+    first = names[0] if names else "name"
+    listed = ", ".join(repr(n) for n in names) if names else "none"
+    return TypeError(f"Expected an xarray.DataArray (one variable), got an xarray.Dataset with data variables "
+                     f"{listed}; pick one: ds[{first!r}]")
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -468,6 +491,26 @@ def _array_kind(values) -> str:
     return "lazy"
 
 
+def _count_infinite(a, block_bytes: int = 64 * 1024**2):
+    """(n +inf, n -inf, first index as a tuple or None) of an array in memory, read in blocks
+    along its first axis (at most ``block_bytes`` of booleans at a time)."""
+    npos = nneg = 0
+    first = None
+    per = max(1, int(block_bytes // max(1, math.prod(int(n) for n in a.shape[1:]))))
+    for i in range(0, int(a.shape[0]), per):
+        b = np.asarray(a[i:i + per])
+        inf = np.isinf(b)
+        if not inf.any():
+            continue
+        pos = int(np.count_nonzero(inf & (b > 0)))
+        npos += pos
+        nneg += int(np.count_nonzero(inf)) - pos
+        if first is None:
+            j = np.unravel_index(int(np.flatnonzero(inf.ravel())[0]), inf.shape)
+            first = (i + int(j[0]),) + tuple(int(v) for v in j[1:])
+    return npos, nneg, first
+
+
 # ----------------------------------------------------------------------------- the field
 class Field4D:
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
@@ -477,10 +520,18 @@ class Field4D:
     values : 4-D array-like
         numpy array or memmap, dask array, zarr array or anything with ``shape``,
         ``ndim``, ``dtype`` and slicing; real numbers (NaN allowed: below every level).
-        Chunked/lazy arrays are never read whole except once for `coarse`.
+        Chunked/lazy arrays are never read whole except once for `coarse`.  An xarray
+        DataArray goes through `from_xarray` (a Dataset: pick a variable, ``ds["T"]``).
+        +inf / -inf samples are allowed but reported once, by a `NonFiniteWarning` naming
+        how many (and, in memory, where) when the data range is first needed: they sit
+        above / below every level, and an interpolated point whose cell holds one is +-inf,
+        or NaN (below every level) where its weight is 0 -- mask them (``np.where(np.isfinite(a), a, np.nan)``) or clip.
     axes : str
-        Which of x, y, z, w each array axis is, a permutation of ``"xyzw"``
-        (``"wzyx"`` for ``f[t, z, y, x]``).
+        Which of x, y, z, w each array axis is, a permutation of ``"xyzw"``:
+        ``"wzyx"`` for ``f[t, z, y, x]`` (the usual time-first layout), ``"xyzw"``
+        for ``f[x, y, z, t]``.  Give it: when omitted the order ``"xyzw"`` is assumed
+        with an `AxesWarning` (a guess cannot tell time from x); `repr` and the readout
+        always name the order (``f[w, z, y, x]``).  `from_xarray` takes it from the dims.
     extent : ((xmin, xmax), (ymin, ymax), (zmin, zmax), (wmin, wmax)), optional
         Data coordinates of the first and last node along each axis (samples sit
         on the nodes).  Default: x, y, z span ``[-(n-1)/2, (n-1)/2] * h`` with one
@@ -504,11 +555,19 @@ class Field4D:
         rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
     """
 
-    def __init__(self, values, *, axes: str = "xyzw", extent=None, name=None, units=None,
+    def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, _coords=None, _function=None):
         self._function = _function
+        self._dims = None  # the array's dim names (from_xarray), for the readout
+        self.axes_given = axes is not None
         if _function is None:
+            if _is_xarray(values, "Dataset"):
+                raise _dataset_error(values)
+            if _is_xarray(values, "DataArray"):
+                raise TypeError("Field4D(values) takes a plain array; for an xarray.DataArray use "
+                                "Field4D.from_xarray(da, w='time') (dims by name, extents from the coordinates), "
+                                "or pass da.data with axes=")
             for attr in ("shape", "ndim", "__getitem__"):
                 if not hasattr(values, attr):
                     raise TypeError(f"Expected `values` to be a 4-D array-like (numpy, dask, zarr ...) with shape, "
@@ -528,9 +587,17 @@ class Field4D:
                     values = values.astype(np.float64)
             self._values = values
             self._kind = kind
-            if not isinstance(axes, str) or sorted(axes) != sorted(_AXES):
+            if axes is not None and (not isinstance(axes, str) or sorted(axes) != sorted(_AXES)):
                 raise ValueError(f"Expected `axes` to be a permutation of 'xyzw' naming each array axis "
                                  f"(e.g. 'wzyx' for f[t, z, y, x]), got {axes!r}")
+            if axes is None:
+                axes = _AXES
+                sh = tuple(int(n) for n in values.shape)
+                warnings.warn(
+                    f"Field4D: `axes` not given, so the array's axes are taken as f[x, y, z, w] (axes='xyzw'): "
+                    f"its shape {sh} puts {sh[0]} samples along x and {sh[3]} along w. Say which array axis is "
+                    f"which: axes='wzyx' for f[t, z, y, x] (time first), axes='xyzw' for f[x, y, z, t]",
+                    AxesWarning, stacklevel=2)
             self.axes = axes
             self._axis_of = tuple(axes.index(c) for c in _AXES)  # array axis of x, y, z, w
             self.shape = tuple(int(values.shape[a]) for a in self._axis_of)
@@ -571,6 +638,9 @@ class Field4D:
         self._reader = None
         self._box = None
         self._levels = None if levels is None else _as_levels(levels)
+        #: (n +inf, n -inf, first index or None) once known; reported once (`NonFiniteWarning`)
+        self._infinite = None
+        self._infinite_reported = False
 
     # -- constructors ---------------------------------------------------------
     @classmethod
@@ -597,6 +667,8 @@ class Field4D:
         value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
         mean w spacing over the mean spatial spacing (voxels are cubes).
         """
+        if _is_xarray(da, "Dataset") or (hasattr(da, "data_vars") and hasattr(da, "dims")):
+            raise _dataset_error(da)
         if not (hasattr(da, "dims") and hasattr(da, "coords") and hasattr(da, "isel")):
             raise TypeError(f"Expected an xarray.DataArray, got {type(da).__name__}")
         dims = tuple(str(d) for d in da.dims)
@@ -625,6 +697,12 @@ class Field4D:
                 f"Field4D.from_xarray(da, x='lon', y='lat', z='depth', w='time')"
             )
         axes = "".join(next(k for k, v in chosen.items() if v == d) for d in dims)
+        few = [f"{chosen[k]}={int(da.sizes[chosen[k]])} ({k})" for k in _AXES if int(da.sizes[chosen[k]]) < 2]
+        if few:
+            raise ValueError(
+                f"Expected at least 2 samples along every dim (a surface needs a cell to cross), got "
+                f"{', '.join(few)}; dims {dict((d, int(da.sizes[d])) for d in dims)}. A single time step is a "
+                f"3-D field, not a 4-D one: select a range, e.g. da.isel({chosen['w']}=slice(0, 2))")
         flips, coords, extent = {}, [None] * 4, []
         for d_i, k in enumerate(_AXES):
             dim = chosen[k]
@@ -660,8 +738,11 @@ class Field4D:
         w_units = kwargs.pop("w_units", da.coords[chosen["w"]].attrs.get("units") if chosen["w"] in da.coords else None)
         if w_units is None and chosen["w"] in da.coords and np.issubdtype(da.coords[chosen["w"]].dtype, np.datetime64):
             w_units = "s"
-        return cls(values, axes=axes, extent=extent, name=kwargs.pop("name", da.name), units=kwargs.pop("units", units),
-                   w_per_unit=w_per_unit, w_units=w_units, _coords=coords, **kwargs)
+        field = cls(values, axes=axes, extent=extent, name=kwargs.pop("name", da.name),
+                    units=kwargs.pop("units", units), w_per_unit=w_per_unit, w_units=w_units, _coords=coords,
+                    **kwargs)
+        field._dims = dims
+        return field
 
     # -- geometry and resolution ------------------------------------------------
     @property
@@ -821,7 +902,8 @@ class Field4D:
             d["function"] = f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', type(f).__name__)}"
         else:
             what = {"numpy": "in-memory numpy", "dask": "dask array", "zarr": "zarr array"}.get(
-                self._kind, type(self._values).__name__)
+                self._kind, "lazily read xarray array" if isinstance(self._values, _LazyXarray)
+                else type(self._values).__name__)
             d["array"] = f"{what} (not recordable)"
             d["shape"] = list(self._values.shape)
             d["dtype"] = str(np.dtype(self._values.dtype))
@@ -848,6 +930,7 @@ class Field4D:
         if self._kind == "numpy" and list(nshape) == target:
             return self
         x = self._values
+        floating = np.dtype(self._values.dtype).kind == "f"
         if self._kind != "numpy":
             if "dask.array" not in sys.modules:
                 try:
@@ -862,7 +945,9 @@ class Field4D:
                     x = dsa.from_array(x, chunks=ch if isinstance(ch, tuple) else "auto", asarray=False)
             else:  # pragma: no cover
                 x = np.asarray(x)
+                self._infinite = _count_infinite(x) if floating else (0, 0, None)
         xp = sys.modules["dask.array"] if self._kind != "numpy" and "dask.array" in sys.modules else np
+        whole = x
         coords = list(self._coords)
         for a in np.argsort([t / n for t, n in zip(target, nshape)]):  # biggest reduction first
             n, m = int(nshape[a]), target[a]
@@ -876,13 +961,23 @@ class Field4D:
             di = _AXES.index(d)
             if coords[di] is not None:
                 coords[di] = _sealed(np.interp(u, np.arange(n), coords[di]))
-        x = np.asarray(x.compute() if hasattr(x, "compute") else x, dtype=np.float64
-                       if np.dtype(self._values.dtype) != np.float32 else np.float32)
+        if xp is not np:
+            import dask
+
+            # the only pass over every chunk: the +-inf counts ride along (the reads are shared)
+            if floating:
+                x, npos, nneg = dask.compute(x, xp.isposinf(whole).sum(), xp.isneginf(whole).sum())
+                self._infinite = (int(npos), int(nneg), None)
+            else:
+                (x,) = dask.compute(x)
+                self._infinite = (0, 0, None)
+        x = np.asarray(x, dtype=np.float64 if np.dtype(self._values.dtype) != np.float32 else np.float32)
         x = np.ascontiguousarray(x)
         x.flags.writeable = False
         c = Field4D(x, axes=self.axes, extent=self.extent, name=self.name, units=self.units,
                     w_per_unit=self.w_per_unit, w_units=self.w_units, _coords=coords)
         c._coarse = c
+        c._infinite_reported = True  # its infinities are the field's: reported by the field
         return c
 
     def _statistics(self):
@@ -897,6 +992,7 @@ class Field4D:
             spacing = [(b - a_) / (m - 1) / u for (a_, b), u in zip(self.extent, self._unit)]
         else:
             c = self.coarse()
+            self._report_infinite()
             if c is not self:  # the same numbers: computed once, on the coarse copy
                 self._stats = c._statistics()
                 return self._stats
@@ -929,11 +1025,36 @@ class Field4D:
         self._stats = (rng, k)
         return self._stats
 
+    def _report_infinite(self) -> None:
+        """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf: how many, and where
+        (the first, for an array in memory).  Counted over the whole array: in blocks for numpy,
+        alongside the coarse copy's pass for chunked and lazy arrays."""
+        if self._infinite_reported:
+            return
+        self._infinite_reported = True
+        if self._infinite is None:
+            a = self._values
+            self._infinite = _count_infinite(a) if np.dtype(a.dtype).kind == "f" else (0, 0, None)
+        npos, nneg, first = self._infinite
+        if npos == 0 and nneg == 0:
+            return
+        what = " and ".join(t for t in (f"{npos} +inf" if npos else "", f"{nneg} -inf" if nneg else "") if t)
+        where = f" (the first at index {first} of {_axes_text(self.axes)})" if first is not None else ""
+        warnings.warn(
+            f"Field4D{' ' + repr(self.name) if self.name else ''}: the data hold {what} of "
+            f"{math.prod(int(n) for n in self._values.shape)} samples{where}. They are kept: +inf lies above "
+            f"and -inf below every level, the data range ignores them, and a point interpolated in a cell "
+            f"that holds one is +-inf, or NaN (below every level) where two meet or its weight is 0. To draw them otherwise, mask or clip first, "
+            f"e.g. np.where(np.isfinite(a), a, np.nan) or np.clip(a, lo, hi)",
+            NonFiniteWarning, stacklevel=4)
+
     # -- readout -------------------------------------------------------------------
     def _readout(self, m, c0, slices, box, coarse) -> tuple:
         rows = []
         label = self.name or "field"
         rows.append(("field", f"{label}" + (f" [{self.units}]" if self.units else "")))
+        if self._kind != "function":
+            rows.append(("axes", f"{self._order_text()}, shape {tuple(int(n) for n in self._values.shape)}"))
         lo, hi = self.data_range
         parts = []
         for s in slices:
@@ -962,8 +1083,22 @@ class Field4D:
             rows.append(("resolution", f"{self.coarse_resolution} (coarse copy)"))
         return tuple(rows)
 
+    def _order_text(self) -> str:
+        """Which of x, y, z, w each array axis is: 'f[w, z, y, x]', with the dim names from xarray
+        ('T[time, z, y, x] as [w, z, y, x]'), marked when the order was assumed."""
+        if self._kind == "function":
+            return "f(x, y, z, w)"
+        if self._dims is not None:
+            label = self.name or "f"
+            return f"{label}[{', '.join(self._dims)}] as [{', '.join(self.axes)}]"
+        return _axes_text(self.axes) + ("" if self.axes_given else " (assumed: axes not given)")
+
     def __repr__(self) -> str:
-        what = "function" if self._kind == "function" else f"{self._kind} {tuple(self._values.shape)}"
+        if self._kind == "function":
+            what = "function f(x, y, z, w)"
+        else:
+            kind = "array" if self._kind == "numpy" else f"{self._kind} array"
+            what = f"{kind} {tuple(int(n) for n in self._values.shape)} {self._order_text()}"
         return f"Field4D({self.name or ''!s}{' ' if self.name else ''}{what}, axes={self.axes!r}, extent={self.extent})"
 
 

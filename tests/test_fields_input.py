@@ -127,3 +127,87 @@ print("dask.dataframe" in sys.modules)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-1] == "False"
+
+
+# ---------------------------------------------------------------- the axis order, named
+def test_an_array_without_axes_warns_naming_the_choices_and_repr_names_the_order():
+    """`Field4D(f)` for the README's f[t, z, y, x] used to take x as time without a word."""
+    from rot4d_widget.fields import AxesWarning
+
+    f = np.zeros((24, 20, 20, 20))
+    with pytest.warns(AxesWarning, match=r"axes='wzyx' for f\[t, z, y, x\].*axes='xyzw' for f\[x, y, z, t\]"):
+        field = Field4D(f)
+    assert field.axes == "xyzw" and not field.axes_given
+    assert "(24, 20, 20, 20) f[x, y, z, w] (assumed" in repr(field)
+    m = np.eye(4)
+    assert dict(field.slice(m, 0.0).readout)["axes"].startswith("f[x, y, z, w] (assumed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # given: no warning
+        named = Field4D(f, axes="wzyx")
+    assert repr(named).startswith("Field4D(array (24, 20, 20, 20) f[w, z, y, x],")
+    assert dict(named.slice(m, 0.0).readout)["axes"] == "f[w, z, y, x], shape (24, 20, 20, 20)"
+    assert named.shape == (20, 20, 20, 24)
+
+
+def test_from_xarray_names_its_dims_in_repr_and_readout():
+    xr = pytest.importorskip("xarray")
+    da = xr.DataArray(tzyx_array(), dims=("time", "z", "y", "x"), name="T")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", category=UserWarning)
+        field = Field4D.from_xarray(da)
+    assert "T[time, z, y, x] as [w, z, y, x]" in repr(field)
+    assert dict(field.slice(np.eye(4), 0.0).readout)["axes"].startswith("T[time, z, y, x] as [w, z, y, x]")
+
+
+# ---------------------------------------------------------------- bad input, named
+def test_a_dataset_is_refused_naming_its_variables():
+    xr = pytest.importorskip("xarray")
+    ds = dataset(xr)
+    ds["S"] = ds["T"] * 2
+    for call in (lambda: Field4D.from_xarray(ds, w="time"), lambda: Field4D(ds, axes="wzyx")):
+        with pytest.raises(TypeError, match=r"Dataset with data variables 'T', 'S'; pick one: ds\['T'\]"):
+            call()
+    with pytest.raises(TypeError, match=r"from_xarray\(da, w='time'\)"):
+        Field4D(ds["T"], axes="wzyx")
+
+
+@pytest.mark.parametrize("n", [0, 1])
+def test_a_dim_with_fewer_than_two_samples_is_named(n):
+    xr = pytest.importorskip("xarray")
+    da = dataset(xr)["T"].isel(time=slice(0, n))
+    with pytest.raises(ValueError, match=rf"at least 2 samples along every dim.*time={n} \(w\)"):
+        Field4D.from_xarray(da, w="time")
+
+
+def test_infinite_samples_are_reported_once_with_count_and_place():
+    from rot4d_widget.fields import NonFiniteWarning
+
+    a = tzyx_array()
+    a[3, 1, 2, 4] = np.inf
+    a[5, 0, 0, 0] = np.inf
+    a[7, 7, 7, 7] = -np.inf
+    field = Field4D(a, axes="wzyx")
+    with pytest.warns(NonFiniteWarning, match=r"2 \+inf and 1 -inf of 30720 samples \(the first at index "
+                                              r"\(3, 1, 2, 4\) of f\[w, z, y, x\]\)"):
+        lo, hi = field.data_range
+    assert math.isfinite(lo) and math.isfinite(hi)  # the range ignores them
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once
+        s = field.slice(random_rotation(4), 0.0)
+    assert np.isfinite(s.points).all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # NaN stays silent: below every level
+        b = tzyx_array()
+        b[3, 1, 2, 4] = np.nan
+        Field4D(b, axes="wzyx").slice(np.eye(4), 0.0)
+
+
+def test_infinite_samples_in_a_chunked_array_are_counted_with_the_coarse_copy():
+    dsa = pytest.importorskip("dask.array")
+    from rot4d_widget.fields import NonFiniteWarning
+
+    a = tzyx_array()
+    a[50, 1, 2, 4] = np.inf  # beyond the coarse copy's first 48 nodes
+    field = Field4D(dsa.from_array(a, chunks=(16, 8, 8, 8)), axes="wzyx")
+    with pytest.warns(NonFiniteWarning, match=r"1 \+inf of 30720 samples\. They are kept"):
+        field.slice(np.eye(4), 0.0, coarse=True)
