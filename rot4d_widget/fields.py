@@ -550,6 +550,15 @@ class Field4D:
         coarse step (default ``max(24, resolution // 2)``).
     levels : float or sequence of floats, optional
         Iso levels (default: one, midway between the min and max of `coarse`).
+    inside : "above" or "below"
+        Which side of each level the surface encloses: ``"above"`` {f >= level} (a density,
+        a phase field), ``"below"`` {f <= level} (a signed distance, negative inside: the ball,
+        not the box around it).  NaN is never enclosed.
+    caps : bool
+        True (default): the surface is closed on the box's faces (the enclosed part of each face
+        is drawn; ``volume`` is the enclosed 3-volume).  False: only {f = level} itself, open where
+        it meets a face (its edge within one sample of it) -- for fields that fill the box, e.g.
+        periodic ones, whose caps would hide the inside; ``volume`` is then NaN (not closed).
     chunk_cache_bytes : int
         Recently read chunks of a chunked array kept in memory (default 128 MiB: with the
         rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
@@ -557,7 +566,8 @@ class Field4D:
 
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, resolution: int = 64, coarse_resolution=None,
-                 levels=None, chunk_cache_bytes: int = 128 * 1024**2, _coords=None, _function=None):
+                 levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
+                 _coords=None, _function=None):
         self._function = _function
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
@@ -638,6 +648,8 @@ class Field4D:
         self._reader = None
         self._box = None
         self._levels = None if levels is None else _as_levels(levels)
+        self.inside = inside
+        self.caps = caps
         #: (n +inf, n -inf, first index or None) once known; reported once (`NonFiniteWarning`)
         self._infinite = None
         self._infinite_reported = False
@@ -763,6 +775,30 @@ class Field4D:
         self._stats = None  # K is per slice unit
         if self._coarse is not None and self._coarse is not self:
             self._coarse.w_per_unit = value
+
+    @property
+    def inside(self) -> str:
+        """Which side of each level the surface encloses: "above" {f >= level} or "below" {f <= level}."""
+        return self._inside
+
+    @inside.setter
+    def inside(self, value) -> None:
+        if not isinstance(value, str) or value not in ("above", "below"):
+            raise ValueError(f"Expected `inside` to be 'above' (the surface encloses f >= level) or 'below' "
+                             f"(f <= level, e.g. a signed distance negative inside), got {value!r}")
+        self._inside = value
+
+    @property
+    def caps(self) -> bool:
+        """Whether the surface is closed on the box's faces (True) or left open there (False)."""
+        return self._caps
+
+    @caps.setter
+    def caps(self, value) -> None:
+        if not isinstance(value, (bool, np.bool_)):
+            raise TypeError(f"Expected `caps` to be True (close the surface on the box's faces) or False "
+                            f"(leave it open there), got {value!r}")
+        self._caps = bool(value)
 
     @property
     def resolution(self) -> int:
@@ -896,7 +932,8 @@ class Field4D:
     def describe(self) -> dict:
         """A JSON-able description; rebuilds nothing for in-memory arrays (not recordable)."""
         d = {"kind": "field", "axes": self.axes, "extent": [list(e) for e in self.extent],
-             "w_per_unit": self.w_per_unit, "levels": list(self.levels), "name": self.name, "units": self.units}
+             "w_per_unit": self.w_per_unit, "levels": list(self.levels), "name": self.name, "units": self.units,
+             "inside": self.inside, "caps": self.caps}
         if self._kind == "function":
             f = self._function
             d["function"] = f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', type(f).__name__)}"
@@ -1059,15 +1096,19 @@ class Field4D:
         parts = []
         for s in slices:
             t = f"{s.level:.4g}"
-            if math.isfinite(hi) and s.level > hi:
-                t += " (above the max: empty)"
-            elif math.isfinite(lo) and s.level <= lo:
-                t += " (at or below the min: the whole box)"
+            above = self.inside == "above"
+            if math.isfinite(hi) and (s.level > hi if above else s.level >= hi):
+                t += " (above the max: empty)" if above else " (at or above the max: the whole box)"
+            elif math.isfinite(lo) and (s.level <= lo if above else s.level < lo):
+                t += " (at or below the min: the whole box)" if above else " (below the min: empty)"
             elif s.empty:
                 t += " (empty here)"
             parts.append(t)
         rng = f" of {lo:.4g} \u2026 {hi:.4g}" if math.isfinite(lo) else " (all NaN)"
         rows.append(("level" if len(slices) == 1 else "levels", ", ".join(parts) + rng))
+        if self.inside != "above" or not self.caps:
+            rows.append(("surface", ("encloses f <= level" if self.inside == "below" else "encloses f >= level")
+                         + ("" if self.caps else ", open on the box's faces (no volume)")))
         if len(slices) > 1:
             rows.append(("volumes", ", ".join(f"{s.volume:.4g}" for s in slices)))
         wu = f" {self.w_units}" if self.w_units else ""
@@ -1331,22 +1372,56 @@ def _chunked_values(field, x, inside):
     return out
 
 
-def _surface(s: _Samples, level: float) -> FieldSlice:
-    """Marching cubes of min(f - level, K g) = 0 on one step's samples."""
+def _surface(s: _Samples, level: float, inside: str = "above", caps: bool = True) -> FieldSlice:
+    """Marching cubes of min(±(f - level), K g) = 0 on one step's samples (+ for inside="above",
+    - for "below"); without caps, of ±(f - level) alone within the box (an open surface)."""
     from skimage.measure import marching_cubes
 
     d = s.spacing
+    sign = 1.0 if inside == "above" else -1.0
     with np.errstate(invalid="ignore"):
-        v = s.f - level
-        v[v == 0] = 1e-9 * s.k * d  # f == level belongs to {f >= level}
-        v[np.isnan(v)] = -s.k * d  # NaN: below every level
-        v[s.g < 0] = np.inf  # outside the box f means nothing: v is K g alone, so caps sit on the faces
-        v = np.minimum(v, s.k * s.g).astype(np.float32)
-    if not v.max() > 0:
+        v = sign * (s.f - level)
+        v[v == 0] = 1e-9 * s.k * d  # f == level belongs to the enclosed side
+        v[np.isnan(v)] = -s.k * d  # NaN: never enclosed (below every level for inside="above")
+        out = s.g < 0
+        if caps:
+            v[out] = np.inf  # outside the box f means nothing: v is K g alone, so caps sit on the faces
+            v = np.minimum(v, s.k * s.g).astype(np.float32)
+        else:
+            v = v.astype(np.float32)
+    mask = None
+    if not caps:
+        if out.all():
+            return _empty_slice(level, d)
+        if out.any():
+            # outside the box: the nearest inside sample's value (so cells across a face see the data
+            # carried on, not zeros); cells wholly outside are skipped; triangles beyond the faces dropped
+            from scipy.ndimage import binary_dilation, distance_transform_edt
+
+            idx = distance_transform_edt(out, return_distances=False, return_indices=True)
+            v = v[tuple(idx)]
+            mask = binary_dilation(~out, structure=np.ones((3, 3, 3), dtype=bool))
+        if not (v.max() > 0 and v.min() < 0):
+            return _empty_slice(level, d)
+    elif not v.max() > 0:
         return _empty_slice(level, d)
     # in index space (spacing 1): skimage scales in float32, which overflows beyond ~3e38; the
     # vertices, volume and area are scaled here in float64, so any field scale works alike
-    verts, faces, normals, _ = marching_cubes(v, 0.0, method="lewiner")
+    try:
+        verts, faces, normals, _ = marching_cubes(v, 0.0, method="lewiner", mask=mask)
+    except (ValueError, RuntimeError):
+        if caps:
+            raise
+        return _empty_slice(level, d)  # no crossing within the box
+    if not caps and len(faces):
+        from scipy.ndimage import map_coordinates
+
+        gc = map_coordinates(s.g, verts[faces].mean(axis=1).T, order=1, mode="nearest")
+        faces = faces[gc >= 0]  # keep triangles centred in the box: the open edge lies within a cell of a face
+        used = np.unique(faces)
+        remap = np.full(len(verts), -1, dtype=np.int64)
+        remap[used] = np.arange(len(used))
+        verts, normals, faces = verts[used], normals[used], remap[faces]
     if len(faces) == 0:
         return _empty_slice(level, d)
     iv = verts.astype(np.float64)  # index coordinates
@@ -1374,7 +1449,7 @@ def _surface(s: _Samples, level: float) -> FieldSlice:
     c = iv.mean(axis=0)
     A, B, C = (iv - c)[tri[:, 0]], (iv - c)[tri[:, 1]], (iv - c)[tri[:, 2]]
     cr = np.cross(B - A, C - A)
-    volume = float(np.einsum("ij,ij->", A, np.cross(B, C))) / 6.0 * d * d * d
+    volume = float(np.einsum("ij,ij->", A, np.cross(B, C))) / 6.0 * d * d * d if caps else math.nan
     area = float(np.linalg.norm(cr, axis=1).sum()) / 2.0 * d * d
     return FieldSlice(_sealed(vertices), _sealed(tri), _sealed(nrm), volume, area, level, d)
 
@@ -1388,7 +1463,9 @@ def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool 
     matrix : (4, 4) rotation (validated: orthogonal, det +1); a data point q is at
         ``matrix @ (q - centre)`` (w scaled by ``1 / field.w_per_unit``)
     c0 : float -- the hyperplane w = c0, slice units
-    level : float or sequence of floats -- the surface closes {f >= level}
+    level : float or sequence of floats -- the surface closes {f >= level} (``field.inside``
+        "above", the default) or {f <= level} ("below"); capped on the box's faces unless
+        ``field.caps`` is False
     resolution : int -- samples along the longest side of the bounding box of the
         box's cut (padding not counted), same spacing on all three axes
     coarse : bool -- resample ``field.coarse()`` instead (for held keys)
@@ -1410,5 +1487,5 @@ def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool 
     if s is None:
         out = tuple(_empty_slice(lv, 0.0) for lv in levels)
     else:
-        out = tuple(_surface(s, lv) for lv in levels)
+        out = tuple(_surface(s, lv, field.inside, field.caps) for lv in levels)
     return out if many else out[0]

@@ -211,3 +211,62 @@ def test_infinite_samples_in_a_chunked_array_are_counted_with_the_coarse_copy():
     field = Field4D(dsa.from_array(a, chunks=(16, 8, 8, 8)), axes="wzyx")
     with pytest.warns(NonFiniteWarning, match=r"1 \+inf of 30720 samples\. They are kept"):
         field.slice(np.eye(4), 0.0, coarse=True)
+
+
+# ---------------------------------------------------------------- which side is inside; caps
+def _ball_distance(R, n=33):
+    g = np.linspace(-1.0, 1.0, n)
+    X = np.meshgrid(g, g, g, g, indexing="ij")
+    return np.sqrt(sum(x * x for x in X)) - R  # signed distance, negative inside
+
+
+def test_inside_below_encloses_a_signed_distance_ball():
+    """A signed distance (negative inside) with inside="below" is the ball, not the box around it."""
+    R = 0.6
+    ball = 4 / 3 * math.pi * R**3
+    sd = _ball_distance(R)
+    below = Field4D(sd, axes="xyzw", extent=[(-1, 1)] * 4, inside="below", levels=[0.0])
+    above = Field4D(sd, axes="xyzw", extent=[(-1, 1)] * 4, levels=[0.0])
+    assert below.inside == "below" and above.inside == "above"
+    assert below.describe()["inside"] == "below" and below.describe()["caps"] is True
+    s = slice_field(below, random_rotation(2), 0.0, 0.0, 64)
+    assert s.volume == pytest.approx(ball, rel=0.03)
+    assert np.linalg.norm(s.vertices, axis=1) == pytest.approx(R, abs=0.03)
+    # the default side: the cube's cut (8 at the identity) less the ball
+    assert slice_field(above, np.eye(4), 0.0, 0.0, 64).volume == pytest.approx(8 - ball, rel=0.01)
+    rows = dict(below.slice(np.eye(4), 0.0).readout)
+    assert rows["surface"] == "encloses f <= level"
+    with pytest.raises(ValueError, match=r"'above'.*'below'.*got 'inner'"):
+        Field4D(sd, axes="xyzw", inside="inner")
+    with pytest.raises(ValueError, match=r"'above'.*'below'"):
+        below.inside = "outside"
+
+
+def _face_area(s, half=1.0, eps=1e-6):
+    """Area of the triangles lying on the cube's faces |x_i| = half (slice at the identity)."""
+    v = s.vertices[s.triangles]  # (k, 3, 3)
+    on = np.zeros(len(v), dtype=bool)
+    for i in range(3):
+        on |= np.all(np.abs(np.abs(v[:, :, i]) - half) < eps, axis=1)
+    cr = np.cross(v[on, 1] - v[on, 0], v[on, 2] - v[on, 0])
+    return float(np.linalg.norm(cr, axis=1).sum()) / 2
+
+
+def test_caps_off_leaves_a_box_filling_field_open_on_the_faces():
+    g = np.linspace(-1.0, 1.0, 25)
+    X = np.meshgrid(g, g, g, g, indexing="ij")
+    per = np.cos(np.pi * X[0]) * np.cos(np.pi * X[1]) + np.cos(np.pi * X[2]) * np.cos(np.pi * X[3])
+    capped = Field4D(per, axes="xyzw", extent=[(-1, 1)] * 4, levels=[0.0])
+    open_ = Field4D(per, axes="xyzw", extent=[(-1, 1)] * 4, levels=[0.0], caps=False)
+    a = slice_field(capped, np.eye(4), 0.1, 0.0, 48)
+    b = slice_field(open_, np.eye(4), 0.1, 0.0, 48)
+    assert _face_area(a) > 5.0  # about half of the six faces (24) is enclosed
+    assert _face_area(b) < 0.01 * _face_area(a)
+    assert b.area < a.area and math.isnan(b.volume) and not math.isnan(a.volume)
+    # the open surface stays in the box, its edge within one sample of a face
+    assert np.abs(b.vertices).max() <= 1 + b.spacing
+    assert open_.describe()["caps"] is False
+    assert "open on the box's faces" in dict(open_.slice(np.eye(4), 0.1).readout)["surface"]
+    assert open_.slice(random_rotation(3), 0.1).volume is None  # the widget shows no volume
+    with pytest.raises(TypeError, match="caps"):
+        Field4D(per, axes="xyzw", caps="no")
