@@ -323,11 +323,13 @@ def _check_positive(value, name: str) -> float:
 # ----------------------------------------------------------------------------- the result
 @dataclass(frozen=True, eq=False)
 class FieldSlice:
-    """The isosurface {f = level} closing {f >= level} in one slice (all arrays read-only).
+    """The isosurface {f = level} closing {f >= level} (or {f <= level} for a field with
+    ``inside="below"``) in one slice (all arrays read-only).
 
     vertices : (n, 3) float64 -- in slice coordinates
-    triangles : (k, 3) intp -- counter-clockwise seen from where f < level
+    triangles : (k, 3) intp -- counter-clockwise seen from outside the enclosed side
         (outward from {f >= level}); the surface is closed, capped on the box's faces
+        (open there, and ``volume`` NaN, for a field with ``caps=False``)
     normals : (n, 3) float64 -- unit, outward
     volume : float -- 3-volume of {f >= level} in the slice (inf, or 0, when beyond float64's
         range: slice coordinates above about 5e102 or below about 2e-103)
