@@ -49,6 +49,7 @@ __all__ = [
     "PolytopeSource",
     "as_source",
     "check_slice",
+    "BadSlice",
 ]
 
 
@@ -154,6 +155,11 @@ class SliceData:
         data = cls(p, s, t, g, normals, **kwargs)
         check_slice(data)
         return data
+
+
+class BadSlice(ValueError):
+    """A source's ``slice`` returned something that breaks the protocol (the message names the
+    source and the member that is wrong).  Never drawn; the widget shows the message alone."""
 
 
 def check_slice(data, n_groups: int | None = None) -> None:

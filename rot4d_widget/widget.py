@@ -53,7 +53,7 @@ from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
-from .source import as_source, check_slice
+from .source import BadSlice, as_source, check_slice
 from .state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
@@ -1324,8 +1324,13 @@ class Rot4DWidget(widgets.HBox):
             text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
             log.error("Rot4DWidget: error while handling a key\n%s", text)
             self._repeater.clear()
+            if isinstance(exc, BadSlice):  # the source's fault, said in one line: no traceback of ours
+                text = f"{type(exc).__name__}: {exc}\n"
+            shown = tuple(self.errors.outputs)
+            if shown and shown[-1].get("text") == text:
+                return  # the same error again (a retry of the same picture): shown once
             item = {"output_type": "stream", "name": "stderr", "text": text}
-            self.errors.outputs = tuple(self.errors.outputs[-(MAX_ERRORS_SHOWN - 1):]) + (item,)
+            self.errors.outputs = shown[-(MAX_ERRORS_SHOWN - 1):] + (item,)
             self._update_errors = self.errors.outputs
         except Exception:
             log.exception("Rot4DWidget: could not report an error")
@@ -1378,7 +1383,7 @@ def _checked_slice(source, matrix, c0, coarse, lock):
     try:
         check_slice(data, n_groups)
     except (TypeError, ValueError) as exc:
-        raise type(exc)(f"{_title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
+        raise BadSlice(f"{_title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
     return data
 
 

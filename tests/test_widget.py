@@ -619,8 +619,11 @@ def test_malformed_events_are_ignored(make, event):
 def test_errors_in_key_handling_are_shown_not_lost(make, clock):
     w = make()
 
+    failures = []
+
     def broken(s, single_rgb=None, group_rgb=None):
-        raise RuntimeError("scene exploded")
+        failures.append(1)
+        raise RuntimeError("scene exploded" + ("" if len(failures) == 1 else f" ({len(failures)})"))
 
     w.scene.show = broken
     down(w, "4")  # must not raise into the kernel's comm handler
@@ -631,6 +634,10 @@ def test_errors_in_key_handling_are_shown_not_lost(make, clock):
     for _ in range(10):
         down(w, "2")
     assert len(w.errors.outputs) == wmod.MAX_ERRORS_SHOWN  # bounded
+    w.scene.show = lambda s, single_rgb=None, group_rgb=None: 1 / 0
+    for _ in range(3):
+        down(w, "2")
+    assert sum("ZeroDivisionError" in o["text"] for o in w.errors.outputs) == 1  # the same error: once
 
 
 def test_errors_in_the_ticker_are_shown_and_stop_the_hold(make, clock):
