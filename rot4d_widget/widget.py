@@ -1289,9 +1289,8 @@ class Rot4DWidget(widgets.HBox):
                 f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
                 for t, rgb in zip(labels, colors))))
         volume = getattr(data, "volume", None)
-        drawn = None if volume is None else float(volume) * self._scale * self._scale * self._scale
-        if drawn is not None and math.isfinite(drawn):  # a factor at a time: no overflow at any scale
-            rows.append(("volume", f"{drawn:.4f} as drawn"))
+        if volume is not None and math.isfinite(float(volume)):
+            rows.append(("volume", _volume_text(self.source, float(volume), st.matrix)))
         if self._note:
             rows.append(("picture", html.escape(self._note)))
         return ro.readout_html(_title(self.source), rows, gizmo=ro.gizmo_svg(st.matrix))
@@ -1308,7 +1307,7 @@ class Rot4DWidget(widgets.HBox):
         if _is_stack(src):
             rgb = src.group_colors()
             if rgb is not None:
-                return rgb, [f"w {w:.3g}" for w in src.levels_at(self.state.c0)]
+                return rgb, [_data_w_text(src.source, w, self.state.matrix) for w in src.levels_at(self.state.c0)]
             src = src.source
         rgb = _level_colors(src)
         if rgb is not None:
@@ -1361,6 +1360,34 @@ def _source_settings(source) -> dict:
         out["spacing"] = None if source.spacing_is_default else float(source.spacing)
         out["arrangement"] = source.arrangement
     return out
+
+
+def _data_w_text(source, w: float, matrix) -> str:
+    """A parallel slice's label in the data's own w (a field's time, in its ``w_units``): the
+    data w at the centre of the cut, ``w_centre + m[3, 3] * w * w_per_unit``; a source without
+    ``w_per_unit`` and ``extent`` (a polytope) keeps its own w."""
+    wpu, extent = getattr(source, "w_per_unit", None), getattr(source, "extent", None)
+    if wpu is None or extent is None:
+        return f"w {ro.number_text(w, getattr(source, 'size', 1.0), 3)}"
+    lo, hi = float(extent[3][0]), float(extent[3][1])
+    value = (lo + hi) / 2 + float(np.asarray(matrix)[3, 3]) * float(w) * float(wpu)
+    unit = getattr(source, "w_units", None)
+    return f"w {ro.number_text(value, max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+
+
+def _volume_text(source, volume: float, matrix) -> str:
+    """The slice's 3-volume in the source's own units (a field's space units cubed when it names
+    them, ``space_units``); a field turned so that w is mixed in counts w at ``w_per_unit`` data
+    w per unit of space, and says so."""
+    inner = source.source if _is_stack(source) else source
+    unit = getattr(inner, "space_units", None)
+    text = ro.number_text(volume) + (f" {unit}³" if unit else "")
+    wpu = getattr(inner, "w_per_unit", None)
+    if wpu is not None and abs(abs(float(np.asarray(matrix)[3, 3])) - 1.0) > 1e-12:
+        wu = getattr(inner, "w_units", None)
+        text += (f" (w counted at {ro.number_text(wpu)}{' ' + wu if wu else ''} per "
+                 f"{unit if unit else 'unit of space'})")
+    return text
 
 
 class _LiveSource:

@@ -537,8 +537,8 @@ def test_readout_shows_parameters_last_action_census_and_volume(make):
     for label in ("\u03b80", "\u03b1", "\u03b2", "c0", "volume"):
         assert label in text
     assert f"{w.state.theta0:.5f}" in text and f"{w.state.beta:.5f}" in text
-    scale = REFERENCE_RADIUS / w.polytope.circumradius
-    assert f"{w.slice.volume * scale ** 3:.4f} as drawn" in text
+    # in the source's own units (issue 19: "as drawn" scaled numbers were not the object's)
+    assert f"<td>volume</td><td>{w.slice.volume:.4g}</td>" in text
     census = w.slice.face_census()
     assert str(sum(census.values())) in text or any(f"{c} " in text for c in census.values())
     down(w, "2", code="Digit2", shift=True)

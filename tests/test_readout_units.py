@@ -1,0 +1,48 @@
+"""The readout in the data's own units (issue 19, item 6, the widget's part): a field's slice
+volume in its space units cubed (not "as drawn" in the view's scale), parallel slices labelled
+by the data's w (a time in seconds), numbers without rounding noise."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+
+from rot4d_widget.fields import Field4D
+from rot4d_widget.readout import number_text
+
+pytestmark = pytest.mark.usefixtures("recording_comms")
+
+R = 1.5  # metres
+
+
+def ball(**kw):
+    f = Field4D.from_function(lambda x, y, z, w: R * R - (x * x + y * y + z * z), extent=[(-2, 2)] * 3 + [(0, 60)],
+                              w_per_unit=15.0, w_units="s", levels=0.0, resolution=48, **kw)
+    f.space_units = "m"
+    return f
+
+
+def test_the_volume_readout_is_the_slice_s_volume_in_cubic_metres(make):
+    w = make(ball())
+    text = w.readout.value
+    true = 4 / 3 * math.pi * R ** 3  # the cylinder R over every t: each cut a ball of radius R
+    shown = float(text.split("<td>volume</td><td>")[1].split(" ")[0])
+    assert shown == pytest.approx(w.slice.volume, rel=1e-3)
+    assert shown == pytest.approx(true, rel=0.03) and "m\u00b3" in text
+    assert "counted at" not in text  # at rest nothing of w is in the volume
+    w.press("4")
+    assert "w counted at 15 s per m" in w.readout.value
+
+
+def test_parallel_slices_are_labelled_in_seconds(make):
+    w = make(ball(), slices=3, spacing=1.0)
+    legend = re.search(r"colours</td><td>(.*?)</td>", w.readout.value).group(1)
+    labels = [t.strip() for t in re.findall(r"&nbsp;([^<]*)", legend)]
+    assert labels == ["w 15 s", "w 30 s", "w 45 s"]
+
+
+def test_numbers_for_people():
+    assert number_text(-2.132e-14, 73.3) == "0"
+    assert number_text(0.50671234) == "0.5067"
