@@ -32,6 +32,7 @@ them short.  The traits live in the kernel only (use ``link``, not
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import inspect
 import logging
@@ -41,7 +42,6 @@ import threading
 import traceback
 import warnings
 from collections.abc import Mapping
-import dataclasses
 
 import ipywidgets as widgets
 import numpy as np
@@ -455,8 +455,9 @@ class Rot4DWidget(widgets.HBox):
             return self._ask_screenshot(path, callback, warn=True)
 
     def _ask_screenshot(self, path, callback, warn=False):
-        # asked in any case: a front end that does not count views (count 0) may still answer,
-        # but such a request is not kept (an answer to it is dropped), so none piles up
+        # asked in any case: a front end that does not count views (count 0) may still answer;
+        # unanswered requests are dropped after SCREENSHOT_TIMEOUT and beyond
+        # MAX_PENDING_SCREENSHOTS, so none piles up whatever is pressed
         now = self._pump.clock()
         for old in [k for k, v in self._screenshots.items() if now - v[2] > SCREENSHOT_TIMEOUT]:
             del self._screenshots[old]  # nobody answered: dropped
@@ -466,8 +467,7 @@ class Rot4DWidget(widgets.HBox):
         rid = self._screenshot_seq
         self._screenshots[rid] = (path, callback, now)
         self.companion.request_screenshot(rid)
-        if self.scene.view_count == 0:
-            del self._screenshots[rid]  # no view to answer (a front end that counts none: see below)
+        if self.scene.view_count == 0:  # kept, bounded by the timeout and the cap above
             text = "no view is displayed to answer: no screenshot (display the widget first)"
             self._set_note(text)
             if warn:  # from code: say it where the code runs (key p: the readout says it)
