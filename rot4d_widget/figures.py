@@ -69,6 +69,10 @@ __all__ = [
     "render_tomography",
     "render_state",
     "state_source",
+    "FIT_FILL",
+    "frame_extent",
+    "union_extent",
+    "annotation",
 ]
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
@@ -207,6 +211,12 @@ def _axes_aspect(ax) -> float:
     return box.width / box.height if box.width > 0 and box.height > 0 else 1.0
 
 
+def _add_patch(ax, patch):
+    """``ax.add_patch`` without updating the data limits (every frame here sets its limits itself;
+    matplotlib's per-patch limit update was most of the time of a frame)."""
+    return ax.add_artist(patch)
+
+
 # --------------------------------------------------------------------------- one panel
 @dataclass
 class SliceDrawing:
@@ -309,7 +319,7 @@ def draw_slice(
             p2[order], closed=True, facecolor=(*rgba[:3], face_alpha), edgecolor="none",
             zorder=_Z_BASE + depth + _Z_KIND["face"], gid="face",
         )
-        ax.add_patch(patch)
+        _add_patch(ax, patch)
         drawing.faces.append(patch)
 
     # bars: a trapezoid from end a to end b, half-width bar_radius * factor at each end
@@ -328,7 +338,7 @@ def draw_slice(
                 corners = [pa + n * ra, pb + n * rb, pb - n * rb, pa - n * ra]
                 patch = Polygon(corners, closed=True, facecolor=bar_rgba, edgecolor=edge_rgba,
                                 linewidth=0.3, zorder=zo, gid="bar")
-            ax.add_patch(patch)
+            _add_patch(ax, patch)
             drawing.bars.append(patch)
 
     # balls: circles of radius ball_radius * factor, with a highlight towards the upper left
@@ -340,8 +350,8 @@ def draw_slice(
             ball = Circle(xy[i], r, facecolor=ball_rgba, edgecolor=dark, linewidth=0.4, zorder=zo, gid="ball")
             shine = Circle(xy[i] + np.array([-0.35, 0.35]) * r, 0.3 * r, facecolor=(1, 1, 1, 0.55),
                            edgecolor="none", zorder=zo + 1e-5, gid="highlight")
-            ax.add_patch(ball)
-            ax.add_patch(shine)
+            _add_patch(ax, ball)
+            _add_patch(ax, shine)
             drawing.balls.append(ball)
             drawing.highlights.append(shine)
 
@@ -549,6 +559,123 @@ def paper_figure_4(path=None, *, panel_size: float = 2.0, dpi: float = 100, titl
     return fig
 
 
+# --------------------------------------------------------------------------- framing and annotation
+#: With ``frame="fit"`` the bounding box of what is drawn spans this fraction of the picture's
+#: width or height (whichever it reaches first).
+FIT_FILL = 0.9
+
+
+def frame_extent(data, source, *, ball_radius: float = 0.0):
+    """``(x0, x1, y0, y1)``: the projected bounding box of slice ``data`` of ``source`` (a
+    `StackSource`'s slice, as `render_tomography` draws it) in the picture plane of the live
+    view's camera, every point widened by ``ball_radius`` (displayed units) times its
+    perspective factor.  None when the slice is empty."""
+    pts = np.asarray(data.points, dtype=np.float64).reshape(-1, 3) * (REFERENCE_RADIUS / source.size)
+    if not len(pts):
+        return None
+    xy, fac = perspective(pts)
+    m = float(ball_radius) * fac
+    return (float((xy[:, 0] - m).min()), float((xy[:, 0] + m).max()),
+            float((xy[:, 1] - m).min()), float((xy[:, 1] + m).max()))
+
+
+def union_extent(boxes):
+    """The box holding every ``(x0, x1, y0, y1)`` of ``boxes`` (None ones skipped); None if none."""
+    boxes = [b for b in boxes if b is not None]
+    if not boxes:
+        return None
+    b = np.asarray(boxes, dtype=np.float64)
+    return (float(b[:, 0].min()), float(b[:, 1].max()), float(b[:, 2].min()), float(b[:, 3].max()))
+
+
+def _as_box(frame):
+    try:
+        box = tuple(float(v) for v in frame)
+    except (TypeError, ValueError):
+        box = ()
+    if len(box) != 4 or not all(math.isfinite(v) for v in box) or box[1] < box[0] or box[3] < box[2]:
+        raise ValueError(f"Expected `frame` to be 'camera', 'fit' or a box (x0, x1, y0, y1) with x0 <= x1 and "
+                         f"y0 <= y1, got {frame!r}")
+    return box
+
+
+def _frame_limits(box, aspect: float):
+    """``((x0, x1), (y0, y1))`` axes limits: the camera's frustum for ``box`` None, else ``box``
+    centred and grown to the picture's ``aspect`` so that it fills `FIT_FILL` of it."""
+    if box is None:
+        limit = CAMERA_DISTANCE * math.tan(math.radians(CAMERA_FOV) / 2.0)
+        return (-limit * aspect, limit * aspect), (-limit, limit)
+    cx, cy = 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3])
+    half = max(0.5 * (box[3] - box[2]), 0.5 * (box[1] - box[0]) / aspect, 1e-3) / FIT_FILL
+    return (cx - half * aspect, cx + half * aspect), (cy - half, cy + half)
+
+
+def _fmt_angle(theta: float) -> str:
+    for k in (1, 2, 3, 4, 6, 8, 12, 16, 32, 64):
+        if abs(theta * k / math.pi - round(theta * k / math.pi)) < 1e-9 and round(theta * k / math.pi):
+            num = round(theta * k / math.pi)
+            frac = ("\u03c0" if num == 1 else f"{num}\u03c0") + ("" if k == 1 else f"/{k}")
+            return f"{frac} ({math.degrees(theta):.4g}\u00b0)"
+    return f"{theta:.4g} rad ({math.degrees(theta):.4g}\u00b0)"
+
+
+def annotation(source, data, c0: float, *, theta0: float | None = None):
+    """``(lines, legend)`` describing slice ``data`` of ``source`` (a `StackSource`) at ``c0``:
+    ``lines`` of text (θ0 when given and c0; the inner source's ``name`` and ``units``; its
+    ``levels``; the w span of the slice from its ``readout`` row "w cut" (in ``w_units``); a
+    polytope slice's census, its readout row "slice"; a stack's slices' w, from ``levels_at``)
+    and ``legend``, ``[(rgb, label), ...]``: the colours of a field's levels or of a stack's
+    slices.  Only attributes the sources have are read, never their class."""
+    inner = getattr(source, "source", source)
+    lines = []
+    state = f"c0 = {float(c0):+.4g}"
+    lines.append(state if theta0 is None else f"\u03b80 = {_fmt_angle(float(theta0))}, {state}")
+    name, units = getattr(inner, "name", None), getattr(inner, "units", None)
+    u = f" {units}" if units else ""
+    if name:
+        lines.append(f"{name}" + (f" [{units}]" if units else ""))
+    levels = tuple(getattr(inner, "levels", ()) or ())
+    if levels:
+        lines.append(("level " if len(levels) == 1 else "levels ") + ", ".join(f"{v:.4g}" for v in levels) + u)
+    rows = dict(tuple(r) for r in (getattr(data, "readout", ()) or ()) if len(r) == 2)
+    if "w cut" in rows:
+        lines.append(f"w cut {rows['w cut']}")
+    elif "slice" in rows:
+        lines.append(str(rows["slice"]))
+    n = int(getattr(source, "slices", 1) or 1)
+    ws = np.asarray(source.levels_at(c0)) if n > 1 and hasattr(source, "levels_at") else np.zeros(0)
+    if len(ws):
+        spacing = getattr(source, "spacing", None)
+        lines.append(f"{n} slices w = {ws[0]:+.3g} \u2026 {ws[-1]:+.3g}"
+                     + (f", \u0394 = {spacing:.3g}" if spacing else ""))
+    legend = []
+    group_rgb = (getattr(data, "extra", None) or {}).get("group_rgb")
+    if len(ws) and group_rgb is not None:
+        picks = range(n) if n <= 8 else sorted({0, n // 4, n // 2, (3 * n) // 4, n - 1})
+        legend = [(tuple(np.asarray(group_rgb[k], dtype=float)[:3]), f"w = {ws[k]:+.3g}") for k in picks]
+    elif levels:
+        lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
+        rgb = look.level_colors(levels, lo, hi)
+        legend = [(tuple(rgb[k]), f"{v:.4g}{u}") for k, v in enumerate(levels)]
+    return lines, legend
+
+
+def _draw_annotation(ax, lines, legend, height: float) -> None:
+    """``lines`` in the upper left corner, ``legend`` swatches in the lower left (gid "annotation")."""
+    from matplotlib.patches import Patch
+
+    fs = max(6.0, min(10.0, 1.7 * height))
+    box = dict(facecolor="white", alpha=0.75, edgecolor="none", pad=2.0)
+    ax.text(0.015, 0.985, "\n".join(lines), transform=ax.transAxes, ha="left", va="top", fontsize=fs,
+            zorder=_Z_LABEL, gid="annotation", bbox=box)
+    if legend:
+        handles = [Patch(facecolor=rgb, edgecolor="none", label=label) for rgb, label in legend]
+        leg = ax.legend(handles=handles, loc="lower left", fontsize=fs, framealpha=0.75, edgecolor="none",
+                        handlelength=1.0, borderaxespad=0.3)
+        leg.set_zorder(_Z_LABEL)
+        leg.set_gid("legend")
+
+
 # --------------------------------------------------------------------------- stacks of slices
 def render_tomography(
     source="24-cell",
@@ -574,6 +701,10 @@ def render_tomography(
     face_color=None,
     group_colors=None,
     background=look.BACKGROUND,
+    frame="camera",
+    annotate=False,
+    _data=None,
+    _theta0=None,
 ) -> Figure:
     """N parallel slices w_k = c0 + (k - (N-1)/2) Δ of ``source``, in one scene, as the live view lays them out.
 
@@ -594,6 +725,15 @@ def render_tomography(
     ``show_balls`` / ``show_bars`` / ``show_faces``, ``face_color`` one colour for every face
     (the widget's ``color_by`` when it is a colour), ``group_colors`` one colour per group,
     ``background``.
+
+    ``frame``: ``"camera"`` (default) the live camera's frustum; ``"fit"`` the same eye and
+    perspective, zoomed so that the projected bounding box of what is drawn (every point of
+    the slice, balls included) fills `FIT_FILL` of the picture, centred on it (`frame_extent`);
+    or ``(x0, x1, y0, y1)``, a box in the picture plane to fit the same way (an animation passes
+    the union of its frames' boxes so that the framing does not jump).  ``annotate``: False,
+    True (a corner text naming the source, c0, a field's level(s) and w span with their units,
+    a stack's slices' w, and a legend of the levels' or slices' colours: `annotation`), or a
+    string written as the first line of that text.
     """
     from .source import as_source
     from .tomography import StackSource
@@ -619,7 +759,7 @@ def render_tomography(
         palette = np.asarray([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
                              dtype=np.float64).reshape(-1, 3)
     background = to_rgba(background)
-    data = src.slice(matrix, c0)
+    data = src.slice(matrix, c0) if _data is None else _data
     ex = data.extra
     n = src.slices
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
@@ -634,15 +774,22 @@ def render_tomography(
     ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
     ax.set_axis_off()
     ax.set_facecolor(background)
-    d = CAMERA_DISTANCE
-    limit = d * math.tan(math.radians(CAMERA_FOV) / 2.0)
     aspect = width / height
-    ax.set_xlim(-limit * aspect, limit * aspect)
-    ax.set_ylim(-limit, limit)
-    ax.set_aspect("equal")
-
     edge = getattr(src.source, "edge_length", None)
     base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
+    if isinstance(frame, str) and frame == "fit":
+        box = frame_extent(data, src, ball_radius=(ball_radius if ball_radius is not None else base_ball)
+                           if show_balls else 0.0)
+    elif isinstance(frame, str) and frame == "camera":
+        box = None
+    else:
+        box = _as_box(frame)
+    (x0, x1), (y0, y1) = _frame_limits(box, aspect)
+    limit = 0.5 * (y1 - y0)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
+
     poly = getattr(src.source, "polytope", None)
     offs = np.asarray(ex["point_offsets"])
     toff = np.asarray(ex["triangle_offsets"])
@@ -682,8 +829,13 @@ def render_tomography(
     point = 2.0 * limit / (height * 72.0)  # data units per typographic point
     for job in sorted(jobs, key=lambda j: (not j[3], -j[1] * perspective(np.asarray(j[0])[None, :])[1][0])):
         _label_slice(ax, *job, point=point, placed=placed)
-    ax.set_xlim(-limit * aspect, limit * aspect)
-    ax.set_ylim(-limit, limit)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    if annotate:
+        lines, legend = annotation(src, data, c0, theta0=_theta0)
+        if isinstance(annotate, str):
+            lines = [annotate, *lines]
+        _draw_annotation(ax, lines, legend, height)
     if title:
         name = getattr(src.source, "name", None) or type(src.source).__name__
         text = title if isinstance(title, str) else (
@@ -721,7 +873,7 @@ def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, pla
     ax.text(x0, y1, text, ha="left", va="top", fontsize=fs,
             fontweight="bold" if highlighted else "normal", zorder=z, gid="label")
     if highlighted:
-        ax.add_patch(Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
+        _add_patch(ax, Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
                             zorder=z, gid="highlight-ring"))
 
 
@@ -762,11 +914,11 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
         alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, look.SURFACE_OPACITY)
         coll = PolyCollection(xy[tri[order]], facecolors=np.column_stack([rgb[order], np.full(len(order), alpha)]),
                               edgecolors="none", zorder=z_base, gid="surface")
-        ax.add_collection(coll)
+        ax.add_collection(coll, autolim=False)
     if len(seg) and bar_width > 0:
         lines = LineCollection(xy[seg], colors=look.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
                                zorder=z_base + 1e-3, gid="bar")
-        ax.add_collection(lines)
+        ax.add_collection(lines, autolim=False)
 
 
 # --------------------------------------------------------------------------- the live view's picture
@@ -820,6 +972,9 @@ def render_state(
     dpi: float = 100,
     labels: bool = False,
     title: str | None = None,
+    frame="fit",
+    annotate=False,
+    _prepared=None,
 ) -> Figure:
     """The picture the widget shows for ``state`` and ``source``, without a browser.
 
@@ -838,6 +993,14 @@ def render_state(
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
     `look.level_colors`; a stack coloured by w: its levels' colormap).  It does not follow a
     camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
+
+    ``frame="fit"`` (the default) keeps that eye and perspective but zooms so that the projected
+    bounding box of what is drawn fills `FIT_FILL` (90 %) of the picture's width or height;
+    ``frame="camera"`` is the live view's frame exactly (an object there fills about a third of
+    the picture); a box ``(x0, x1, y0, y1)`` in the picture plane is fitted like "fit" (see
+    `render_tomography`).  ``annotate``: True writes θ0, c0 and what the source tells of itself
+    (`annotation`: name, units, levels, w span, a stack's w) in the upper left corner and a
+    legend of the levels' or slices' colours in the lower left; a string is written first.
     Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels (plus the title's strip when ``title`` is given).
     Returns the Figure.
     """
@@ -852,17 +1015,39 @@ def render_state(
     dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
     if title is not None and not isinstance(title, str):
         raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
-    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement)
     face_color = None
     if color_by != "group":
         face_color = look.as_rgb(color_by, "color_by")
-    if ball_radius is None:
-        edge = getattr(stack, "edge_length", None)
-        if edge:
-            ball_radius = look.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
+    if _prepared is None:
+        _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
+                             ball_radius=ball_radius, show_balls=show_balls)
+    stack, data, ball_radius, box = _prepared
+    if isinstance(frame, str) and frame == "fit":
+        frame = "camera" if box is None else box
     return render_tomography(
         stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi, dpi=dpi,
         title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
         bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
-        face_color=face_color, group_colors=group_colors, background=background,
+        face_color=face_color, group_colors=group_colors, background=background, frame=frame,
+        annotate=annotate, _data=data, _theta0=state.theta0,
     )
+
+
+def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
+             show_balls=True, **_ignored):
+    """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
+    source with the settings applied (`state_source`), its slice at ``state``, the ball radius
+    in displayed units (None: the stack's default) and the projected bounding box of the
+    drawing (`frame_extent`; None when empty).  An animation takes the boxes of all its frames
+    first to frame them alike, and draws each frame from the slice computed then."""
+    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement)
+    if ball_radius is None:
+        edge = getattr(stack, "edge_length", None)
+        if edge:
+            ball_radius = look.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
+    data = stack.slice(state.matrix, state.c0)
+    if show_balls:
+        ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
+    else:
+        ball = 0.0
+    return stack, data, ball_radius, frame_extent(data, stack, ball_radius=ball)

@@ -402,7 +402,7 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
 
     st = RotationState(matrix=random_rotation(4), c0=0.1)
     path = tmp_path / "s.png"
-    render_state(st, "24-cell", path, size=size, dpi=80, ball_radius=0.09)
+    render_state(st, "24-cell", path, size=size, dpi=80, ball_radius=0.09, frame="camera")
     img = imread(path)
     assert img.shape[:2] == (size[1], size[0])  # the size asked for, in pixels
     s = slice_polytope(polytope("24-cell"), st.matrix, st.c0)
@@ -414,7 +414,8 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
     # a corner is background
     np.testing.assert_allclose(img[2, 2, :3], [1, 1, 1], atol=1e-6)
     # balls only: every vertex, the widest ones too, is drawn where the camera puts it
-    render_state(st, "24-cell", path, size=size, dpi=80, show_faces=False, show_bars=False)
+    render_state(st, "24-cell", path, size=size, dpi=80, show_faces=False, show_bars=False,
+                 frame="camera")
     img = imread(path)[..., :3]
     for p3 in v:
         col, row = _ndc_pixel(p3, size)
