@@ -85,7 +85,7 @@ MESH_FORMATS = {
 
 #: ``"format"`` and ``"version"`` of a state file.
 STATE_FILE_FORMAT = "rot4d_widget state"
-STATE_FILE_VERSION = 1
+STATE_FILE_VERSION = 2
 
 
 class SourceNotRebuildable(UserWarning):
@@ -337,7 +337,8 @@ def describe_source(source) -> dict:
             d["cells"] = [np.asarray(c).tolist() for c in p.cells]
         d["rebuild"] = True
     elif isinstance(source, Field4D):
-        d.update(resolution=source.resolution, coarse_resolution=source.coarse_resolution, w_units=source.w_units)
+        d.update(resolution=source.resolution, coarse_resolution=source.coarse_resolution, w_units=source.w_units,
+                 chunk_cache_bytes=source.chunk_cache_bytes)
         origin = getattr(source, "origin", None)
         if source._kind == "function":
             path, why = _function_path(source._function)
@@ -349,14 +350,15 @@ def describe_source(source) -> dict:
             d["rebuild"] = True
         else:
             d["rebuild"] = (f"its values are a {d.get('array', 'array').replace(' (not recordable)', '')} held in "
-                            "memory, not written into a state file; open it with rot4d_widget.export.open_field(path, "
-                            "variable) to record where it comes from")
+                            "memory, not written into a state file; open the file with Field4D.open(path, variable, "
+                            "w=...) (or rot4d_widget.export.open_field) to record where it comes from -- "
+                            "the only way for a zarr store or a file xarray read with the scipy engine")
     else:
         d["rebuild"] = f"a source of kind {d.get('kind', type(source).__name__)!r} cannot be rebuilt from its description"
     return _jsonable(d, "source.describe()")
 
 
-def rebuild_source(description: Mapping, *, allow_code: bool = False, function=None):
+def rebuild_source(description: Mapping, *, allow_code: bool = False, function=None, base=None):
     """The source a `describe_source` dict describes.
 
     ``ValueError`` says why it cannot be rebuilt and what to do (pass the source to
@@ -364,7 +366,9 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
     A field described by a function's name (``"module:qualname"``) is rebuilt with ``function``
     if given (a callable ``f(x, y, z, w)``), else by importing the name only when
     ``allow_code`` is True; otherwise `CodeNotAllowed` (a ValueError) says how to allow it.
-    Nothing else in a description is ever imported or called.
+    Nothing else in a description is ever imported or called.  A field opened from a file
+    (``"origin"``) is reopened by path, with xarray (data only): its ``"relative_path"`` under
+    ``base`` (the state file's folder) when that exists, else its absolute ``"path"``.
     """
     if function is not None and not callable(function):
         raise TypeError(f"Expected `function` to be a callable f(x, y, z, w), got {type(function).__name__}")
@@ -386,7 +390,7 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
     if kind == "stack":
         from .tomography import StackSource
 
-        inner = rebuild_source(description["source"], allow_code=allow_code, function=function)
+        inner = rebuild_source(description["source"], allow_code=allow_code, function=function, base=base)
         return StackSource(inner, slices=description["slices"], spacing=description.get("spacing"),
                            arrangement=description.get("arrangement", "oval"),
                            color_by=description.get("color_by", "w"))
@@ -394,21 +398,90 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
         raise _CannotRebuild(f"The state file's source cannot be rebuilt: {why}. "
                          "Pass it in: load_state(path, source=...)")
     if kind == "field":
-        return _rebuild_field(description, allow_code, function)
+        return _rebuild_field(description, allow_code, function, base)
     raise _CannotRebuild(f"Unknown source kind {kind!r}; pass the source in: load_state(path, source=...)")
 
 
-def _rebuild_field(d, allow_code=False, function=None):
+#: The `Field4D.from_xarray` keywords an origin's ``"kwargs"`` may carry (files written by
+#: `open_field` before version 2 keep the dims and any of these there).
+_ORIGIN_KWARGS = ("x", "y", "z", "w", "w_per_unit", "name", "units", "w_units", "resolution", "coarse_resolution",
+                  "levels", "inside", "caps", "chunk_cache_bytes")
+
+
+def _origin_path(origin, base):
+    """The data file an origin names: its ``"relative_path"`` beside the state file (``base``, the
+    state file's folder) when that exists, else its absolute ``"path"``; `_CannotRebuild` naming
+    both when neither exists."""
+    path = origin.get("path")
+    rel = origin.get("relative_path")
+    for name, value in (("path", path), ("relative_path", rel)):
+        if value is not None and not isinstance(value, str):
+            raise ValueError(f"Expected the origin's {name!r} to be a string, got {value!r}")
+    if not path and not rel:
+        raise ValueError("Expected the field's origin to have a 'path'")
+    tried = []
+    if rel and base is not None:
+        cand = os.path.normpath(os.path.join(base, rel))
+        if os.path.exists(cand):
+            return cand
+        tried.append(cand)
+    if path:
+        if os.path.exists(path):
+            return path
+        tried.append(path)
+    raise _CannotRebuild(f"the field's data are not found at {' or '.join(map(repr, tried))}; put the file "
+                         "back, or open it and pass it in: load_state(path, source=Field4D.open(...))")
+
+
+def _open_origin(origin, base):
+    from .fields import Field4D, _selection_from_json
+
+    origin = dict(origin)
+    if origin.get("kind", "xarray") != "xarray":
+        raise ValueError(f"Unknown field origin kind {origin.get('kind')!r}")
+    path = _origin_path(origin, base)
+    engine = origin.get("engine")
+    if engine is not None and not (isinstance(engine, str) and engine.isidentifier()):
+        raise ValueError(f"Expected the origin's 'engine' to be an xarray engine's name, got {engine!r}")
+    chunks = origin.get("chunks")
+    if not (chunks is None or isinstance(chunks, (str, int)) or (
+            isinstance(chunks, dict) and all(c is None or isinstance(c, (int, str)) for c in chunks.values()))):
+        raise ValueError(f"Expected the origin's 'chunks' to be None, a string, an int or a dict, got {chunks!r}")
+    kwargs = origin.get("kwargs") or {}
+    if not isinstance(kwargs, Mapping) or any(k not in _ORIGIN_KWARGS for k in kwargs):
+        raise ValueError(f"Expected the origin's 'kwargs' to name only {', '.join(_ORIGIN_KWARGS)}, got {kwargs!r}")
+    kwargs = dict(kwargs)
+    variable = origin.get("variable")
+    if variable is not None and not isinstance(variable, str):
+        raise ValueError(f"Expected the origin's 'variable' to be a string, got {variable!r}")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", category=RuntimeWarning)  # zarr: no consolidated metadata
+            field = Field4D.open(path, variable, engine=engine, chunks=chunks,
+                                 isel=_selection_from_json(origin.get("isel"), "isel"),
+                                 sel=_selection_from_json(origin.get("sel"), "sel"),
+                                 load=bool(origin.get("load", False)), **kwargs)
+    except (OSError, KeyError, IndexError) as exc:
+        raise _CannotRebuild(f"the field's data at {path!r} cannot be opened as saved ({type(exc).__name__}: "
+                             f"{exc}); open it and pass it in: load_state(path, source=...)") from None
+    if origin.get("relative_path") is not None:
+        field.origin["relative_path"] = origin["relative_path"]
+    return field
+
+
+def _rebuild_field(d, allow_code=False, function=None, base=None):
     from .fields import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
     if d.get("w_units") is not None:
         common["w_units"] = d["w_units"]
     if "origin" in d:
-        origin = dict(d["origin"])
-        field = open_field(origin.pop("path"), origin.pop("variable", None), engine=origin.pop("engine", None),
-                           **origin.pop("kwargs", {}))
+        field = _open_origin(d["origin"], base)
+        _same_data(field, d)
         field.w_per_unit = d["w_per_unit"]
+        for attr in ("name", "units", "w_units"):
+            if attr in d:
+                setattr(field, attr, None if d[attr] is None else str(d[attr]))
     elif function is not None:
         field = Field4D.from_function(function, d["extent"], **common)
     else:
@@ -431,41 +504,49 @@ def _rebuild_field(d, allow_code=False, function=None):
             raise _CannotRebuild(f"The field's function {spec!r} cannot be imported ({exc}); "
                              "pass the source in: load_state(path, source=...)") from None
         field = Field4D.from_function(obj, d["extent"], **common)
-    for attr in ("resolution", "coarse_resolution"):
+    for attr in ("resolution", "coarse_resolution", "chunk_cache_bytes"):
         if d.get(attr) is not None:
+            setattr(field, attr, d[attr])
+    for attr in ("inside", "caps"):  # files before version 2 have neither: the defaults
+        if attr in d:
             setattr(field, attr, d[attr])
     if d.get("levels"):
         field.levels = d["levels"]
     return field
 
 
-def open_field(path, variable=None, *, engine=None, **from_xarray_kwargs):
-    """`Field4D.from_xarray` of ``variable`` in the file (or zarr store) at ``path``, remembering
-    where it came from (``field.origin``) so that a state file can reopen it.
+def _same_data(field, d) -> None:
+    """`_CannotRebuild` when a reopened file no longer holds what was saved: another shape, axis
+    order or extent (the file was rewritten, or the saved field was a selection xarray's
+    encoding did not show)."""
+    got = {"shape": [int(n) for n in field.values.shape], "axes": field.axes,
+           "extent": [[float(a), float(b)] for a, b in field.extent]}
+    for key, value in got.items():
+        want = d.get(key)
+        if want is None:
+            continue
+        if key == "extent":
+            same = np.allclose(np.asarray(want, dtype=np.float64), np.asarray(value), rtol=1e-12, atol=0)
+        else:
+            same = want == value
+        if not same:
+            raise _CannotRebuild(f"the file {field.origin.get('path')!r} no longer holds the saved field: its "
+                                 f"{key} is {value}, the state file's {want}; open the data as they were and pass "
+                                 "them in: load_state(path, source=...)")
+
+
+def open_field(path, variable=None, *, engine=None, **kwargs):
+    """`Field4D.open`: ``variable`` of the netCDF file or zarr store at ``path`` as a field that
+    remembers where it came from (``field.origin``), so a state file reopens it.
 
     ``variable`` may be omitted when the dataset has one data variable; ``engine`` goes to
-    ``xarray.open_dataset`` (a directory ending in ``.zarr`` opens with ``engine="zarr"``);
-    other keywords go to `Field4D.from_xarray` (``x=, y=, z=, w=, w_per_unit=`` ...).
+    ``xarray.open_dataset`` (a directory or a path ending in ``.zarr`` opens with ``"zarr"``);
+    ``chunks=``, ``isel=``, ``sel=`` and the keywords of `Field4D.from_xarray`
+    (``x=, y=, z=, w=, w_per_unit=`` ...) as in `Field4D.open`.
     """
-    import xarray
-
     from .fields import Field4D
 
-    p = os.path.abspath(os.fspath(path))
-    if engine is None and p.rstrip("/").endswith(".zarr"):
-        engine = "zarr"
-    ds = xarray.open_dataset(p, engine=engine)
-    if variable is None:
-        names = list(ds.data_vars)
-        if len(names) != 1:
-            raise ValueError(f"{path!r} has data variables {names}; name one: open_field(path, variable)")
-        variable = names[0]
-    if variable not in ds.data_vars:
-        raise ValueError(f"{path!r} has no data variable {variable!r}; it has {list(ds.data_vars)}")
-    field = Field4D.from_xarray(ds[variable], **from_xarray_kwargs)
-    field.origin = {"kind": "xarray", "path": p, "variable": variable, "engine": engine,
-                    "kwargs": _jsonable(dict(from_xarray_kwargs), "from_xarray keywords")}
-    return field
+    return Field4D.open(path, variable, engine=engine, **kwargs)
 
 
 def _made_by_function(d) -> bool:
@@ -553,9 +634,11 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
             warnings.warn(f"The source is described in {os.fspath(path)!r} but cannot be rebuilt from it: "
                           f"{src['rebuild']}. Loading the file will need it passed in: "
                           "load_state(path, source=...)", SourceNotRebuildable, stacklevel=2)
+    if src is not None:
+        _add_relative_paths(src, os.path.dirname(os.path.abspath(os.fspath(path))))
     doc = {
         "format": STATE_FILE_FORMAT,
-        "version": STATE_FILE_VERSION,
+        "version": _version_needed(src),
         "state": state.to_dict(),
         "source": src,
         "settings": _jsonable(dict(settings or {}), "settings"),
@@ -566,6 +649,35 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     text = json.dumps(doc, indent=1, allow_nan=False)
     _write_atomically(os.fspath(path), text + "\n")
     return doc
+
+
+def _fields_in(d):
+    while isinstance(d, Mapping) and d.get("kind") == "stack":
+        d = d.get("source")
+    return [d] if isinstance(d, Mapping) and d.get("kind") == "field" else []
+
+
+def _add_relative_paths(desc, folder: str) -> None:
+    """Give a file field's origin its path relative to the state file's ``folder`` when the data
+    sit there or below it (so the folder can move, or be copied, with its data)."""
+    for d in _fields_in(desc):
+        origin = d.get("origin")
+        if isinstance(origin, dict) and isinstance(origin.get("path"), str):
+            rel = os.path.relpath(origin["path"], folder)
+            if rel != os.pardir and not rel.startswith(os.pardir + os.sep) and not os.path.isabs(rel):
+                origin["relative_path"] = rel.replace(os.sep, "/")
+
+
+def _version_needed(desc) -> int:
+    """1 unless a field needs what version 1 readers would drop without a word: a selection of
+    its file (``isel``, ``sel``: they would open the whole variable), ``inside="below"`` or
+    ``caps=False`` (they would draw the other side, or close it)."""
+    for d in _fields_in(desc):
+        origin = d.get("origin") or {}
+        if any(origin.get(k) for k in ("isel", "sel")) or d.get("inside", "above") != "above" \
+                or d.get("caps", True) is not True:
+            return 2
+    return 1
 
 
 def _write_atomically(path: str, text: str) -> None:
@@ -661,7 +773,8 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     if desc is None:
         return LoadedState(state, None, settings)
     try:
-        rebuilt = rebuild_source(desc, allow_code=allow_code, function=function)
+        rebuilt = rebuild_source(desc, allow_code=allow_code, function=function,
+                                 base=os.path.dirname(os.path.abspath(path)))
     except CodeNotAllowed as exc:
         raise CodeNotAllowed(f"{path!r}: {exc}") from None
     except _CannotRebuild as exc:

@@ -55,6 +55,7 @@ import collections
 import itertools
 import math
 import numbers
+import os
 import sys
 import threading
 import warnings
@@ -513,6 +514,154 @@ def _count_infinite(a, block_bytes: int = 64 * 1024**2):
     return npos, nneg, first
 
 
+def _finite_range(a, block_bytes: int = 64 * 1024**2) -> tuple:
+    """(min, max) of the finite values of an array in memory, read in blocks along its first axis;
+    (nan, nan) when none is finite."""
+    lo, hi = math.inf, -math.inf
+    per = max(1, int(block_bytes // max(1, 8 * math.prod(int(n) for n in a.shape[1:]))))
+    for i in range(0, int(a.shape[0]), per):
+        b = np.asarray(a[i:i + per])
+        if b.dtype.kind == "f":
+            b = b[np.isfinite(b)]
+        if b.size:
+            lo, hi = min(lo, float(b.min())), max(hi, float(b.max()))
+    return (lo, hi) if lo <= hi else (math.nan, math.nan)
+
+
+def _attr_numbers(v, n: int):
+    """``n`` finite floats from an attribute value (a number or an array), else None."""
+    try:
+        a = np.asarray(v, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        return None
+    return tuple(float(x) for x in a) if a.size == n and np.all(np.isfinite(a)) else None
+
+
+def _metadata_range(attrs, encoding):
+    """(lo, hi, where) of a variable from its attributes, read without touching its data, or None.
+
+    ``actual_range`` (CF: the data's own min and max, in unpacked units) first, else
+    ``valid_range`` or ``valid_min`` and ``valid_max`` (CF: the bounds of valid values, in packed
+    units: unpacked here by the ``scale_factor`` / ``add_offset`` xarray moved into the encoding
+    when it decoded the data).  A pair that is not finite and ordered is ignored."""
+    attrs = attrs or {}
+    encoding = encoding or {}
+    packed = "scale_factor" in attrs or "add_offset" in attrs  # not decoded: the data are still packed
+    pair = None if packed else _attr_numbers(attrs.get("actual_range"), 2)
+    if pair is not None and pair[0] <= pair[1]:
+        return pair[0], pair[1], "actual_range"
+    pair, where = _attr_numbers(attrs.get("valid_range"), 2), "valid_range"
+    if pair is None:
+        lo, hi = _attr_numbers(attrs.get("valid_min"), 1), _attr_numbers(attrs.get("valid_max"), 1)
+        pair, where = (None if lo is None or hi is None else lo + hi), "valid_min/valid_max"
+    if pair is None:
+        return None
+    if not packed:
+        scale = _attr_numbers(encoding.get("scale_factor", 1.0), 1)
+        offset = _attr_numbers(encoding.get("add_offset", 0.0), 1)
+        if scale is None or offset is None:
+            return None
+        pair = tuple(sorted((pair[0] * scale[0] + offset[0], pair[1] * scale[0] + offset[0])))
+    return (pair[0], pair[1], where) if pair[0] <= pair[1] else None
+
+
+def _encoding_origin(da, chosen):
+    """What a state file needs to reopen a DataArray read from a file, from what xarray kept:
+    the path in ``da.encoding["source"]`` (the netCDF4 and h5netcdf engines put it there; scipy
+    and zarr do not), when the array is the file's whole variable (its shape is the encoding's
+    ``original_shape``; a selection made after opening cannot be seen).  None otherwise."""
+    enc = getattr(da, "encoding", None) or {}
+    src = enc.get("source")
+    if not isinstance(src, str) or not os.path.exists(src) or da.name is None:
+        return None
+    shape = enc.get("original_shape")
+    if shape is not None and tuple(int(n) for n in shape) != tuple(int(n) for n in da.shape):
+        return None
+    if da.chunks is not None:
+        chunks = {str(d): int(c[0]) for d, c in zip(da.dims, da.chunks)}
+    else:
+        chunks = None
+    return {"kind": "xarray", "path": os.path.abspath(src), "variable": str(da.name), "engine": None,
+            "chunks": chunks, "isel": None, "sel": None, "kwargs": dict(chosen),
+            "load": bool(da.chunks is None and getattr(da.variable, "_in_memory", False))}
+
+
+def _label_json(v, where):
+    if isinstance(v, (np.datetime64, np.timedelta64)):
+        return str(v)
+    if hasattr(v, "isoformat") and not isinstance(v, (int, float)):  # datetime, pandas Timestamp
+        return v.isoformat()
+    if isinstance(v, (bool, np.bool_)):
+        raise TypeError(f"{where} = {v!r}: expected an integer, a label (number or string) or a slice")
+    if isinstance(v, (numbers.Integral, np.integer)):
+        return int(v)
+    if isinstance(v, (numbers.Real, np.floating)) and math.isfinite(float(v)):
+        return float(v)
+    if v is None or isinstance(v, str):
+        return v
+    raise TypeError(f"{where} = {v!r}: expected an integer, a label (number or string) or a slice")
+
+
+def _selection_json(selection, name):
+    """``{dim: value}`` as JSON: numbers and strings as they are, ``slice(a, b, c)`` as
+    ``{"slice": [a, b, c]}``, lists as lists; TypeError naming anything else."""
+    if not selection:
+        return None
+    if not isinstance(selection, dict):
+        raise TypeError(f"Expected `{name}` to be a dict {{dim: index or label or slice}}, got {type(selection).__name__}")
+    out = {}
+    for dim, v in selection.items():
+        where = f"{name}[{dim!r}]"
+        if isinstance(v, slice):
+            out[str(dim)] = {"slice": [_label_json(e, where) for e in (v.start, v.stop, v.step)]}
+        elif isinstance(v, (list, tuple, np.ndarray)):
+            out[str(dim)] = [_label_json(e, where) for e in v]
+        else:
+            out[str(dim)] = _label_json(v, where)
+    return out
+
+
+def _selection_from_json(selection, name):
+    """The inverse of `_selection_json` (a state file's selection for isel / sel)."""
+    if selection is None:
+        return None
+    if not isinstance(selection, dict):
+        raise ValueError(f"Expected `{name}` to be a dict, got {selection!r}")
+    out = {}
+    for dim, v in selection.items():
+        if isinstance(v, dict):
+            parts = v.get("slice")
+            if set(v) != {"slice"} or not isinstance(parts, list) or len(parts) != 3:
+                raise ValueError(f"Expected {name}[{dim!r}] to be {{'slice': [start, stop, step]}}, got {v!r}")
+            v = slice(*parts)
+            items = (v.start, v.stop, v.step)
+        else:
+            items = v if isinstance(v, list) else [v]
+        for e in items:
+            if e is not None and (isinstance(e, bool) or not isinstance(e, (int, float, str))):
+                raise ValueError(f"Expected {name}[{dim!r}] to hold numbers, strings or slices, got {e!r}")
+        out[str(dim)] = v
+    return out
+
+
+def _chunks_json(chunks):
+    if chunks is None or isinstance(chunks, str):
+        return chunks
+    if isinstance(chunks, (numbers.Integral, np.integer)) and not isinstance(chunks, bool):
+        return int(chunks)
+    if isinstance(chunks, dict):
+        out = {}
+        for d, c in chunks.items():
+            if isinstance(c, (numbers.Integral, np.integer)) and not isinstance(c, bool):
+                out[str(d)] = int(c)
+            elif isinstance(c, str) or c is None:
+                out[str(d)] = c
+            else:
+                raise TypeError(f"Expected chunks[{d!r}] to be an int, 'auto' or None, got {c!r}")
+        return out
+    raise TypeError(f"Expected `chunks` to be None, 'auto', an int or a dict {{dim: size}}, got {chunks!r}")
+
+
 # ----------------------------------------------------------------------------- the field
 class Field4D:
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
@@ -655,6 +804,12 @@ class Field4D:
         #: (n +inf, n -inf, first index or None) once known; reported once (`NonFiniteWarning`)
         self._infinite = None
         self._infinite_reported = False
+        #: (lo, hi, where) from the data's metadata (`from_xarray`: actual_range, valid_min/valid_max)
+        self._meta_range = None
+        self._range = None  # ((lo, hi), where the range comes from), once known
+        #: Where the values come from, for a state file to reopen them (`Field4D.open`; `from_xarray`
+        #: when xarray's encoding names the file): a JSON-able dict, or None (not reopenable)
+        self.origin = None
 
     # -- constructors ---------------------------------------------------------
     @classmethod
@@ -717,6 +872,8 @@ class Field4D:
                 f"Expected at least 2 samples along every dim (a surface needs a cell to cross), got "
                 f"{', '.join(few)}; dims {dict((d, int(da.sizes[d])) for d in dims)}. A single time step is a "
                 f"3-D field, not a 4-D one: select a range, e.g. da.isel({chosen['w']}=slice(0, 2))")
+        meta_range = _metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None))
+        origin = _encoding_origin(da, chosen)
         flips, coords, extent = {}, [None] * 4, []
         for d_i, k in enumerate(_AXES):
             dim = chosen[k]
@@ -756,6 +913,57 @@ class Field4D:
                     units=kwargs.pop("units", units), w_per_unit=w_per_unit, w_units=w_units, _coords=coords,
                     **kwargs)
         field._dims = dims
+        field._meta_range = meta_range
+        field.origin = origin
+        return field
+
+    @classmethod
+    def open(cls, path, variable=None, *, x=None, y=None, z=None, w=None, engine=None, chunks=None,
+             isel=None, sel=None, load: bool = False, **kwargs) -> "Field4D":
+        """`from_xarray` of ``variable`` in the netCDF file or zarr store at ``path``, remembering
+        where it came from (``field.origin``), so that a state file reopens it
+        (`rot4d_widget.export.save_state`, `Rot4DWidget.save_state` / ``from_state``).
+
+        ``variable`` may be omitted when the file has one data variable.  ``engine`` goes to
+        ``xarray.open_dataset`` (None: xarray's guess; a directory opens with ``"zarr"``).
+        ``chunks``: None reads lazily, block by block, as needed; ``{}`` (the store's own chunks),
+        ``"auto"`` or ``{"time": 10}`` make it a dask array.  ``isel`` / ``sel`` select a 4-D part
+        before `from_xarray` (``isel={"member": 0}``, ``sel={"time": slice("2020-01", "2020-06")}``;
+        isel first): integers, labels (numbers, strings) and slices of them, kept in the origin.
+        ``load=True`` reads the selected part into memory now (a numpy array).
+        ``x=, y=, z=, w=`` name the dims as in `from_xarray`; other keywords go to it
+        (``w_per_unit=``, ``levels=``, ``inside=``, ``caps=``, ``resolution=`` ...).
+
+        Opening reads the file's metadata and coordinates, not its data.
+        """
+        import xarray
+
+        p = os.path.abspath(os.fspath(path))
+        if engine is None and (os.path.isdir(p) or p.rstrip("/").endswith(".zarr")):
+            engine = "zarr"
+        rec_isel = _selection_json(isel, "isel")
+        rec_sel = _selection_json(sel, "sel")
+        rec_chunks = _chunks_json(chunks)
+        ds = xarray.open_dataset(p, engine=engine, chunks=chunks)
+        if variable is None:
+            names = list(ds.data_vars)
+            if len(names) != 1:
+                raise ValueError(f"{os.fspath(path)!r} has data variables {names}; name one: "
+                                 f"Field4D.open(path, variable)")
+            variable = names[0]
+        if variable not in ds.data_vars:
+            raise ValueError(f"{os.fspath(path)!r} has no data variable {variable!r}; it has {list(ds.data_vars)}")
+        da = ds[variable]
+        if isel:
+            da = da.isel(isel)
+        if sel:
+            da = da.sel(sel)
+        if load:
+            da = da.load()
+        field = cls.from_xarray(da, x=x, y=y, z=z, w=w, **kwargs)
+        field.origin = {"kind": "xarray", "path": p, "variable": str(variable), "engine": engine,
+                        "chunks": rec_chunks, "isel": rec_isel, "sel": rec_sel,
+                        "kwargs": dict(zip(field.axes, field._dims)), "load": bool(load)}
         return field
 
     # -- geometry and resolution ------------------------------------------------
@@ -849,8 +1057,45 @@ class Field4D:
 
     @property
     def data_range(self) -> tuple:
-        """(nanmin, nanmax) of `coarse` (of a probe grid for a function); (nan, nan) if all NaN."""
-        return self._statistics()[0]
+        """(min, max) of the finite values; (nan, nan) if there are none.  Where it comes from
+        (`data_range_source`): the metadata of a variable from xarray (``actual_range``, else
+        ``valid_range`` or ``valid_min``/``valid_max``), read without touching the data; else an
+        array in memory, whole; a chunked or lazy array's `coarse` copy (which may miss a peak
+        between its nodes); a function's probe grid."""
+        return self._range_info()[0]
+
+    @property
+    def data_range_source(self) -> str:
+        """Where `data_range` comes from: ``"data"``, ``"coarse copy"``, ``"probe grid"``,
+        ``"actual_range"``, ``"valid_range"`` or ``"valid_min/valid_max"``."""
+        return self._range_info()[1]
+
+    def _range_info(self):
+        if self._range is None:
+            if self._meta_range is not None:
+                lo, hi, where = self._meta_range
+                self._range = ((lo, hi), where)
+            elif self._kind == "function":
+                a = self._probe_values()
+                finite = np.isfinite(a)
+                rng = (float(a[finite].min()), float(a[finite].max())) if finite.any() else (math.nan, math.nan)
+                self._range = (rng, "probe grid")
+            elif self._kind == "numpy":
+                self._report_infinite()
+                self._range = (_finite_range(self._values), "data")
+            else:
+                c = self.coarse()
+                self._report_infinite()
+                self._range = (c.data_range, "coarse copy")
+        return self._range
+
+    def _probe_values(self):
+        """A function field's values on a `_FUNCTION_PROBE`^4 grid over its box, float64 (x, y, z, w)."""
+        if getattr(self, "_probe", None) is None:
+            m = _FUNCTION_PROBE
+            grids = np.meshgrid(*[np.linspace(a, b, m) for a, b in self.extent], indexing="ij")
+            self._probe = _call(self._function, *grids)
+        return self._probe
 
     @property
     def level_step(self) -> float:
@@ -1020,21 +1265,23 @@ class Field4D:
         return c
 
     def _statistics(self):
-        """((nanmin, nanmax), K): the data range and a typical |grad f| (level units per slice unit)."""
-        if self._stats is not None:
-            return self._stats
+        """((min, max), K): `data_range` and a typical |grad f| (level units per slice unit)."""
+        if self._stats is None:
+            self._stats = (self.data_range, self._gradient_scale())
+        return self._stats
+
+    def _gradient_scale(self) -> float:
+        """K, the 95th percentile of |grad f| in level units per slice unit, from `coarse` (a
+        function's probe grid); from the data range when f is flat."""
         if self._kind == "function":
             m = _FUNCTION_PROBE
-            axes = [np.linspace(a, b, m) for a, b in self.extent]
-            grids = np.meshgrid(*axes, indexing="ij")
-            a = _call(self._function, *grids)
+            a = self._probe_values()
             spacing = [(b - a_) / (m - 1) / u for (a_, b), u in zip(self.extent, self._unit)]
         else:
             c = self.coarse()
             self._report_infinite()
-            if c is not self:  # the same numbers: computed once, on the coarse copy
-                self._stats = c._statistics()
-                return self._stats
+            if c is not self:  # the same numbers: computed on the coarse copy
+                return c._statistics()[1]
             a = np.asarray(c._values, dtype=np.float32).transpose(c._axis_of)  # x, y, z, w order
             spacing = []
             for d in range(4):
@@ -1044,11 +1291,6 @@ class Field4D:
                     spacing.append((hi - lo) / (a.shape[d] - 1) / c._unit[d])
                 else:
                     spacing.append(np.asarray(cd) / c._unit[d])
-        finite = np.isfinite(a)
-        if finite.any():
-            rng = (float(np.min(a[finite])), float(np.max(a[finite])))
-        else:
-            rng = (math.nan, math.nan)
         with np.errstate(invalid="ignore"):
             # spacings in units of the box's size (a power of two: exact), so a float32 gradient
             # neither overflows nor underflows at any scale; K is scaled back below
@@ -1057,12 +1299,10 @@ class Field4D:
             gm = np.sqrt(sum(g * g for g in grads))
         ok = np.isfinite(gm) & (gm > 0)
         if ok.any():
-            k = float(np.percentile(gm[ok], 95)) / u  # steep places: a phase field's plateaus must not set it
-        else:
-            span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
-            k = max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * self.size)
-        self._stats = (rng, k)
-        return self._stats
+            return float(np.percentile(gm[ok], 95)) / u  # steep places: a phase field's plateaus must not set it
+        rng = self.data_range
+        span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
+        return max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * self.size)
 
     def _report_infinite(self) -> None:
         """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf: how many, and where
@@ -1106,7 +1346,9 @@ class Field4D:
             elif s.empty:
                 t += " (empty here)"
             parts.append(t)
-        rng = f" of {lo:.4g} \u2026 {hi:.4g}" if math.isfinite(lo) else " (all NaN)"
+        where = self.data_range_source
+        rng = (f" of {lo:.4g} \u2026 {hi:.4g}" + ("" if where == "data" else f" ({where})") if math.isfinite(lo)
+               else " (all NaN)")
         rows.append(("level" if len(slices) == 1 else "levels", ", ".join(parts) + rng))
         if self.inside != "above" or not self.caps:
             rows.append(("surface", ("encloses f <= level" if self.inside == "below" else "encloses f >= level")

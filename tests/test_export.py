@@ -335,7 +335,7 @@ def test_a_loaded_orientation_is_validated(tmp_path):
     ("not json {", "not a rot4d_widget state file: not JSON"),
     ('{"format": "something else"}', "not a rot4d_widget state file"),
     ('{"format": "rot4d_widget state", "version": 9, "state": {}, "source": null, "settings": {}}',
-     "version 9; this rot4d_widget reads versions 1 ... 1"),
+     "version 9; this rot4d_widget reads versions 1 ... 2"),
     ('{"format": "rot4d_widget state", "version": 1, "state": {}}', "lacks 'source', 'settings'"),
     ('{"format": "rot4d_widget state", "version": 1, "state": {}, "source": null, "settings": {}}',
      "bad state: A state needs its 'orientation'"),
