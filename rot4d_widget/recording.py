@@ -601,8 +601,19 @@ def _figure_rgb(fig) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba())[..., :3].copy()
 
 
+#: Slices kept from the framing pass for the drawing pass, in bytes (beyond it they are recomputed).
+_SLICE_CACHE_BYTES = 256 * 2**20
+_PREPARE_KEYS = ("levels", "slices", "spacing", "arrangement", "ball_radius", "show_balls")
+
+
+def _data_bytes(data) -> int:
+    return sum(int(getattr(np.asarray(getattr(data, name, ())), "nbytes", 0))
+               for name in ("points", "segments", "triangles", "groups", "normals"))
+
+
 def render_frames(recording: Recording, initial_state=None, source="5-cell", *, per: str = "step",
-                  fps: float = 10.0, max_frames: int = 3000, titles=None, **settings) -> Iterator[np.ndarray]:
+                  fps: float = 10.0, max_frames: int = 3000, titles=None, frame="fit", annotate=True,
+                  **settings) -> Iterator[np.ndarray]:
     """The frames of `render_animation`, one (H, W, 3) uint8 array at a time.
 
     ``settings`` go to `rot4d_widget.figures.render_state` (``size``, ``dpi``, ``levels``,
@@ -612,8 +623,16 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     ``arrangement``: its `Recording.initial_source` or recorded ones), those keywords are the
     source's settings at the start unless ``initial_source`` has them, and each frame shows them
     as recorded up to it.
+
+    ``frame="fit"`` (default): every frame is framed alike, by the union of the projected
+    bounding boxes of all frames' slices (`figures.frame_extent`), which fills 90 % of the
+    picture's width or height -- the slices are computed once for this, in a first pass, and
+    kept for drawing (up to 256 MB); ``"camera"`` or a box as `render_state`.  ``annotate``
+    (default True): each frame carries "t = ... s, frame k/n", θ0, c0 and what the source tells
+    of itself (`figures.annotation`), and a legend; False for a bare picture.
     """
-    from .figures import render_state, state_source
+    from . import figures
+    from .figures import state_source
 
     fps = _positive("fps", fps)
     n = _frame_count(recording, per, fps)
@@ -624,23 +643,59 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
         # the settings given are where the source starts; the recorded ones change it from there
         start = {k: settings.pop(k) for k in SOURCE_SETTINGS if k in settings}
         source = state_source(source, **start)
+    prep = {k: settings[k] for k in _PREPARE_KEYS if k in settings}
+    cache: list = []
+    if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
+        boxes, kept = [], 0
+        for t, state, src in animation_states(recording, initial_state, source, per=per, fps=fps):
+            _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep)
+            boxes.append(box)
+            kept += _data_bytes(data)
+            cache.append(data if kept <= _SLICE_CACHE_BYTES else None)
+        box = figures.union_extent(boxes)
+        frame = "camera" if box is None else box
     for k, (t, state, src) in enumerate(animation_states(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
-        fig = render_state(state, src if src is not None else "5-cell", title=title, **settings)
+        note = f"t = {t:.2f} s, frame {k + 1}/{n}" if annotate else False
+        drawn = src if src is not None else "5-cell"
+        extra = {}
+        if k < len(cache) and cache[k] is not None:
+            extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep)
+            cache[k] = None  # drawn once: let it go
+        fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, **extra, **settings)
         yield _figure_rgb(fig)
+
+
+def _progress_sink(progress, total: int):
+    """``(update(done), close())`` for render_animation's ``progress=`` (True, False or a callable)."""
+    if progress is True:
+        from .progress import progress as make_progress
+
+        bar = make_progress(total, "rendering frames")
+        return (lambda done: bar.update(done - bar.count)), bar.close
+    if progress is False or progress is None:
+        return (lambda done: None), (lambda: None)
+    if callable(progress):
+        return (lambda done: progress(done, total)), (lambda: None)
+    raise TypeError(f"Expected `progress` to be True, False or a callable (done, total), got {progress!r}")
 
 
 def render_animation(recording: Recording, initial_state=None, source="5-cell", path=None, *,
                      fps: float = 10.0, per: str = "step", max_frames: int = 3000, titles=None,
-                     **settings) -> int:
+                     frame="fit", annotate=True, progress=True, **settings) -> int:
     """Draw ``recording`` (from ``initial_state``, default its own start) of ``source`` into ``path``.
 
     ``.gif``: an animated GIF (Pillow), looping, 1/fps s per frame (Pillow merges identical
-    consecutive frames into one longer frame); ``.mp4``: H.264 (imageio with imageio-ffmpeg's
-    ffmpeg), ``fps`` frames per second.  One frame per step (``per="step"``, plus the
+    consecutive frames into one longer frame; each frame gets its own 256-colour palette, fast
+    octree); ``.mp4``: H.264 (imageio with imageio-ffmpeg's ffmpeg), ``fps`` frames per second,
+    streamed to ffmpeg as they are drawn.  One frame per step (``per="step"``, plus the
     starting state) or per 1/``fps`` s of the recorded time (``per="time"``).  ``settings``
     are `rot4d_widget.figures.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...; an MP4's size is rounded up to even numbers of pixels).
+    ``frame`` and ``annotate`` as `render_frames` (default: every frame framed alike to fill
+    the picture, and annotated).  ``progress``: True (default) shows a progress bar
+    (`rot4d_widget.progress`: a widget in a notebook, a line on a terminal's stderr, only after
+    a second), False nothing, a callable ``progress(done, total)`` is called after each frame.
     Returns the number of frames drawn.
     """
     if path is None:
@@ -649,27 +704,38 @@ def render_animation(recording: Recording, initial_state=None, source="5-cell", 
     if ext not in ANIMATION_FORMATS:
         raise ValueError(f"Expected `path` to end in one of {', '.join(ANIMATION_FORMATS)}, got {os.fspath(path)!r}")
     fps = _positive("fps", fps)
+    total = _frame_count(recording, per, fps)
+    update, close = _progress_sink(progress, total)
     frames = render_frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames,
-                           titles=titles, **settings)
-    if ext == ".gif":
-        from PIL import Image
-
-        images = [Image.fromarray(f) for f in frames]
-        images[0].save(os.fspath(path), save_all=True, append_images=images[1:], duration=round(1000.0 / fps),
-                       loop=0)
-        return len(images)
-    import imageio.v2 as imageio
-
+                           titles=titles, frame=frame, annotate=annotate, **settings)
     count = 0
-    with imageio.get_writer(os.fspath(path), format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                            pixelformat="yuv420p", macro_block_size=1, ffmpeg_log_level="error") as writer:
-        for f in frames:
-            h, w = f.shape[:2]
-            if h % 2 or w % 2:  # yuv420p needs even sizes: repeat the last row / column
-                f = np.pad(f, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
-            writer.append_data(f)
-            count += 1
-    return count
+    try:
+        if ext == ".gif":
+            from PIL import Image
+
+            images = []
+            for f in frames:
+                images.append(Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
+                                                          dither=Image.Dither.NONE))
+                count += 1
+                update(count)
+            images[0].save(os.fspath(path), save_all=True, append_images=images[1:],
+                           duration=round(1000.0 / fps), loop=0)
+            return count
+        import imageio.v2 as imageio
+
+        with imageio.get_writer(os.fspath(path), format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                                pixelformat="yuv420p", macro_block_size=1, ffmpeg_log_level="error") as writer:
+            for f in frames:
+                h, w = f.shape[:2]
+                if h % 2 or w % 2:  # yuv420p needs even sizes: repeat the last row / column
+                    f = np.pad(f, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+                writer.append_data(f)
+                count += 1
+                update(count)
+        return count
+    finally:
+        close()
 
 
 # ============================================================================ the paper's figures

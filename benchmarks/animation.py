@@ -1,0 +1,98 @@
+"""render_animation, before and after "Keeping it": the same 33-frame recordings, old and new code, one run.
+
+A held "4" (32 steps of R_xw, 33 frames, 600 x 500) on the 24-cell and on the moving sphere
+(`rot4d_widget.datasets.moving_sphere()`, a Field4D), each to GIF and MP4.  The old code is
+the package at commit 7ba6e62, checked out with ``git worktree add /tmp/old-anim 7ba6e62``
+(``--old`` elsewhere); the new is this checkout.  Each side runs in its own Python process
+(PYTHONPATH set to its tree), imports and draws one small warm-up animation first, then times
+``--repeats`` renders of every case; old and new alternate case by case so that the load of the
+machine falls on both alike.  Prints a table of medians (seconds) and the speed-up.
+
+    python benchmarks/animation.py [--repeats 3] [--old /tmp/old-anim]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+CASES = [("24-cell", ".gif"), ("24-cell", ".mp4"), ("field", ".gif"), ("field", ".mp4")]
+
+
+def _recording():
+    from rot4d_widget.recording import Recorder
+    from rot4d_widget.state import RotationState
+
+    st = RotationState()
+    rec = Recorder(st, clock=lambda: 0.0)
+    action, inverted = st.keymap.resolve("4")
+    for k in range(1, 33):  # a held key: 32 repeats at 30 Hz
+        rec.record("4", False, action, inverted, t=k / 30)
+    return rec.recording()
+
+
+def worker(case: str, ext: str, repeats: int, new: bool) -> list:
+    """Seconds of each of ``repeats`` renders of one case, in this process."""
+    import inspect
+
+    from rot4d_widget import datasets
+    from rot4d_widget.recording import render_animation
+
+    quiet = {"progress": False} if "progress" in inspect.signature(render_animation).parameters else {}
+    rec = _recording()
+    source = datasets.moving_sphere() if case == "field" else case
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        render_animation(rec, None, "5-cell", os.path.join(tmp, "warm" + ext), size=(80, 60), max_frames=40,
+                         **quiet)
+        for r in range(repeats):
+            t = time.perf_counter()
+            n = render_animation(rec, None, source, os.path.join(tmp, f"a{r}{ext}"), fps=10, **quiet)
+            times.append(time.perf_counter() - t)
+            assert n == 33, n
+    return times
+
+
+def _run(tree: str, case: str, ext: str, repeats: int) -> list:
+    env = {**os.environ, "PYTHONPATH": tree}
+    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--worker", case, ext, str(repeats)],
+                         env=env, cwd=tree, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--old", default="/tmp/old-anim", help="a checkout of 7ba6e62 (git worktree add ... 7ba6e62)")
+    p.add_argument("--worker", nargs=3, help=argparse.SUPPRESS)
+    a = p.parse_args(argv)
+    if a.worker:
+        case, ext, repeats = a.worker
+        print(json.dumps(worker(case, ext, int(repeats), new=True)))
+        return
+    new_tree = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if not os.path.isdir(os.path.join(a.old, "rot4d_widget")):
+        sys.exit(f"No old checkout at {a.old}: git worktree add {a.old} 7ba6e62")
+    rows = []
+    for case, ext in CASES:
+        old = _run(a.old, case, ext, a.repeats)
+        new = _run(new_tree, case, ext, a.repeats)
+        rows.append((case, ext, statistics.median(old), statistics.median(new)))
+        print(f"  {case} {ext}: old {old}, new {new}", file=sys.stderr)
+    print(f"render_animation, 33 frames 600 x 500, median of {a.repeats} (s); load average "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    print("| source | file | old 7ba6e62 | new | speed-up |")
+    print("|---|---|---:|---:|---:|")
+    for case, ext, o, n in rows:
+        name = "24-cell" if case == "24-cell" else "moving_sphere() field"
+        print(f"| {name} | {ext} | {o:.2f} | {n:.2f} | {o / n:.1f}x |")
+
+
+if __name__ == "__main__":
+    main()
