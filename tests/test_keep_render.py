@@ -1,0 +1,125 @@
+"""Keeping it: pictures and animations frame the object, can be annotated, and show progress.
+
+Runs against the old code too (``PYTHONPATH=/tmp/old-anim pytest tests/test_keep_render.py``):
+the framing test fails there (the object filled about a third of the picture).
+"""
+
+import io
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from rot4d_widget.recording import Recorder, render_animation, render_frames
+from rot4d_widget.state import RotationState
+
+
+def _held_4(steps=6):
+    st = RotationState()
+    rec = Recorder(st, clock=lambda: 0.0)
+    action, inverted = st.keymap.resolve("4")
+    for k in range(1, steps + 1):
+        rec.record("4", False, action, inverted, t=k / 30)
+    return rec.recording()
+
+
+def _filled(rgb, background=(1.0, 1.0, 1.0)):
+    """Width and height of the bounding box of non-background pixels, as fractions."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    if rgb.max() > 1.0:
+        rgb = rgb / 255.0
+    drawn = np.abs(rgb[..., :3] - np.asarray(background)).max(axis=2) > 0.05
+    rows, cols = np.nonzero(drawn)
+    h, w = drawn.shape
+    return (cols.max() - cols.min() + 1) / w, (rows.max() - rows.min() + 1) / h
+
+
+@pytest.mark.parametrize("source", ["24-cell", "5-cell"])
+def test_render_state_fills_most_of_the_picture(tmp_path, source):
+    from rot4d_widget.figures import render_state
+
+    path = tmp_path / "v.png"
+    render_state(RotationState(c0=0.1), source, path, size=(600, 500), dpi=100)
+    fw, fh = _filled(np.asarray(Image.open(path).convert("RGB")))
+    # the object's box reaches across most of the width or the height (old code: about a third)
+    assert max(fw * 600, fh * 500) > 0.6 * 500
+    assert max(fw, fh) > 0.8
+
+
+def test_animation_frames_fill_the_picture_and_keep_one_frame(tmp_path):
+    rec = _held_4(8)
+    frames = list(render_frames(rec, None, "24-cell", size=(300, 250), dpi=50))
+    assert len(frames) == len(rec) + 1  # per="step": the start and one per step, as before
+    boxes = [_filled(f) for f in frames]
+    assert max(max(w, h) for w, h in boxes) > 0.8
+
+
+def test_annotation_is_written_when_asked(tmp_path):
+    from rot4d_widget import datasets
+    from rot4d_widget.figures import render_state
+
+    st = RotationState(theta0=np.pi / 16, c0=0.25)
+    fig = render_state(st, "24-cell", annotate=True, size=(300, 250), dpi=50)
+    text = " ".join(t.get_text() for ax in fig.axes for t in ax.texts)
+    assert "c0 = +0.25" in text and "\u03c0/16" in text
+    plain = render_state(st, "24-cell", size=(300, 250), dpi=50)
+    assert not any(t.get_gid() == "annotation" for ax in plain.axes for t in ax.texts)
+    # a field: its name, its level with units and a legend, read from the source's attributes
+    f = datasets.moving_sphere(resolution=16)
+    f.units = "K"
+    buf = io.BytesIO()
+    fig = render_state(st, f, annotate="hello", size=(300, 250), dpi=50)
+    fig.savefig(buf, format="svg")
+    svg = buf.getvalue().decode()
+    assert "hello" in svg and "level 0 K" in svg and "w cut" in svg
+    assert fig.axes[0].get_legend() is not None
+    # a stack: the slices' w and their colours
+    fig = render_state(RotationState(), "24-cell", slices=3, spacing=0.3, annotate=True, size=(300, 250), dpi=50)
+    text = " ".join(t.get_text() for t in fig.axes[0].texts)
+    assert "3 slices w = -0.3" in text
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels == ["w = -0.3", "w = +0", "w = +0.3"]
+
+
+def test_progress_callback_counts_up_to_the_frames(tmp_path):
+    rec = _held_4(5)
+    seen = []
+    n = render_animation(rec, None, "5-cell", tmp_path / "a.gif", size=(120, 100), dpi=40,
+                         progress=lambda done, total: seen.append((done, total)))
+    assert n == len(rec) + 1
+    assert [d for d, _ in seen] == list(range(1, n + 1)) and {t for _, t in seen} == {n}
+    with pytest.raises(TypeError, match="progress"):
+        render_animation(rec, None, "5-cell", tmp_path / "b.gif", progress="yes")
+
+
+def test_progress_shows_only_after_a_second_and_only_on_a_terminal():
+    from rot4d_widget.progress import progress
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    now = [0.0]
+    out = Tty()
+    bar = progress(10, "work", file=out, clock=lambda: now[0])
+    assert bar.mode == "text"
+    bar.update(3)
+    assert out.getvalue() == ""  # quick work stays silent
+    now[0] = 1.5
+    bar.update(2)
+    assert "5/10" in out.getvalue() and "work" in out.getvalue()
+    bar.close()
+    assert out.getvalue().endswith("\n") and bar.count == 5
+    piped = progress(10, file=io.StringIO(), clock=lambda: now[0] + 5)
+    assert piped.mode == "none"
+    with pytest.raises(ValueError, match="total"):
+        progress(-1)
+
+
+def test_progress_does_not_import_pythreejs():
+    import subprocess
+    import sys
+
+    code = "import sys, rot4d_widget.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
