@@ -464,8 +464,6 @@ def _open_origin(origin, base):
     except (OSError, KeyError, IndexError) as exc:
         raise _CannotRebuild(f"the field's data at {path!r} cannot be opened as saved ({type(exc).__name__}: "
                              f"{exc}); open it and pass it in: load_state(path, source=...)") from None
-    if origin.get("relative_path") is not None:
-        field.origin["relative_path"] = origin["relative_path"]
     return field
 
 
@@ -662,6 +660,8 @@ def _add_relative_paths(desc, folder: str) -> None:
     sit there or below it (so the folder can move, or be copied, with its data)."""
     for d in _fields_in(desc):
         origin = d.get("origin")
+        if isinstance(origin, dict):
+            origin.pop("relative_path", None)
         if isinstance(origin, dict) and isinstance(origin.get("path"), str):
             rel = os.path.relpath(origin["path"], folder)
             if rel != os.pardir and not rel.startswith(os.pardir + os.sep) and not os.path.isabs(rel):

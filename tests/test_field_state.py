@@ -1,0 +1,334 @@
+"""A field opened from a file keeps through a state file (the scientist's path, trustworthy).
+
+`Rot4DWidget.from_state("view.json")` used to raise "pass it, from_state(path, source=...)" for
+any field read with xarray unless it was opened with `open_field`, and a loaded field lost its
+``inside`` and ``caps``.  Here a small netCDF file (scipy engine) and a zarr store are written in
+tmp_path, opened lazily and chunked, with a selection, saved with `save_state` and loaded with
+`load_state`: the rebuilt field must slice exactly as the saved one and keep its levels, inside,
+caps, w_per_unit and resolution.  A file written in today's version-1 format (by hand, as the old
+code wrote it) still loads.
+
+The data range: from the variable's metadata (``actual_range``, ``valid_min``/``valid_max``)
+without a single read; from the whole array when it is in memory; from the coarse copy for
+chunked data, and then the readout says so.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import warnings
+
+import numpy as np
+import pytest
+
+from rot4d_widget.export import SourceNotRebuildable, load_state, save_state
+from rot4d_widget.fields import COARSE_SAMPLES, Field4D
+from rot4d_widget.rotation import random_rotation
+from rot4d_widget.state import RotationState
+
+xr = pytest.importorskip("xarray")
+pytest.importorskip("scipy")
+
+NT = 12
+G = np.linspace(-1.0, 1.0, 9)
+M = random_rotation(np.random.default_rng(7))
+
+
+def _values():
+    t = np.linspace(0.0, 1.0, NT)[:, None, None, None]
+    r2 = G[None, None, None, :] ** 2 + G[None, None, :, None] ** 2 + G[None, :, None, None] ** 2
+    return 0.9 - r2 + 0.4 * t + np.random.default_rng(1).normal(0.0, 0.01, (NT, 9, 9, 9))
+
+
+def _dataset():
+    return xr.Dataset({"T": (("time", "z", "y", "x"), _values(), {"units": "K"}),
+                       "other": (("time", "z", "y", "x"), -_values())},
+                      coords={"time": np.linspace(0.0, 5.5, NT), "z": G, "y": G, "x": G})
+
+
+def _has(module):
+    try:
+        __import__(module)
+    except ImportError:
+        return False
+    return True
+
+
+@pytest.fixture
+def data(tmp_path):
+    """A folder holding run.nc (netCDF3, scipy) and, with zarr, run.zarr."""
+    d = tmp_path / "data"
+    d.mkdir()
+    ds = _dataset()
+    ds.to_netcdf(d / "run.nc", engine="scipy")
+    if _has("zarr"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # zarr 3: consolidated metadata is not in the spec
+            ds.to_zarr(d / "run.zarr", mode="w")
+    return d
+
+
+def _state():
+    return RotationState(0.05, c0=0.1)
+
+
+def _tune(field):
+    field.levels = (0.3, 0.55)
+    field.inside = "below"
+    field.caps = False
+    field.w_per_unit = 0.7
+    field.resolution = 20
+    return field
+
+
+def _assert_same_field(back, field):
+    assert isinstance(back, Field4D)
+    assert back.levels == field.levels and back.inside == field.inside and back.caps == field.caps
+    assert back.w_per_unit == field.w_per_unit and back.resolution == field.resolution
+    assert back.axes == field.axes and back.extent == field.extent and back.shape == field.shape
+    assert back.name == field.name and back.units == field.units and back.w_units == field.w_units
+    for c0 in (0.0, 0.15):
+        a, b = field.slice(M, c0), back.slice(M, c0)
+        assert len(a.triangles) > 0
+        np.testing.assert_array_equal(b.points, a.points)
+        np.testing.assert_array_equal(b.triangles, a.triangles)
+        for sa, sb in zip(a.extra["levels"], b.extra["levels"]):
+            np.testing.assert_array_equal(sb.vertices, sa.vertices)
+            assert sb.volume == sa.volume or (np.isnan(sb.volume) and np.isnan(sa.volume))
+
+
+OPENINGS = {
+    "netcdf lazy": dict(path="run.nc", engine="scipy"),
+    "netcdf chunked": dict(path="run.nc", engine="scipy", chunks={}),
+    "netcdf isel": dict(path="run.nc", engine="scipy", isel={"time": slice(2, 10)}),
+    "netcdf loaded": dict(path="run.nc", engine="scipy", load=True),
+    "zarr lazy": dict(path="run.zarr"),
+    "zarr chunked sel": dict(path="run.zarr", chunks={}, sel={"time": slice(1.0, 4.5)}),
+}
+
+
+@pytest.mark.parametrize("how", list(OPENINGS))
+def test_a_field_opened_from_a_file_is_rebuilt_by_a_state_file(data, tmp_path, how):
+    kw = dict(OPENINGS[how])
+    if "zarr" in how and not _has("zarr"):
+        pytest.skip("zarr is not installed")
+    if "chunks" in kw:
+        pytest.importorskip("dask")
+    field = _tune(Field4D.open(data / kw.pop("path"), "T", w="time", **kw))
+    if "isel" in kw or "sel" in kw:
+        assert field.shape[3] < NT
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # rebuildable: no SourceNotRebuildable, on saving or loading
+        save_state(tmp_path / "view.json", _state(), field, {"levels": list(field.levels)})
+        state, back, settings = load_state(tmp_path / "view.json")
+    doc = json.loads((tmp_path / "view.json").read_text())
+    origin = doc["source"]["origin"]
+    assert origin["path"] == os.path.abspath(field.origin["path"]) and origin["variable"] == "T"
+    assert origin["kwargs"]["w"] == "time" and doc["source"]["inside"] == "below" and doc["source"]["caps"] is False
+    assert doc["version"] == 2  # inside="below" and caps=False: a version-1 reader would drop them
+    assert settings == {"levels": [0.3, 0.55]}
+    np.testing.assert_array_equal(state.matrix, _state().matrix)
+    _assert_same_field(back, field)
+    assert back.values.shape == field.values.shape
+    assert type(back.values) is type(field.values)  # lazy stays lazy, chunked chunked, loaded in memory
+
+
+def test_the_widget_from_state_rebuilds_a_file_field(data, tmp_path, make):
+    """The README's `Rot4DWidget.from_state("view.json")`, for a field read from a netCDF file."""
+    from rot4d_widget import Rot4DWidget
+
+    field = Field4D.open(data / "run.nc", w="time", engine="scipy", variable="T")
+    w = make(field, levels=[0.4])
+    w.press("4")
+    w.save_state(tmp_path / "view.json")
+    w2 = Rot4DWidget.from_state(tmp_path / "view.json", _autotick=False)
+    try:
+        assert isinstance(w2.source, Field4D) and w2.levels == (0.4,)
+        np.testing.assert_array_equal(w2.state.matrix, w.state.matrix)
+        np.testing.assert_array_equal(w2.slice.points, w.slice.points)
+    finally:
+        w2.close()
+
+
+def test_the_state_file_keeps_a_path_relative_to_itself_when_the_data_sit_beside_it(data, tmp_path):
+    field = _tune(Field4D.open(data / "run.nc", "T", w="time", engine="scipy"))
+    save_state(data / "view.json", _state(), field)
+    doc = json.loads((data / "view.json").read_text())
+    assert doc["source"]["origin"]["relative_path"] == "run.nc"
+    moved = tmp_path / "moved"
+    shutil.move(data, moved)  # the folder moved, data and state file together: the absolute path is gone
+    _, back, _ = load_state(moved / "view.json")
+    assert back.origin["path"] == str(moved / "run.nc")
+    _assert_same_field(back, field)
+    # a state file in a folder the data are not in keeps the absolute path only
+    (tmp_path / "other").mkdir()
+    save_state(tmp_path / "other" / "view.json", _state(), back)
+    assert "relative_path" not in json.loads((tmp_path / "other" / "view.json").read_text())["source"]["origin"]
+    save_state(tmp_path / "above.json", _state(), back)  # a folder above the data: a path down to them
+    assert json.loads((tmp_path / "above.json").read_text())["source"]["origin"]["relative_path"] == "moved/run.nc"
+    os.remove(moved / "run.nc")
+    with pytest.warns(SourceNotRebuildable, match="not found at .*run.nc.*Field4D.open"):
+        _, gone, _ = load_state(moved / "view.json")
+    assert gone is None
+
+
+def test_a_rewritten_file_is_refused_not_read_as_the_saved_field(data, tmp_path):
+    field = Field4D.open(data / "run.nc", "T", w="time", engine="scipy")
+    save_state(tmp_path / "view.json", _state(), field)
+    _dataset().isel(time=slice(0, 6)).to_netcdf(data / "run2.nc", engine="scipy")
+    os.replace(data / "run2.nc", data / "run.nc")
+    with pytest.warns(SourceNotRebuildable, match="no longer holds the saved field: its shape"):
+        _, back, _ = load_state(tmp_path / "view.json")
+    assert back is None
+
+
+def test_from_xarray_records_the_path_xarray_s_encoding_gives(data, tmp_path):
+    """The netCDF4 and h5netcdf engines put the file's path in ``da.encoding["source"]`` (scipy
+    and zarr do not: set here by hand, as netCDF4 does); `from_xarray` records it."""
+    da = xr.open_dataset(data / "run.nc", engine="scipy")["T"]
+    da.encoding["source"] = str(data / "run.nc")
+    field = _tune(Field4D.from_xarray(da, w="time"))
+    assert field.origin["path"] == str(data / "run.nc") and field.origin["variable"] == "T"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        save_state(tmp_path / "view.json", _state(), field)
+        _, back, _ = load_state(tmp_path / "view.json")
+    _assert_same_field(back, field)
+    # a selection xarray's encoding shows (original_shape) is not taken for the whole variable
+    part = da.isel(time=slice(0, 5))
+    part.encoding["original_shape"] = da.shape
+    assert Field4D.from_xarray(part, w="time").origin is None
+
+
+def test_a_zarr_field_from_xarray_says_to_use_field4d_open(data, tmp_path):
+    if not _has("zarr"):
+        pytest.skip("zarr is not installed")
+    field = Field4D.from_xarray(xr.open_dataset(data / "run.zarr", engine="zarr")["T"], w="time")
+    assert field.origin is None  # xarray keeps no path for a zarr store
+    with pytest.warns(SourceNotRebuildable, match=r"Field4D.open\(path, variable"):
+        save_state(tmp_path / "view.json", _state(), field)
+
+
+def test_a_version_1_state_file_still_loads(data, tmp_path):
+    """A file as the code before version 2 wrote it (open_field's origin, no inside/caps)."""
+    field = Field4D.open(data / "run.nc", "T", w="time", engine="scipy", levels=(0.35,))
+    d = field.describe()
+    for key in ("inside", "caps"):
+        d.pop(key)
+    d.update(resolution=32, coarse_resolution=24, w_units=None, rebuild=True,
+             origin={"kind": "xarray", "path": str(data / "run.nc"), "variable": "T", "engine": "scipy",
+                     "kwargs": {"w": "time"}},
+             array=f"read from {str(data / 'run.nc')!r} (reopened from there)")
+    doc = {"format": "rot4d_widget state", "version": 1, "state": _state().to_dict(), "source": d,
+           "settings": {"levels": [0.35]}, "rot4d_widget": "0.1.0"}
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    _, back, settings = load_state(tmp_path / "old.json")
+    assert back.levels == (0.35,) and back.inside == "above" and back.caps is True and back.resolution == 32
+    _assert_same_field(back, Field4D.open(data / "run.nc", "T", w="time", engine="scipy", levels=(0.35,),
+                                          resolution=32))
+
+
+@pytest.mark.parametrize("origin, match", [
+    ({"kwargs": {"_function": "os:system"}}, "'kwargs' to name only"),
+    ({"engine": "../evil"}, "xarray engine's name"),
+    ({"isel": {"time": {"slice": [0, 3, None], "x": 1}}}, "slice"),
+    ({"isel": {"time": [{"a": 1}]}}, "numbers, strings or slices"),
+])
+def test_a_state_file_origin_is_data_only(data, tmp_path, origin, match):
+    """An origin names a file, a variable, an xarray engine, a selection and from_xarray's own
+    keywords -- nothing else is taken from it (a file stays data: allow_code is not needed)."""
+    field = Field4D.open(data / "run.nc", "T", w="time", engine="scipy")
+    save_state(tmp_path / "view.json", _state(), field)
+    doc = json.loads((tmp_path / "view.json").read_text())
+    doc["source"]["origin"].update(origin)
+    (tmp_path / "bad.json").write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match=match):
+        load_state(tmp_path / "bad.json")
+
+
+def test_inside_and_caps_of_a_function_field_are_restored(tmp_path):
+    from test_export import ball_minus_w
+
+    f = Field4D.from_function(ball_minus_w, [(-1, 1)] * 4, resolution=24, levels=(0.2,))
+    f.inside, f.caps = "below", False
+    save_state(tmp_path / "f.json", _state(), f)
+    _, back, _ = load_state(tmp_path / "f.json", function=ball_minus_w)
+    assert back.inside == "below" and back.caps is False
+    a, b = f.slice(M, 0.1), back.slice(M, 0.1)
+    np.testing.assert_array_equal(b.points, a.points)
+
+
+# ----------------------------------------------------------------------------- the data range
+#: Reads of the data behind `_lazy_dataarray`, counted in a module global (xarray or dask may copy
+#: the array objects they are handed; a global is the same one in every copy).
+READS = {"n": 0}
+
+
+def _read(values, key):
+    READS["n"] += 1
+    return values[key]
+
+
+def _lazy_dataarray(values, attrs, encoding=None):
+    """A DataArray over a lazily indexed backend array (as netCDF or zarr opened without chunks)
+    whose reads are counted in `READS`."""
+    from xarray.backends import BackendArray
+    from xarray.core import indexing
+
+    class Backend(BackendArray):
+        shape, dtype = values.shape, values.dtype
+
+        def __getitem__(self, key):
+            return indexing.explicit_indexing_adapter(key, self.shape, indexing.IndexingSupport.BASIC,
+                                                      lambda k: _read(values, k))
+
+    var = xr.Variable(("time", "z", "y", "x"), indexing.LazilyIndexedArray(Backend()), attrs=attrs)
+    da = xr.DataArray(var, coords={"time": np.arange(NT, dtype=float), "z": G, "y": G, "x": G}, name="T")
+    da.encoding.update(encoding or {})
+    READS["n"] = 0
+    return da
+
+
+@pytest.mark.parametrize("attrs, encoding, want, where", [
+    ({"valid_min": -2.0, "valid_max": 2.5}, None, (-2.0, 2.5), "valid_min/valid_max"),
+    ({"valid_range": np.array([-1.0, 1.5])}, None, (-1.0, 1.5), "valid_range"),
+    ({"actual_range": [-0.5, 1.25], "valid_min": -9.0, "valid_max": 9.0}, None, (-0.5, 1.25), "actual_range"),
+    ({"valid_min": np.int16(0), "valid_max": np.int16(1000)}, {"scale_factor": 0.01, "add_offset": -5.0},
+     (-5.0, 5.0), "valid_min/valid_max"),  # packed bounds, unpacked as xarray unpacks the data
+])
+def test_the_data_range_comes_from_metadata_without_a_read(attrs, encoding, want, where):
+    da = _lazy_dataarray(_values(), attrs, encoding)
+    field = Field4D.from_xarray(da, w="time")
+    assert field.data_range == pytest.approx(want) and field.data_range_source == where
+    assert field.levels == pytest.approx(((want[0] + want[1]) / 2,))
+    assert READS["n"] == 0
+    rows = dict(field.slice(M, 0.0).readout)  # a slice reads, and names the range's source
+    assert READS["n"] > 0 and rows["level"].endswith(f"({where})")
+
+
+def test_the_data_range_of_a_lazy_field_without_metadata_is_the_coarse_copy_s_and_says_so():
+    da = _lazy_dataarray(_values(), {})
+    field = Field4D.from_xarray(da, w="time")
+    rng = field.data_range
+    assert READS["n"] > 0 and rng == field.coarse().data_range
+    assert field.data_range_source == "coarse copy"
+    assert dict(field.slice(M, 0.0).readout)["level"].endswith("(coarse copy)")
+
+
+def test_an_array_in_memory_has_the_range_of_all_its_samples_not_the_coarse_copy_s():
+    n = 2 * COARSE_SAMPLES + 3
+    a = np.zeros((n, 6, 6, 6))
+    a[:, 2:4, 2:4, 2:4] = np.linspace(0.0, 0.5, n)[:, None, None, None]
+    a[7, 3, 3, 3] = 0.53  # a peak between two of the coarse copy's nodes
+    field = Field4D(a, axes="wzyx")
+    assert field.coarse().data_range[1] < 0.53
+    assert field.data_range == (0.0, 0.53) and field.data_range_source == "data"
+    assert field.levels == (0.265,)
+    level = dict(field.slice(M, 0.0).readout)["level"]
+    assert level.endswith("of 0 \u2026 0.53"), level
+    dask = pytest.importorskip("dask.array")
+    lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")
+    assert lazy.data_range == field.coarse().data_range and lazy.data_range_source == "coarse copy"
+    assert dict(lazy.slice(M, 0.0).readout)["level"].endswith("(coarse copy)")
