@@ -18,9 +18,15 @@ State files
     display options: any JSON-able dict) and a format version; `load_state(path)` reads it
     back as ``(state, source or None, settings)``.  A polytope is rebuilt from its name (or its
     vertices); a stack from its inner source and its settings; a `Field4D` from a module-level
-    function (``module.name``) or from the file `open_field` opened.  An in-memory array is not
-    written into the file: saving says so (`SourceNotRebuildable` warning) and loading then
-    needs the source passed in (``load_state(path, source=field)``).
+    function (``module.name``) or from the file it was opened from (``field.origin``:
+    `Field4D.open` / `open_field`, or `Field4D.from_xarray` when xarray's encoding names the
+    file), by its path relative to the state file when the data sit in its folder, else its
+    absolute path, with the selection and dims it was opened with; its levels, ``inside``,
+    ``caps``, ``w_per_unit`` and resolution restored.  An in-memory array is not written into
+    the file: saving says so (`SourceNotRebuildable` warning) and loading then needs the source
+    passed in (``load_state(path, source=field)``).  Files are written as version 1 unless a
+    field needs what a version-1 reader would silently drop (a selection, ``inside="below"``,
+    ``caps=False``: version 2); both versions load.
 
     A state file is data, never code: loading one imports no module and calls nothing the file
     names.  A field made from a function is described by the function's name
@@ -29,7 +35,7 @@ State files
     trust, ``load_state(path, function=f)`` to give the function yourself, or
     ``load_state(path, source=field)``.
 
-numpy, trimesh (and xarray for `open_field`); nothing here knows about widgets.
+numpy, trimesh (and xarray to reopen a field's file); nothing here knows about widgets.
 """
 
 from __future__ import annotations
