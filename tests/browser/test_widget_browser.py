@@ -177,7 +177,8 @@ def test_every_key_and_its_inverse(jupyter_server, page, artifacts, shift_style)
         sign = 1 if key in "kl" else -1
         assert after[field] == pytest.approx(before[field] + sign * step), key
         assert after["m"] == before["m"]
-        assert after["readout"] != before["readout"]
+        # the readout follows: the ticker thread sends it with the picture, just after the state
+        assert jp.wait_for(lambda: _state(jp)["readout"] != before["readout"], timeout=10), key
     assert not _bad_console(page), _bad_console(page)
 
 
@@ -394,7 +395,10 @@ def test_drawn_acks_follow_the_pixels_and_at_most_three_updates_are_in_flight(ju
     assert len(acks) >= 3
     hashes = [a["hash"] for a in acks]
     assert initial not in hashes
-    assert all(a != b for a, b in zip(hashes, hashes[1:]))
+    # each ack on a new picture while the key is held; after the keyup a picture may come back:
+    # a keyup the kernel handled late takes back the steps the page says were too many
+    held = [a["hash"] for a in acks if a["t"] <= released]
+    assert all(a != b for a, b in zip(held, held[1:])), diag
     assert hashes[-1] == final
 
 
