@@ -75,7 +75,7 @@ __all__ = [
 
 #: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
 #: `rot4d_widget.figures.render_state` takes them as keywords).
-SETTING_NAMES = ("levels", "slices", "spacing", "arrangement", "color_by", "face_opacity", "ball_radius",
+SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity", "ball_radius",
                  "bar_radius", "background", "show_balls", "show_bars", "show_faces")
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
