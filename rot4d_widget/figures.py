@@ -968,7 +968,7 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
 
 
 # --------------------------------------------------------------------------- the live view's picture
-def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=None):
+def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=None, inside=None, caps=None):
     """``source`` (a name, a Polytope or any source) with a widget's source settings applied, as a
     `StackSource` (N = 1 is today's single slice, point for point).  The source given is not
     changed: a field whose ``levels`` differ is copied (shallowly, sharing its array), a stack is
@@ -993,6 +993,10 @@ def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=
         if tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist()) != tuple(inner.levels):
             inner = copy.copy(inner)
             inner.levels = levels
+    for name, value in (("inside", inside), ("caps", caps)):  # a field's other settings, likewise
+        if value is not None and getattr(inner, name, value) != value:
+            inner = copy.copy(inner)
+            setattr(inner, name, value)
     return StackSource(inner, slices=n, spacing=spc, arrangement=arr, color_by=color_by)
 
 
@@ -1005,6 +1009,8 @@ def render_state(
     slices: int | None = None,
     spacing: float | None = None,
     arrangement: str | None = None,
+    inside: str | None = None,
+    caps: bool | None = None,
     color_by="group",
     group_colors=None,
     face_opacity: float = look.FACE_OPACITY,
@@ -1066,7 +1072,7 @@ def render_state(
         face_color = look.as_rgb(color_by, "color_by")
     if _prepared is None:
         _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
-                             ball_radius=ball_radius, show_balls=show_balls)
+                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps)
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
@@ -1080,13 +1086,14 @@ def render_state(
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
-             show_balls=True, data=None, **_ignored):
+             show_balls=True, data=None, inside=None, caps=None, **_ignored):
     """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
     source with the settings applied (`state_source`), its slice at ``state``, the ball radius
     in displayed units (None: the stack's default) and the projected bounding box of the
     drawing (`frame_extent`; None when empty).  ``data``: the slice, computed before.  An animation takes the boxes of all its frames
     first to frame them alike, and draws each frame from the slice computed then."""
-    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement)
+    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
+                         inside=inside, caps=caps)
     if ball_radius is None:
         edge = getattr(stack, "edge_length", None)
         if edge:

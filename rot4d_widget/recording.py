@@ -80,7 +80,9 @@ ANIMATION_FORMATS = (".gif", ".mp4")
 #: What `Recorder.record_set` accepts: the state's settable parameters.
 SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
 #: What `Recorder.record_source` accepts: the source's settings the widget has as traits.
-SOURCE_SETTINGS = ("levels", "slices", "spacing", "arrangement")
+SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement")
+#: The settings of a field (a stack's inner source).
+_FIELD_SETTINGS = ("levels", "inside", "caps")
 #: The settings that need parallel slices (a `StackSource`).
 _STACK_SETTINGS = ("slices", "spacing", "arrangement")
 
@@ -128,6 +130,7 @@ class Setting:
 class SourceSetting:
     """A setting of the source (the widget's traits): ``name`` in `SOURCE_SETTINGS` and its
     ``value`` -- ``levels`` a list of floats (a field's iso levels; a stack's inner source's),
+    ``inside`` ``"above"`` or ``"below"`` and ``caps`` a bool (a field's, likewise),
     ``slices`` an int >= 1, ``spacing`` a number > 0 or None (the default), ``arrangement``
     ``"oval"``, ``"grid"`` or ``"stack"``."""
 
@@ -173,6 +176,14 @@ def _check_source_setting(name, value):
             raise ValueError(f"Expected 'levels' to be set to a finite number or a non-empty sequence of them, "
                              f"got {value!r}")
         return [float(v) for v in values]
+    if name == "inside":
+        if value not in ("above", "below"):
+            raise ValueError(f"Expected 'inside' to be set to 'above' or 'below', got {value!r}")
+        return str(value)
+    if name == "caps":
+        if not isinstance(value, (bool, np.bool_)):
+            raise ValueError(f"Expected 'caps' to be set to True or False, got {value!r}")
+        return bool(value)
     if name == "slices":
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral) or value < 1:
             raise ValueError(f"Expected 'slices' to be set to an int >= 1, got {value!r}")
@@ -240,12 +251,12 @@ def _is_stack(source) -> bool:
 def _set_on_source(source, name: str, value) -> None:
     """Set a source setting on ``source`` in place: ``levels`` on a field (a stack's inner one),
     the others on a stack.  ValueError if ``source`` has no such setting."""
-    if name == "levels":
+    if name in _FIELD_SETTINGS:
         target = source.source if _is_stack(source) else source
-        if not hasattr(target, "levels"):
-            raise ValueError(f"A recorded 'levels' applies to a source with iso levels (a field), not "
+        if not hasattr(target, name):
+            raise ValueError(f"A recorded {name!r} applies to a source that has it (a field), not "
                              f"{type(target).__name__}")
-        target.levels = tuple(value)
+        setattr(target, name, tuple(value) if name == "levels" else value)
         return
     if not _is_stack(source):
         raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a single "
@@ -419,9 +430,10 @@ class Recording:
         if restart:
             names |= set(self._initial_source)
         inner = source.source if _is_stack(source) else source
-        if "levels" in names and not hasattr(inner, "levels"):
-            raise ValueError(f"The recording sets 'levels', which applies to a source with iso levels (a field), "
-                             f"not {type(inner).__name__}")
+        missing = [n for n in _FIELD_SETTINGS if n in names and not hasattr(inner, n)]
+        if missing:
+            raise ValueError(f"The recording sets {', '.join(map(repr, missing))}, which apply to a field "
+                             f"(a source with iso levels), not {type(inner).__name__}")
         stack_names = sorted(names & set(_STACK_SETTINGS))
         if stack_names and not _is_stack(source):
             raise ValueError(f"The recording sets {', '.join(map(repr, stack_names))}, which apply to parallel "
@@ -603,7 +615,7 @@ def _figure_rgb(fig) -> np.ndarray:
 
 #: Slices kept from the framing pass for the drawing pass, in bytes (beyond it they are recomputed).
 _SLICE_CACHE_BYTES = 256 * 2**20
-_PREPARE_KEYS = ("levels", "slices", "spacing", "arrangement", "ball_radius", "show_balls")
+_PREPARE_KEYS = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "ball_radius", "show_balls")
 
 
 def _data_bytes(data) -> int:

@@ -172,6 +172,12 @@ class Rot4DWidget(widgets.HBox):
     keypad = traitlets.Bool(False, help="show the on-screen key pad (buttons for every action)")
     levels = _Value(None, help="iso levels of a field source (tuple of floats); None for sources without levels")
     levels.allow_none = True
+    inside = _Value(None, help='which side of a field\'s iso level its surface encloses: "above" or "below"; None '
+                                'for sources without one')
+    inside.allow_none = True
+    caps = _Value(None, help="a field's surface closed on the data box's faces (True) or open (False); None for "
+                             "sources without one")
+    caps.allow_none = True
     slices = _Value(None, help="parallel slices shown (int 1...64); None for a single view until set (or n pressed)")
     slices.allow_none = True
     spacing = _Value(None, help="distance between parallel slices, in the source's units")
@@ -361,6 +367,7 @@ class Rot4DWidget(widgets.HBox):
         self.observe(self._on_display_trait, names=list(_DISPLAY_TRAITS))
         self.observe(self._on_color_by, names="color_by")
         self.observe(self._on_levels, names="levels")
+        self.observe(self._on_field_setting, names=["inside", "caps"])
         self.observe(self._on_stack_trait, names=["slices", "spacing", "arrangement"])
         self.observe(self._on_keypad, names="keypad")
         self.keypad = keypad
@@ -971,11 +978,19 @@ class Rot4DWidget(widgets.HBox):
         self.help_panel.value = ro.help_html(_help_groups(keymap), self._repeater.hold_delay, self._repeater.tick_rate)
 
     def _sync_levels(self) -> None:
-        """Copy the source's iso levels (if it has any) into the `levels` trait."""
-        levels = getattr(self._level_source, "levels", None)
-        if levels is None:
-            return
-        self._set_quietly("levels", tuple(float(v) for v in levels))
+        """Copy the field's settings (iso levels, inside, caps: where the source has them) into the traits."""
+        src = self._level_source
+        levels = getattr(src, "levels", None)
+        if levels is not None:
+            self._set_quietly("levels", tuple(float(v) for v in levels))
+        for name in ("inside", "caps"):
+            if hasattr(src, name):
+                self._set_quietly(name, getattr(src, name))
+
+    def _on_field_setting(self, change) -> None:
+        src = self._level_source
+        self._source_setting(change, src if hasattr(src, change["name"]) else None,
+                             f"{_title(self.source)} has no `{change['name']}`: it applies to field sources")
 
     def _on_levels(self, change) -> None:
         src = self._level_source
@@ -1355,6 +1370,9 @@ def _source_settings(source) -> dict:
     levels = getattr(inner, "levels", None)
     if levels is not None:
         out["levels"] = tuple(float(v) for v in levels)
+    for name in ("inside", "caps"):
+        if hasattr(inner, name):
+            out[name] = getattr(inner, name)
     if stack:
         out["slices"] = int(source.slices)
         out["spacing"] = None if source.spacing_is_default else float(source.spacing)

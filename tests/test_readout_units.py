@@ -46,3 +46,29 @@ def test_parallel_slices_are_labelled_in_seconds(make):
 def test_numbers_for_people():
     assert number_text(-2.132e-14, 73.3) == "0"
     assert number_text(0.50671234) == "0.5067"
+
+
+def test_inside_and_caps_are_traits_recorded_replayed_and_saved(make, tmp_path):
+    """Issue 19: the field's new settings behave like every trait (recorded, replayed, saved)."""
+    from rot4d_widget import Rot4DWidget
+
+    w = make(ball())
+    assert (w.inside, w.caps) == ("above", True)
+    w.inside = "below"
+    w.caps = False
+    assert (w.source.inside, w.source.caps) == ("below", False)
+    w.press("4")
+    again = make(ball())
+    again.replay(w.recording)
+    assert (again.inside, again.caps) == ("below", False) and (again.source.inside, again.source.caps) == ("below", False)
+    with pytest.raises((TypeError, ValueError)):
+        w.inside = "sideways"
+    assert w.inside == "below"
+    poly = make("5-cell")
+    with pytest.raises(TypeError, match="field"):
+        poly.caps = False
+    path = tmp_path / "view.json"
+    w.save_state(path)
+    back = make(ball())
+    back.load_state(path)
+    assert (back.inside, back.caps) == ("below", False)

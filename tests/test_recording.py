@@ -431,7 +431,7 @@ def test_the_source_settings_at_the_start_are_kept_and_replayed_first(tmp_path):
 
 
 @pytest.mark.parametrize("name, value, match", [
-    ("colour", 1, "a source setting among 'levels', 'slices', 'spacing', 'arrangement'"),
+    ("colour", 1, "a source setting among 'levels', 'inside', 'caps', 'slices', 'spacing', 'arrangement'"),
     ("levels", (), "non-empty sequence"),
     ("levels", ("a",), "finite number or a non-empty sequence"),
     ("levels", float("nan"), "finite number"),
@@ -439,6 +439,8 @@ def test_the_source_settings_at_the_start_are_kept_and_replayed_first(tmp_path):
     ("slices", 2.0, "an int >= 1"),
     ("spacing", -1.0, "finite number > 0 or None"),
     ("arrangement", "circle", "one of 'oval', 'grid', 'stack'"),
+    ("inside", "out", "'above' or 'below'"),
+    ("caps", 1, "True or False"),
 ])
 def test_record_source_names_what_is_allowed(name, value, match):
     rec = Recorder(RotationState(), clock=Clock())
