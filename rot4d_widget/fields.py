@@ -1143,10 +1143,21 @@ class Field4D:
         s = float(np.abs(m[3]) @ self._hw)
         return -s, s
 
+    def to_data(self, points, matrix, c0) -> np.ndarray:
+        """(n, 4) float64: the data coordinates (x, y, z, w in the field's own units) of the
+        slice points ``points`` (n, 3) of the cut w = ``c0`` after ``matrix``:
+        ``centre + (matrix.T @ (p, c0)) * (1, 1, 1, w_per_unit)``."""
+        m = as_rotation_matrix(matrix)
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        q = np.column_stack([p, np.full(len(p), _real(c0, "c0"))]) @ m  # rows of (m.T @ (p, c0))
+        return self._centre + q * self._unit
+
     def slice(self, matrix, c0, coarse: bool = False):
         """The slice as the widget draws it (`SliceData`): the isosurface of every level
         (group = level index) and the cut of the data's box as bars.  ``coarse``:
-        the in-memory coarse copy at `coarse_resolution` (for held keys)."""
+        the in-memory coarse copy at `coarse_resolution` (for held keys).  ``extra["data_frame"]``
+        records the cut and the field's frame then (``matrix``, ``c0``, ``centre``, ``unit``: a
+        point p is at data ``centre + (matrix.T @ (p, c0)) * unit``, as `to_data`)."""
         m = as_rotation_matrix(matrix)
         c0 = _real(c0, "c0")
         levels = self.levels
@@ -1173,7 +1184,9 @@ class Field4D:
             groups=np.concatenate(groups), normals=np.concatenate(nrm),
             volume=_representable(slices[0]) if len(slices) == 1 else None,
             readout=readout, convex=False, show_points=False,
-            extra={"levels": slices, "box": box},
+            extra={"levels": slices, "box": box, "data_frame": {
+                "matrix": _sealed(m.copy()), "c0": c0, "centre": _sealed(self._centre.copy()),
+                "unit": _sealed(self._unit.copy())}},
         )
 
     def describe(self) -> dict:
@@ -1405,17 +1418,22 @@ def _turned_slice(s: FieldSlice, t: np.ndarray) -> FieldSlice:
 
 class FieldSliceData(SliceData):
     """`SliceData` of a `Field4D`: ``extra["levels"]`` holds one `FieldSlice` per level and
-    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.slicing.Slice`)."""
+    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.slicing.Slice`);
+    ``extra["data_frame"]`` the cut's matrix and c0 and the field's centre and units (`Field4D.slice`)."""
 
     def turned(self, t) -> "FieldSliceData":
         """The same slice turned by the 3-D rotation ``t`` (3, 3): the slice at ``T @ matrix``
         when T turns x, y, z only (points and normals ``@ t.T``; nothing is resampled).
-        ``extra["box"]`` stays the unturned cut."""
+        ``extra["box"]`` stays the unturned cut; ``extra["data_frame"]`` gets the turned matrix."""
         t = np.asarray(t, dtype=np.float64)
         if t.shape != (3, 3) or not np.allclose(t @ t.T, np.eye(3), atol=1e-9):
             raise ValueError(f"Expected `t` to be a (3, 3) rotation, got shape {t.shape}")
         extra = dict(self.extra)
         extra["levels"] = tuple(_turned_slice(s, t) for s in self.extra.get("levels", ()))
+        if "data_frame" in extra:  # the slice at T @ matrix (T turning x, y, z only)
+            t4 = np.eye(4)
+            t4[:3, :3] = t
+            extra["data_frame"] = {**extra["data_frame"], "matrix": _sealed(t4 @ extra["data_frame"]["matrix"])}
         return type(self).build(
             points=self.points @ t.T, segments=self.segments, triangles=self.triangles, groups=self.groups,
             normals=None if self.normals is None else self.normals @ t.T, volume=self.volume,
