@@ -35,6 +35,7 @@ PROJECT_NOTEBOOKS = [
     "04_time_varying_field.ipynb",
     "05_tomography.ipynb",
     "06_uniform_polychora.ipynb",
+    "07_your_data.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
