@@ -392,6 +392,8 @@ class _ChunkReader:
         self._lock = threading.Lock()
         #: chunks read from the array (not from the cache) so far
         self.reads = 0
+        #: [min, max] of the finite values of every chunk read so far (the "first cut" range)
+        self.seen = [math.inf, -math.inf]
 
     def _slices(self, idx):
         return tuple(slice(int(b[i]), int(b[i + 1])) for b, i in zip(self.bounds, idx))
@@ -421,6 +423,10 @@ class _ChunkReader:
                 for idx, a in zip(missing, parts):
                     a = np.asarray(a, dtype=self.dtype)
                     got[idx] = a
+                    fin = a[np.isfinite(a)] if a.dtype.kind == "f" else a
+                    if fin.size:
+                        self.seen[0] = min(self.seen[0], float(fin.min()))
+                        self.seen[1] = max(self.seen[1], float(fin.max()))
                     if a.nbytes <= self.cache_bytes:
                         self._cache[idx] = a
                         self._cached += a.nbytes
@@ -792,6 +798,12 @@ class Field4D:
         e = np.array(self.extent)
         self._centre = (e[:, 0] + e[:, 1]) / 2
         self._coarse = None
+        self._coarse_lock = threading.Lock()
+        self._coarse_thread = None  # the background build (`prepare_coarse`)
+        self._coarse_error = None
+        #: (chunks done, chunks in all) of the coarse copy's build, once it started
+        self.coarse_progress = None
+        self._k_first = None  # K from the first cut's samples, until the coarse copy is ready
         self.w_per_unit = wpu
         self.resolution = resolution
         self.coarse_resolution = max(24, self.resolution // 2) if coarse_resolution is None else coarse_resolution
@@ -983,6 +995,7 @@ class Field4D:
         self._w_per_unit, self._unit, self._hw = wpu, unit, hw
         self.half_widths = tuple(float(v) for v in self._hw)
         self._stats = None  # K is per slice unit
+        self._k_first = None
         if self._coarse is not None and self._coarse is not self:
             self._coarse.w_per_unit = value
 
@@ -1042,7 +1055,7 @@ class Field4D:
     def levels(self) -> tuple:
         """The iso levels (tuple of floats); settable with a number or a sequence."""
         if self._levels is None:
-            lo, hi = self.data_range
+            lo, hi = self._range_info(first_cut=True)[0]
             self._levels = ((lo + hi) / 2,) if math.isfinite(lo) and math.isfinite(hi) else (0.0,)
         return self._levels
 
@@ -1061,16 +1074,39 @@ class Field4D:
         (`data_range_source`): the metadata of a variable from xarray (``actual_range``, else
         ``valid_range`` or ``valid_min``/``valid_max``), read without touching the data; else an
         array in memory, whole; a chunked or lazy array's `coarse` copy (which may miss a peak
-        between its nodes); a function's probe grid."""
+        between its nodes), or, until the coarse copy is ready, the chunks a slice has read so far
+        (``"first cut"``: a fresh field's first slice reads only the chunks its hyperplane touches
+        and takes the default level from them); a function's probe grid.  Asked before any slice
+        and before the coarse copy is ready, it builds (or waits for) the coarse copy."""
         return self._range_info()[0]
 
     @property
     def data_range_source(self) -> str:
-        """Where `data_range` comes from: ``"data"``, ``"coarse copy"``, ``"probe grid"``,
+        """Where `data_range` comes from: ``"data"``, ``"coarse copy"``, ``"first cut"`` (the
+        chunks read so far, until the coarse copy is ready), ``"probe grid"``,
         ``"actual_range"``, ``"valid_range"`` or ``"valid_min/valid_max"``."""
         return self._range_info()[1]
 
-    def _range_info(self):
+    def _first_cut_range(self, first_cut: bool):
+        """((lo, hi), "first cut") from the chunks read so far while the coarse copy is not ready
+        (with ``first_cut``, reading the cut at rest when nothing was read yet), else None."""
+        if self._range is not None or self._meta_range is not None or self._kind in ("function", "numpy"):
+            return None
+        if self._coarse is not None:
+            return None
+        rd = self._reader
+        if (rd is None or rd.reads == 0) and first_cut:
+            _sample_raw(self, np.eye(4), 0.0, self.resolution)  # the picture at rest: its chunks only
+            rd = self._reader
+        if rd is None or rd.reads == 0:
+            return None
+        lo, hi = rd.seen
+        return ((lo, hi) if lo <= hi else (math.nan, math.nan)), "first cut"
+
+    def _range_info(self, first_cut: bool = False):
+        prov = self._first_cut_range(first_cut)
+        if prov is not None:
+            return prov
         if self._range is None:
             if self._meta_range is not None:
                 lo, hi, where = self._meta_range
@@ -1160,9 +1196,17 @@ class Field4D:
         point p is at data ``centre + (matrix.T @ (p, c0)) * unit``, as `to_data`)."""
         m = as_rotation_matrix(matrix)
         c0 = _real(c0, "c0")
-        levels = self.levels
+        meanwhile = bool(coarse) and self._coarse_building()
+        if meanwhile:  # held keys meanwhile slice at full resolution (the build goes on)
+            coarse = False
         res = self.coarse_resolution if coarse else self.resolution
-        slices = slice_field(self, m, c0, levels, res, coarse=coarse)
+        if coarse:
+            slices = slice_field(self, m, c0, self.levels, res, coarse=True)
+        else:  # read first: a fresh chunked field takes its range and level from this cut's chunks
+            s = _sample(self, m, c0, _check_resolution(res), first_cut=True)
+            levels = self.levels
+            slices = (tuple(_empty_slice(lv, 0.0) for lv in levels) if s is None
+                      else tuple(_surface(s, lv, self.inside, self.caps) for lv in levels))
         box = _box_slice(self, m, c0)
         pts, tris, nrm, groups = [], [], [], []
         off = 0
@@ -1179,6 +1223,10 @@ class Field4D:
         nrm.append(bn)
         segments = np.asarray(box.edges) + off
         readout = self._readout(m, c0, slices, box, coarse)
+        if meanwhile:
+            done, total = self.coarse_progress or (0, 0)
+            readout = readout + (("resolution", f"{self.resolution} (full: the coarse copy is being built, "
+                                                f"{done}/{total} chunks)"),)
         return FieldSliceData.build(
             points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
             groups=np.concatenate(groups), normals=np.concatenate(nrm),
@@ -1214,12 +1262,56 @@ class Field4D:
         """An in-memory copy with at most `COARSE_SAMPLES` nodes per axis over the same box
         (linear resampling onto evenly spaced fractional indices), built once.
 
-        The field itself when it already is that small and in memory, or a function."""
+        The field itself when it already is that small and in memory, or a function.  A chunked or
+        lazy array is read chunk by chunk (each downsampled into the copy and dropped: memory is the
+        copy plus a few chunks).  Blocks until the copy is built: when `prepare_coarse` started it
+        in the background, waits for that build."""
         if self._coarse is None:
-            self._coarse = self._make_coarse()
+            with self._coarse_lock:
+                t = self._coarse_thread
+                if self._coarse is None and t is None:
+                    self._coarse = self._make_coarse()
+            if t is not None:
+                t.join()
+                if self._coarse is None:
+                    raise RuntimeError("Field4D: building the coarse copy failed") from self._coarse_error
         return self._coarse
 
-    def _make_coarse(self) -> "Field4D":
+    @property
+    def coarse_ready(self) -> bool:
+        """True once the coarse copy is built (`coarse`, or the background build of `prepare_coarse`)."""
+        return self._coarse is not None
+
+    def prepare_coarse(self, progress: bool = True) -> None:
+        """Start building the coarse copy (`coarse`) on a daemon thread and return at once.
+
+        The build reads the array chunk by chunk (memory: the copy plus a few chunks), counting
+        chunks on a progress bar (`rot4d_widget.progress`, shown after a second: a widget in a
+        kernel, a line on a terminal) when ``progress`` is true; `coarse_progress` holds
+        (chunks done, chunks in all).  Until `coarse_ready`, held keys meanwhile slice at full
+        resolution (``slice(..., coarse=True)`` returns the full-resolution slice and says so), the
+        data range and default level come from the chunks read so far ("first cut"); `coarse`
+        waits for the build.  Does nothing when the copy is built or being built."""
+        with self._coarse_lock:
+            if self._coarse is not None or self._coarse_thread is not None:
+                return
+            t = threading.Thread(target=self._build_coarse, args=(bool(progress),), daemon=True,
+                                 name=f"rot4d coarse copy {self.name or ''}".strip())
+            self._coarse_thread = t
+        t.start()
+
+    def _build_coarse(self, show: bool) -> None:
+        try:
+            c = self._make_coarse(progress_bar=show)
+            self._coarse = c
+        except BaseException as e:  # noqa: BLE001 - kept for `coarse` to raise
+            self._coarse_error = e
+
+    def _coarse_building(self) -> bool:
+        t = self._coarse_thread
+        return self._coarse is None and t is not None and t.is_alive()
+
+    def _make_coarse(self, progress_bar: bool = False) -> "Field4D":
         if self._kind == "function":
             return self
         nshape = self._values.shape
@@ -1229,6 +1321,8 @@ class Field4D:
         x = self._values
         floating = np.dtype(self._values.dtype).kind == "f"
         if self._kind != "numpy":
+            return self._coarse_by_chunks(progress_bar)
+        if self._kind != "numpy":  # pragma: no cover - the former whole-graph build, kept for reference
             if "dask.array" not in sys.modules:
                 try:
                     import dask.array  # noqa: F401
@@ -1276,6 +1370,120 @@ class Field4D:
         c._coarse = c
         c._infinite_reported = True  # its infinities are the field's: reported by the field
         return c
+
+    def _coarse_by_chunks(self, progress_bar: bool = False) -> "Field4D":
+        """The coarse copy of a chunked or lazy array, read chunk by chunk: each chunk's share of
+        the linear resampling (the same nodes and weights as for an array in memory) is added into
+        the copy and the chunk dropped; the +-inf counts ride along."""
+        vals = self._values
+        nshape = tuple(int(n) for n in vals.shape)
+        target = [min(n, COARSE_SAMPLES) for n in nshape]
+        rd = _ChunkReader(vals, 0)  # no cache: every chunk once, then dropped
+        nch = tuple(len(b) - 1 for b in rd.bounds)
+        plans = []  # per axis, per chunk: (rows, local i0, has i0, local i0+1, has i0+1, 1-t, t), or rows only
+        for a, (n, m) in enumerate(zip(nshape, target)):
+            b = rd.bounds[a]
+            per = []
+            if m == n:
+                for c in range(nch[a]):
+                    per.append((np.arange(b[c], b[c + 1]),))
+            else:
+                u = np.linspace(0.0, n - 1.0, m)
+                i0 = np.minimum(np.floor(u).astype(np.int64), n - 2)
+                t = u - i0
+                for c in range(nch[a]):
+                    lo, hi = int(b[c]), int(b[c + 1])
+                    in0 = (i0 >= lo) & (i0 < hi)
+                    in1 = (i0 + 1 >= lo) & (i0 + 1 < hi)
+                    rows = np.flatnonzero(in0 | in1)
+                    per.append((rows, np.clip(i0[rows] - lo, 0, hi - lo - 1), in0[rows],
+                                np.clip(i0[rows] + 1 - lo, 0, hi - lo - 1), in1[rows], 1.0 - t[rows], t[rows]))
+            plans.append(per)
+        order = [int(a) for a in np.argsort([t / n for t, n in zip(target, nshape)])]  # biggest reduction first
+        out = np.zeros(target, dtype=np.float64)
+        floating = np.dtype(vals.dtype).kind == "f"
+        npos = nneg = 0
+        total = math.prod(nch)
+        chunk_bytes = math.prod(int(np.diff(b).max()) for b in rd.bounds) * rd.dtype.itemsize
+        batch = max(1, min(CHUNK_BATCH, (64 * 1024**2) // max(1, chunk_bytes)))
+        self.coarse_progress = (0, total)
+        bar = None
+        if progress_bar:
+            from .progress import progress
+
+            bar = progress(total, f"coarse copy of {self.name or 'the field'} (chunks)")
+        done = 0
+        try:
+            ids = list(np.ndindex(*nch))
+            for b0 in range(0, total, batch):
+                part = ids[b0:b0 + batch]
+                got = rd.read(part)
+                for idx in part:
+                    x = got.pop(idx)
+                    if floating:
+                        inf = np.isinf(x)
+                        if inf.any():
+                            p = int(np.count_nonzero(inf & (x > 0)))
+                            npos += p
+                            nneg += int(np.count_nonzero(inf)) - p
+                    rows = [None] * 4
+                    for a in order:
+                        plan = plans[a][idx[a]]
+                        rows[a] = plan[0]
+                        if len(plan) == 1 or not len(plan[0]):
+                            continue
+                        _, l0, m0, l1, m1, w0, w1 = plan
+                        shp = [-1 if k == a else 1 for k in range(4)]
+                        with np.errstate(invalid="ignore"):
+                            A = np.take(x, l0, axis=a) * w0.reshape(shp)
+                            B = np.take(x, l1, axis=a) * w1.reshape(shp)
+                            x = np.where(m0.reshape(shp), A, 0.0) + np.where(m1.reshape(shp), B, 0.0)
+                    if all(len(r) for r in rows):
+                        out[np.ix_(*rows)] += x
+                    del x
+                    done += 1
+                    self.coarse_progress = (done, total)
+                    if bar is not None:
+                        bar.update(1)
+                del got
+        finally:
+            if bar is not None:
+                bar.close()
+        self._infinite = (npos, nneg, None) if floating else (0, 0, None)
+        x = out.astype(np.float32) if np.dtype(vals.dtype) == np.float32 else out
+        x.flags.writeable = False
+        coords = list(self._coords)
+        for a, (n, m) in enumerate(zip(nshape, target)):
+            di = _AXES.index(self.axes[a])
+            if m != n and coords[di] is not None:
+                coords[di] = _sealed(np.interp(np.linspace(0.0, n - 1.0, m), np.arange(n), coords[di]))
+        c = Field4D(x, axes=self.axes, extent=self.extent, name=self.name, units=self.units,
+                    w_per_unit=self.w_per_unit, w_units=self.w_units, _coords=coords)
+        c._coarse = c
+        c._infinite_reported = True  # its infinities are the field's: reported by the field
+        return c
+
+    def _cap_scale(self, s, first_cut: bool = False) -> float:
+        """K for one step's samples: the field's (`_statistics`), or, for a chunked or lazy array
+        whose coarse copy is not ready, the 95th percentile of |grad f| within the first cut's
+        samples (kept until the coarse copy is ready, so the pictures agree) -- with ``first_cut``
+        (`Field4D.slice`; `slice_field` builds the coarse copy) or once K was taken so."""
+        if (first_cut or self._k_first is not None) and self._stats is None and self._kind not in ("numpy", "function") and self._coarse is None:
+            if self._k_first is None:
+                u = _power_of_two_unit(self.size)
+                inner = s.g > s.spacing  # both neighbours inside the box: no step to the zeros outside
+                with np.errstate(invalid="ignore", over="ignore"):
+                    grads = np.gradient(np.asarray(s.f, dtype=np.float32), s.spacing / u)
+                    gm = np.sqrt(sum(g * g for g in grads))
+                ok = np.isfinite(gm) & (gm > 0) & inner
+                if ok.any():
+                    self._k_first = float(np.percentile(gm[ok], 95)) / u
+                else:
+                    lo, hi = self._range_info()[0] if self._reader is not None and self._reader.reads else (0.0, 0.0)
+                    span = hi - lo if math.isfinite(lo) and math.isfinite(hi) else 0.0
+                    self._k_first = max(span, abs(hi) if math.isfinite(hi) else 0.0, 1.0) / (2 * self.size)
+            return self._k_first
+        return self._statistics()[1]
 
     def _statistics(self):
         """((min, max), K): `data_range` and a typical |grad f| (level units per slice unit)."""
@@ -1514,8 +1722,17 @@ def _geometric_nodes(field, d):
     return (np.asarray(c) - field._centre[d]) / field._unit[d]
 
 
-def _sample(field, m, c0, res) -> _Samples | None:
-    """Resample ``field`` on the grid of one step, or None when w = c0 misses the box."""
+def _sample(field, m, c0, res, first_cut: bool = False) -> _Samples | None:
+    """Resample ``field`` on the grid of one step, or None when w = c0 misses the box; with its
+    cap scale K (`Field4D._cap_scale`: taken after the read, so a first cut needs nothing more)."""
+    s = _sample_raw(field, m, c0, res)
+    if s is not None:
+        s.k = field._cap_scale(s, first_cut)
+    return s
+
+
+def _sample_raw(field, m, c0, res) -> _Samples | None:
+    """`_sample` without K (``s.k`` None)."""
     box = _box_slice(field, m, c0)
     if box.dim < 3:
         return None
@@ -1531,7 +1748,7 @@ def _sample(field, m, c0, res) -> _Samples | None:
     n = n + 2
     s = _Samples()
     s.origin, s.spacing, s.box = origin, d, box
-    s.k = field._statistics()[1]
+    s.k = None
     hw = field._hw
     p0 = np.array([origin[0], origin[1], origin[2], c0])
     if field._kind == "function":
