@@ -706,7 +706,9 @@ class Field4D:
         Samples along the longest side of a full step (default 64) and of a
         coarse step (default ``max(24, resolution // 2)``).
     levels : float or sequence of floats, optional
-        Iso levels (default: one, midway between the min and max of `coarse`).
+        Iso levels (default: one, midway between the min and max of `data_range`: for a chunked
+        array, of the first slice's chunks until `coarse` is ready -- the first picture never
+        reads the whole array; `prepare_coarse` builds the copy in the background).
     inside : "above" or "below"
         Which side of each level the surface encloses: ``"above"`` {f >= level} (a density,
         a phase field), ``"below"`` {f <= level} (a signed distance, negative inside: the ball,
