@@ -1324,22 +1324,7 @@ class Field4D:
         floating = np.dtype(self._values.dtype).kind == "f"
         if self._kind != "numpy":
             return self._coarse_by_chunks(progress_bar)
-        if self._kind != "numpy":  # pragma: no cover - the former whole-graph build, kept for reference
-            if "dask.array" not in sys.modules:
-                try:
-                    import dask.array  # noqa: F401
-                except ImportError:  # pragma: no cover
-                    pass
-            if "dask.array" in sys.modules:
-                import dask.array as dsa
-
-                if self._kind != "dask":
-                    ch = getattr(x, "chunks", None)
-                    x = dsa.from_array(x, chunks=ch if isinstance(ch, tuple) else "auto", asarray=False)
-            else:  # pragma: no cover
-                x = np.asarray(x)
-                self._infinite = _count_infinite(x) if floating else (0, 0, None)
-        xp = sys.modules["dask.array"] if self._kind != "numpy" and "dask.array" in sys.modules else np
+        xp = np  # chunked and lazy arrays took `_coarse_by_chunks` above
         whole = x
         coords = list(self._coords)
         for a in np.argsort([t / n for t, n in zip(target, nshape)]):  # biggest reduction first

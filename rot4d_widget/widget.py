@@ -374,6 +374,12 @@ class Rot4DWidget(widgets.HBox):
 
         # The initial picture is part of the models' state: not "in flight".
         self._pump.send_now(expect_ack=False)
+        # A big field's coarse copy (for held keys) is built in the background from now on, with
+        # a progress bar; its first picture above read only the chunks the cut touches.  Only with
+        # the ticker running (a live widget): scripts and tests stay deterministic.
+        prepare = getattr(self._level_source, "prepare_coarse", None)
+        if prepare is not None and self._pump.autotick:
+            prepare(progress=True)
 
     # ------------------------------------------------------------------ API
     @property
