@@ -526,7 +526,7 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
 
 #: The `Field4D.from_xarray` keywords an origin's ``"kwargs"`` may carry (files written by
 #: `open_field` before version 2 keep the dims and any of these there).
-_ORIGIN_KWARGS = ("x", "y", "z", "w", "w_per_unit", "name", "units", "w_units", "resolution", "coarse_resolution",
+_ORIGIN_KWARGS = ("x", "y", "z", "w", "w_per_unit", "name", "units", "w_units", "space_units", "resolution", "coarse_resolution",
                   "levels", "inside", "caps", "chunk_cache_bytes")
 
 
@@ -595,11 +595,13 @@ def _rebuild_field(d, allow_code=False, function=None, base=None):
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
     if d.get("w_units") is not None:
         common["w_units"] = d["w_units"]
+    if d.get("space_units") is not None:
+        common["space_units"] = d["space_units"]
     if "origin" in d:
         field = _open_origin(d["origin"], base)
         _same_data(field, d)
         field.w_per_unit = d["w_per_unit"]
-        for attr in ("name", "units", "w_units"):
+        for attr in ("name", "units", "w_units", "space_units"):
             if attr in d:
                 setattr(field, attr, None if d[attr] is None else str(d[attr]))
     elif function is not None:

@@ -702,6 +702,9 @@ class Field4D:
         one spatial sample: voxels are cubes in 4-D).  Larger values squash time.
     w_units : str, optional
         Unit of w for the readout (default ``"sample"`` with the default extent).
+    space_units : str, optional
+        Unit of x, y and z (e.g. ``"m"``): the readout gives a slice's volume in it, cubed.
+        `from_xarray` takes it from the coordinates' ``units`` when x, y and z agree.
     resolution, coarse_resolution : int
         Samples along the longest side of a full step (default 64) and of a
         coarse step (default ``max(24, resolution // 2)``).
@@ -724,7 +727,7 @@ class Field4D:
     """
 
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
-                 w_per_unit=None, w_units=None, resolution: int = 64, coarse_resolution=None,
+                 w_per_unit=None, w_units=None, space_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
                  _coords=None, _function=None):
         self._function = _function
@@ -797,6 +800,7 @@ class Field4D:
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
         self.name = None if name is None else str(name)
         self.units = None if units is None else str(units)
+        self.space_units = None if space_units is None else str(space_units)
         e = np.array(self.extent)
         self._centre = (e[:, 0] + e[:, 1]) / 2
         self._coarse = None
@@ -923,9 +927,11 @@ class Field4D:
         w_units = kwargs.pop("w_units", da.coords[chosen["w"]].attrs.get("units") if chosen["w"] in da.coords else None)
         if w_units is None and chosen["w"] in da.coords and np.issubdtype(da.coords[chosen["w"]].dtype, np.datetime64):
             w_units = "s"
+        space = {da.coords[chosen[k]].attrs.get("units") if chosen[k] in da.coords else None for k in "xyz"}
+        space_units = kwargs.pop("space_units", space.pop() if len(space) == 1 else None)
         field = cls(values, axes=axes, extent=extent, name=kwargs.pop("name", da.name),
                     units=kwargs.pop("units", units), w_per_unit=w_per_unit, w_units=w_units, _coords=coords,
-                    **kwargs)
+                    space_units=space_units, **kwargs)
         field._dims = dims
         field._meta_range = meta_range
         field.origin = origin
@@ -1243,7 +1249,7 @@ class Field4D:
         """A JSON-able description; rebuilds nothing for in-memory arrays (not recordable)."""
         d = {"kind": "field", "axes": self.axes, "extent": [list(e) for e in self.extent],
              "w_per_unit": self.w_per_unit, "levels": list(self.levels), "name": self.name, "units": self.units,
-             "inside": self.inside, "caps": self.caps}
+             "space_units": self.space_units, "inside": self.inside, "caps": self.caps}
         if self._kind == "function":
             f = self._function
             d["function"] = f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', type(f).__name__)}"

@@ -72,3 +72,32 @@ def test_inside_and_caps_are_traits_recorded_replayed_and_saved(make, tmp_path):
     back = make(ball())
     back.load_state(path)
     assert (back.inside, back.caps) == ("below", False)
+
+
+def test_from_xarray_takes_the_space_units_and_the_readout_gives_cubic_metres(make, tmp_path):
+    xr = pytest.importorskip("xarray")
+    import numpy as np
+
+    from rot4d_widget import Rot4DWidget
+
+    x = np.linspace(-2, 2, 17)
+    t = np.linspace(0.0, 60.0, 9)
+    f = R * R - (x[None, None, None, :] ** 2 + x[None, None, :, None] ** 2 + x[None, :, None, None] ** 2)
+    f = np.broadcast_to(f, (len(t), 17, 17, 17)).copy()
+    da = xr.DataArray(f, dims=("time", "z", "y", "x"), name="f",
+                      coords={"time": ("time", t, {"units": "s"}), "z": ("z", x, {"units": "m"}),
+                              "y": ("y", x, {"units": "m"}), "x": ("x", x, {"units": "m"})})
+    field = Field4D.from_xarray(da, w="time", levels=0.0)
+    assert field.space_units == "m" and field.describe()["space_units"] == "m"
+    w = make(field)
+    assert "m\u00b3" in w.readout.value
+    path = tmp_path / "f.nc"
+    da.to_netcdf(path, engine="scipy")
+    opened = Field4D.open(str(path), "f", w="time", levels=0.0)
+    w2 = make(opened)
+    w2.save_state(tmp_path / "v.json")
+    back = Rot4DWidget.from_state(tmp_path / "v.json", _autotick=False)
+    try:
+        assert back.source.space_units == "m"
+    finally:
+        back.close()
