@@ -1577,7 +1577,8 @@ class Field4D:
                                   f"{self.extent[3][1]:.4g})"))
         else:
             rows.append(("w cut", "none (w = c0 misses the data)"))
-        rows.append(("w per unit", f"{self.w_per_unit:.4g}{wu} per unit of space"))
+        per = self.space_units if self.space_units else "unit of space"
+        rows.append(("w per unit", f"{self.w_per_unit:.4g}{wu} per {per}"))
         if coarse:
             rows.append(("resolution", f"{self.coarse_resolution} (coarse copy)"))
         return tuple(rows)

@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from .look import number_text
+
 __all__ = ["readout_html", "help_html", "gizmo_svg", "gauge_html", "angle_text", "number_text", "STYLE"]
 
 #: Compact tables (Jupyter's rendered-HTML CSS pads cells generously).  Sent
@@ -32,21 +34,6 @@ STYLE = (
 
 #: The colours of the object's axes x, y, z, w in the gizmo.
 AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4", "#9467bd")
-
-
-def number_text(value: float, scale: float = 0.0, digits: int = 4) -> str:
-    """A number for people: ``digits`` significant digits, and 0 for a value that is rounding noise
-    next to ``scale`` (below 1e-9 of it: no "-2.132e-14" for a cut through t = 0).
-
-    >>> number_text(-2.132e-14, 73.3), number_text(2.1362, 0), number_text(1234567.0)
-    ('0', '2.136', '1.235e+06')
-    """
-    value = float(value)
-    if not math.isfinite(value):
-        return str(value)
-    if abs(value) <= 1e-9 * abs(float(scale)):
-        return "0"
-    return f"{value:.{digits}g}"
 
 
 def angle_text(rad: float) -> str:

@@ -50,6 +50,7 @@ __all__ = [
     "as_source",
     "check_slice",
     "BadSlice",
+    "data_w_text",
 ]
 
 
@@ -155,6 +156,22 @@ class SliceData:
         data = cls(p, s, t, g, normals, **kwargs)
         check_slice(data)
         return data
+
+
+def data_w_text(source, w: float, matrix) -> str:
+    """A cut's label in the data's own w: ``"w 30 s"`` for a field (its time, in its ``w_units``) --
+    the data w at the centre of the cut w = ``w`` (slice units), ``w_centre + m[3, 3] w w_per_unit``
+    -- and ``"w +0.5"`` for a source without ``w_per_unit`` and ``extent`` (a polytope's own w)."""
+    from .look import number_text
+
+    wpu, extent = getattr(source, "w_per_unit", None), getattr(source, "extent", None)
+    if wpu is None or extent is None:
+        text = number_text(w, getattr(source, "size", 1.0), 3)
+        return f"w {'+' if not text.startswith('-') else ''}{text}"
+    lo, hi = float(extent[3][0]), float(extent[3][1])
+    value = (lo + hi) / 2 + float(np.asarray(matrix)[3, 3]) * float(w) * float(wpu)
+    unit = getattr(source, "w_units", None)
+    return f"w {number_text(value, max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
 
 
 class BadSlice(ValueError):

@@ -64,7 +64,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from . import look
-from .source import SliceData, SourceAction, as_source, census_text
+from .source import SliceData, SourceAction, as_source, census_text, data_w_text
 
 __all__ = [
     "ARRANGEMENTS",
@@ -506,25 +506,34 @@ class StackSource:
         return StackSliceData.build(
             np.concatenate(pts), np.concatenate(segs), np.concatenate(tris), np.concatenate(groups),
             normals=np.concatenate(nrms) if has_normals else None, volume=None,
-            readout=self._readout(levels, pieces, volumes, hi), convex=False,
+            readout=self._readout(levels, pieces, volumes, hi, m), convex=False,
             show_points=any(bool(getattr(p, "show_points", True)) for p in pieces), extra=extra)
 
-    def _readout(self, levels, pieces, volumes, hi) -> tuple:
+    def _readout(self, levels, pieces, volumes, hi, m) -> tuple:
+        """Rows for the readout: each slice labelled by its w in the data's own units (a field's
+        time, `data_w_text`), its census (polytopes) and volume (the source's own units)."""
         n = len(levels)
         how = "colour by w (viridis, low w dark)" if self._color_by == "w" else "colour by cell"
-        rows = [("stack", f"{n} slices, \u0394 = {self.spacing:.4g}, {self._arrangement}, {how}")]
+        wpu = getattr(self.source, "w_per_unit", None)
+        unit = getattr(self.source, "w_units", None)
+        delta = look.number_text(self.spacing * (wpu if wpu is not None else 1.0))
+        delta += f" {unit}" if wpu is not None and unit else ""
+        rows = [("stack", f"{n} slices, \u0394 = {delta}, {self._arrangement}, {how}")]
         polytope = self._polytope is not None
         if n <= 12:
             for k, (w, piece, v) in enumerate(zip(levels, pieces, volumes)):
-                label = ("\u25b8 " if k == hi else "") + f"w {w:+.3g}"
+                label = ("\u25b8 " if k == hi else "") + data_w_text(self.source, w, m)
                 parts = []
                 if polytope:
                     parts.append(_short_census(piece.slice))
                 if v is not None:
-                    parts.append(f"vol {v:.4g}")
+                    space = getattr(self.source, "space_units", None)
+                    parts.append(f"vol {look.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
-            rows.append(("w", f"{levels[0]:+.4g} \u2026 {levels[-1]:+.4g} (\u25b8 {levels[hi]:+.4g})"))
+            rows.append(("w", f"{data_w_text(self.source, levels[0], m)[2:]} \u2026 "
+                              f"{data_w_text(self.source, levels[-1], m)[2:]} "
+                              f"(\u25b8 {data_w_text(self.source, levels[hi], m)[2:]})"))
             if any(v is not None for v in volumes):
                 rows.append(("volumes", " ".join("\u2014" if v is None else f"{v:.3g}" for v in volumes)))
         return tuple(rows)

@@ -53,7 +53,7 @@ from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
-from .source import BadSlice, as_source, check_slice
+from .source import BadSlice, as_source, check_slice, data_w_text
 from .state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
@@ -1328,7 +1328,7 @@ class Rot4DWidget(widgets.HBox):
         if _is_stack(src):
             rgb = src.group_colors()
             if rgb is not None:
-                return rgb, [_data_w_text(src.source, w, self.state.matrix) for w in src.levels_at(self.state.c0)]
+                return rgb, [data_w_text(src.source, w, self.state.matrix) for w in src.levels_at(self.state.c0)]
             src = src.source
         rgb = _level_colors(src)
         if rgb is not None:
@@ -1384,19 +1384,6 @@ def _source_settings(source) -> dict:
         out["spacing"] = None if source.spacing_is_default else float(source.spacing)
         out["arrangement"] = source.arrangement
     return out
-
-
-def _data_w_text(source, w: float, matrix) -> str:
-    """A parallel slice's label in the data's own w (a field's time, in its ``w_units``): the
-    data w at the centre of the cut, ``w_centre + m[3, 3] * w * w_per_unit``; a source without
-    ``w_per_unit`` and ``extent`` (a polytope) keeps its own w."""
-    wpu, extent = getattr(source, "w_per_unit", None), getattr(source, "extent", None)
-    if wpu is None or extent is None:
-        return f"w {ro.number_text(w, getattr(source, 'size', 1.0), 3)}"
-    lo, hi = float(extent[3][0]), float(extent[3][1])
-    value = (lo + hi) / 2 + float(np.asarray(matrix)[3, 3]) * float(w) * float(wpu)
-    unit = getattr(source, "w_units", None)
-    return f"w {ro.number_text(value, max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
 
 
 def _volume_text(source, volume: float, matrix) -> str:
