@@ -381,6 +381,120 @@ def draw_slice(
     return drawing
 
 
+# --------------------------------------------------------------------------- one panel, fast (animations)
+_CIRCLE = None  # Path.unit_circle()'s vertices and codes, made on first use
+_POLY_CODES: dict = {}  # closed polygon codes by corner count
+
+
+def _closed_codes(n: int) -> np.ndarray:
+    codes = _POLY_CODES.get(n)
+    if codes is None:
+        from matplotlib.path import Path
+
+        codes = np.full(n + 1, Path.LINETO, dtype=Path.code_type)
+        codes[0], codes[-1] = Path.MOVETO, Path.CLOSEPOLY
+        _POLY_CODES[n] = codes
+    return codes
+
+
+def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radius: float, face_alpha: float,
+                      cmap=None, ball_color=look.BALL_COLOR, bar_color=look.BAR_COLOR, z_shift: float = 0.0,
+                      distance: float = CAMERA_DISTANCE):
+    """What `draw_slice` draws -- the same faces, bars, balls and highlights, with the same paths,
+    colours, edges and painter's order (zorders plus ``z_shift``, ties in draw_slice's order) --
+    as ONE `PathCollection` (gid "slice"), drawn by a single renderer call.  For animations:
+    a frame of the 24-cell is ~100 patches, whose building and drawing was most of its time.
+    ``cmap`` a Colormap or None; radii and sizes already checked.  None when nothing is drawn."""
+    from matplotlib.collections import PathCollection
+    from matplotlib.path import Path
+
+    global _CIRCLE
+    if _CIRCLE is None:
+        c = Path.unit_circle()
+        _CIRCLE = (np.asarray(c.vertices, dtype=np.float64), np.asarray(c.codes))
+    circ_v, circ_c = _CIRCLE
+    pts = np.asarray(slice.vertices, dtype=np.float64).reshape(-1, 3) * scale
+    if not len(pts):
+        return None
+    xy, fac = perspective(pts, distance)
+    z = pts[:, 2]
+    paths, face, edge, width, zo = [], [], [], [], []
+    none = (0.0, 0.0, 0.0, 0.0)
+
+    # faces: corners ordered around the projected centroid (draw_slice's order), one loop-free pass
+    off = np.asarray(slice.polygon_offsets, dtype=np.int64)
+    lens = np.diff(off)
+    if len(lens):
+        rgba = _cell_colors(np.asarray(slice.cell_ids), cmap)
+        flat = np.asarray(slice.polygon_indices, dtype=np.int64)
+        seg = np.repeat(np.arange(len(lens)), lens)
+        p2 = xy[flat]
+        cnt = np.maximum(lens, 1)
+        cx = np.bincount(seg, p2[:, 0], len(lens)) / cnt
+        cy = np.bincount(seg, p2[:, 1], len(lens)) / cnt
+        depth = np.bincount(seg, z[flat], len(lens)) / cnt
+        ang = np.arctan2(p2[:, 1] - cy[seg], p2[:, 0] - cx[seg])
+        ring = p2[np.lexsort((ang, seg))]
+        for k in np.flatnonzero(lens >= 3):
+            v = ring[off[k]:off[k + 1]]
+            paths.append(Path(np.concatenate([v, v[:1]]), _closed_codes(len(v))))
+            face.append((*rgba[k][:3], face_alpha))
+            edge.append(none)
+            width.append(0.0)
+            zo.append(_Z_BASE + depth[k] + _Z_KIND["face"])
+
+    # bars: trapezoids, half-width bar_radius * factor at each end; an end-on edge is a disc
+    e = np.asarray(slice.edges, dtype=np.int64).reshape(-1, 2)
+    if bar_radius > 0 and len(e):
+        bar_rgba = to_rgba(bar_color)
+        edge_rgba = tuple(0.6 * np.asarray(bar_rgba[:3])) + (bar_rgba[3],)
+        pa, pb = xy[e[:, 0]], xy[e[:, 1]]
+        ra, rb = bar_radius * fac[e[:, 0]], bar_radius * fac[e[:, 1]]
+        u = pb - pa
+        length = np.hypot(u[:, 0], u[:, 1])
+        flat_end = length <= 1e-12
+        n = np.stack([-u[:, 1], u[:, 0]], axis=1) / np.where(flat_end, 1.0, length)[:, None]
+        quad = np.stack([pa + n * ra[:, None], pb + n * rb[:, None], pb - n * rb[:, None], pa - n * ra[:, None],
+                         pa + n * ra[:, None]], axis=1)
+        zb = _Z_BASE + 0.5 * (z[e[:, 0]] + z[e[:, 1]]) + _Z_KIND["bar"]
+        codes = _closed_codes(4)
+        for j in range(len(e)):
+            if flat_end[j]:
+                paths.append(Path(circ_v * max(ra[j], rb[j]) + pa[j], circ_c))
+                edge.append(none)
+                width.append(0.0)
+            else:
+                paths.append(Path(quad[j], codes))
+                edge.append(edge_rgba)
+                width.append(0.3)
+            face.append(bar_rgba)
+            zo.append(zb[j])
+
+    # balls and their highlights (each highlight right after its ball)
+    if ball_radius > 0:
+        ball_rgba = to_rgba(ball_color)
+        dark = tuple(0.55 * np.asarray(ball_rgba[:3])) + (ball_rgba[3],)
+        r = ball_radius * fac
+        zb = _Z_BASE + z + _Z_KIND["ball"]
+        shine = xy + np.array([-0.35, 0.35]) * r[:, None]
+        for i in range(len(pts)):
+            paths.append(Path(circ_v * r[i] + xy[i], circ_c))
+            paths.append(Path(circ_v * (0.3 * r[i]) + shine[i], circ_c))
+            face += [ball_rgba, (1.0, 1.0, 1.0, 0.55)]
+            edge += [dark, none]
+            width += [0.4, 0.0]
+            zo += [zb[i], zb[i] + 1e-5]
+    if not paths:
+        return None
+    zo = np.asarray(zo) + z_shift
+    order = np.argsort(zo, kind="stable")  # matplotlib sorts artists by zorder, stably
+    coll = PathCollection([paths[i] for i in order], facecolors=np.asarray(face)[order],
+                          edgecolors=np.asarray(edge)[order], linewidths=np.asarray(width)[order],
+                          joinstyle="miter", capstyle="butt", zorder=float(zo.min()), gid="slice")
+    coll._items_zorder = zo[order]
+    return coll
+
+
 # --------------------------------------------------------------------------- grids of panels
 def _panel_label(k: int) -> str:
     return f"({string.ascii_lowercase[k]})" if k < 26 else f"({k + 1})"
@@ -660,20 +774,41 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     return lines, legend
 
 
-def _draw_annotation(ax, lines, legend, height: float) -> None:
-    """``lines`` in the upper left corner, ``legend`` swatches in the lower left (gid "annotation")."""
+def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
+    """``lines`` in the upper left corner, ``legend`` swatches in the lower left (gid "annotation").
+    With a `_FrameCanvas`, the previous frame's text is given the new lines and its legend is
+    kept when the swatches are the same."""
     from matplotlib.patches import Patch
 
     fs = max(6.0, min(10.0, 1.7 * height))
-    box = dict(facecolor="white", alpha=0.75, edgecolor="none", pad=2.0)
-    ax.text(0.015, 0.985, "\n".join(lines), transform=ax.transAxes, ha="left", va="top", fontsize=fs,
-            zorder=_Z_LABEL, gid="annotation", bbox=box)
+    text = "\n".join(lines)
+    if canvas is not None and canvas.note is not None and canvas.note.get_fontsize() == fs:
+        canvas.note.set_text(text)
+        canvas.keep.add(canvas.note)
+    else:
+        if canvas is not None and canvas.note is not None:
+            canvas.note.remove()
+        box = dict(facecolor="white", alpha=0.75, edgecolor="none", pad=2.0)
+        note = ax.text(0.015, 0.985, text, transform=ax.transAxes, ha="left", va="top", fontsize=fs,
+                       zorder=_Z_LABEL, gid="annotation", bbox=box)
+        if canvas is not None:
+            canvas.note = note
+            canvas.keep.add(note)
+    if canvas is not None:
+        key = (tuple((tuple(float(c) for c in rgb), label) for rgb, label in legend), fs)
+        if ax.get_legend() is not None and canvas.legend_key == key:
+            return  # the same swatches as the frame before: keep its legend
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+        canvas.legend_key = key
     if legend:
         handles = [Patch(facecolor=rgb, edgecolor="none", label=label) for rgb, label in legend]
         leg = ax.legend(handles=handles, loc="lower left", fontsize=fs, framealpha=0.75, edgecolor="none",
                         handlelength=1.0, borderaxespad=0.3)
         leg.set_zorder(_Z_LABEL)
         leg.set_gid("legend")
+        if canvas is not None:
+            canvas.as_picture(leg)
 
 
 # --------------------------------------------------------------------------- stacks of slices
@@ -705,6 +840,7 @@ def render_tomography(
     annotate=False,
     _data=None,
     _theta0=None,
+    _canvas=None,
 ) -> Figure:
     """N parallel slices w_k = c0 + (k - (N-1)/2) Δ of ``source``, in one scene, as the live view lays them out.
 
@@ -770,10 +906,13 @@ def render_tomography(
     group_rgb = ex.get("group_rgb")
 
     top = TITLE_HEIGHT if title else 0.0
-    fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
-    ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
-    ax.set_axis_off()
-    ax.set_facecolor(background)
+    if _canvas is None:
+        fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
+        ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
+        ax.set_axis_off()
+        ax.set_facecolor(background)
+    else:  # an animation's next frame: the same figure, this frame's artists only
+        fig, ax = _canvas.begin(width, height, top, dpi, background)
     aspect = width / height
     edge = getattr(src.source, "edge_length", None)
     base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
@@ -788,7 +927,8 @@ def render_tomography(
     limit = 0.5 * (y1 - y0)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
-    ax.set_aspect("equal")
+    if _canvas is None:
+        ax.set_aspect("equal")
 
     poly = getattr(src.source, "polytope", None)
     offs = np.asarray(ex["point_offsets"])
@@ -813,10 +953,18 @@ def render_tomography(
                 placed = Slice(placed.vertices, placed.edges, placed.polygon_indices[:0], placed.polygon_offsets[:1],
                                placed.cell_ids[:0], placed.triangles[:0], placed.triangle_cells[:0], placed.volume,
                                placed.dim)
-            drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV, ball_radius=ball if show_balls else 0.0,
-                                 bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap)
-            for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
-                a.set_zorder(a.get_zorder() + z_shift)
+            if _canvas is not None:  # one collection per slice, in draw_slice's painter's order
+                coll = _slice_collection(placed, scale=scale, ball_radius=ball if show_balls else 0.0,
+                                         bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap,
+                                         z_shift=z_shift)
+                if coll is not None:
+                    ax.add_collection(coll, autolim=False)
+            else:
+                drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV,
+                                     ball_radius=ball if show_balls else 0.0,
+                                     bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap)
+                for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
+                    a.set_zorder(a.get_zorder() + z_shift)
         else:
             bar_width = (0.35 * bar if bar_radius is None else bar) if show_bars else 0.0  # a field's box: thin
             _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
@@ -835,15 +983,197 @@ def render_tomography(
         lines, legend = annotation(src, data, c0, theta0=_theta0)
         if isinstance(annotate, str):
             lines = [annotate, *lines]
-        _draw_annotation(ax, lines, legend, height)
+        _draw_annotation(ax, lines, legend, height, _canvas)
     if title:
         name = getattr(src.source, "name", None) or type(src.source).__name__
         text = title if isinstance(title, str) else (
             f"{name}: {n} slice{'s' if n != 1 else ''} w = c0 + (k \u2212 {(n - 1) / 2:g})\u0394, "
             f"c0 = {c0:.3g}, \u0394 = {src.spacing:.3g}, {src.arrangement}")
-        fig.text(0.5, 1.0 - 0.5 * top / (height + top), text, ha="center", va="center", fontsize=9)
+        if _canvas is not None and _canvas.title is not None:
+            _canvas.title.set_text(text)
+        else:
+            t = fig.text(0.5, 1.0 - 0.5 * top / (height + top), text, ha="center", va="center", fontsize=9)
+            if _canvas is not None:
+                _canvas.title = t
+        if _canvas is not None:
+            _canvas.keep.add(_canvas.title)
+    if _canvas is not None:
+        _canvas.end()
     _save(fig, path)
     return fig
+
+
+_TEXT_CACHE_SIZE = 512  # rendered lines of text an animation's canvas keeps
+
+
+def _text_caching_canvas(fig):
+    """A `FigureCanvasAgg` for ``fig`` whose renderer draws a line of text it drew before from a
+    picture of it: matplotlib renders text glyph by glyph (FreeType, a few tens of µs each), and
+    an animation's annotation, legend and title repeat from frame to frame but for a line or two.
+    A line is rendered once into a transparent buffer at the same sub-pixel offset (so the same
+    glyph bitmaps), cropped, and blended where it goes (Agg's draw_image, the same blending as
+    drawing the glyphs there: the pixels agree up to rounding).  Rotated text and mathtext are
+    drawn as usual."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
+
+    class TextCachingRenderer(RendererAgg):
+        def __init__(self, *args):
+            super().__init__(*args)
+            self._lines: dict = {}
+
+        def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+            if ismath or angle or not s or gc.get_url() is not None:
+                return super().draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+            up = self.height - y  # FreeType's y is upwards
+            ix, iy = math.floor(x), math.floor(up)
+            feats = (tuple(mtext.get_fontfeatures() or ()), mtext.get_language()) if mtext is not None else None
+            font = (tuple(prop.get_family()), prop.get_style(), prop.get_variant(), prop.get_weight(),
+                    prop.get_stretch(), prop.get_size(), prop.get_file(), prop.get_math_fontfamily())
+            key = (s, font, tuple(gc.get_rgb()), gc.get_alpha(), gc.get_forced_alpha(), gc.get_antialiased(),
+                   x - ix, up - iy, feats)
+            hit = self._lines.get(key)
+            if hit is None:
+                hit = self._render_line(gc, x - ix, up - iy, s, prop, mtext)
+                if len(self._lines) >= _TEXT_CACHE_SIZE:
+                    self._lines.clear()
+                self._lines[key] = hit
+            img, dx, dy = hit
+            if img is None:
+                return
+            gc1 = self.new_gc()
+            gc1.copy_properties(gc)
+            gc1.set_alpha(1.0)  # the picture carries the text's alpha already
+            self.draw_image(gc1, ix + dx, iy + dy, img)
+            gc1.restore()
+
+        def _render_line(self, gc, fx, fy, s, prop, mtext):
+            """``(rgba, dx, dy)``: line ``s`` drawn at (fx, fy) in a transparent buffer, cropped to
+            its ink; (dx, dy) the crop's lower left corner relative to the pen's whole pixel."""
+            em = self.points_to_pixels(prop.get_size_in_points())
+            m = int(math.ceil(3.0 * em)) + 4  # room enough around the pen for any glyph (cropped below)
+            wd, ht = int(math.ceil(1.5 * em * len(s))) + 2 * m, 2 * m
+            off = RendererAgg(wd, ht, self.dpi)
+            gc1 = off.new_gc()
+            gc1.copy_properties(gc)
+            gc1.set_clip_rectangle(None)
+            gc1.set_clip_path(None)
+            oy = ht // 2
+            RendererAgg.draw_text(off, gc1, m + fx, ht - (oy + fy), s, prop, 0.0, ismath=False, mtext=mtext)
+            gc1.restore()
+            rgba = np.asarray(off.buffer_rgba())
+            rows = np.flatnonzero(rgba[..., 3].any(axis=1))
+            cols = np.flatnonzero(rgba[..., 3].any(axis=0))
+            if not len(rows):
+                return None, 0, 0
+            r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+            # draw_image takes the rows bottom up (as matplotlib's images hand them over)
+            return np.ascontiguousarray(rgba[r0:r1, c0:c1][::-1]), int(c0 - m), int(ht - r1 - oy)
+
+    class TextCachingCanvas(FigureCanvasAgg):
+        def get_renderer(self):
+            w, h = self.get_width_height(physical=True)
+            key = w, h, self.figure.dpi
+            if self._lastKey != key:
+                self.renderer = TextCachingRenderer(w, h, self.figure.dpi)
+                self._lastKey = key
+            return self.renderer
+
+    return TextCachingCanvas(fig)
+
+
+class _FrameCanvas:
+    """One figure, axes and Agg canvas that an animation's frames are drawn into in turn
+    (`render_state(..., _canvas=)`): building a figure and its axes was a third of a frame's time.
+    `begin` takes the figure (a new one when the size, dpi, title strip or background change)
+    and removes what the frame before added; the annotation, its legend and the title are kept
+    and given the new frame's text (`_draw_annotation`), and removed when a frame has none.
+    A polytope's slice is drawn as one collection (`_slice_collection`) instead of a patch per
+    ball, highlight, bar and face.  `rgb()` draws the frame and returns its pixels."""
+
+    def __init__(self):
+        self.fig = self.ax = self.canvas = None
+        self.key = None
+        self.note = self.title = None
+        self.legend_key = None
+        self.keep: set = set()
+
+    def begin(self, width, height, top, dpi, background):
+        key = (width, height, top, dpi, tuple(background))
+        if self.fig is None or key != self.key:
+            self.fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
+            self.ax = self.fig.add_axes([0, 0, 1, height / (height + top)])
+            self.ax.set_axis_off()
+            self.ax.set_facecolor(background)
+            self.ax.set_aspect("equal")
+            self.canvas = _text_caching_canvas(self.fig)
+            self.key = key
+            self.note = self.title = self.legend_key = None
+        else:  # the frame before's artists go, but for the annotation and the title (kept if used)
+            ax = self.ax
+            for a in (*ax.collections, *ax.patches, *ax.texts, *ax.lines, *ax.images, *self.fig.texts):
+                if a is not self.note and a is not self.title:
+                    a.remove()
+        self.keep = set()
+        return self.fig, self.ax
+
+    def end(self):
+        """After a frame is built: what it did not use of the kept artists goes."""
+        if self.note is not None and self.note not in self.keep:
+            self.note.remove()
+            self.note = None
+            if self.ax.get_legend() is not None:
+                self.ax.get_legend().remove()
+            self.legend_key = None
+        if self.title is not None and self.title not in self.keep:
+            self.title.remove()
+            self.title = None
+
+    @staticmethod
+    def as_picture(artist) -> None:
+        """Draw ``artist`` (one that stays the same from frame to frame: the legend) from a picture
+        of it taken the first time: rendered alone into a transparent buffer of the canvas's size,
+        cropped, then blended in place each frame (Agg's draw_image: the same pixels up to rounding)."""
+        draw = artist.draw
+        kept = {}
+
+        def drawn_from_picture(renderer):
+            if not artist.get_visible():
+                return
+            key = (renderer.width, renderer.height, renderer.dpi, type(renderer))
+            if key not in kept:
+                from matplotlib.backends.backend_agg import RendererAgg
+
+                if not isinstance(renderer, RendererAgg):
+                    return draw(renderer)
+                off = RendererAgg(int(renderer.width), int(renderer.height), renderer.dpi)
+                draw(off)
+                rgba = np.asarray(off.buffer_rgba())
+                rows = np.flatnonzero(rgba[..., 3].any(axis=1))
+                cols = np.flatnonzero(rgba[..., 3].any(axis=0))
+                if not len(rows):
+                    kept[key] = None
+                else:
+                    r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+                    kept[key] = (np.ascontiguousarray(rgba[r0:r1, c0:c1][::-1]), int(c0),
+                                 int(renderer.height) - int(r1))
+            if kept[key] is not None:
+                img, x, y = kept[key]
+                gc = renderer.new_gc()
+                renderer.draw_image(gc, x, y, img)
+                gc.restore()
+            artist.stale = False
+
+        artist.draw = drawn_from_picture
+
+    def rgba(self) -> np.ndarray:
+        """Draw the frame; its (H, W, 4) uint8 pixels, a view valid until the next frame is drawn."""
+        self.canvas.draw()
+        return np.asarray(self.canvas.buffer_rgba())
+
+    def rgb(self) -> np.ndarray:
+        """The frame's (H, W, 3) uint8 pixels (a copy), drawn by Agg at the figure's size."""
+        self.canvas.draw()
+        return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()
 
 
 def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
@@ -1027,6 +1357,7 @@ def render_state(
     frame="fit",
     annotate=False,
     _prepared=None,
+    _canvas=None,
 ) -> Figure:
     """The picture the widget shows for ``state`` and ``source``, without a browser.
 
@@ -1081,7 +1412,7 @@ def render_state(
         title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
         bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
-        annotate=annotate, _data=data, _theta0=state.theta0,
+        annotate=annotate, _data=data, _theta0=state.theta0, _canvas=_canvas,
     )
 
 

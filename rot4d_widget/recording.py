@@ -643,6 +643,17 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     (default True): each frame carries "t = ... s, frame k/n", θ0, c0 and what the source tells
     of itself (`figures.annotation`), and a legend; False for a bare picture.
     """
+    for f in _frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames, titles=titles,
+                     frame=frame, annotate=annotate, **settings):
+        yield _as_rgb(f)
+
+
+def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: str = "step", fps: float = 10.0,
+            max_frames: int = 3000, titles=None, frame="fit", annotate=True, **settings) -> Iterator[np.ndarray]:
+    """`render_frames`' frames as they are drawn: (H, W, 4) uint8 RGBA views of one reused canvas
+    (valid until the next frame is asked for), or (H, W, 3) RGB arrays when `figures.render_state`
+    hands back a figure of its own.  Every frame is drawn into ONE figure (`figures._FrameCanvas`):
+    its artists replaced, the annotation's text and legend kept and updated."""
     from . import figures
     from .figures import state_source
 
@@ -657,6 +668,7 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
         source = state_source(source, **start)
     prep = {k: settings[k] for k in _PREPARE_KEYS if k in settings}
     cache: list = []
+    canvas = figures._FrameCanvas()  # one figure for every frame
     if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
         boxes, kept = [], 0
         for t, state, src in animation_states(recording, initial_state, source, per=per, fps=fps):
@@ -674,8 +686,26 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
         if k < len(cache) and cache[k] is not None:
             extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep)
             cache[k] = None  # drawn once: let it go
-        fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, **extra, **settings)
-        yield _figure_rgb(fig)
+        fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,
+                                   **settings)
+        yield canvas.rgba() if fig is canvas.fig else _figure_rgb(fig)
+
+
+def _as_rgb(frame) -> np.ndarray:
+    """A frame of `_frames` as its own (H, W, 3) uint8 array."""
+    f = np.asarray(frame)
+    return f[..., :3].copy() if f.shape[-1] == 4 else f
+
+
+def _pil_rgb(frame):
+    """A frame of `_frames` as a Pillow RGB image of its own (Pillow drops the alpha in C)."""
+    from PIL import Image
+
+    f = np.asarray(frame)
+    if f.shape[-1] == 4 and f.flags.c_contiguous:
+        h, w = f.shape[:2]
+        return Image.frombuffer("RGBA", (w, h), f, "raw", "RGBA", 0, 1).convert("RGB")
+    return Image.fromarray(np.ascontiguousarray(f[..., :3]))
 
 
 def _progress_sink(progress, total: int):
@@ -718,36 +748,127 @@ def render_animation(recording: Recording, initial_state=None, source="5-cell", 
     fps = _positive("fps", fps)
     total = _frame_count(recording, per, fps)
     update, close = _progress_sink(progress, total)
-    frames = render_frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames,
-                           titles=titles, frame=frame, annotate=annotate, **settings)
+    frames = _frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames,
+                     titles=titles, frame=frame, annotate=annotate, **settings)
     count = 0
+    # The file is written by a thread of its own while the next frame is drawn: Pillow's quantizing,
+    # its GIF frame differences and the pipe to ffmpeg let go of the GIL; drawing holds it.
+    encoder = _Encoder(_write_gif if ext == ".gif" else _write_mp4, os.fspath(path), fps)
     try:
-        if ext == ".gif":
-            from PIL import Image
-
-            images = []
-            for f in frames:
-                images.append(Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
-                                                          dither=Image.Dither.NONE))
-                count += 1
-                update(count)
-            images[0].save(os.fspath(path), save_all=True, append_images=images[1:],
-                           duration=round(1000.0 / fps), loop=0)
-            return count
-        import imageio.v2 as imageio
-
-        with imageio.get_writer(os.fspath(path), format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                                pixelformat="yuv420p", macro_block_size=1, ffmpeg_log_level="error") as writer:
-            for f in frames:
-                h, w = f.shape[:2]
-                if h % 2 or w % 2:  # yuv420p needs even sizes: repeat the last row / column
-                    f = np.pad(f, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
-                writer.append_data(f)
-                count += 1
-                update(count)
+        for f in frames:
+            encoder.put(_pil_rgb(f))  # a copy: the canvas is drawn over for the next frame
+            count += 1
+            update(count)
+        encoder.finish()
         return count
     finally:
+        encoder.abort()
         close()
+
+
+class _Encoding(Exception):
+    """The frames stopped coming (an error while drawing): the encoder gives up the file."""
+
+
+class _Encoder:
+    """``write(path, fps, images)`` run in a thread, fed frame by frame through a short queue
+    (`put`, then `finish`, which waits for the file and raises what the writer raised)."""
+
+    _END = object()
+
+    def __init__(self, write, path, fps, depth: int = 4):
+        import queue
+        import threading
+
+        self._queue = queue.Queue(depth)
+        self._error = None
+        self._aborted = False
+        self._thread = threading.Thread(target=self._run, args=(write, path, fps), name="rot4d-encoder",
+                                        daemon=True)
+        self._thread.start()
+
+    def _images(self):
+        while True:
+            item = self._queue.get()
+            if self._aborted:
+                raise _Encoding("the frames stopped")
+            if item is self._END:
+                return
+            yield item
+
+    def _run(self, write, path, fps):
+        try:
+            write(path, fps, self._images())
+        except BaseException as e:  # handed to the drawing thread by put / finish
+            self._error = e
+            while True:  # unblock a put waiting on a full queue
+                try:
+                    self._queue.get_nowait()
+                except Exception:
+                    break
+
+    def _check(self):
+        if self._error is not None and not isinstance(self._error, _Encoding):
+            raise self._error
+
+    def put(self, item) -> None:
+        import queue
+
+        while True:
+            self._check()
+            if not self._thread.is_alive():
+                raise RuntimeError("the animation's encoder stopped before the last frame")
+            try:
+                self._queue.put(item, timeout=0.05)
+                return
+            except queue.Full:
+                continue
+
+    def finish(self) -> None:
+        self.put(self._END)
+        self._thread.join()
+        self._check()
+
+    def abort(self) -> None:
+        """After an error while drawing (no-op after `finish`): the writer stops without a file."""
+        if not self._thread.is_alive():
+            return
+        self._aborted = True
+        try:
+            self._queue.put(self._END, timeout=1.0)
+        except Exception:
+            pass
+        self._thread.join(timeout=10.0)
+
+
+def _write_gif(path, fps, images) -> None:
+    """An animated GIF from RGB images as they come: each quantized to 256 colours (fast octree)
+    and handed to Pillow's writer, which compares each frame with the one before as it goes."""
+    from PIL import Image
+
+    def quantized():
+        for im in images:
+            yield im.quantize(256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+
+    frames = quantized()
+    first = next(frames, None)
+    if first is None:
+        return
+    first.save(path, save_all=True, append_images=frames, duration=round(1000.0 / fps), loop=0)
+
+
+def _write_mp4(path, fps, images) -> None:
+    """H.264 (imageio with imageio-ffmpeg's ffmpeg) from RGB images, streamed as they come."""
+    import imageio.v2 as imageio
+
+    with imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                            pixelformat="yuv420p", macro_block_size=1, ffmpeg_log_level="error") as writer:
+        for im in images:
+            f = np.asarray(im)
+            h, w = f.shape[:2]
+            if h % 2 or w % 2:  # yuv420p needs even sizes: repeat the last row / column
+                f = np.pad(f, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+            writer.append_data(f)
 
 
 # ============================================================================ the paper's figures

@@ -123,3 +123,87 @@ def test_progress_does_not_import_pythreejs():
     code = "import sys, rot4d_widget.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+# -- the animation's fast path draws what render_state draws ----------------------------------------------
+
+def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
+    """`figures._slice_collection` (animations) has draw_slice's paths, colours and edges, in the
+    order matplotlib would paint draw_slice's patches (by zorder, ties in the order added)."""
+    from matplotlib.figure import Figure
+
+    from rot4d_widget import figures, look
+    from rot4d_widget.polytopes import polytope
+    from rot4d_widget.rotation import random_rotation
+    from rot4d_widget.slicing import slice_polytope
+
+    p = polytope("24-cell")
+    s = slice_polytope(p, random_rotation(np.random.default_rng(3)), 0.1)
+    style = figures.panel_style(p)
+    ax = Figure().add_subplot()
+    d = figures.draw_slice(ax, s, **style)
+    patches = [a for a in ax.get_children() if a in {*d.faces, *d.bars, *d.balls, *d.highlights}]
+    patches.sort(key=lambda a: a.get_zorder())  # stable: matplotlib's painting order
+    coll = figures._slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
+                                     bar_radius=style["bar_radius"], face_alpha=look.FACE_OPACITY)
+    paths = coll.get_paths()
+    assert len(paths) == len(patches) == len(s.polygons) + len(s.edges) + 2 * len(s.vertices)
+    for k, (patch, path) in enumerate(zip(patches, paths)):
+        want = patch.get_patch_transform().transform_path(patch.get_path())
+        np.testing.assert_allclose(path.vertices, want.vertices, atol=1e-12)
+        np.testing.assert_allclose(coll.get_facecolor()[k], patch.get_facecolor(), atol=1e-12)
+        edge = patch.get_edgecolor() if patch.get_edgecolor()[3] else (0, 0, 0, 0)
+        np.testing.assert_allclose(coll.get_edgecolor()[k], edge, atol=1e-12)
+        lw = patch.get_linewidth() if patch.get_edgecolor()[3] else 0.0
+        assert coll.get_linewidth()[k] == pytest.approx(lw)
+    np.testing.assert_allclose(coll._items_zorder, [a.get_zorder() for a in patches], atol=1e-9)
+
+
+@pytest.mark.parametrize("source", ["24-cell", "field"])
+def test_animation_frames_are_render_states_pictures(source):
+    """Frames drawn into the one reused canvas equal render_state's picture of the same state,
+    framing and annotation (text is blended from cached pictures: equal up to rounding)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from rot4d_widget import datasets, figures
+    from rot4d_widget.recording import animation_states
+
+    rec = _held_4(4)
+    src = datasets.moving_sphere(resolution=16) if source == "field" else source
+    frames = list(render_frames(rec, None, src, size=(240, 200), dpi=40, titles=lambda k, t, s: f"frame {k}"))
+    boxes = [figures._prepare(st, s if s is not None else src)[3]
+             for _, st, s in animation_states(rec, None, src)]
+    box = figures.union_extent(boxes)
+    for k, (t, st, s) in enumerate(animation_states(rec, None, src)):
+        fig = figures.render_state(st, s if s is not None else src, size=(240, 200), dpi=40, frame=box,
+                                   title=f"frame {k}", annotate=f"t = {t:.2f} s, frame {k + 1}/{len(frames)}")
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        want = np.asarray(canvas.buffer_rgba())[..., :3].astype(int)
+        assert frames[k].shape == want.shape
+        assert np.abs(frames[k].astype(int) - want).max() <= 2
+
+
+def test_an_error_while_drawing_leaves_no_gif_and_no_encoder(tmp_path, monkeypatch):
+    import threading
+
+    from rot4d_widget import figures
+
+    real, calls = figures.render_state, []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise RuntimeError("boom")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(figures, "render_state", failing)
+    path = tmp_path / "a.gif"
+    with pytest.raises(RuntimeError, match="boom"):
+        render_animation(_held_4(5), None, "5-cell", path, size=(120, 100), dpi=40, progress=False)
+    assert not path.exists()
+    assert not any(t.name == "rot4d-encoder" for t in threading.enumerate())
+    # and the writer's own errors reach the caller
+    with pytest.raises(OSError):
+        render_animation(_held_4(2), None, "5-cell", tmp_path / "no" / "such" / "dir.gif", size=(120, 100),
+                         dpi=40, progress=False)
