@@ -206,24 +206,22 @@ class UpdatePump:
             self.stats.timeouts += 1
         return True
 
-    def _flush(self, now, *, unlocked: bool = False) -> None:
+    def _flush(self, now, *, worker: bool = False) -> None:
         if self._dirty and self._may_send(now):
-            self._send_locked(now, True, unlocked)
+            self._send_locked(now, True, worker)
         self.wake()
 
-    def send_now(self, now=None, *, expect_ack=True, unlocked: bool = False) -> None:
-        """Compute and send the latest state now, whatever is in flight (the initial picture).
-
-        ``unlocked``: run a generator ``send``'s slow part with the lock released (the
-        ticker thread, which holds the lock exactly once).  If ``send`` raises, the state
-        stays dirty (the picture is not lost) and the exception propagates."""
+    def send_now(self, now=None, *, expect_ack=True) -> None:
+        """Compute and send the latest state now, here, whatever is in flight (the initial
+        picture).  If ``send`` raises, the state stays dirty (the picture is not lost) and the
+        exception propagates."""
         with self.lock:
-            self._send_locked(now, expect_ack, unlocked)
+            self._send_locked(now, expect_ack, False)
 
-    def _send_locked(self, now, expect_ack, unlocked) -> None:
-        """`send_now` with the lock held once.  ``unlocked`` (the ticker thread): a two-phase
-        send's slow part goes to a worker thread, so ticks go on meanwhile; the worker finishes
-        the send under the lock (`_finish`)."""
+    def _send_locked(self, now, expect_ack, worker) -> None:
+        """Send under the lock.  ``worker`` (the ticker thread): a two-phase send's slow part goes
+        to a worker thread, so ticks go on meanwhile; the worker finishes the send under the lock
+        (`_work`), and until then no other send starts."""
         self._dirty = False
         self._sending = True
         try:
@@ -234,10 +232,10 @@ class UpdatePump:
                 except StopIteration as stop:
                     seq = stop.value
                 else:
-                    if unlocked:
+                    if worker:
                         threading.Thread(target=self._work, args=(seq, work, now, expect_ack),
                                          name=f"{self._name}-slice", daemon=True).start()
-                        return  # still sending: `_finish` ends it
+                        return  # still sending: `_work` ends it
                     seq = _complete(seq, work())
         except BaseException:
             self._sending = False
@@ -288,10 +286,10 @@ class UpdatePump:
             self.flush()
             return True
 
-    def service(self, now=None, *, unlocked: bool = False):
+    def service(self, now=None, *, worker: bool = False):
         """Run due ticks, honour the timeout, send if allowed; the clock time to run next (or None).
 
-        ``unlocked`` (the ticker thread): a two-phase send's slow part runs without the lock."""
+        ``worker`` (the ticker thread): a two-phase send's slow part runs on a worker thread."""
         with self.lock:
             if self._closed:
                 return None
@@ -302,7 +300,7 @@ class UpdatePump:
             except Exception as exc:
                 self._report(exc)
             try:
-                self._flush(now, unlocked=unlocked)
+                self._flush(now, worker=worker)
             except Exception as exc:  # the state stays dirty: the next ack, key or flush retries
                 self._report(exc)
             return self.next_deadline()
@@ -336,7 +334,7 @@ class UpdatePump:
         """The ticker: one `service` per turn under the lock, then a wait (at least `MIN_WAIT`)
         that releases it, so other threads always get the lock between ticks."""
         while True:
-            self.service(unlocked=True)  # takes the lock once, so its slow part can release it
+            self.service(worker=True)  # the lock for this service only; slicing goes to a worker
             with self.lock:
                 if self._closed:
                     return

@@ -110,40 +110,37 @@ class Step:
 
 
 @dataclass(frozen=True)
-class Setting:
-    """A parameter set from outside the keys (a slider, code): ``name`` in `SETTABLE` and its
-    ``value`` (a float, or a 4 x 4 list for ``"matrix"``)."""
+class _NamedValue:
+    """A value set by name at time ``t``; saved as ``{"t", <_KEY>: name, "value"}``."""
 
     t: float
     name: str
     value: object
+    _KEY = "set"
 
     @property
     def label(self) -> str:
         return f"{self.name} set"
 
     def to_dict(self) -> dict:
-        return {"t": self.t, "set": self.name, "value": self.value}
+        return {"t": self.t, self._KEY: self.name, "value": self.value}
 
 
 @dataclass(frozen=True)
-class SourceSetting:
+class Setting(_NamedValue):
+    """A parameter set from outside the keys (a slider, code): ``name`` in `SETTABLE` and its
+    ``value`` (a float, or a 4 x 4 list for ``"matrix"``)."""
+
+
+@dataclass(frozen=True)
+class SourceSetting(_NamedValue):
     """A setting of the source (the widget's traits): ``name`` in `SOURCE_SETTINGS` and its
     ``value`` -- ``levels`` a list of floats (a field's iso levels; a stack's inner source's),
     ``inside`` ``"above"`` or ``"below"`` and ``caps`` a bool (a field's, likewise),
     ``slices`` an int >= 1, ``spacing`` a number > 0 or None (the default), ``arrangement``
-    ``"oval"``, ``"grid"`` or ``"stack"``."""
+    ``"oval"``, ``"grid"`` or ``"stack"``.  Not a `Setting` (the state's): a sibling."""
 
-    t: float
-    name: str
-    value: object
-
-    @property
-    def label(self) -> str:
-        return f"{self.name} set"
-
-    def to_dict(self) -> dict:
-        return {"t": self.t, "source": self.name, "value": self.value}
+    _KEY = "source"
 
 
 def _time(t) -> float:
