@@ -168,8 +168,9 @@ def _as_slice_data(obj):
 
 
 def _data_frame(data):
-    """(matrix (4, 4), c0, centre (4,), unit (4,)) of what a slice offers as ``extra["data_frame"]``
-    (a `Field4D`'s: a point p of the cut is at data ``centre + (matrix.T @ (p, c0)) * unit``), or
+    """(matrix (4, 4), d, centre (4,), unit (4,)) of what a slice offers as ``extra["data_frame"]``
+    (a `Field4D`'s: a point p of the cut, d slice units along the turned w axis from the box's
+    centre, is at data ``centre + (matrix.T @ (p, d)) * unit``), or
     None when it offers none, or not a usable one."""
     ex = getattr(data, "extra", None)
     fr = ex.get("data_frame") if isinstance(ex, Mapping) else None
@@ -177,7 +178,7 @@ def _data_frame(data):
         return None
     try:
         m = np.asarray(fr["matrix"], dtype=np.float64)
-        c0 = float(fr["c0"])
+        c0 = float(fr["d"])
         centre = np.asarray(fr["centre"], dtype=np.float64)
         unit = np.asarray(fr["unit"], dtype=np.float64)
     except (KeyError, TypeError, ValueError):
@@ -282,7 +283,7 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
         `look.FACE_OPACITY`).
     frame : "data" (default) or "view"
         Where a slice that knows its data coordinates (a `Field4D`'s, a stack of them: any slice
-        data whose ``extra["data_frame"]`` gives the cut's ``matrix``, ``c0`` and the data's
+        data whose ``extra["data_frame"]`` gives the cut's ``matrix``, offset ``d`` and the data's
         ``centre`` and ``unit``, see `rot4d_widget.fields.Field4D.slice`) puts its vertices.
         ``"data"``: in the data's units at the data's place -- the view's 3-D picture scaled by
         the data's units of x, y, z (1 for a field) and moved by the data box's centre, so at
@@ -310,10 +311,11 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
     * ``mesh.vertex_attributes["data_xyzw"]`` (n, 4) float64, when every slice knows its data
       coordinates (a field's, a stack of a field's; not a polytope's), in either ``frame``:
       each vertex's 4-D data coordinates (x, y, z, w in the data's own units), the slice point
-      p of the cut w = c0 rotated back, ``centre + (matrix.T @ (p, c0)) * (1, 1, 1, w_per_unit)``
+      p of the cut w = c0 rotated back, ``centre + (matrix.T @ (p, d)) * (1, 1, 1, w_per_unit)`` with
+      d = (c0 - centre_w) / w_per_unit the cut's offset in slice units
       (`Field4D.to_data`); a stack's vertices each from its own slice's level.  At rest,
       ``data_xyzw[:, :3] == mesh.vertices`` (``frame="data"``) and ``data_xyzw[:, 3]`` is the
-      cut's time, ``centre_w + c0 * w_per_unit``.  Binary PLY keeps it exactly (a vertex
+      cut's time, c0.  Binary PLY keeps it exactly (a vertex
       property ``list uchar double data_xyzw``; `load_mesh` puts it back), ASCII PLY to about 8
       digits, GLB as float32 (``_data_xyzw``), OBJ and STL not at all.
     * ``mesh.faces`` (k, 3), counter-clockwise seen from outside (a field's: from where f < level).
@@ -678,6 +680,25 @@ def _made_by_function(d) -> bool:
     return isinstance(d, Mapping) and d.get("kind") == "field" and "origin" not in d and bool(d.get("function"))
 
 
+def _described_w_frame(desc):
+    """``(origin, per_unit)`` of c0 for the source a state file describes (`describe_source`): a
+    field's (w at its box's centre, ``w_per_unit``), also inside stacks; None for any other (a
+    polytope's c0 is its own w) or a description without them."""
+    d = desc
+    while isinstance(d, Mapping) and d.get("kind") == "stack":
+        d = d.get("source")
+    if not isinstance(d, Mapping) or d.get("kind") != "field":
+        return None
+    try:
+        lo, hi = (float(v) for v in d["extent"][3])
+        per = float(d["w_per_unit"])
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+    if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(per) and per > 0):
+        return None
+    return (lo + hi) / 2, per
+
+
 def _inner_identity(d):
     while d.get("kind") == "stack":
         d = d.get("source", {})
@@ -872,8 +893,8 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     missing = [k for k in ("state", "source", "settings") if k not in doc]
     if missing:
         raise ValueError(f"{path!r} lacks {', '.join(map(repr, missing))}")
-    try:
-        state = RotationState.from_dict(doc["state"])
+    try:  # a state from before c0 followed the data's units: converted by the file's own source
+        state = RotationState.from_dict(doc["state"], w_frame=_described_w_frame(doc.get("source")))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{path!r}: bad state: {exc}") from None
     settings = doc["settings"]

@@ -6,10 +6,13 @@ zarr array -- or a vectorised function f(x, y, z, w).  Each step
 (`slice_field`):
 
 1. the data's 4-D box is cut by w = c0 after the rotation (the exact polytope
-   slicer on the box, an 8-cell scaled to the extent);
+   slicer on the box, an 8-cell scaled to the extent); c0 is in the data's w
+   units (`Field4D.w_frame`): the hyperplane lies d = (c0 - w_centre) / w_per_unit
+   slice units from the box's centre along the turned w axis, so that at rest
+   c0 = 30 cuts the data at w = 30;
 2. a 3-D grid of ``resolution`` samples along the longest side of that cut's
    bounding box (same spacing on all three axes, one sample of padding) is
-   pulled back into the data, ``q = matrix.T @ (x, y, z, c0) + centre``, and
+   pulled back into the data, ``q = matrix.T @ (x, y, z, d) + centre``, and
    the array is interpolated there, multilinearly (order 1, no prefilter),
    by a numba kernel that walks the affine grid (base + i a + j b + k c in
    index space) -- a function is evaluated exactly at those points instead;
@@ -42,7 +45,7 @@ float64; everything returned is read-only.
 Scale: the box's half widths (slice units) and the ends of ``extent`` must lie
 in `rot4d_widget.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
 ValueError naming it).  Within it a field scaled by ``s`` (extent times s, the
-same samples) slices as the unscaled one at ``c0 / s``, its surfaces scaled by
+same samples) slices as the unscaled one at ``c0 / s`` (extent's w scaled too), its surfaces scaled by
 s: the box cut is the exact slicer's (normalised), the resampling works in
 index units, and marching cubes runs with unit spacing, its vertices, volume
 and area scaled afterwards in float64.  Only a volume or area beyond float64
@@ -1181,35 +1184,49 @@ class Field4D:
                               lambda sign=1: self.step_levels(-sign)),
         }
 
+    @property
+    def w_frame(self) -> tuple:
+        """``(origin, per_unit)`` = (the data's w at the box's centre, `w_per_unit`): c0 =
+        origin + per_unit * d, d the hyperplane's offset from the box's centre along the turned
+        w axis in slice units (the source protocol's ``w_frame``)."""
+        return float(self._centre[3]), float(self._w_per_unit)
+
+    def offset(self, c0) -> float:
+        """d, the offset in slice units of the hyperplane w = ``c0`` (data w units): ``(c0 -
+        origin) / w_per_unit`` (`w_frame`)."""
+        return (_real(c0, "c0") - float(self._centre[3])) / float(self._w_per_unit)
+
     def w_range(self, matrix) -> tuple:
-        """(lowest, highest) w of the rotated box, in slice units."""
+        """(lowest, highest) c0, in the data's w units, at which w = c0 touches the rotated box."""
         m = as_rotation_matrix(matrix)
-        s = float(np.abs(m[3]) @ self._hw)
-        return -s, s
+        s = float(np.abs(m[3]) @ self._hw) * float(self._w_per_unit)
+        origin = float(self._centre[3])
+        return origin - s, origin + s
 
     def to_data(self, points, matrix, c0) -> np.ndarray:
         """(n, 4) float64: the data coordinates (x, y, z, w in the field's own units) of the
-        slice points ``points`` (n, 3) of the cut w = ``c0`` after ``matrix``:
-        ``centre + (matrix.T @ (p, c0)) * (1, 1, 1, w_per_unit)``."""
+        slice points ``points`` (n, 3) of the cut w = ``c0`` (data w units) after ``matrix``:
+        ``centre + (matrix.T @ (p, d)) * (1, 1, 1, w_per_unit)``, d = `offset` (c0)."""
         m = as_rotation_matrix(matrix)
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        q = np.column_stack([p, np.full(len(p), _real(c0, "c0"))]) @ m  # rows of (m.T @ (p, c0))
+        q = np.column_stack([p, np.full(len(p), self.offset(c0))]) @ m  # rows of (m.T @ (p, d))
         return self._centre + q * self._unit
 
     def slice(self, matrix, c0, coarse: bool = False):
         """The slice as the widget draws it (`SliceData`): the isosurface of every level
         (group = level index) and the cut of the data's box as bars.  ``coarse``:
-        the in-memory coarse copy at `coarse_resolution` (for held keys).  ``extra["data_frame"]``
-        records the cut and the field's frame then (``matrix``, ``c0``, ``centre``, ``unit``: a
-        point p is at data ``centre + (matrix.T @ (p, c0)) * unit``, as `to_data`)."""
+        the in-memory coarse copy at `coarse_resolution` (for held keys).  ``c0`` in the data's w
+        units (`w_frame`).  ``extra["data_frame"]`` records the cut and the field's frame then
+        (``matrix``, ``d`` the offset in slice units, ``centre``, ``unit``: a point p is at data
+        ``centre + (matrix.T @ (p, d)) * unit``, as `to_data`)."""
         m = as_rotation_matrix(matrix)
-        c0 = _real(c0, "c0")
+        c0 = self.offset(c0)  # slice units from here on
         meanwhile = bool(coarse) and self._coarse_building()
-        if meanwhile:  # held keys meanwhile slice at full resolution (the build goes on)
-            coarse = False
+        # held keys while the coarse copy is built: the full data sampled at the coarse resolution
+        # (the chunks the cut touches, kept by the reader's cache; the build goes on)
         res = self.coarse_resolution if coarse else self.resolution
-        if coarse:
-            slices = slice_field(self, m, c0, self.levels, res, coarse=True)
+        if coarse and not meanwhile:
+            slices = _slice_offset(self, m, c0, self.levels, res, coarse=True)
         else:  # read first: a fresh chunked field takes its range and level from this cut's chunks
             s = _sample(self, m, c0, _check_resolution(res), first_cut=True)
             levels = self.levels
@@ -1230,10 +1247,10 @@ class Field4D:
         pts.append(bv)
         nrm.append(bn)
         segments = np.asarray(box.edges) + off
-        readout = self._readout(m, c0, slices, box, coarse)
+        readout = self._readout(m, c0, slices, box, coarse and not meanwhile)
         if meanwhile:
             done, total = self.coarse_progress or (0, 0)
-            readout = readout + (("resolution", f"{self.resolution} (full: the coarse copy is being built, "
+            readout = readout + (("resolution", f"{res} (from the full data: the coarse copy is being built, "
                                                 f"{done}/{total} chunks)"),)
         return FieldSliceData.build(
             points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
@@ -1241,7 +1258,7 @@ class Field4D:
             volume=_representable(slices[0]) if len(slices) == 1 else None,
             readout=readout, convex=False, show_points=False,
             extra={"levels": slices, "box": box, "data_frame": {
-                "matrix": _sealed(m.copy()), "c0": c0, "centre": _sealed(self._centre.copy()),
+                "matrix": _sealed(m.copy()), "d": c0, "centre": _sealed(self._centre.copy()),
                 "unit": _sealed(self._unit.copy())}},
         )
 
@@ -1935,7 +1952,8 @@ def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool 
     field : Field4D
     matrix : (4, 4) rotation (validated: orthogonal, det +1); a data point q is at
         ``matrix @ (q - centre)`` (w scaled by ``1 / field.w_per_unit``)
-    c0 : float -- the hyperplane w = c0, slice units
+    c0 : float -- the hyperplane w = c0, in the data's w units (`Field4D.w_frame`: at rest
+        c0 = 30 cuts the data at w = 30)
     level : float or sequence of floats -- the surface closes {f >= level} (``field.inside``
         "above", the default) or {f <= level} ("below"); capped on the box's faces unless
         ``field.caps`` is False
@@ -1950,13 +1968,17 @@ def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool 
     """
     if not isinstance(field, Field4D):
         raise TypeError(f"Expected `field` to be a Field4D, got {type(field).__name__}")
+    return _slice_offset(field, matrix, field.offset(c0), level, resolution, coarse=coarse)
+
+
+def _slice_offset(field, matrix, d, level, resolution, *, coarse):
+    """`slice_field` at the offset ``d`` (slice units) instead of c0."""
     m = as_rotation_matrix(matrix)
-    c0 = _real(c0, "c0")
     many = not isinstance(level, (numbers.Real, np.integer, np.floating)) or isinstance(level, (bool, np.bool_))
     levels = _as_levels(level)
     res = _check_resolution(resolution)
     src = field.coarse() if coarse else field
-    s = _sample(src, m, c0, res)
+    s = _sample(src, m, d, res)
     if s is None:
         out = tuple(_empty_slice(lv, 0.0) for lv in levels)
     else:

@@ -41,15 +41,22 @@ def angle_text(rad: float) -> str:
     return f"{rad:.5f} rad ({math.degrees(rad):.2f}\u00b0)"
 
 
-def gauge_html(c0: float, lo: float, hi: float) -> str:
-    """c0 with a small bar: where w = c0 lies between ``lo`` and ``hi`` (clamped, marked outside)."""
+def gauge_html(c0: float, lo: float, hi: float, unit: str | None = None) -> str:
+    """c0 with a small bar: where w = c0 lies between ``lo`` and ``hi`` (clamped, marked outside).
+    ``unit``: c0's unit (a field's ``w_units``), written after the number; the number has four
+    decimals within 1000 of zero (a polytope's w), else four significant digits (a time in s)."""
     span = hi - lo
     frac = 0.5 if span <= 0 else (c0 - lo) / span
     where = "below" if frac < 0 else "above" if frac > 1 else ""
     pos = min(max(frac, 0.0), 1.0) * 100.0
     note = f" ({where} the object)" if where else ""
+    big = max(abs(lo), abs(hi), abs(c0))
+    text = f"{c0:.4f}" if big < 1000 else number_text(c0, big, 6)
+    if text.lstrip("-").strip("0.") == "":  # no "-0.0000"
+        text = text.lstrip("-")
+    u = f" {html.escape(unit)}" if unit else ""
     return (
-        f"{c0:.4f}<span class='rot4d-gauge' title='w from {lo:.3g} to {hi:.3g}'>"
+        f"{text}{u}<span class='rot4d-gauge' title='w from {lo:.4g} to {hi:.4g}{u}'>"
         f"<i style='left:{pos:.0f}%'></i></span>{note}"
     )
 

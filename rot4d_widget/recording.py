@@ -329,6 +329,32 @@ class Recording:
         """A fresh `RotationState` at the start of the recording (its reset point as recorded)."""
         return RotationState.from_dict(self._initial, keymap=keymap)
 
+    def for_source(self, source) -> "Recording":
+        """This recording with c0 in ``source``'s w units: a recording made before c0 followed
+        the data's units (its starting state of format 1) has its c0, initial c0, c0 step and
+        every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
+        (`rot4d_widget.source.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
+        source whose frame is (0, 1) (a polytope), gives ``self``."""
+        from .source import w_frame
+
+        if source is None or self._initial.get("format", 2) >= 2:
+            return self
+        frame = w_frame(source)
+        if frame == (0.0, 1.0):
+            return self
+        origin, per = frame
+        initial = RotationState.from_dict(self._initial, w_frame=frame).to_dict(initial=True)
+
+        def converted(e):
+            if isinstance(e, Setting) and e.name == "c0":
+                return Setting(e.t, "c0", origin + per * float(e.value))
+            if isinstance(e, Setting) and e.name == "c0_step":
+                return Setting(e.t, "c0_step", per * float(e.value))
+            return e
+
+        return Recording(initial, [converted(e) for e in self.events], dropped=self.dropped,
+                         initial_source=self._initial_source)
+
     @property
     def duration(self) -> float:
         """Seconds from the start to the last event (0 without events)."""
@@ -400,6 +426,8 @@ class Recording:
         """
         if set_source is not None and not callable(set_source):
             raise TypeError(f"Expected `set_source` to be a callable (name, value), got {type(set_source).__name__}")
+        if source is not None and self._initial.get("format", 2) < 2:
+            return self.for_source(source).replay(state, source, restart=restart, set_source=set_source)
         if set_source is None and source is not None:
             self._check_source_settings(source, restart)
         if state is None:
@@ -556,6 +584,8 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
     if per not in ("step", "time"):
         raise ValueError(f"Expected `per` to be 'step' or 'time', got {per!r}")
     fps = _positive("fps", fps)
+    if source is not None and not isinstance(source, str):
+        recording = recording.for_source(source)  # c0 of an older recording in the source's units
     if initial_state is None:
         state = recording.initial_state()
     elif isinstance(initial_state, RotationState):

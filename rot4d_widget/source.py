@@ -10,7 +10,8 @@ A source has
 
 ``slice(matrix, c0)``
     -> a slice object (see `SliceData`) for the (4, 4) rotation ``matrix`` and
-    the level ``c0``, in the source's own units.
+    the level ``c0``, in the source's own w units (a field's: its time, in seconds
+    if its w is in seconds; see ``w_frame``).
 ``size``
     Circumradius about the rotation centre, in the source's units: the view
     scales every source to the same displayed size, the default l/h step is
@@ -24,8 +25,15 @@ A source has
     A mapping ``key -> SourceAction``: extra keys the source brings (for
     instance a level up/down).  The widget binds them and lists them in its help.
 ``w_range(matrix)`` (optional)
-    ``(lowest, highest)`` w of the rotated object, for the c0 gauge (default
-    ``(-size, size)``).
+    ``(lowest, highest)`` c0 at which w = c0 still touches the rotated object, in
+    the same units as c0, for the c0 gauge (default ``(-size, size)``).
+``w_frame`` (optional)
+    ``(origin, per_unit)``: c0 = origin + per_unit * d, where d is the offset of
+    the hyperplane from the rotation centre along the turned w axis, in the units
+    the slice is drawn in.  A polytope's c0 is its own w (the default ``(0, 1)``);
+    a field's is its data's w, ``(w at the box's centre, w_per_unit)``, so that
+    at rest c0 = 30 cuts the data at t = 30.  The widget's l/h step, c0 bounds
+    and gauge follow it; `w_frame` reads it, validated.
 
 Rotations in the planes xy, xz and yz never change which part of a source
 the hyperplane cuts, only how the cut is turned in 3-D: the slice at
@@ -51,6 +59,7 @@ __all__ = [
     "check_slice",
     "BadSlice",
     "data_w_text",
+    "w_frame",
 ]
 
 
@@ -158,20 +167,39 @@ class SliceData:
         return data
 
 
-def data_w_text(source, w: float, matrix) -> str:
-    """A cut's label in the data's own w: ``"w 30 s"`` for a field (its time, in its ``w_units``) --
-    the data w at the centre of the cut w = ``w`` (slice units), ``w_centre + m[3, 3] w w_per_unit``
-    -- and ``"w +0.5"`` for a source without ``w_per_unit`` and ``extent`` (a polytope's own w)."""
+def w_frame(source) -> tuple:
+    """``(origin, per_unit)`` of ``source``'s c0 (its ``w_frame``, default ``(0.0, 1.0)``): c0 =
+    origin + per_unit * d, d the offset in the drawn units.  A stack answers for its inner source.
+    TypeError / ValueError when a source offers a frame that is not two finite numbers, per_unit > 0."""
+    inner = getattr(source, "source", None)
+    frame = getattr(source, "w_frame", None)
+    if frame is None and inner is not None and inner is not source:
+        frame = getattr(inner, "w_frame", None)
+    if frame is None:
+        return 0.0, 1.0
+    try:
+        origin, per = (float(v) for v in frame)
+    except (TypeError, ValueError):
+        raise TypeError(f"Expected a source's `w_frame` to be (origin, per_unit), two numbers, got {frame!r}") from None
+    if not (math.isfinite(origin) and math.isfinite(per) and per > 0):
+        raise ValueError(f"Expected a source's `w_frame` (origin, per_unit) finite with per_unit > 0, got {frame!r}")
+    return origin, per
+
+
+def data_w_text(source, w: float, matrix=None) -> str:
+    """A cut's label in the source's own w, c0's units: ``"w 30 s"`` for a field (its time, in its
+    ``w_units``), ``"w +0.5"`` for a polytope.  ``w`` is a c0 (`w_frame`); ``matrix`` is unused
+    (kept for callers of the older form)."""
     from .look import number_text
 
-    wpu, extent = getattr(source, "w_per_unit", None), getattr(source, "extent", None)
-    if wpu is None or extent is None:
+    inner = getattr(source, "source", source)
+    extent = getattr(inner, "extent", None)
+    if extent is None:
         text = number_text(w, getattr(source, "size", 1.0), 3)
         return f"w {'+' if not text.startswith('-') else ''}{text}"
     lo, hi = float(extent[3][0]), float(extent[3][1])
-    value = (lo + hi) / 2 + float(np.asarray(matrix)[3, 3]) * float(w) * float(wpu)
-    unit = getattr(source, "w_units", None)
-    return f"w {number_text(value, max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+    unit = getattr(inner, "w_units", None)
+    return f"w {number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
 
 
 class BadSlice(ValueError):

@@ -17,9 +17,13 @@ Defaults (documented in the README):
 **Bounds of the repeating keys.**  A key step that would leave its range is refused
 (``apply`` returns False, nothing changes), never clamped, so the opposite key always
 undoes a step that was made: theta0 stays in [`THETA0_MIN`, `THETA0_MAX`] = [pi/2^20, pi];
-alpha and beta in [-pi, pi] (`ALPHA_MAX`); c0 in [-c0_limit, c0_limit] (``c0_limit``,
-default infinite; the widget sets twice the source's size), where a c0 set outside by hand
-may still step back towards the range.
+alpha and beta in [-pi, pi] (`ALPHA_MAX`); c0 within ``c0_limit`` of ``c0_origin`` (default
+infinite about 0; the widget sets the source's w frame: twice its size, in its w units, about
+its centre), where a c0 set outside by hand may still step back towards the range.
+
+**Units of c0.**  c0 and ``c0_step`` are in the source's w units -- a polytope's own w, a
+field's data w (seconds for a time axis in seconds: at rest c0 = 30 cuts at t = 30 s); the
+state itself is unit-free and only keeps the numbers.
 
 ``to_dict()`` / ``from_dict(d)`` turn a state into JSON-able data and back, exactly (floats
 are written with Python's shortest round-tripping repr): the orientation, theta0, alpha, c0,
@@ -60,8 +64,10 @@ __all__ = [
     "without_source_keys",
 ]
 
-#: The version of `RotationState.to_dict`'s layout (``d["format"]``).
-STATE_FORMAT = 1
+#: The version of `RotationState.to_dict`'s layout (``d["format"]``).  2: c0 and its step are in
+#: the source's w units (a field's data w, `rot4d_widget.source.w_frame`); 1 had them in the drawn
+#: (slice) units -- `RotationState.from_dict` converts them given the source's ``w_frame``.
+STATE_FORMAT = 2
 #: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
 #: further off, up to `rotation.ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
 _EXACT_ENOUGH = 1e-14
@@ -135,6 +141,7 @@ class RotationState:
         c0_step: float = DEFAULT_C0_STEP,
         matrix=None,
         c0_limit: float = math.inf,
+        c0_origin: float = 0.0,
     ):
         if not isinstance(keymap, Keymap):
             raise TypeError(f"Expected `keymap` to be a rot4d_widget.Keymap, got {type(keymap).__name__}")
@@ -145,6 +152,7 @@ class RotationState:
         self._c0 = _finite("c0", c0)
         self.c0_step = c0_step
         self.c0_limit = c0_limit
+        self.c0_origin = c0_origin
         self._matrix = _read_only(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
         self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
         self._steps: dict = {}
@@ -212,8 +220,18 @@ class RotationState:
 
     @property
     def c0_limit(self) -> float:
-        """The l / h keys keep |c0| within this (inf: no limit); setting c0 directly is not limited."""
+        """The l / h keys keep |c0 - c0_origin| within this (inf: no limit); setting c0 directly is
+        not limited."""
         return self._c0_limit
+
+    @property
+    def c0_origin(self) -> float:
+        """The centre of the l / h keys' range (`c0_limit`): the source's w at its centre."""
+        return self._c0_origin
+
+    @c0_origin.setter
+    def c0_origin(self, value) -> None:
+        self._c0_origin = _finite("c0_origin", value)
 
     @c0_limit.setter
     def c0_limit(self, value) -> None:
@@ -256,7 +274,8 @@ class RotationState:
             self.alpha = new
         elif kind == "c0":
             new = self._c0 + action.sign * self._c0_step
-            if abs(new) > self._c0_limit and abs(new) >= abs(self._c0):
+            o = self._c0_origin
+            if abs(new - o) > self._c0_limit and abs(new - o) >= abs(self._c0 - o):
                 return False
             self.c0 = new
         elif kind == "theta0":
@@ -300,7 +319,7 @@ class RotationState:
     def to_dict(self, *, initial: bool = False) -> dict:
         """The state as JSON-able data (lists, floats, strings); `from_dict` reads it back exactly.
 
-        ``{"format": 1, "orientation": 4 x 4 list (rows), "theta0", "alpha", "c0", "c0_step",
+        ``{"format": 2, "orientation": 4 x 4 list (rows), "theta0", "alpha", "c0", "c0_step",
         "keymap": {key: action}}``; an action is its name as `Action.parse` reads it
         (``"xw"``, ``"xz,yw"``, ``"c0+"`` ...) or, for a source's own action, a dict of the
         `Action` fields.  ``initial=True`` adds ``"initial"``: the state `reset` returns to
@@ -322,7 +341,7 @@ class RotationState:
         return d
 
     @classmethod
-    def from_dict(cls, d, *, keymap: Keymap | None = None) -> "RotationState":
+    def from_dict(cls, d, *, keymap: Keymap | None = None, w_frame=None) -> "RotationState":
         """A state from `to_dict`'s data (a dict, e.g. read from JSON).
 
         The orientation is validated: within 1e-6 of orthogonal (max |M M^T - I|) it is
@@ -331,6 +350,11 @@ class RotationState:
         it is.  Missing fields take their defaults (the default keymap, ``c0_step`` 0.02);
         unknown fields, or a newer ``format``, are refused.  ``keymap`` replaces the stored
         bindings.  The state read is what `reset` returns to (unless ``d`` has ``"initial"``).
+
+        ``w_frame``: the source's ``(origin, per_unit)`` (`rot4d_widget.source.w_frame`); a
+        format-1 state (c0 in slice units) has its c0 (and initial c0) converted to ``origin +
+        per_unit * c0`` and its c0 step multiplied by ``per_unit``.  Without it a format-1 state is
+        read as it is (right for a polytope, whose frame is (0, 1)).
         """
         if not isinstance(d, Mapping):
             raise TypeError(f"Expected a dict from RotationState.to_dict, got {type(d).__name__}")
@@ -346,20 +370,26 @@ class RotationState:
         if keymap is None:
             keymap = keymap_from_dict(d["keymap"]) if "keymap" in d else DEFAULT_KEYMAP
         kwargs = {k: d[k] for k in ("theta0", "alpha", "c0", "c0_step") if k in d}
+        origin, per = _old_units(fmt, w_frame)
+        if "c0" in kwargs:
+            kwargs["c0"] = origin + per * _finite("c0", kwargs["c0"])
+        if "c0_step" in kwargs:
+            kwargs["c0_step"] = per * _finite("c0_step", kwargs["c0_step"])
         state = cls(keymap=keymap, matrix=_loaded_rotation(d["orientation"], "orientation"), **kwargs)
         if "initial" in d:
             init = d["initial"]
             if not isinstance(init, Mapping) or set(init) != {"orientation", "theta0", "alpha", "c0"}:
                 raise ValueError("Expected 'initial' to hold 'orientation', 'theta0', 'alpha' and 'c0'")
             state._initial = (_theta0(init["theta0"]), _finite("initial alpha", init["alpha"]),
-                              _finite("initial c0", init["c0"]),
+                              origin + per * _finite("initial c0", init["c0"]),
                               _read_only(_loaded_rotation(init["orientation"], "initial orientation")))
         return state
 
-    def restore(self, d) -> None:
-        """Set this state (in place) from `to_dict`'s data, as `from_dict` reads it; it becomes
-        what `reset` returns to.  The keymap is kept unless ``d`` has one."""
-        other = type(self).from_dict(d, keymap=None if "keymap" in d else self.keymap)
+    def restore(self, d, *, w_frame=None) -> None:
+        """Set this state (in place) from `to_dict`'s data, as `from_dict` reads it (``w_frame``
+        converts a format-1 c0); it becomes what `reset` returns to.  The keymap is kept unless
+        ``d`` has one; the c0 range (`c0_limit`, `c0_origin`) is kept."""
+        other = type(self).from_dict(d, keymap=None if "keymap" in d else self.keymap, w_frame=w_frame)
         self.keymap = other.keymap
         self._theta0, self._alpha, self._c0, self._c0_step = other._theta0, other._alpha, other._c0, other._c0_step
         self._matrix = other._matrix
@@ -367,9 +397,10 @@ class RotationState:
         self._steps.clear()
 
     def copy(self) -> "RotationState":
-        """An independent state with the same values, keymap and reset point."""
+        """An independent state with the same values, keymap, reset point and c0 range."""
         new = type(self).from_dict(self.to_dict(initial=True), keymap=self.keymap)
         new.c0_limit = self._c0_limit
+        new.c0_origin = self._c0_origin
         return new
 
     def __repr__(self) -> str:
@@ -380,6 +411,19 @@ class RotationState:
 
 
 # ----------------------------------------------------------------------------- data helpers
+def _old_units(fmt: int, w_frame) -> tuple:
+    """(origin, per_unit) that turn a format-``fmt`` c0 into today's: identity for format 2."""
+    if fmt >= 2 or w_frame is None:
+        return 0.0, 1.0
+    try:
+        origin, per = (float(v) for v in w_frame)
+    except (TypeError, ValueError):
+        raise TypeError(f"Expected `w_frame` to be (origin, per_unit), two numbers, got {w_frame!r}") from None
+    if not (math.isfinite(origin) and math.isfinite(per) and per > 0):
+        raise ValueError(f"Expected `w_frame` (origin, per_unit) finite with per_unit > 0, got {w_frame!r}")
+    return origin, per
+
+
 _DICT_KEYS = frozenset({"format", "orientation", "theta0", "alpha", "c0", "c0_step", "keymap", "initial"})
 _ACTION_FIELDS = ("kind", "planes", "sign", "name", "text")
 

@@ -64,7 +64,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from . import look
-from .source import SliceData, SourceAction, as_source, census_text, data_w_text
+from .source import SliceData, SourceAction, as_source, census_text, data_w_text, w_frame
 
 __all__ = [
     "ARRANGEMENTS",
@@ -389,9 +389,15 @@ class StackSource:
         f = getattr(self.source, "w_range", None)
         return tuple(f(matrix)) if f is not None else (-self.size, self.size)
 
+    @property
+    def w_frame(self) -> tuple:
+        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.source.w_frame`): c0 and the
+        levels are in its w units, Δ in the drawn units (a level is Δ * per_unit from the next)."""
+        return w_frame(self.source)
+
     def levels_at(self, c0: float) -> np.ndarray:
-        """The N levels w_k for the plane w = ``c0``."""
-        return stack_levels(c0, self._slices, self.spacing)
+        """The N levels for the plane w = ``c0``, in c0's units: ``c0 + (k - (N - 1)/2) Δ per_unit``."""
+        return stack_levels(c0, self._slices, self.spacing * w_frame(self.source)[1])
 
     def layout(self):
         """``(centres (N, 3), scales (N,))`` in the source's units (`arrangement_layout`)."""

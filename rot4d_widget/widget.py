@@ -53,7 +53,7 @@ from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
-from .source import BadSlice, as_source, check_slice, data_w_text
+from .source import BadSlice, as_source, check_slice, data_w_text, w_frame
 from .state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
@@ -110,11 +110,14 @@ class Rot4DWidget(widgets.HBox):
     theta0, alpha, c0 :
         Initial step angle (radians, in (0, pi]), double-rotation angle alpha
         (default: the paper's ratio, ``beta = theta0 - alpha``) and slice level
-        (in the source's units), as in `RotationState`.
+        c0 in the source's w units (a field's data w: seconds for a time in
+        seconds; `rot4d_widget.source.w_frame`), as in `RotationState`; default
+        the source's centre (0 for a polytope, the middle time for a field).
     keymap : Keymap
         Key bindings (default: the paper's tables plus r, +/-, ?).
     c0_step : float, optional
-        The l/h step; default ``source.size * C0_STEP_FRACTION`` (1/64).
+        The l/h step, in c0's units; default 1/64 (`C0_STEP_FRACTION`) of the
+        source's size, in its w units (``size * per_unit / 64``).
     width, height : int
         Canvas size in pixels (default 600 x 500).
     ball_radius, bar_radius : float, optional
@@ -159,7 +162,7 @@ class Rot4DWidget(widgets.HBox):
 
     theta0 = _Value(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
     alpha = _Value(0.0, help="double-rotation angle alpha (beta = theta0 - alpha), radians")
-    c0 = _Value(0.0, help="level of the slicing hyperplane w = c0, in the source's units")
+    c0 = _Value(0.0, help="level of the slicing hyperplane w = c0, in the source's w units (a field's data w)")
     orientation = traitlets.Any(read_only=True, help="(4, 4) rotation matrix, read-only")
     ball_radius = _Value(0.07)
     bar_radius = _Value(0.028)
@@ -190,7 +193,7 @@ class Rot4DWidget(widgets.HBox):
         source="5-cell",
         theta0: float = DEFAULT_THETA0,
         alpha: float | None = None,
-        c0: float = 0.0,
+        c0: float | None = None,
         *,
         keymap: Keymap = DEFAULT_KEYMAP,
         c0_step: float | None = None,
@@ -240,10 +243,11 @@ class Rot4DWidget(widgets.HBox):
         actions = _source_actions(src)
         if actions:
             keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
+        origin, per = w_frame(src)
         if c0_step is None:
-            c0_step = float(src.size) * C0_STEP_FRACTION
-        state = RotationState(theta0, alpha, c0, keymap=keymap, c0_step=c0_step,
-                              c0_limit=C0_LIMIT_SIZES * float(src.size))
+            c0_step = float(src.size) * C0_STEP_FRACTION * per
+        state = RotationState(theta0, alpha, origin if c0 is None else c0, keymap=keymap, c0_step=c0_step,
+                              c0_limit=C0_LIMIT_SIZES * float(src.size) * per, c0_origin=origin)
         color_by = _check_color_by(color_by)
         scale = look.REFERENCE_RADIUS / float(src.size)
         if ball_radius is None:
@@ -608,6 +612,7 @@ class Rot4DWidget(widgets.HBox):
                 raise RuntimeError("This Rot4DWidget is closed")
             self._source_version += 1
             st = self.state
+            _fit_c0_range(st, self.source)  # a field's w_per_unit may have changed
             for name in ("c0_step", "theta0", "alpha", "c0", "matrix"):  # `state` may have been set directly
                 self._recorder.record_set(name, getattr(st, name))
             self._sync_traits()
@@ -1299,7 +1304,7 @@ class Rot4DWidget(widgets.HBox):
             ("\u03b80", ro.angle_text(st.theta0)),
             ("\u03b1", ro.angle_text(st.alpha)),
             ("\u03b2", ro.angle_text(st.beta)),
-            ("c0", ro.gauge_html(st.c0, lo, hi)),
+            ("c0", ro.gauge_html(st.c0, lo, hi, _w_units(self.source))),
             ("last", last),
         ]
         rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
@@ -1328,7 +1333,7 @@ class Rot4DWidget(widgets.HBox):
         if _is_stack(src):
             rgb = src.group_colors()
             if rgb is not None:
-                return rgb, [data_w_text(src.source, w, self.state.matrix) for w in src.levels_at(self.state.c0)]
+                return rgb, [data_w_text(src.source, w) for w in src.levels_at(self.state.c0)]
             src = src.source
         rgb = _level_colors(src)
         if rgb is not None:
@@ -1409,6 +1414,19 @@ class _LiveSource:
 
     def __getattr__(self, name):
         return getattr(self._widget.source, name)
+
+
+def _fit_c0_range(state, source) -> None:
+    """The l / h range of ``state`` from ``source``'s w frame: twice its size about its centre."""
+    origin, per = w_frame(source)
+    state.c0_origin = origin
+    state.c0_limit = C0_LIMIT_SIZES * float(source.size) * per
+
+
+def _w_units(source):
+    """The unit of c0 (a field's ``w_units``; None for a polytope)."""
+    inner = getattr(source, "source", source) if _is_stack(source) else source
+    return getattr(inner, "w_units", None)
 
 
 def _checked_slice(source, matrix, c0, coarse, lock):

@@ -89,7 +89,10 @@ def _assert_same_field(back, field):
     assert back.w_per_unit == field.w_per_unit and back.resolution == field.resolution
     assert back.axes == field.axes and back.extent == field.extent and back.shape == field.shape
     assert back.name == field.name and back.units == field.units and back.w_units == field.w_units
-    for c0 in (0.0, 0.15):
+    origin, per = field.w_frame
+    assert back.w_frame == (origin, per)
+    for d in (0.0, 0.15):  # the box's centre, and 0.15 slice units past it, in the data's w
+        c0 = origin + per * d
         a, b = field.slice(M, c0), back.slice(M, c0)
         assert len(a.triangles) > 0
         np.testing.assert_array_equal(b.points, a.points)

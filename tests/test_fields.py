@@ -24,6 +24,12 @@ def nodes(extent, shape):
     return np.meshgrid(*[np.linspace(a, b, n) for (a, b), n in zip(extent, shape)], indexing="ij")
 
 
+def at(field, d):
+    """The c0 (the field's data w) of the hyperplane d slice units from the box's centre."""
+    origin, per = field.w_frame
+    return origin + per * d
+
+
 def sphere_fn(R):
     return lambda x, y, z, w: R * R - (x * x + y * y + z * z + w * w)
 
@@ -70,10 +76,12 @@ def test_three_sphere_slices_to_a_sphere(kind):
     p, nrm = d.points[:n], d.normals[:n]
     assert np.abs(np.linalg.norm(p, axis=1) - math.sqrt(R * R - 0.35**2)).max() < tol_r
     assert np.all(np.einsum("ij,ij->i", nrm, p / np.linalg.norm(p, axis=1, keepdims=True)) > 0.99)
-    # w squashed: one unit of slice space is 2 units of data w, so w = c0 cuts the data at w = 2 c0
+    # w squashed: one unit of slice space is 2 units of data w; c0 stays the data's w (at rest
+    # c0 = 0.4 cuts the data at w = 0.4), and the gauge's range is the data's w range
     field.w_per_unit = 2.0
-    assert field.half_widths == (1.0, 1.0, 1.0, 0.5) and field.w_range(np.eye(4)) == (-0.5, 0.5)
-    s = slice_field(field, np.eye(4), 0.2, 0.0, 64)
+    assert field.half_widths == (1.0, 1.0, 1.0, 0.5) and field.w_range(np.eye(4)) == (-1.0, 1.0)
+    assert field.w_frame == (0.0, 2.0) and field.offset(0.4) == 0.2
+    s = slice_field(field, np.eye(4), 0.4, 0.0, 64)
     assert np.abs(np.linalg.norm(s.vertices, axis=1) - math.sqrt(R * R - 0.4**2)).max() < tol_r
 
 
@@ -227,12 +235,12 @@ def test_uneven_coordinates_interpolate_exactly_a_multilinear_function():
     ref = Field4D.from_function(f, ext, w_per_unit=4.0)
     ref._stats = field._statistics()  # the same K for the caps (K comes from each field's own probe)
     m = random_rotation(rng)
-    a, b = slice_field(field, m, 0.1, 0.02, 40), slice_field(ref, m, 0.1, 0.02, 40)
+    a, b = slice_field(field, m, at(field, 0.1), 0.02, 40), slice_field(ref, m, at(ref, 0.1), 0.02, 40)
     assert len(a.triangles) > 100
     np.testing.assert_allclose(a.vertices, b.vertices, atol=1e-9)
     # decreasing coordinates are read reversed: the same field
     flipped = Field4D.from_xarray(da.isel(x=slice(None, None, -1)), w_per_unit=4.0)
-    np.testing.assert_allclose(slice_field(flipped, m, 0.1, 0.02, 40).vertices, a.vertices, atol=1e-12)
+    np.testing.assert_allclose(slice_field(flipped, m, at(flipped, 0.1), 0.02, 40).vertices, a.vertices, atol=1e-12)
 
 
 # ---------------------------------------------------------------- backends and chunk reads
@@ -292,33 +300,33 @@ def test_numpy_dask_xarray_zarr_give_the_same_surface_and_read_few_chunks():
     from rot4d_widget.rotation import double_rotation
 
     m = double_rotation("xw,yz", 0.12, 0.4)  # tilted a little into w: the cut spans few time steps
-    ref = slice_field(fields["numpy"], m, 0.02, 0.5, 40)
+    ref = slice_field(fields["numpy"], m, at(fields["numpy"], 1 / 64), 0.5, 40)
     assert len(ref.triangles) > 200
     for f in fields.values():  # the coarse copy (data range, cap scale K) is the one pass over every chunk
         f.coarse()
     Counting.reads = 0
     counting.reads = 0
     for name, f in fields.items():
-        s = slice_field(f, m, 0.02, 0.5, 40)
+        s = slice_field(f, m, at(f, 1 / 64), 0.5, 40)
         np.testing.assert_allclose(s.vertices, ref.vertices, atol=1e-5, err_msg=name)
         np.testing.assert_array_equal(s.triangles, ref.triangles, err_msg=name)
-    # 8 chunks of 4 time steps; the cut has |q_w| <= (0.02 + sin 0.12) / cos 0.12 = 0.14 of the half-width 1:
-    # data t in 0.43 ... 0.57, samples 13.3 ... 17.7, chunks 3 and 4 (plus a neighbour within one sample)
+    # 8 chunks of 4 time steps; the cut has |q_w| <= (1/64 + sin 0.12) / cos 0.12 = 0.136 of the half-width 1:
+    # data t in 0.432 ... 0.568, samples 13.4 ... 17.6, chunks 3 and 4 (plus a neighbour within one sample)
     assert 2 <= counting.reads <= 3, counting.reads
     assert Counting.reads == counting.reads  # zarr: the same chunks, counted in its store
     assert fields["dask"]._reader.reads == counting.reads
     # the same step again comes from the chunk cache
     before = counting.reads
-    slice_field(fields["dask"], m, 0.02, 0.5, 40)
+    slice_field(fields["dask"], m, at(fields["dask"], 1 / 64), 0.5, 40)
     assert counting.reads == before
-    # a cut through the last cell of a chunk needs the first sample of the next one (identity, c0 = 0:
+    # a cut through the last cell of a chunk needs the first sample of the next one (identity, c0 = 0.5:
     # data t = 0.5, sample 15.5, between chunk 3 (12-15) and chunk 4 (16-19))
     for name in ("dask", "zarr"):
-        np.testing.assert_allclose(slice_field(fields[name], np.eye(4), 0.0, 0.5, 40).vertices,
-                                   slice_field(fields["numpy"], np.eye(4), 0.0, 0.5, 40).vertices, atol=1e-5)
+        np.testing.assert_allclose(slice_field(fields[name], np.eye(4), 0.5, 0.5, 40).vertices,
+                                   slice_field(fields["numpy"], np.eye(4), 0.5, 0.5, 40).vertices, atol=1e-5)
     before = counting.reads
     # a general orientation still reads each touched chunk once, never more than there are
-    slice_field(fields["dask"], random_rotation(0), 0.0, 0.5, 40)
+    slice_field(fields["dask"], random_rotation(0), 0.5, 0.5, 40)
     assert counting.reads - before <= 8
 
 
@@ -370,11 +378,12 @@ def test_field_is_a_source():
     assert field.half_widths[3] == pytest.approx(11 / 2 * h)
     assert field.size == pytest.approx(np.linalg.norm(field.half_widths))
     m = random_rotation(12)
-    lo, hi = field.w_range(m)
-    assert hi == -lo == pytest.approx(np.abs(m[3]) @ np.array(field.half_widths))
+    lo, hi = field.w_range(m)  # in the data's w (samples here), about the middle sample
+    reach = float(np.abs(m[3]) @ np.array(field.half_widths)) * field.w_per_unit
+    assert (lo, hi) == (pytest.approx(5.5 - reach), pytest.approx(5.5 + reach)) and field.w_frame[0] == 5.5
     field.levels = (0.3, 0.6)
     assert field.n_groups == 2
-    d = field.slice(m, 0.1)
+    d = field.slice(m, 5.5 + 0.1 * field.w_per_unit)  # c0 in samples: 0.1 slice units past the middle
     assert isinstance(d, SliceData) and not d.show_points and not d.convex and d.volume is None
     levels = d.extra["levels"]
     assert [s.level for s in levels] == [0.3, 0.6]
@@ -409,27 +418,28 @@ def test_field_is_a_source():
     top = field.data_range[1] + field.level_step
     assert top - field.level_step < field.levels[0] <= top
     assert field.actions["o"].run(1) is False
-    above = field.slice(m, 0.0)
+    above = field.slice(m, at(field, 0.0))
     assert len(above.triangles) == 0 and "above the max: empty" in dict(above.readout)["level"]
     for _ in range(200):
         field.actions["i"].run(1)
-    below = field.slice(m, 0.0)
+    below = field.slice(m, at(field, 0.0))
     assert "the whole box" in dict(below.readout)["level"]
     assert below.volume == pytest.approx(_box_slice(field, m, 0.0).volume, rel=0.03)
-    assert field.slice(m, 0.0, coarse=True).readout[-1] == ("resolution", "32 (coarse copy)")
+    assert field.slice(m, at(field, 0.0), coarse=True).readout[-1] == ("resolution", "32 (coarse copy)")
     # turned in 3-D = sliced at the turned orientation (what the widget shows at rest without resampling)
     from rot4d_widget.rotation import simple_rotation
 
     field.levels = 0.5
     t = simple_rotation("xy", 0.4) @ simple_rotation("yz", -1.1)
-    turned, direct = field.slice(m, 0.1).turned(t[:3, :3]), field.slice(t @ m, 0.1)
+    c = at(field, 0.1)
+    turned, direct = field.slice(m, c).turned(t[:3, :3]), field.slice(t @ m, c)
     assert turned.volume == pytest.approx(direct.volume, rel=0.03)
     np.testing.assert_allclose(np.sort(np.linalg.norm(turned.points[-len(box.vertices):], axis=1)),
                                np.sort(np.linalg.norm(direct.points[-len(box.vertices):], axis=1)))
     np.testing.assert_allclose(turned.extra["levels"][0].vertices.mean(axis=0),
                                direct.extra["levels"][0].vertices.mean(axis=0), atol=0.02)
     assert not turned.points.flags.writeable
-    assert dict(field.slice(m, 5 * field.size).readout)["w cut"].startswith("none")
+    assert dict(field.slice(m, at(field, 5 * field.size)).readout)["w cut"].startswith("none")
 
 
 def test_nan_constant_and_empty_are_not_errors():

@@ -102,7 +102,8 @@ def test_the_readme_xarray_line_works_however_the_file_is_opened(files, how):
     assert field.data_range == pytest.approx(ref.data_range if loaded else ref.coarse().data_range)
     level = 0.25
     rng = np.random.default_rng(3)
-    for c0 in (0.0, 0.2):
+    origin, per = field.w_frame
+    for c0 in (origin, origin + 0.2 * per):  # c0 in the data's time: the middle, and 0.2 slice units on
         m = random_rotation(rng)
         for coarse in (False, True):
             _same_slices(slice_field(field, m, c0, level, 24, coarse=coarse),

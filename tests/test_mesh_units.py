@@ -2,8 +2,8 @@
 coordinates kept (``mesh.vertex_attributes["data_xyzw"]``), checked against closed forms.
 
 The field: a ball of radius R about (4, 4, 4) m in a box x, y, z in [2, 6] m (not centred at 0),
-w in [100, 160] s, w_per_unit = 10 s per unit of space; the cut at c0 (slice units) is the time
-130 + 10 c0 s.
+w in [100, 160] s, w_per_unit = 10 s per unit of space; c0 is the data's time (s), the hyperplane
+D0 = (c0 - 130) / 10 slice units from the box's centre.
 """
 
 import numpy as np
@@ -22,7 +22,8 @@ EXTENT = ((2.0, 6.0), (2.0, 6.0), (2.0, 6.0), (100.0, 160.0))
 CENTRE = np.array([4.0, 4.0, 4.0, 130.0])
 WPU = 10.0
 UNIT = np.array([1.0, 1.0, 1.0, WPU])
-C0 = 0.5  # slice units: the time 135 s
+C0 = 135.0  # the data's time, s
+D0 = 0.5  # its offset in slice units
 
 
 def ball(x, y, z, w):
@@ -66,7 +67,7 @@ def test_at_rest_the_mesh_is_the_ball_at_its_data_place(make_field):
     xyzw = mesh.vertex_attributes["data_xyzw"]
     assert xyzw.shape == (len(v), 4) and xyzw.dtype == np.float64
     np.testing.assert_allclose(xyzw[:, :3], v, rtol=0, atol=1e-12)  # at rest: the data's x, y, z
-    np.testing.assert_allclose(xyzw[:, 3], C0 * WPU + 130.0, rtol=0, atol=1e-12)  # the cut's time, 135 s
+    np.testing.assert_allclose(xyzw[:, 3], C0, rtol=0, atol=1e-12)  # the cut's time, 135 s = 130 + 10 D0
     # the shape is the slice's: the same volume, watertight
     assert mesh.is_watertight
     assert mesh.volume == pytest.approx(data.extra["levels"][0].volume, rel=1e-9)
@@ -88,7 +89,7 @@ def test_frame_view_is_the_view_s_slice_coordinates_with_the_data_coordinates_ke
 
 def test_several_levels_and_separate_groups_keep_each_vertex_s_data_coordinates():
     radii = (0.8, 1.5)
-    data = _field(levels=[R * R - r * r for r in radii]).slice(np.eye(4), -1.0)
+    data = _field(levels=[R * R - r * r for r in radii]).slice(np.eye(4), 120.0)  # t = 120 s
     d = _spacing(data)
     for sep in (False, True):
         mesh = slice_mesh(data, separate_groups=sep)
@@ -109,7 +110,7 @@ def test_after_a_turn_the_data_coordinates_lie_on_the_cut_and_on_the_ball():
     mesh = slice_mesh(data)
     xyzw = mesh.vertex_attributes["data_xyzw"]
     q = _hyperplane(xyzw, m)
-    np.testing.assert_allclose(q[:, 3], C0, rtol=0, atol=1e-9)  # the hyperplane w = c0
+    np.testing.assert_allclose(q[:, 3], D0, rtol=0, atol=1e-9)  # the hyperplane w = c0
     view = slice_mesh(data, frame="view")
     np.testing.assert_allclose(q[:, :3], view.vertices, rtol=0, atol=1e-9)  # and the point drawn
     # the 3 coordinates: the slice's own frame, moved to the data's centre (not turned back)
@@ -134,7 +135,7 @@ def test_field_to_data_is_the_same_map():
     mesh = slice_mesh(data, frame="view")
     np.testing.assert_allclose(f.to_data(mesh.vertices, m, C0), mesh.vertex_attributes["data_xyzw"],
                                rtol=0, atol=1e-12)
-    np.testing.assert_allclose(f.to_data([[0.0, 0.0, 0.0]], np.eye(4), 0.0), [CENTRE], rtol=0, atol=0)
+    np.testing.assert_allclose(f.to_data([[0.0, 0.0, 0.0]], np.eye(4), 130.0), [CENTRE], rtol=0, atol=0)
 
 
 def test_a_slice_turned_in_3d_keeps_its_data_coordinates():
@@ -162,7 +163,8 @@ def test_a_widget_turned_by_key_4_exports_data_coordinates_on_its_cut(make):
     mesh = w.slice_mesh()
     xyzw = mesh.vertex_attributes["data_xyzw"]
     q = _hyperplane(xyzw, m)
-    np.testing.assert_allclose(q[:, 3], w.state.c0, rtol=0, atol=1e-9)
+    assert w.state.c0 == C0  # the widget's c0 is the data's time
+    np.testing.assert_allclose(q[:, 3], (w.state.c0 - 130.0) / WPU, rtol=0, atol=1e-9)
     np.testing.assert_allclose(mesh.vertices, q[:, :3] + CENTRE[:3], rtol=0, atol=1e-9)
     d = _spacing(w.slice)
     r = np.linalg.norm(xyzw[:, :3] - CENTRE[:3], axis=1)
@@ -201,7 +203,8 @@ def test_a_stack_keeps_its_layout_and_each_slice_s_own_time():
     sl = mesh.face_attributes["slice"]
     for k in range(3):
         rows = np.unique(mesh.faces[sl == k])
-        np.testing.assert_allclose(xyzw[rows, 3], 130.0 + WPU * levels[k], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(xyzw[rows, 3], levels[k], rtol=0, atol=1e-12)  # levels in s
+        assert levels[k] == C0 + (k - 1) * 0.5 * WPU  # spacing 0.5 slice units = 5 s
         piece = data.extra["slices"][k]
         assert np.abs(np.linalg.norm(xyzw[rows, :3] - CENTRE[:3], axis=1) - R).max() < _spacing(piece)
     assert len(set(np.round(xyzw[:, 3], 9))) == 3

@@ -316,7 +316,7 @@ def test_to_dict_round_trips_exactly_through_json():
     assert (back.theta0, back.alpha, back.c0, back.c0_step) == (st.theta0, st.alpha, st.c0, st.c0_step)
     assert list(back.keymap.items()) == list(st.keymap.items())  # same bindings, same order
     assert back.keymap["o"].kind == "custom" and back.keymap["o"].text == "raise the level"
-    assert d["keymap"]["4"] == "xw" and d["keymap"]["l"] == "c0+" and d["format"] == 1
+    assert d["keymap"]["4"] == "xw" and d["keymap"]["l"] == "c0+" and d["format"] == 2
     # the loaded state steps like the original
     st.press("y"), back.press("y")
     assert np.array_equal(back.matrix, st.matrix)
@@ -406,3 +406,28 @@ def test_without_source_keys_lets_a_widget_extend_a_stored_keymap_again():
     assert base["o"] == DEFAULT_KEYMAP["o"] and "x" not in base
     assert list(base.items()) == list(DEFAULT_KEYMAP.items())
     assert base.extended(custom)["x"].name == "phase"
+
+
+def test_a_format_1_state_has_its_c0_converted_to_the_source_s_w_units():
+    """Format 1 kept c0 in slice units; read with the source's w frame it becomes the data's w."""
+    st = _walked_state()
+    d = st.to_dict(initial=True)
+    d["format"] = 1
+    back = RotationState.from_dict(d, w_frame=(30.0, 4.0))
+    assert back.c0 == 30.0 + 4.0 * st.c0 and back.c0_step == 4.0 * st.c0_step
+    back.reset()
+    assert back.c0 == 30.0 + 4.0 * 0.1  # the reset point converted too
+    # format 2 is already in the source's units, and a polytope's frame (0, 1) changes nothing
+    d2 = st.to_dict()
+    assert RotationState.from_dict(d2, w_frame=(30.0, 4.0)).c0 == st.c0
+    assert RotationState.from_dict(d, w_frame=(0.0, 1.0)).c0 == st.c0
+    with pytest.raises(ValueError, match="per_unit > 0"):
+        RotationState.from_dict(d, w_frame=(0.0, -1.0))
+
+
+def test_the_l_h_range_is_centred_on_the_source_s_origin():
+    st = RotationState(c0=30.0, c0_step=1.0, c0_limit=2.5, c0_origin=30.0)
+    assert [st.press("l") for _ in range(4)] == [True, True, False, False]  # 32 then 33 is refused
+    assert st.c0 == 32.0
+    assert [st.press("h") for _ in range(6)] == [True] * 4 + [False] * 2  # down to 28
+    assert st.c0 == 28.0

@@ -257,7 +257,7 @@ def test_accepts_a_name_alias_or_polytope_and_options(make):
         ({"theta0": -0.1}, ValueError, r"theta0.*\(0, pi\]"),
         ({"theta0": "fast"}, TypeError, "theta0"),
         ({"alpha": float("nan")}, ValueError, "alpha"),
-        ({"c0": None}, TypeError, "c0"),
+        ({"c0": "0.5"}, TypeError, "c0"),
         ({"c0_step": -1.0}, ValueError, "c0_step"),
         ({"hold_delay": 0}, ValueError, "hold_delay"),
         ({"tick_rate": float("inf")}, ValueError, "tick_rate"),
