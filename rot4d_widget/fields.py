@@ -546,6 +546,14 @@ def _attr_numbers(v, n: int):
     return tuple(float(x) for x in a) if a.size == n and np.all(np.isfinite(a)) else None
 
 
+def _zarr_attrs(values) -> dict:
+    """A zarr array's attributes as a plain dict ({} when it has none or they cannot be read)."""
+    try:
+        return dict(values.attrs)
+    except Exception:  # noqa: BLE001 - metadata is a bonus: without it the range comes from the data
+        return {}
+
+
 def _metadata_range(attrs, encoding):
     """(lo, hi, where) of a variable from its attributes, read without touching its data, or None.
 
@@ -825,8 +833,9 @@ class Field4D:
         #: (n +inf, n -inf, first index or None) once known; reported once (`NonFiniteWarning`)
         self._infinite = None
         self._infinite_reported = False
-        #: (lo, hi, where) from the data's metadata (`from_xarray`: actual_range, valid_min/valid_max)
-        self._meta_range = None
+        #: (lo, hi, where) from the data's metadata (`from_xarray`: actual_range, valid_min/valid_max;
+        #: a zarr array's own attributes likewise)
+        self._meta_range = _metadata_range(_zarr_attrs(self._values), None) if self._kind == "zarr" else None
         self._range = None  # ((lo, hi), where the range comes from), once known
         #: Where the values come from, for a state file to reopen them (`Field4D.open`; `from_xarray`
         #: when xarray's encoding names the file): a JSON-able dict, or None (not reopenable)

@@ -335,3 +335,16 @@ def test_an_array_in_memory_has_the_range_of_all_its_samples_not_the_coarse_copy
     lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")
     assert lazy.data_range == field.coarse().data_range and lazy.data_range_source == "coarse copy"
     assert dict(lazy.slice(M, 0.0).readout)["level"].endswith("(coarse copy)")
+
+
+def test_a_plain_zarr_array_s_own_attributes_give_the_range_without_a_read():
+    zarr = pytest.importorskip("zarr")
+    z = zarr.create_array(zarr.storage.MemoryStore(), shape=(NT, 6, 6, 6), chunks=(2, 6, 6, 6), dtype="f4")
+    z[:] = np.linspace(-1.0, 1.0, NT * 216, dtype=np.float32).reshape(z.shape)
+    z.attrs["actual_range"] = [-1.0, 1.0]
+    field = Field4D(z, axes="wzyx")
+    assert field.data_range == (-1.0, 1.0) and field.data_range_source == "actual_range"
+    assert field._reader is None or field._reader.reads == 0  # nothing read for it
+    z2 = zarr.create_array(zarr.storage.MemoryStore(), shape=(NT, 6, 6, 6), chunks=(2, 6, 6, 6), dtype="f4")
+    z2[:] = z[:]
+    assert Field4D(z2, axes="wzyx").data_range_source != "actual_range"  # without the attribute: from the data
