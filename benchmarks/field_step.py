@@ -47,7 +47,7 @@ def sphere_field(n: int = 64, R: float = 0.8) -> Field4D:
     a = np.empty((n, n, n, n), dtype=np.float32)
     for i, w in enumerate(x):
         a[..., i] = R * R - r2 - w * w
-    f = Field4D(a, extent=((-1, 1),) * 4, name="sphere")
+    f = Field4D(a, axes="xyzw", extent=((-1, 1),) * 4, name="sphere")
     f.levels = 0.0
     return f
 
@@ -62,7 +62,7 @@ def blob_field(n: int = 128, nt: int = 32, seed: int = 0) -> Field4D:
     for t in range(nt):
         cx = -0.6 + 1.2 * t / (nt - 1)
         a[..., t] = np.exp(-((x[:, None, None] - cx) ** 2 + yz) / 0.15) + 0.15 * noise
-    f = Field4D(a, name="blob")
+    f = Field4D(a, axes="xyzw", name="blob")
     f.levels = 0.5
     return f
 

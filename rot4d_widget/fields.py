@@ -86,7 +86,7 @@ _AXES = "xyzw"
 
 
 class AxesWarning(UserWarning):
-    """`Field4D(array)` without ``axes=``: the array's axes were taken as f[x, y, z, w]."""
+    """Kept for code that filters it; `Field4D(array)` without ``axes=`` is now a TypeError."""
 
 
 class NonFiniteWarning(RuntimeWarning):
@@ -697,9 +697,9 @@ class Field4D:
     axes : str
         Which of x, y, z, w each array axis is, a permutation of ``"xyzw"``:
         ``"wzyx"`` for ``f[t, z, y, x]`` (the usual time-first layout), ``"xyzw"``
-        for ``f[x, y, z, t]``.  Give it: when omitted the order ``"xyzw"`` is assumed
-        with an `AxesWarning` (a guess cannot tell time from x); `repr` and the readout
-        always name the order (``f[w, z, y, x]``).  `from_xarray` takes it from the dims.
+        for ``f[x, y, z, t]``.  Required for an array (TypeError without it: a guess
+        cannot tell time from x); `repr` and the readout name the order
+        (``f[w, z, y, x]``).  `from_xarray` takes it from the dims.
     extent : ((xmin, xmax), (ymin, ymax), (zmin, zmax), (wmin, wmax)), optional
         Data coordinates of the first and last node along each axis (samples sit
         on the nodes).  Default: x, y, z span ``[-(n-1)/2, (n-1)/2] * h`` with one
@@ -773,14 +773,12 @@ class Field4D:
             if axes is not None and (not isinstance(axes, str) or sorted(axes) != sorted(_AXES)):
                 raise ValueError(f"Expected `axes` to be a permutation of 'xyzw' naming each array axis "
                                  f"(e.g. 'wzyx' for f[t, z, y, x]), got {axes!r}")
-            if axes is None:
-                axes = _AXES
+            if axes is None:  # a guess cannot tell time from x: the caller says which axis is which
                 sh = tuple(int(n) for n in values.shape)
-                warnings.warn(
-                    f"Field4D: `axes` not given, so the array's axes are taken as f[x, y, z, w] (axes='xyzw'): "
-                    f"its shape {sh} puts {sh[0]} samples along x and {sh[3]} along w. Say which array axis is "
-                    f"which: axes='wzyx' for f[t, z, y, x] (time first), axes='xyzw' for f[x, y, z, t]",
-                    AxesWarning, stacklevel=2)
+                raise TypeError(
+                    f"Field4D needs `axes`, which of x, y, z, w each array axis is (shape {sh}): "
+                    f"axes='wzyx' for f[t, z, y, x] (time first), axes='xyzw' for f[x, y, z, t]; "
+                    f"Field4D.from_xarray(da, w='time') takes them from the dims")
             self.axes = axes
             self._axis_of = tuple(axes.index(c) for c in _AXES)  # array axis of x, y, z, w
             self.shape = tuple(int(values.shape[a]) for a in self._axis_of)
@@ -1611,13 +1609,13 @@ class Field4D:
 
     def _order_text(self) -> str:
         """Which of x, y, z, w each array axis is: 'f[w, z, y, x]', with the dim names from xarray
-        ('T[time, z, y, x] as [w, z, y, x]'), marked when the order was assumed."""
+        ('T[time, z, y, x] as [w, z, y, x]')."""
         if self._kind == "function":
             return "f(x, y, z, w)"
         if self._dims is not None:
             label = self.name or "f"
             return f"{label}[{', '.join(self._dims)}] as [{', '.join(self.axes)}]"
-        return _axes_text(self.axes) + ("" if self.axes_given else " (assumed: axes not given)")
+        return _axes_text(self.axes)
 
     def __repr__(self) -> str:
         if self._kind == "function":

@@ -298,7 +298,7 @@ def test_file_field_state_file_reopens_the_file(tmp_path):
 
 
 def test_an_in_memory_array_is_described_but_needs_the_source_to_load(tmp_path):
-    f = Field4D(np.random.default_rng(0).random((6, 6, 6, 6)))
+    f = Field4D(np.random.default_rng(0).random((6, 6, 6, 6)), axes="xyzw")
     with pytest.warns(SourceNotRebuildable, match="in-memory numpy.*not written into a state file.*source="):
         save_state(tmp_path / "a.json", _state(), f)
     with pytest.warns(SourceNotRebuildable, match="cannot be rebuilt.*load_state\\(path, source=...\\)"):

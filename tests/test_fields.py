@@ -49,7 +49,7 @@ def test_three_sphere_slices_to_a_sphere(kind):
         tol_r, tol_v = 0.002, 0.02
     else:
         X = nodes(BOX, (40,) * 4)
-        field = Field4D((R * R - sum(x * x for x in X)).astype(np.float32), extent=BOX)
+        field = Field4D((R * R - sum(x * x for x in X)).astype(np.float32), axes="xyzw", extent=BOX)
         tol_r, tol_v = 0.01, 0.03
     rng = np.random.default_rng(1)
     for c0 in (0.0, 0.35, -0.6):
@@ -123,7 +123,7 @@ def test_ellipsoid_from_a_48_array_at_96():
     for _ in range(2):
         A, m, c0 = random_ellipsoid(rng), random_rotation(rng), rng.uniform(-0.2, 0.2)
         a = (1 - np.einsum("i...,ij,j...->...", X, A, X)).astype(np.float32)
-        v = slice_field(Field4D(a, extent=BOX), m, c0, 0.0, 96).volume
+        v = slice_field(Field4D(a, axes="xyzw", extent=BOX), m, c0, 0.0, 96).volume
         assert v == pytest.approx(ellipsoid_slice_volume(A, m, c0), rel=0.02)
 
 
@@ -158,7 +158,7 @@ def test_cavalieri_slice_volumes_integrate_to_the_4_volume(case):
     else:  # a ball bigger than the box: caps dominate
         a = 1 - sum(x * x for x in nodes(extent, shape)) / 1.3**2
         level = 0.0
-    field = Field4D(a, extent=extent)
+    field = Field4D(a, axes="xyzw", extent=extent)
     assert cavalieri(field, random_rotation(rng), level) == pytest.approx(trapezoid_count(a, level, extent), rel=0.03)
 
 
@@ -171,7 +171,7 @@ def open_edges(s) -> int:
 
 def test_constant_field_slices_fill_the_box():
     extent = ((-1, 1), (-0.8, 0.9), (-1, 1), (-0.6, 0.6))
-    field = Field4D(np.full((12, 12, 12, 8), 2.0), extent=extent)
+    field = Field4D(np.full((12, 12, 12, 8), 2.0), axes="xyzw", extent=extent)
     m = random_rotation(3)
     for c0 in (0.0, 0.5):
         s = slice_field(field, m, c0, 1.0, 48)
@@ -288,7 +288,7 @@ def test_numpy_dask_xarray_zarr_give_the_same_surface_and_read_few_chunks():
               "x": np.linspace(-1, 1, 24)}
     kw = dict(extent=ext, w_per_unit=0.5)
     fields = {
-        "numpy": Field4D(a, **kw),
+        "numpy": Field4D(a, axes="xyzw", **kw),
         "numpy wzyx": Field4D(tzyx, axes="wzyx", **kw),
         "dask": Field4D(da_.from_array(counting, chunks=chunks, asarray=False), axes="wzyx", **kw),
         "zarr": Field4D(z, axes="wzyx", **kw),
@@ -336,10 +336,10 @@ def test_dask_field_under_a_distributed_client():
     a = blob_array((16, 16, 16, 16))
     ext = ((-1, 1), (-1, 1), (-1, 1), (0, 1))
     m = random_rotation(8)
-    ref = slice_field(Field4D(a, extent=ext), m, 0.1, 0.5, 32)
+    ref = slice_field(Field4D(a, axes="xyzw", extent=ext), m, 0.1, 0.5, 32)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
                                   timeout=30) as cluster, distributed.Client(cluster, timeout=30):
-        field = Field4D(da_.from_array(a, chunks=(16, 16, 16, 4)), extent=ext)
+        field = Field4D(da_.from_array(a, chunks=(16, 16, 16, 4)), axes="xyzw", extent=ext)
         s = slice_field(field, m, 0.1, 0.5, 32)
         field.coarse()
     np.testing.assert_allclose(s.vertices, ref.vertices, atol=1e-5)
@@ -349,7 +349,7 @@ def test_coarse_copy_is_small_in_memory_and_spans_the_same_box():
     da_ = pytest.importorskip("dask.array")
     a = blob_array((60, 20, 22, 32))
     counting = CountingArray(a)
-    field = Field4D(da_.from_array(counting, chunks=(30, 20, 22, 8), asarray=False), extent=((-1, 1),) * 3 + ((0, 1),))
+    field = Field4D(da_.from_array(counting, chunks=(30, 20, 22, 8), asarray=False), axes="xyzw", extent=((-1, 1),) * 3 + ((0, 1),))
     c = field.coarse()
     assert c is field.coarse() and c._kind == "numpy" and c.values.shape == (48, 20, 22, 32)
     assert c.extent == field.extent and c.size == field.size
@@ -358,18 +358,18 @@ def test_coarse_copy_is_small_in_memory_and_spans_the_same_box():
     m = random_rotation(9)
     s = slice_field(field, m, 0.0, 0.5, 32, coarse=True)
     assert counting.reads == reads  # a coarse step reads nothing
-    full = slice_field(Field4D(a, extent=field.extent), m, 0.0, 0.5, 32)
+    full = slice_field(Field4D(a, axes="xyzw", extent=field.extent), m, 0.0, 0.5, 32)
     assert s.volume == pytest.approx(full.volume, rel=0.05)
     lo, hi = field.data_range
     assert lo == pytest.approx(a.min(), abs=0.05) and hi == pytest.approx(a.max(), abs=0.05)
-    small = Field4D(np.zeros((5, 5, 5, 5)))
+    small = Field4D(np.zeros((5, 5, 5, 5)), axes="xyzw")
     assert small.coarse() is small
 
 
 # ---------------------------------------------------------------- the source
 def test_field_is_a_source():
     a = blob_array((20, 18, 16, 12))
-    field = Field4D(a, name="density", units="kg/m3")
+    field = Field4D(a, axes="xyzw", name="density", units="kg/m3")
     assert as_source(field) is field
     # default extent: longest spatial side 2, cubic voxels, w in samples
     h = 2 / 19
@@ -447,13 +447,13 @@ def test_nan_constant_and_empty_are_not_errors():
     a = 0.64 - sum(x * x for x in X)
     a[X[0] > 0.3] = np.nan  # a NaN half-space: counts as below every level
     m = np.eye(4)
-    s = slice_field(Field4D(a, extent=BOX), m, 0.0, 0.0, 48)
+    s = slice_field(Field4D(a, axes="xyzw", extent=BOX), m, 0.0, 0.0, 48)
     assert not s.empty and s.vertices[:, 0].max() < 0.3 + 2 / 15 + 1e-9
     assert np.all(np.isfinite(s.vertices)) and np.all(np.isfinite(s.normals))
-    nan = Field4D(np.full((4, 4, 4, 4), np.nan))
+    nan = Field4D(np.full((4, 4, 4, 4), np.nan), axes="xyzw")
     assert math.isnan(nan.data_range[0]) and nan.levels == (0.0,)
     assert nan.slice(m, 0.0).triangles.shape == (0, 3)
-    const = Field4D(np.ones((4, 4, 4, 4)))
+    const = Field4D(np.ones((4, 4, 4, 4)), axes="xyzw")
     assert const.levels == (1.0,) and const.level_step == pytest.approx(0.02)
     assert slice_field(const, m, 0.0, 2.0).empty
     many = slice_field(const, m, 0.0, [0.5, 2.0])
@@ -477,22 +477,22 @@ def test_returned_arrays_are_read_only():
 def test_bad_input_is_named():
     ok = np.zeros((4, 4, 4, 4))
     with pytest.raises(ValueError, match="4-D"):
-        Field4D(np.zeros((4, 4, 4)))
+        Field4D(np.zeros((4, 4, 4)), axes="xyzw")
     with pytest.raises(ValueError, match="permutation of 'xyzw'"):
         Field4D(ok, axes="xyzt")
     with pytest.raises(ValueError, match="min < max .* y"):
-        Field4D(ok, extent=((0, 1), (1, 1), (0, 1), (0, 1)))
+        Field4D(ok, axes="xyzw", extent=((0, 1), (1, 1), (0, 1), (0, 1)))
     with pytest.raises(ValueError, match="finite"):
-        Field4D(ok, extent=((0, 1), (0, np.inf), (0, 1), (0, 1)))
+        Field4D(ok, axes="xyzw", extent=((0, 1), (0, np.inf), (0, 1), (0, 1)))
     with pytest.raises(ValueError, match=r"shape \(4, 2\)"):
-        Field4D(ok, extent=((0, 1),) * 3)
+        Field4D(ok, axes="xyzw", extent=((0, 1),) * 3)
     with pytest.raises(TypeError, match="real numbers"):
-        Field4D(ok.astype(complex))
+        Field4D(ok.astype(complex), axes="xyzw")
     with pytest.raises(ValueError, match="at least 2 samples"):
-        Field4D(np.zeros((4, 1, 4, 4)))
+        Field4D(np.zeros((4, 1, 4, 4)), axes="xyzw")
     with pytest.raises(TypeError, match="array-like"):
-        Field4D(object())
-    f = Field4D(ok)
+        Field4D(object(), axes="xyzw")
+    f = Field4D(ok, axes="xyzw")
     with pytest.raises(ValueError, match="finite"):
         slice_field(f, np.eye(4), 0.0, math.nan)
     with pytest.raises(ValueError, match="finite"):
@@ -520,7 +520,7 @@ def test_bad_input_is_named():
     with pytest.raises(TypeError, match="callable"):
         Field4D.from_function(3.0, BOX)
     with pytest.raises(ValueError, match="w_per_unit"):
-        Field4D(ok, w_per_unit=0)
+        Field4D(ok, axes="xyzw", w_per_unit=0)
     with pytest.raises(ValueError, match="coarse_resolution"):
         f.coarse_resolution = 1
 
@@ -562,7 +562,7 @@ def test_a_chunked_full_step_never_assembles_the_array(tmp_path):
         gi = g[i:i + 16]
         z[i:i + 16] = 0.5 - (gi[:, None, None, None] ** 2 + g[None, :, None, None] ** 2
                              + g[None, None, :, None] ** 2 + g[None, None, None, :] ** 2)
-    f = Field4D(z, extent=[(-1.0, 1.0)] * 4, levels=[0.0], chunk_cache_bytes=1 << 22, resolution=40)
+    f = Field4D(z, axes="xyzw", extent=[(-1.0, 1.0)] * 4, levels=[0.0], chunk_cache_bytes=1 << 22, resolution=40)
     m = random_rotation(np.random.default_rng(5))
     f.slice(m, 0.1, coarse=True)  # the coarse copy is built first (it reads every chunk once)
     tracemalloc.start()

@@ -134,17 +134,12 @@ print("dask.dataframe" in sys.modules)
 
 
 # ---------------------------------------------------------------- the axis order, named
-def test_an_array_without_axes_warns_naming_the_choices_and_repr_names_the_order():
+def test_an_array_without_axes_is_refused_naming_the_choices_and_repr_names_the_order():
     """`Field4D(f)` for the README's f[t, z, y, x] used to take x as time without a word."""
-    from rot4d_widget.fields import AxesWarning
-
     f = np.zeros((24, 20, 20, 20))
-    with pytest.warns(AxesWarning, match=r"axes='wzyx' for f\[t, z, y, x\].*axes='xyzw' for f\[x, y, z, t\]"):
-        field = Field4D(f)
-    assert field.axes == "xyzw" and not field.axes_given
-    assert "(24, 20, 20, 20) f[x, y, z, w] (assumed" in repr(field)
+    with pytest.raises(TypeError, match=r"needs `axes`.*axes='wzyx' for f\[t, z, y, x\].*axes='xyzw' for f\[x, y, z, t\]"):
+        Field4D(f)
     m = np.eye(4)
-    assert dict(field.slice(m, 0.0).readout)["axes"].startswith("f[x, y, z, w] (assumed")
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # given: no warning
         named = Field4D(f, axes="wzyx")

@@ -251,8 +251,8 @@ def test_a_scaled_field_slices_as_the_unit_one_scaled(target, seed, frac, functi
         f1 = Field4D.from_function(lambda x, y, z, w: f(x, y, z, w, 1.0), [(-1.0, 1.0)] * 4, resolution=16)
         fs = Field4D.from_function(f, [(-s, s)] * 4, resolution=16)
     else:
-        f1 = Field4D(ball_values(), extent=[(-1.0, 1.0)] * 4, resolution=16)
-        fs = Field4D(ball_values(), extent=[(-s, s)] * 4, resolution=16)
+        f1 = Field4D(ball_values(), axes="xyzw", extent=[(-1.0, 1.0)] * 4, resolution=16)
+        fs = Field4D(ball_values(), axes="xyzw", extent=[(-s, s)] * 4, resolution=16)
     m = rotation(seed)
     a = slice_field(f1, m, frac, 0.0, 16)
     b = slice_field(fs, m, frac * s, 0.0, 16)
@@ -302,8 +302,8 @@ def test_power_of_two_scales_give_exactly_the_unit_results_scaled(k):
             np.testing.assert_array_equal(b.vertices, a.vertices * s)
             np.testing.assert_array_equal(b.triangles, a.triangles)
             assert b.volume == a.volume * s * s * s
-    f1 = Field4D(ball_values(), extent=[(-1.0, 1.0)] * 4)
-    fs = Field4D(ball_values(), extent=[(-s, s)] * 4)
+    f1 = Field4D(ball_values(), axes="xyzw", extent=[(-1.0, 1.0)] * 4)
+    fs = Field4D(ball_values(), axes="xyzw", extent=[(-s, s)] * 4)
     a, b = slice_field(f1, m, 0.2, 0.0, 20), slice_field(fs, m, 0.2 * s, 0.0, 20)
     np.testing.assert_array_equal(b.vertices, a.vertices * s)
     np.testing.assert_array_equal(b.triangles, a.triangles)
@@ -356,8 +356,8 @@ def test_the_widget_shows_a_scaled_polytope_as_the_unit_one(make, target):
 @given(target=targets)
 def test_the_widget_shows_a_scaled_field_as_the_unit_one(make, target):
     s = target
-    f1 = Field4D(ball_values(), extent=[(-1.0, 1.0)] * 4, resolution=16, coarse_resolution=8)
-    fs = Field4D(ball_values(), extent=[(-s, s)] * 4, resolution=16, coarse_resolution=8)
+    f1 = Field4D(ball_values(), axes="xyzw", extent=[(-1.0, 1.0)] * 4, resolution=16, coarse_resolution=8)
+    fs = Field4D(ball_values(), axes="xyzw", extent=[(-s, s)] * 4, resolution=16, coarse_resolution=8)
     w, u = widget_case(make, fs, f1, s)
     sw, su = w.scene.surface, u.scene.surface
     assert sw["n_vertices"] > 0 and su["n_vertices"] > 0
