@@ -26,6 +26,7 @@ STYLE = (
     ".rot4d-side .rot4d-readout td,.rot4d-side .rot4d-help td"
     "{padding:1px 0.5em 1px 0;line-height:1.3;text-align:left;vertical-align:top}"
     ".rot4d-side .rot4d-readout table{font-family:monospace}"
+    ".rot4d-side .rot4d-readout td:first-child{white-space:nowrap}"  # "▸ w 30 s" on one line
     ".rot4d-side .rot4d-help{font-size:90%}"
     ".rot4d-gauge{display:inline-block;position:relative;width:8em;height:0.6em;"
     "background:#ddd;vertical-align:middle;margin-left:0.4em}"

@@ -43,6 +43,7 @@ def test_a_field_s_readout_and_stack_labels_are_in_the_data_s_units(jupyter_serv
         text = side.inner_text()
         if var == "w":
             assert "m\u00b3" in text and "phi [m2]" in text and "s per m" in text, text
+            assert "30.0000 s" in text, text  # c0 is the data's time: the middle, 30 s
         else:
             # 30 s per unit of space (5 s per time step over 1/6 m per grid step): Δ = 1 is 30 s
             for label in ("w 0 s", "w 30 s", "w 60 s", "\u0394 = 30 s", "vol 11.35 m\u00b3"):
