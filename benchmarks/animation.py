@@ -8,7 +8,12 @@ the package at commit 7ba6e62, checked out with ``git worktree add /tmp/old-anim
 ``--repeats`` renders of every case; old and new alternate case by case so that the load of the
 machine falls on both alike.  Prints a table of medians (seconds) and the speed-up.
 
-    python benchmarks/animation.py [--repeats 3] [--old /tmp/old-anim]
+``--parts`` adds, for the new code, where each render's time went (medians, seconds): slicing
+(the framing pass's ``figures._prepare``, every frame's slice), building the frame's artists
+(``render_state``), Agg drawing them (``_FrameCanvas.rgba``), the encoder's work after the last
+frame (``_Encoder.finish``: x264's lookahead, the GIF's last frames) and the rest.
+
+    python benchmarks/animation.py [--repeats 3] [--old /tmp/old-anim] [--parts]
 """
 
 from __future__ import annotations
@@ -37,8 +42,38 @@ def _recording():
     return rec.recording()
 
 
-def worker(case: str, ext: str, repeats: int, new: bool) -> list:
-    """Seconds of each of ``repeats`` renders of one case, in this process."""
+PARTS = ("slicing", "building", "drawing", "encoder tail")
+
+
+def _timed(owner, name, part, spent, when=lambda args, kwargs: True):
+    """Wrap ``owner.name`` so that its seconds add up in ``spent[part]`` (when ``when`` says so)."""
+    real = getattr(owner, name)
+
+    def timed(*args, **kwargs):
+        if not when(args, kwargs):
+            return real(*args, **kwargs)
+        t = time.perf_counter()
+        try:
+            return real(*args, **kwargs)
+        finally:
+            spent[part] += time.perf_counter() - t
+
+    setattr(owner, name, timed)
+
+
+def _time_parts(spent: dict) -> None:
+    """Time the parts of the new code's render_animation (see --parts)."""
+    from rot4d_widget import figures, recording
+
+    _timed(figures, "_prepare", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
+    _timed(figures, "render_state", "building", spent)
+    _timed(figures._FrameCanvas, "rgba", "drawing", spent)
+    _timed(recording._Encoder, "finish", "encoder tail", spent)
+
+
+def worker(case: str, ext: str, repeats: int, new: bool, parts: bool = False) -> list:
+    """Seconds of each of ``repeats`` renders of one case, in this process (with ``parts``: a dict
+    per render, its total and `PARTS`)."""
     import inspect
 
     from rot4d_widget import datasets
@@ -47,21 +82,27 @@ def worker(case: str, ext: str, repeats: int, new: bool) -> list:
     quiet = {"progress": False} if "progress" in inspect.signature(render_animation).parameters else {}
     rec = _recording()
     source = datasets.moving_sphere() if case == "field" else case
+    spent = dict.fromkeys(PARTS, 0.0)
+    if parts:
+        _time_parts(spent)
     times = []
     with tempfile.TemporaryDirectory() as tmp:
         render_animation(rec, None, "5-cell", os.path.join(tmp, "warm" + ext), size=(80, 60), max_frames=40,
                          **quiet)
         for r in range(repeats):
+            spent.update(dict.fromkeys(PARTS, 0.0))
             t = time.perf_counter()
             n = render_animation(rec, None, source, os.path.join(tmp, f"a{r}{ext}"), fps=10, **quiet)
-            times.append(time.perf_counter() - t)
+            total = time.perf_counter() - t
+            times.append({"total": total, **spent} if parts else total)
             assert n == 33, n
     return times
 
 
-def _run(tree: str, case: str, ext: str, repeats: int) -> list:
+def _run(tree: str, case: str, ext: str, repeats: int, parts: bool = False) -> list:
     env = {**os.environ, "PYTHONPATH": tree}
-    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--worker", case, ext, str(repeats)],
+    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--worker", case, ext, str(repeats)]
+                         + (["--parts"] if parts else []),
                          env=env, cwd=tree, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -70,19 +111,24 @@ def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--old", default="/tmp/old-anim", help="a checkout of 7ba6e62 (git worktree add ... 7ba6e62)")
+    p.add_argument("--parts", action="store_true", help="also time the new code's slicing, building, drawing, "
+                   "encoder tail")
     p.add_argument("--worker", nargs=3, help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     if a.worker:
         case, ext, repeats = a.worker
-        print(json.dumps(worker(case, ext, int(repeats), new=True)))
+        print(json.dumps(worker(case, ext, int(repeats), new=True, parts=a.parts)))
         return
     new_tree = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     if not os.path.isdir(os.path.join(a.old, "rot4d_widget")):
         sys.exit(f"No old checkout at {a.old}: git worktree add {a.old} 7ba6e62")
-    rows = []
+    rows, split = [], []
     for case, ext in CASES:
         old = _run(a.old, case, ext, a.repeats)
-        new = _run(new_tree, case, ext, a.repeats)
+        new = _run(new_tree, case, ext, a.repeats, a.parts)
+        if a.parts:
+            split.append((case, ext, {k: statistics.median(r[k] for r in new) for k in ("total", *PARTS)}))
+            new = [r["total"] for r in new]
         rows.append((case, ext, statistics.median(old), statistics.median(new)))
         print(f"  {case} {ext}: old {old}, new {new}", file=sys.stderr)
     print(f"render_animation, 33 frames 600 x 500, median of {a.repeats} (s); load average "
@@ -92,6 +138,15 @@ def main(argv=None) -> None:
     for case, ext, o, n in rows:
         name = "24-cell" if case == "24-cell" else "moving_sphere() field"
         print(f"| {name} | {ext} | {o:.2f} | {n:.2f} | {o / n:.1f}x |")
+    if split:
+        print("\nwhere the new code's time went (medians, s; the parts are timed in the same renders)")
+        print("| source | file | total | " + " | ".join(PARTS) + " | rest |")
+        print("|---|---|" + "---:|" * (len(PARTS) + 2))
+        for case, ext, m in split:
+            name = "24-cell" if case == "24-cell" else "moving_sphere() field"
+            rest = m["total"] - sum(m[k] for k in PARTS)
+            print(f"| {name} | {ext} | {m['total']:.2f} | " + " | ".join(f"{m[k]:.2f}" for k in PARTS)
+                  + f" | {rest:.2f} |")
 
 
 if __name__ == "__main__":
