@@ -761,7 +761,9 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     slices.  Only attributes the sources have are read, never their class."""
     inner = getattr(source, "source", source)
     lines = []
-    state = f"c0 = {float(c0):+.4g}"
+    wu = getattr(inner, "w_units", None)
+    wu = f" {wu}" if wu else ""  # c0 and the slices' w are in the source's w units (a field's time)
+    state = f"c0 = {float(c0):+.4g}{wu}"
     lines.append(state if theta0 is None else f"\u03b80 = {_fmt_angle(float(theta0))}, {state}")
     name, units = getattr(inner, "name", None), getattr(inner, "units", None)
     u = f" {units}" if units else ""
@@ -779,13 +781,14 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     ws = np.asarray(source.levels_at(c0)) if n > 1 and hasattr(source, "levels_at") else np.zeros(0)
     if len(ws):
         spacing = getattr(source, "spacing", None)
-        lines.append(f"{n} slices w = {ws[0]:+.3g} \u2026 {ws[-1]:+.3g}"
-                     + (f", \u0394 = {spacing:.3g}" if spacing else ""))
+        per = float(getattr(source, "w_frame", (0.0, 1.0))[1])
+        lines.append(f"{n} slices w = {ws[0]:+.4g} \u2026 {ws[-1]:+.4g}{wu}"
+                     + (f", \u0394 = {spacing * per:.3g}{wu}" if spacing else ""))
     legend = []
     group_rgb = (getattr(data, "extra", None) or {}).get("group_rgb")
     if len(ws) and group_rgb is not None:
         picks = range(n) if n <= 8 else sorted({0, n // 4, n // 2, (3 * n) // 4, n - 1})
-        legend = [(tuple(np.asarray(group_rgb[k], dtype=float)[:3]), f"w = {ws[k]:+.3g}") for k in picks]
+        legend = [(tuple(np.asarray(group_rgb[k], dtype=float)[:3]), f"w = {ws[k]:+.4g}{wu}") for k in picks]
     elif levels:
         lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
         rgb = _level_colors(levels, lo, hi)

@@ -161,3 +161,17 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
     new = rec.for_source(f)
     assert new.initial["format"] == 2 and new.initial["c0"] == 26.0 and new.initial["initial"]["c0"] == 26.0
     assert rec.for_source(make("5-cell").source) is rec  # a polytope's frame (0, 1): nothing to convert
+
+
+def test_a_rendered_picture_names_c0_and_the_slices_in_seconds():
+    from rot4d_widget.figures import render_state
+
+    st = RotationState(c0=26.0)
+    fig = render_state(st, _field(resolution=16), annotate=True, size=(300, 250), dpi=50)
+    text = " ".join(t.get_text() for ax in fig.axes for t in ax.texts)
+    assert "c0 = +26 s" in text
+    fig = render_state(st, _field(resolution=16), slices=3, spacing=0.2, annotate=True, size=(300, 250), dpi=50)
+    text = " ".join(t.get_text() for t in fig.axes[0].texts)
+    assert "3 slices w = +25 \u2026 +27 s, \u0394 = 1 s" in text
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels == ["w = +25 s", "w = +26 s", "w = +27 s"]
