@@ -1,7 +1,7 @@
 """render_animation, before and after "Keeping it": the same 33-frame recordings, old and new code, one run.
 
 A held "4" (32 steps of R_xw, 33 frames, 600 x 500) on the 24-cell and on the moving sphere
-(`rot4d_widget.datasets.moving_sphere()`, a Field4D), each to GIF and MP4.  The old code is
+(`rot4d_widget.sources.datasets.moving_sphere()`, a Field4D), each to GIF and MP4.  The old code is
 the package at commit 7ba6e62, checked out with ``git worktree add /tmp/old-anim 7ba6e62``
 (``--old`` elsewhere); the new is this checkout.  Each side runs in its own Python process
 (PYTHONPATH set to its tree), imports and draws one small warm-up animation first, then times
@@ -31,8 +31,8 @@ CASES = [("24-cell", ".gif"), ("24-cell", ".mp4"), ("field", ".gif"), ("field", 
 
 
 def _recording():
-    from rot4d_widget.recording import Recorder
-    from rot4d_widget.state import RotationState
+    from rot4d_widget.keep.recording import Recorder
+    from rot4d_widget.core.state import RotationState
 
     st = RotationState()
     rec = Recorder(st, clock=lambda: 0.0)
@@ -77,7 +77,7 @@ def worker(case: str, ext: str, repeats: int, new: bool, parts: bool = False) ->
     import inspect
 
     from rot4d_widget import datasets
-    from rot4d_widget.recording import render_animation
+    from rot4d_widget.keep.recording import render_animation
 
     quiet = {"progress": False} if "progress" in inspect.signature(render_animation).parameters else {}
     rec = _recording()

@@ -160,7 +160,7 @@ FIELD_CASES = {
 }
 # notebook 04's data: the Allen-Cahn simulation (py-pde; cached after its first run)
 FIELD_CASES["allen-cahn"] = (
-    "from rot4d_widget import Field4D\nfrom rot4d_widget.datasets import phase_separation\n"
+    "from rot4d_widget import Field4D\nfrom rot4d_widget.sources.datasets import phase_separation\n"
     "field = Field4D.from_xarray(phase_separation(), w='time', levels=[0.0])"
 )
 #: Parallel slices (issue 10): the widget's arguments.

@@ -27,7 +27,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 from rot4d_widget import Field4D  # noqa: E402
 from rot4d_widget import fields as F  # noqa: E402
-from rot4d_widget.rotation import random_rotation  # noqa: E402
+from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 
 
 def store(size: int, chunk: int) -> str:

@@ -3,7 +3,7 @@
 Two fields (float32, in memory):
 
 * ``sphere 64^4``: f = R^2 - |q|^2 on a 64^4 grid over [-1, 1]^4, R = 0.8, level 0;
-* ``Allen-Cahn 32^3x36``: notebook 04's simulation (`rot4d_widget.datasets.phase_separation`),
+* ``Allen-Cahn 32^3x36``: notebook 04's simulation (`rot4d_widget.sources.datasets.phase_separation`),
   c[t, x, y, z] from py-pde, level 0;
 * ``blob 128^3x32``: a Gaussian blob travelling along x as t grows plus a smooth
   random field, f[x, y, z, t] with the default extent (w = sample index, cubic voxels).
@@ -37,8 +37,8 @@ import numba
 import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.fields import PARALLEL_MIN_POINTS, Field4D, _get_kernels, _resample_affine, _sample, _surface
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.sources.fields import PARALLEL_MIN_POINTS, Field4D, _get_kernels, _resample_affine, _sample, _surface
+from rot4d_widget.core.rotation import random_rotation
 
 
 def sphere_field(n: int = 64, R: float = 0.8) -> Field4D:
@@ -69,7 +69,7 @@ def blob_field(n: int = 128, nt: int = 32, seed: int = 0) -> Field4D:
 
 def simulation_field() -> Field4D:
     """Notebook 04's data: py-pde's Allen-Cahn coarsening, c[t, x, y, z] (cached after the first run)."""
-    from rot4d_widget.datasets import phase_separation
+    from rot4d_widget.sources.datasets import phase_separation
 
     return Field4D.from_xarray(phase_separation(), w="time", levels=[0.0])
 

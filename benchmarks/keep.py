@@ -19,12 +19,12 @@ import time
 import numpy as np
 
 from rot4d_widget import Field4D, RotationState
-from rot4d_widget.export import slice_mesh
-from rot4d_widget.figures import render_state
-from rot4d_widget.recording import paper_animation
-from rot4d_widget.rotation import random_rotation
-from rot4d_widget.source import PolytopeSource
-from rot4d_widget.tomography import StackSource
+from rot4d_widget.keep.export import slice_mesh
+from rot4d_widget.keep.figures import render_state
+from rot4d_widget.keep.recording import paper_animation
+from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.tomography import StackSource
 
 
 def median_ms(f, n):

@@ -237,7 +237,7 @@ def rss_mb() -> float:
 # ============================================================================ sources
 def ball_field():
     """A small 4-D field (f = 0.64 - |q|^2 on [-1, 1]^4), two iso levels, cheap to slice."""
-    from rot4d_widget.fields import Field4D
+    from rot4d_widget.sources.fields import Field4D
 
     return Field4D.from_function(lambda x, y, z, w: 0.64 - (x * x + y * y + z * z + w * w),
                                  [(-1.0, 1.0)] * 4, levels=[0.0, 0.3], resolution=12, coarse_resolution=8)
@@ -481,7 +481,7 @@ class Soak:
 
     # -- sessions -----------------------------------------------------------------
     def make(self, kind):
-        from rot4d_widget.widget import Rot4DWidget
+        from rot4d_widget.view.widget import Rot4DWidget
 
         args, kwargs = KINDS[kind](self.rng)
         return Rot4DWidget(*args, _clock=self.clock, _autotick=False, **kwargs)
@@ -1094,7 +1094,7 @@ def threaded_phase(seconds=2.0, seed=1, slow_observer=0.0, bound=None):
 
 
 def _threaded_body(page, seconds, seed, slow_observer, result):
-    from rot4d_widget.widget import Rot4DWidget
+    from rot4d_widget.view.widget import Rot4DWidget
 
     problems = []
     result["stage"] = "making the widget"

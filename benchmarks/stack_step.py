@@ -21,8 +21,8 @@ import time
 import numpy as np
 
 from rot4d_widget import polytope, slice_polytope
-from rot4d_widget.rotation import random_rotation
-from rot4d_widget.tomography import StackSource
+from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.sources.tomography import StackSource
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "600-cell", "120-cell"]
 TARGET = {"600-cell": 4.0, "120-cell": 4.0}

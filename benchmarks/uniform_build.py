@@ -1,4 +1,4 @@
-"""Cold build time and slice time of the uniform polychora (rot4d_widget.uniform).
+"""Cold build time and slice time of the uniform polychora (rot4d_widget.geometry.uniform).
 
 For each polychoron, a fresh Python process (``subprocess``) imports the package, then times
 
@@ -30,7 +30,7 @@ import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
 from rot4d_widget import uniform
-from rot4d_widget.slicing import slice_polytope
+from rot4d_widget.geometry.slicing import slice_polytope
 t1 = time.perf_counter()
 name, steps = sys.argv[1], int(sys.argv[2])
 p = uniform.build(name)
@@ -97,7 +97,7 @@ def main() -> None:
         sym = uniform.dynkin_symbol(name) or "–"
         print(f"| {name} | {sym} | {', '.join(map(str, r['counts']))} | {r['build']:.3f} | {r['first_slice']:.3f} "
               f"| {r['build'] + r['first_slice']:.3f} | {r['slice_ms']:.2f} | {r['slice_F']} |", flush=True)
-    print(f"(import of numpy, scipy and rot4d_widget.uniform + slicing, not in the figures: "
+    print(f"(import of numpy, scipy and rot4d_widget.geometry.uniform + slicing, not in the figures: "
           f"~{r['import']:.2f} s; whole run {time.perf_counter() - t:.0f} s)")
 
 

@@ -10,7 +10,7 @@ of tests/recording_comm.py (it serialises like ipykernel; the widget itself
 counts nothing).  Each update is acknowledged the way the page does it, by a
 "drawn" message from the companion, so the next press goes out at once.
 The update is what the keydown sends: while a key is down the readout changes
-at most every 0.25 s (rot4d_widget.widget.READOUT_PERIOD), so presses this
+at most every 0.25 s (rot4d_widget.view.widget.READOUT_PERIOD), so presses this
 close together send the buffer alone, and the readout follows at rest.
 
     python benchmarks/widget_update.py [--presses 300] [--seed 0]
@@ -29,8 +29,8 @@ import time
 import numpy as np
 from scipy.stats import special_ortho_group
 
-from rot4d_widget.polytopes import POLYTOPE_NAMES
-from rot4d_widget.widget import Rot4DWidget
+from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.view.widget import Rot4DWidget
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from recording_comm import RecordingComm, install  # noqa: E402  (serialises like ipykernel)

@@ -19,44 +19,100 @@ __version__ = "0.1.0"
 #: An entry whose module does not exist (yet) does not break ``import rot4d_widget``:
 #: the name is left out of ``__all__`` and looking it up raises AttributeError.
 _LAZY = {
-    "Action": "keymap",
-    "DEFAULT_KEYMAP": "keymap",
-    "Keymap": "keymap",
-    "Polytope": "polytopes",
-    "MeshError": "polytopes",
-    "pentachoron": "polytopes",
-    "polytope": "polytopes",
-    "double_rotation": "rotation",
-    "simple_rotation": "rotation",
-    "Slice": "slicing",
-    "slice_polytope": "slicing",
-    "RotationState": "state",
-    "Source": "source",
-    "SliceData": "source",
-    "SourceAction": "source",
-    "PolytopeSource": "source",
-    "Rot4DWidget": "widget",
-    "Field4D": "fields",
-    "StackSource": "tomography",
-    "arrangement_layout": "tomography",
-    "slice_field": "fields",
-    "FieldSlice": "fields",
-    "FieldSliceData": "fields",
-    "polytope_names": "uniform",
-    "slice_mesh": "export",
-    "save_state": "export",
-    "load_state": "export",
-    "Recording": "recording",
-    "Recorder": "recording",
-    "render_state": "figures",
+    "Action": "core.keymap",
+    "DEFAULT_KEYMAP": "core.keymap",
+    "Keymap": "core.keymap",
+    "Polytope": "geometry.polytopes",
+    "MeshError": "geometry.polytopes",
+    "pentachoron": "geometry.polytopes",
+    "polytope": "geometry.polytopes",
+    "double_rotation": "core.rotation",
+    "simple_rotation": "core.rotation",
+    "Slice": "geometry.slicing",
+    "slice_polytope": "geometry.slicing",
+    "RotationState": "core.state",
+    "Source": "sources.protocol",
+    "SliceData": "sources.protocol",
+    "SourceAction": "sources.protocol",
+    "PolytopeSource": "sources.protocol",
+    "Rot4DWidget": "view.widget",
+    "Field4D": "sources.fields",
+    "StackSource": "sources.tomography",
+    "arrangement_layout": "sources.tomography",
+    "slice_field": "sources.fields",
+    "FieldSlice": "sources.fields",
+    "FieldSliceData": "sources.fields",
+    "polytope_names": "geometry.uniform",
+    "slice_mesh": "keep.export",
+    "save_state": "keep.export",
+    "load_state": "keep.export",
+    "Recording": "keep.recording",
+    "Recorder": "keep.recording",
+    "render_state": "keep.figures",
+}
+
+#: the wings (subpackages, docs/design.md): rot4d_widget.core ... rot4d_widget.view
+_WINGS = ("core", "geometry", "sources", "keep", "view")
+
+#: module paths from before the wings (``rot4d_widget.fields`` ...) -> where the module is now.
+#: They keep working, as attributes and in import statements (`_OldPaths`), and are the same
+#: module objects as the new paths; CHANGELOG lists them.
+_MOVED = {
+    "rotation": "core.rotation",
+    "keymap": "core.keymap",
+    "state": "core.state",
+    "look": "core.look",
+    "_arrays": "core._arrays",
+    "polytopes": "geometry.polytopes",
+    "uniform": "geometry.uniform",
+    "slicing": "geometry.slicing",
+    "offfile": "geometry.offfile",
+    "source": "sources.protocol",
+    "fields": "sources.fields",
+    "tomography": "sources.tomography",
+    "datasets": "sources.datasets",
+    "export": "keep.export",
+    "recording": "keep.recording",
+    "figures": "keep.figures",
+    "widget": "view.widget",
+    "scene": "view.scene",
+    "buffers": "view.buffers",
+    "companion": "view.companion",
+    "pump": "view.pump",
+    "keyhold": "view.keyhold",
+    "readout": "view.readout",
+    "progress": "view.progress",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
 #: statement, as they were when this ``__init__`` imported the core eagerly.
-_SUBMODULES = ("buffers", "companion", "figures", "keymap", "polytopes", "rotation",
-               "scene", "slicing", "source", "state", "widget",
-               "look", "readout", "keyhold", "pump", "fields", "tomography", "datasets",
-               "uniform", "export", "recording")
+_SUBMODULES = tuple(_MOVED) + _WINGS
+
+
+class _OldPaths:
+    """A meta path finder: ``import rot4d_widget.fields`` (a path from before the wings) imports
+    ``rot4d_widget.sources.fields`` and binds the old name to that same module object."""
+
+    @staticmethod
+    def find_spec(fullname, path=None, target=None):
+        prefix, _, old = fullname.partition(".")
+        if prefix != __name__ or old not in _MOVED:
+            return None
+        return importlib.util.spec_from_loader(fullname, _OldPaths)
+
+    @staticmethod
+    def create_module(spec):
+        return importlib.import_module(f"{__name__}.{_MOVED[spec.name.partition('.')[2]]}")
+
+    @staticmethod
+    def exec_module(module):
+        pass  # already executed under its new name
+
+
+import sys as _sys  # noqa: E402 - the finder goes in once, after its class
+
+if not any(f is _OldPaths for f in _sys.meta_path):
+    _sys.meta_path.append(_OldPaths)
 
 
 def _exists(module: str) -> bool:
@@ -71,7 +127,7 @@ def __getattr__(name: str):
     if module is None and name not in _SUBMODULES:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     try:
-        mod = importlib.import_module(f".{module or name}", __name__)
+        mod = importlib.import_module(f".{module or _MOVED.get(name, name)}", __name__)
     except ModuleNotFoundError as exc:
         # only the submodule itself missing means "no such attribute"; a missing
         # dependency inside it (pythreejs for Rot4DWidget, say) must be seen as it is

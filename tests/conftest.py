@@ -27,7 +27,7 @@ def clock():
 @pytest.fixture
 def make(clock):
     """Build Rot4DWidgets on the fake clock without a ticker thread; closed afterwards."""
-    from rot4d_widget.widget import Rot4DWidget
+    from rot4d_widget.view.widget import Rot4DWidget
 
     made = []
 

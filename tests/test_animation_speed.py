@@ -12,8 +12,8 @@ from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
 from rot4d_widget import datasets, figures, look
-from rot4d_widget.recording import Recorder, render_frames
-from rot4d_widget.state import RotationState
+from rot4d_widget.keep.recording import Recorder, render_frames
+from rot4d_widget.core.state import RotationState
 
 LINES = ["t = 0.03 s, frame 2/33", "\u03b80 = \u03c0/16, c0 = +0.1234", "w cut \u22120.5 \u2026 0.5 s",
          "ball r=0.5 moving at v=0.75", "AVAWAY fij ;:{}|", "level 0 m\u00b3"]

@@ -1,6 +1,6 @@
-"""rot4d_widget.buffers: the row table every update sends, the palette, the template shapes.
+"""rot4d_widget.view.buffers: the row table every update sends, the palette, the template shapes.
 
-Slices come from the source protocol (`rot4d_widget.source`): a polytope's
+Slices come from the source protocol (`rot4d_widget.sources.protocol`): a polytope's
 through `PolytopeSource`, made-up ones as plain objects with ``points``,
 ``segments``, ``triangles``, ``groups`` (and optionally ``convex``,
 ``show_points``).
@@ -12,13 +12,13 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 import pytest
 
 from rot4d_widget import buffers as bf
 from rot4d_widget import polytope
-from rot4d_widget.polytopes import POLYTOPE_NAMES
-from rot4d_widget.source import PolytopeSource, SliceData
+from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 
 
 def fake_slice(n_points=5, n_segments=7, n_triangles=4, n_groups=3, seed=0):

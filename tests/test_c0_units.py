@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from rot4d_widget import Field4D, RotationState
-from rot4d_widget.fields import slice_field
-from rot4d_widget.recording import Recording, Setting, Step
-from rot4d_widget.source import data_w_text, w_frame
-from rot4d_widget.tomography import StackSource
+from rot4d_widget.sources.fields import slice_field
+from rot4d_widget.keep.recording import Recording, Setting, Step
+from rot4d_widget.sources.protocol import data_w_text, w_frame
+from rot4d_widget.sources.tomography import StackSource
 
 EXTENT = ((-1.0, 1.0),) * 3 + ((20.0, 30.0),)
 WPU = 5.0
@@ -55,7 +55,7 @@ def test_at_rest_c0_is_the_data_s_time():
 
 
 def test_a_turned_cut_puts_each_vertex_on_the_sphere_of_its_own_time():
-    from rot4d_widget.rotation import simple_rotation
+    from rot4d_widget.core.rotation import simple_rotation
 
     f = _field()
     m = simple_rotation("xw", 0.3)
@@ -129,7 +129,7 @@ def _old_state_file(tmp_path, source_desc, c0_slice, c0_step_slice):
 
 
 def test_a_state_file_from_before_loads_with_c0_converted(tmp_path, make):
-    from rot4d_widget.export import describe_source, load_state
+    from rot4d_widget.keep.export import describe_source, load_state
 
     f = _field()
     desc = describe_source(f)
@@ -150,7 +150,7 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
     initial = st.to_dict(initial=True)
     initial["format"] = 1
     initial["initial"]["c0"] = 0.2
-    from rot4d_widget.keymap import Action
+    from rot4d_widget.core.keymap import Action
 
     rec = Recording(initial, [Setting(0.5, "c0", -0.4), Step(1.0, "l", False, Action.parse("c0+"), False)])
     f = _field()
@@ -164,7 +164,7 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
 
 
 def test_a_rendered_picture_names_c0_and_the_slices_in_seconds():
-    from rot4d_widget.figures import render_state
+    from rot4d_widget.keep.figures import render_state
 
     st = RotationState(c0=26.0)
     fig = render_state(st, _field(resolution=16), annotate=True, size=(300, 250), dpi=50)

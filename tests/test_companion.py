@@ -1,4 +1,4 @@
-"""rot4d_widget.companion: the Python side, and companion.js run under Node with a fake page.
+"""rot4d_widget.view.companion: the Python side, and companion.js run under Node with a fake page.
 
 The JavaScript is exercised without a browser: Node imports the shipped ES
 module and calls its ``render`` with a fake anywidget model, fake pythreejs
@@ -19,9 +19,9 @@ import subprocess
 import pytest
 
 import rot4d_widget
-from rot4d_widget.companion import Companion
+from rot4d_widget.view.companion import Companion
 
-JS = pathlib.Path(rot4d_widget.__file__).with_name("companion.js")
+JS = pathlib.Path(rot4d_widget.__file__).parent / "view" / "companion.js"
 
 
 pytestmark = pytest.mark.usefixtures("recording_comms")  # tests/conftest.py
@@ -52,7 +52,7 @@ def test_reads_the_scene_and_is_invisible():
 def test_reads_a_real_scene_s_interface():
     """What the companion needs from the Scene: the buffer's and the three.js scene's model ids
     and the canvas's CSS class -- all public on the new Scene."""
-    from rot4d_widget.scene import Scene
+    from rot4d_widget.view.scene import Scene
 
     sc = Scene(scale=1.0, n_groups=5, capacity=16)
     c = Companion(sc)
@@ -107,7 +107,7 @@ def test_a_failing_callback_does_not_escape(caplog):
 
 def test_the_module_ships_inside_the_package():
     assert JS.is_file()
-    assert JS.parent == pathlib.Path(rot4d_widget.__file__).parent  # hatch packages the whole folder
+    assert JS.parent == pathlib.Path(rot4d_widget.__file__).parent / "view"  # hatch packages the whole folder
     text = JS.read_text()
     assert "export default" in text
     assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped file

@@ -1,4 +1,4 @@
-"""rot4d_widget.datasets: the simulated phase separation (cache, shape, physics) and the moving sphere."""
+"""rot4d_widget.sources.datasets: the simulated phase separation (cache, shape, physics) and the moving sphere."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from rot4d_widget import datasets
-from rot4d_widget.datasets import default_cache_dir, moving_sphere, phase_separation, phase_separation_key
-from rot4d_widget.fields import Field4D, slice_field
-from rot4d_widget.rotation import simple_rotation
+from rot4d_widget.sources.datasets import default_cache_dir, moving_sphere, phase_separation, phase_separation_key
+from rot4d_widget.sources.fields import Field4D, slice_field
+from rot4d_widget.core.rotation import simple_rotation
 
 pytest.importorskip("pde")
 pytest.importorskip("xarray")

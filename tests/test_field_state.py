@@ -23,10 +23,10 @@ import warnings
 import numpy as np
 import pytest
 
-from rot4d_widget.export import SourceNotRebuildable, load_state, save_state
-from rot4d_widget.fields import COARSE_SAMPLES, Field4D
-from rot4d_widget.rotation import random_rotation
-from rot4d_widget.state import RotationState
+from rot4d_widget.keep.export import SourceNotRebuildable, load_state, save_state
+from rot4d_widget.sources.fields import COARSE_SAMPLES, Field4D
+from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.core.state import RotationState
 
 xr = pytest.importorskip("xarray")
 pytest.importorskip("scipy")

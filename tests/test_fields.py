@@ -1,7 +1,7 @@
 """Field4D and slice_field: geometry against closed forms, backends against each other,
 chunk reads counted, the interpolation against scipy, bad input named.
 
-Orientations are seeded random rotations (rot4d_widget.rotation.random_rotation).
+Orientations are seeded random rotations (rot4d_widget.core.rotation.random_rotation).
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.fields import Field4D, FieldSlice, slice_field, _box_slice, _sample
-from rot4d_widget.rotation import random_rotation
-from rot4d_widget.source import SliceData, as_source
+from rot4d_widget.sources.fields import Field4D, FieldSlice, slice_field, _box_slice, _sample
+from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.sources.protocol import SliceData, as_source
 
 BOX = ((-1.0, 1.0),) * 4
 
@@ -67,7 +67,7 @@ def test_three_sphere_slices_to_a_sphere(kind):
         assert np.all(np.einsum("ij,ij->i", s.normals, s.vertices) > 0.9 * r)
     assert slice_field(field, random_rotation(rng), 0.85, 0.0).empty  # |c0| > R
     # the widget's slice turned in 3-D keeps points on the sphere and normals radial
-    from rot4d_widget.rotation import simple_rotation
+    from rot4d_widget.core.rotation import simple_rotation
 
     field.levels = 0.0
     t = (simple_rotation("xz", 0.7) @ simple_rotation("xy", -0.4))[:3, :3]
@@ -297,7 +297,7 @@ def test_numpy_dask_xarray_zarr_give_the_same_surface_and_read_few_chunks():
             xr.DataArray(da_.from_array(tzyx, chunks=chunks), dims=tuple(coords), coords=coords), w_per_unit=0.5),
     }
     assert fields["xarray dask"]._kind == "dask"  # stays lazy
-    from rot4d_widget.rotation import double_rotation
+    from rot4d_widget.core.rotation import double_rotation
 
     m = double_rotation("xw,yz", 0.12, 0.4)  # tilted a little into w: the cut spans few time steps
     ref = slice_field(fields["numpy"], m, at(fields["numpy"], 1 / 64), 0.5, 40)
@@ -427,7 +427,7 @@ def test_field_is_a_source():
     assert below.volume == pytest.approx(_box_slice(field, m, 0.0).volume, rel=0.03)
     assert field.slice(m, at(field, 0.0), coarse=True).readout[-1] == ("resolution", "32 (coarse copy)")
     # turned in 3-D = sliced at the turned orientation (what the widget shows at rest without resampling)
-    from rot4d_widget.rotation import simple_rotation
+    from rot4d_widget.core.rotation import simple_rotation
 
     field.levels = 0.5
     t = simple_rotation("xy", 0.4) @ simple_rotation("yz", -1.1)

@@ -16,8 +16,8 @@ import warnings
 import numpy as np
 import pytest
 
-from rot4d_widget.fields import COARSE_SAMPLES, Field4D, slice_field
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.sources.fields import COARSE_SAMPLES, Field4D, slice_field
+from rot4d_widget.core.rotation import random_rotation
 
 NT = 60
 assert NT > COARSE_SAMPLES
@@ -179,7 +179,7 @@ def test_a_dim_with_fewer_than_two_samples_is_named(n):
 
 
 def test_infinite_samples_are_reported_once_with_count_and_place():
-    from rot4d_widget.fields import NonFiniteWarning
+    from rot4d_widget.sources.fields import NonFiniteWarning
 
     a = tzyx_array()
     a[3, 1, 2, 4] = np.inf
@@ -203,7 +203,7 @@ def test_infinite_samples_are_reported_once_with_count_and_place():
 
 def test_infinite_samples_in_a_chunked_array_are_counted_with_the_coarse_copy():
     dsa = pytest.importorskip("dask.array")
-    from rot4d_widget.fields import NonFiniteWarning
+    from rot4d_widget.sources.fields import NonFiniteWarning
 
     a = tzyx_array()
     a[50, 1, 2, 4] = np.inf  # beyond the coarse copy's first 48 nodes

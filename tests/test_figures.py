@@ -12,7 +12,7 @@ from matplotlib.patches import Circle
 
 from rot4d_widget import RotationState, double_rotation, pentachoron, simple_rotation, slice_polytope
 from rot4d_widget import figures
-from rot4d_widget.figures import (
+from rot4d_widget.keep.figures import (
     CAMERA_DISTANCE,
     FIG4_ALPHA,
     TITLE_HEIGHT,
@@ -354,7 +354,7 @@ def test_empty_slice_draws_an_empty_panel():
 
 def test_figures_import_no_pyplot_and_no_widget_library():
     code = (
-        "import sys, rot4d_widget.figures\n"
+        "import sys, rot4d_widget.keep.figures\n"
         "bad = [m for m in ('matplotlib.pyplot', 'ipywidgets', 'pythreejs', 'ipyevents') if m in sys.modules]\n"
         "assert not bad, bad\n"
     )
@@ -397,8 +397,8 @@ def _ndc_pixel(p3, size):
 @pytest.mark.parametrize("size", [(600, 500), (320, 400)])
 def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path, size):
     from rot4d_widget import look, polytope
-    from rot4d_widget.figures import render_state
-    from rot4d_widget.rotation import random_rotation
+    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.core.rotation import random_rotation
 
     st = RotationState(matrix=random_rotation(4), c0=0.1)
     path = tmp_path / "s.png"
@@ -426,7 +426,7 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
 
 def test_render_state_display_options_and_colours(tmp_path):
     from rot4d_widget import look
-    from rot4d_widget.figures import render_state
+    from rot4d_widget.keep.figures import render_state
 
     st = RotationState()
     path = tmp_path / "c.png"
@@ -458,8 +458,8 @@ def test_render_state_display_options_and_colours(tmp_path):
 
 def test_render_state_field_levels_and_stack(tmp_path):
     from rot4d_widget import Field4D, look
-    from rot4d_widget.figures import render_state, state_source
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.keep.figures import render_state, state_source
+    from rot4d_widget.sources.tomography import StackSource
 
     f = Field4D.from_function(lambda x, y, z, w: 1 - (x * x + y * y + z * z) - 0.3 * w,
                               [(-1.2, 1.2)] * 3 + [(-1.0, 1.0)], resolution=24, levels=(0.4,))
@@ -498,7 +498,7 @@ def test_render_state_field_levels_and_stack(tmp_path):
     (dict(path="x.gif"), ValueError, "end in one of"),
 ])
 def test_render_state_bad_input(kwargs, exc, match):
-    from rot4d_widget.figures import render_state
+    from rot4d_widget.keep.figures import render_state
 
     state = kwargs.pop("state", RotationState())
     with pytest.raises(exc, match=match):

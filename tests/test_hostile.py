@@ -19,11 +19,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rot4d_widget import Rot4DWidget, SliceData
-from rot4d_widget.fields import Field4D
-from rot4d_widget.keyhold import steps_for
-from rot4d_widget.keymap import DEFAULT_KEYMAP
-from rot4d_widget.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
-from rot4d_widget.tomography import SPACING_MAX, SPACING_MIN
+from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.view.keyhold import steps_for
+from rot4d_widget.core.keymap import DEFAULT_KEYMAP
+from rot4d_widget.core.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
+from rot4d_widget.sources.tomography import SPACING_MAX, SPACING_MIN
 from test_widget import down, run_ticker, up, xw_steps
 
 pytestmark = pytest.mark.usefixtures("recording_comms")

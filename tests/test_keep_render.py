@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rot4d_widget.recording import Recorder, render_animation, render_frames
-from rot4d_widget.state import RotationState
+from rot4d_widget.keep.recording import Recorder, render_animation, render_frames
+from rot4d_widget.core.state import RotationState
 
 
 def _held_4(steps=6):
@@ -36,7 +36,7 @@ def _filled(rgb, background=(1.0, 1.0, 1.0)):
 
 @pytest.mark.parametrize("source", ["24-cell", "5-cell"])
 def test_render_state_fills_most_of_the_picture(tmp_path, source):
-    from rot4d_widget.figures import render_state
+    from rot4d_widget.keep.figures import render_state
 
     path = tmp_path / "v.png"
     render_state(RotationState(c0=0.1), source, path, size=(600, 500), dpi=100)
@@ -56,7 +56,7 @@ def test_animation_frames_fill_the_picture_and_keep_one_frame(tmp_path):
 
 def test_annotation_is_written_when_asked(tmp_path):
     from rot4d_widget import datasets
-    from rot4d_widget.figures import render_state
+    from rot4d_widget.keep.figures import render_state
 
     st = RotationState(theta0=np.pi / 16, c0=0.25)
     fig = render_state(st, "24-cell", annotate=True, size=(300, 250), dpi=50)
@@ -93,7 +93,7 @@ def test_progress_callback_counts_up_to_the_frames(tmp_path):
 
 
 def test_progress_shows_only_after_a_second_and_only_on_a_terminal():
-    from rot4d_widget.progress import progress
+    from rot4d_widget.view.progress import progress
 
     class Tty(io.StringIO):
         def isatty(self):
@@ -120,7 +120,7 @@ def test_progress_does_not_import_pythreejs():
     import subprocess
     import sys
 
-    code = "import sys, rot4d_widget.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
+    code = "import sys, rot4d_widget.view.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
 
@@ -133,9 +133,9 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     from matplotlib.figure import Figure
 
     from rot4d_widget import figures, look
-    from rot4d_widget.polytopes import polytope
-    from rot4d_widget.rotation import random_rotation
-    from rot4d_widget.slicing import slice_polytope
+    from rot4d_widget.geometry.polytopes import polytope
+    from rot4d_widget.core.rotation import random_rotation
+    from rot4d_widget.geometry.slicing import slice_polytope
 
     p = polytope("24-cell")
     s = slice_polytope(p, random_rotation(np.random.default_rng(3)), 0.1)
@@ -166,7 +166,7 @@ def test_animation_frames_are_render_states_pictures(source):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from rot4d_widget import datasets, figures
-    from rot4d_widget.recording import animation_states
+    from rot4d_widget.keep.recording import animation_states
 
     rec = _held_4(4)
     src = datasets.moving_sphere(resolution=16) if source == "field" else source

@@ -1,4 +1,4 @@
-"""rot4d_widget.look: one palette, scale, camera and default radii for the figures and the live view."""
+"""rot4d_widget.core.look: one palette, scale, camera and default radii for the figures and the live view."""
 
 import math
 import subprocess
@@ -6,13 +6,13 @@ import sys
 
 import numpy as np
 
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from rot4d_widget import buffers, figures, look, pentachoron, polytope, slice_polytope
-from rot4d_widget.figures import draw_slice, panel_style, render_slice
+from rot4d_widget.keep.figures import draw_slice, panel_style, render_slice
 
 
 def _projected_corners(slice_, k, scale):
@@ -183,7 +183,7 @@ def test_panels_of_a_grid_share_the_live_cameras_frame():
 
 def test_look_imports_numpy_only():
     code = (
-        "import sys, rot4d_widget.look\n"
+        "import sys, rot4d_widget.core.look\n"
         "bad = [m for m in ('matplotlib', 'ipywidgets', 'pythreejs', 'ipyevents', 'traitlets') if m in sys.modules]\n"
         "assert not bad, bad\n"
     )

@@ -12,10 +12,10 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 
 from rot4d_widget import Field4D  # noqa: E402
-from rot4d_widget.export import load_mesh, slice_mesh  # noqa: E402
-from rot4d_widget.rotation import random_rotation  # noqa: E402
-from rot4d_widget.source import PolytopeSource  # noqa: E402
-from rot4d_widget.tomography import StackSource  # noqa: E402
+from rot4d_widget.keep.export import load_mesh, slice_mesh  # noqa: E402
+from rot4d_widget.core.rotation import random_rotation  # noqa: E402
+from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
+from rot4d_widget.sources.tomography import StackSource  # noqa: E402
 
 R = 1.5
 EXTENT = ((2.0, 6.0), (2.0, 6.0), (2.0, 6.0), (100.0, 160.0))

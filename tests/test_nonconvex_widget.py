@@ -7,7 +7,7 @@ import pytest
 
 from mesh_shapes import tesseract_union
 from rot4d_widget import polytope
-from rot4d_widget.tomography import StackSource
+from rot4d_widget.sources.tomography import StackSource
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

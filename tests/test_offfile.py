@@ -1,4 +1,4 @@
-"""The 4OFF reader (rot4d_widget.offfile) reads one line at a time and trusts no size in the file:
+"""The 4OFF reader (rot4d_widget.geometry.offfile) reads one line at a time and trusts no size in the file:
 garbage, binary files and absurd counts are refused at once, naming the file and the line."""
 
 import io
@@ -9,8 +9,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from rot4d_widget.offfile import MAX_LINE_CHARS, read_off
-from rot4d_widget.polytopes import polytope
+from rot4d_widget.geometry.offfile import MAX_LINE_CHARS, read_off
+from rot4d_widget.geometry.polytopes import polytope
 
 MB = 1 << 20
 TESSERACT = polytope("8-cell").to_off()

@@ -8,8 +8,8 @@ import pytest
 from mesh_shapes import duoprism, duoprism_mesh, prism_mesh, tesseract_union, tesseract_union_mesh
 from reference_geometry import random_rotation
 from rot4d_widget import Polytope, polytope, slice_polytope
-from rot4d_widget.offfile import read_off
-from rot4d_widget.polytopes import MeshError
+from rot4d_widget.geometry.offfile import read_off
+from rot4d_widget.geometry.polytopes import MeshError
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 

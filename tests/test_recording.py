@@ -1,4 +1,4 @@
-"""Issue 12: recorded key sequences (rot4d_widget.recording): record, save, replay, animate."""
+"""Issue 12: recorded key sequences (rot4d_widget.keep.recording): record, save, replay, animate."""
 
 import json
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget import DEFAULT_KEYMAP, RotationState
-from rot4d_widget.recording import (
+from rot4d_widget.keep.recording import (
     Recorder,
     Recording,
     Setting,
@@ -17,7 +17,7 @@ from rot4d_widget.recording import (
     paper_recording,
     render_animation,
 )
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 
 
 class Clock:
@@ -99,7 +99,7 @@ def test_a_bounded_recorder_still_replays_to_the_live_state():
 
 
 def test_source_actions_replay_on_a_source_and_are_skipped_without():
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     src = StackSource("5-cell", slices=3)
     st = RotationState()
@@ -281,7 +281,7 @@ def test_source_settings_are_recorded_saved_and_loaded(tmp_path):
 
 
 def test_replay_sets_the_source_settings_on_a_stack_and_its_inner_field():
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     r, st = _source_recording()
     field = _ball_field()
@@ -327,12 +327,12 @@ def test_a_single_view_given_stack_settings_is_refused_before_any_change():
         r.replay(state, field)
     assert field.levels == before and np.array_equal(state.matrix, np.eye(4))
     with pytest.raises(ValueError, match="sets 'levels'.*iso levels"):
-        r.replay(None, __import__("rot4d_widget.tomography").tomography.StackSource("5-cell", slices=2))
+        r.replay(None, __import__("rot4d_widget.sources.tomography").tomography.StackSource("5-cell", slices=2))
     assert np.array_equal(r.replay().matrix, r.replay(None, None).matrix)  # skipped without a source
 
 
 def test_animations_follow_the_source_settings_on_their_copy():
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     r, st = _source_recording()
     field = _ball_field()
@@ -350,7 +350,7 @@ def test_animations_follow_the_source_settings_on_their_copy():
 def test_render_frames_follow_the_source_settings(monkeypatch):
     """Each frame is drawn with the settings recorded up to it; the keywords given are the start."""
     from rot4d_widget import figures
-    from rot4d_widget.recording import render_frames
+    from rot4d_widget.keep.recording import render_frames
 
     drawn = []
 
@@ -374,7 +374,7 @@ def test_render_frames_follow_the_source_settings(monkeypatch):
 
 
 def test_a_bounded_recorder_folds_source_settings_into_the_starting_ones():
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     clock = Clock()
     st = RotationState()
@@ -397,7 +397,7 @@ def test_a_bounded_recorder_folds_source_settings_into_the_starting_ones():
 
 
 def test_the_source_settings_at_the_start_are_kept_and_replayed_first(tmp_path):
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     st = RotationState()
     rec = Recorder(st, clock=Clock(), source_settings={"slices": 4, "levels": (1.5,)})

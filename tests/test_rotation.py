@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from rot4d_widget import double_rotation, simple_rotation
-from rot4d_widget.rotation import PLANES, as_rotation_matrix, reorthonormalize
+from rot4d_widget.core.rotation import PLANES, as_rotation_matrix, reorthonormalize
 
 angles = st.floats(-10.0, 10.0, allow_nan=False)
 

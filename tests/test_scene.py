@@ -1,4 +1,4 @@
-"""rot4d_widget.scene without a browser: what the scene is made of and what one update sends.
+"""rot4d_widget.view.scene without a browser: what the scene is made of and what one update sends.
 
 Comm messages are recorded by a comm that serialises like ipykernel's
 (tests/recording_comm.py, the ipywidgets tests' dummy-comm pattern), so counts
@@ -18,7 +18,7 @@ import re
 
 import numpy as np
 
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 import pytest
 import pythreejs as p3
 from ipywidgets.widgets import widget as ipywidget_module
@@ -26,12 +26,12 @@ from ipywidgets.widgets import widget as ipywidget_module
 import rot4d_widget
 from rot4d_widget import buffers as bf
 from rot4d_widget import look, polytope
-from rot4d_widget.polytopes import POLYTOPE_NAMES
-from rot4d_widget.scene import Scene, shader_source
-from rot4d_widget.source import PolytopeSource
+from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.view.scene import Scene, shader_source
+from rot4d_widget.sources.protocol import PolytopeSource
 
 #: The shipped GLSL files (package data).
-GLSL = pathlib.Path(rot4d_widget.__file__).with_name("glsl")
+GLSL = pathlib.Path(rot4d_widget.__file__).parent / "view" / "glsl"
 
 #: Bytes of JSON around the binary array in one buffer message (method, buffer path, dtype,
 #: shape, the sequence number); measured 195 with ipykernel's packer.

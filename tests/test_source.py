@@ -13,14 +13,14 @@ import re
 import ipywidgets
 import numpy as np
 
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 import pytest
 
 from rot4d_widget import SliceData, polytope, simple_rotation, slice_polytope
-from rot4d_widget.look import REFERENCE_RADIUS
+from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget import PolytopeSource, SourceAction
-from rot4d_widget.source import as_source, census_text
-from rot4d_widget.widget import Rot4DWidget
+from rot4d_widget.sources.protocol import as_source, census_text
+from rot4d_widget.view.widget import Rot4DWidget
 
 from widget_time import service
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget import DEFAULT_KEYMAP, RotationState, double_rotation, simple_rotation
-from rot4d_widget.state import ALPHA_STEP_FRACTION, DEFAULT_THETA0, PAPER_ALPHA_RATIO, THETA0_FACTOR
+from rot4d_widget.core.state import ALPHA_STEP_FRACTION, DEFAULT_THETA0, PAPER_ALPHA_RATIO, THETA0_FACTOR
 
 SIMPLE_KEYS = {"2": "xy", "3": "xz", "4": "xw", "6": "yz", "8": "yw", "c": "zw"}
 DOUBLE_KEYS = {"y": "xy,zw", "z": "xz,yw", "w": "xw,yz"}
@@ -297,7 +297,7 @@ def test_custom_actions_change_nothing_in_the_core():
 # ----------------------------------------------------------------- to_dict / from_dict (issue 12)
 def _walked_state():
     from rot4d_widget import Action
-    from rot4d_widget.rotation import random_rotation
+    from rot4d_widget.core.rotation import random_rotation
 
     st = RotationState(0.13, alpha=0.05, c0=0.1, c0_step=0.03, matrix=random_rotation(7))
     st.keymap = st.keymap.extended({"o": Action("custom", name="level up", sign=1, text="raise the level")})
@@ -344,7 +344,7 @@ def test_a_loaded_state_is_where_reset_returns():
 
 
 def test_from_dict_reorthonormalises_a_nearly_orthogonal_orientation():
-    from rot4d_widget.rotation import random_rotation
+    from rot4d_widget.core.rotation import random_rotation
 
     m = random_rotation(5)
     d = RotationState(matrix=m).to_dict()
@@ -396,7 +396,7 @@ def test_copy_is_independent_and_keeps_the_reset_point():
 
 def test_without_source_keys_lets_a_widget_extend_a_stored_keymap_again():
     from rot4d_widget import Action
-    from rot4d_widget.state import without_source_keys
+    from rot4d_widget.core.state import without_source_keys
 
     custom = {"o": Action("custom", name="level up", sign=1), "x": Action("custom", name="phase", sign=1)}
     stored = RotationState.from_dict(RotationState(keymap=DEFAULT_KEYMAP.extended(custom)).to_dict()).keymap

@@ -14,11 +14,11 @@ from scipy.spatial import ConvexHull
 
 from reference_geometry import random_rotation
 from rot4d_widget import look, polytope, slice_polytope
-from rot4d_widget.fields import Field4D
-from rot4d_widget.figures import render_tomography
-from rot4d_widget.rotation import simple_rotation
-from rot4d_widget.source import PolytopeSource
-from rot4d_widget.tomography import (
+from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.keep.figures import render_tomography
+from rot4d_widget.core.rotation import simple_rotation
+from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.tomography import (
     ARRANGEMENTS,
     GAP,
     OVAL_PARABOLA,

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from rot4d_widget import RotationState, export
-from rot4d_widget.export import load_state
-from rot4d_widget.offfile import read_off
-from rot4d_widget.recording import Recording
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.keep.export import load_state
+from rot4d_widget.geometry.offfile import read_off
+from rot4d_widget.keep.recording import Recording
+from rot4d_widget.core.rotation import random_rotation
 
 #: (looked up so that the tests also run, and fail for the right reason, on a version without it)
 CodeNotAllowed = getattr(export, "CodeNotAllowed", ValueError)
@@ -100,7 +100,7 @@ def test_a_state_file_with_a_source_passed_in_needs_no_code(planted, tmp_path):
 
 
 def test_a_recording_naming_a_module_runs_nothing(planted, tmp_path):
-    from rot4d_widget.tomography import StackSource
+    from rot4d_widget.sources.tomography import StackSource
 
     name, imported, called = planted
     spec = f"{name}:ball"

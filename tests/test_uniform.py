@@ -1,4 +1,4 @@
-"""The uniform polychora of rot4d_widget.uniform: counts, geometry, combinatorics, names.
+"""The uniform polychora of rot4d_widget.geometry.uniform: counts, geometry, combinatorics, names.
 
 Published (V, E, F, C) are from the English Wikipedia articles on the uniform 4-polytopes (the
 "Uniform 4-polytope" list and the per-family articles, e.g. "Runcinated 120-cells", "Truncated
@@ -13,7 +13,7 @@ import pytest
 from scipy.spatial import ConvexHull, cKDTree
 
 from rot4d_widget import uniform
-from rot4d_widget.polytopes import Polytope, polytope
+from rot4d_widget.geometry.polytopes import Polytope, polytope
 
 PUBLISHED = {
     # A4
@@ -375,7 +375,7 @@ def test_build_gives_a_polytope(name):
 
 from reference_geometry import merged_hull_faces, random_rotation, slice_volume_by_halfspaces  # noqa: E402
 
-from rot4d_widget.slicing import slice_polytope  # noqa: E402
+from rot4d_widget.geometry.slicing import slice_polytope  # noqa: E402
 
 SLICE_SAMPLE = ["rectified 5-cell", "runcinated 5-cell", "truncated tesseract", "truncated 16-cell",
                 "cantellated 24-cell", "snub 24-cell", "grand antiprism", "5-7 duoprism", "3-32 duoprism",

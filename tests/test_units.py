@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from rot4d_widget.keyhold import KeyRepeater
-from rot4d_widget.pump import UpdatePump
+from rot4d_widget.view.keyhold import KeyRepeater
+from rot4d_widget.view.pump import UpdatePump
 from rot4d_widget import readout as ro
-from rot4d_widget.rotation import simple_rotation
+from rot4d_widget.core.rotation import simple_rotation
 
 
 # ------------------------------------------------------------------ key repeat

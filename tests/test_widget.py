@@ -23,10 +23,10 @@ from widget_time import service
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget import widget as wmod
-from rot4d_widget.keymap import RESERVED_KINDS
-from rot4d_widget.look import REFERENCE_RADIUS
-from rot4d_widget.state import DEFAULT_THETA0
-from rot4d_widget.widget import Rot4DWidget
+from rot4d_widget.core.keymap import RESERVED_KINDS
+from rot4d_widget.core.look import REFERENCE_RADIUS
+from rot4d_widget.core.state import DEFAULT_THETA0
+from rot4d_widget.view.widget import Rot4DWidget
 
 
 # comms: tests/recording_comm.py, installed for every test of this module
@@ -85,7 +85,7 @@ class FakeScene:
 
     @staticmethod
     def check_display(options):
-        from rot4d_widget.scene import Scene
+        from rot4d_widget.view.scene import Scene
 
         return Scene.check_display(options)
 

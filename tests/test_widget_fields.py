@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget import look
-from rot4d_widget.fields import Field4D
+from rot4d_widget.sources.fields import Field4D
 from test_widget import down, up
 from test_widget_scene import drawn, run_ticker
 from widget_time import service
@@ -204,7 +204,7 @@ def test_the_readme_field_example_runs_as_written_and_shows_a_surface(clock):
     import pathlib
     import re
 
-    from rot4d_widget.widget import Rot4DWidget as Real
+    from rot4d_widget.view.widget import Rot4DWidget as Real
 
     readme = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
     blocks = [b for b in re.findall(r"```python\n(.*?)```", readme, re.S) if "Field4D(" in b]

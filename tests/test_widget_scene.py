@@ -18,14 +18,14 @@ from collections import Counter
 
 import numpy as np
 
-from rot4d_widget.rotation import random_rotation
+from rot4d_widget.core.rotation import random_rotation
 import pytest
 from ipywidgets.widgets import widget as ipywidget_module
 
 from rot4d_widget import buffers as bf
 from rot4d_widget import look, polytope
-from rot4d_widget.polytopes import POLYTOPE_NAMES
-from rot4d_widget.widget import Rot4DWidget
+from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.view.widget import Rot4DWidget
 from test_widget import down, up, xw_steps
 from widget_time import service
 

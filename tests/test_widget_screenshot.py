@@ -12,7 +12,7 @@ import io
 import pytest
 from PIL import Image
 
-from rot4d_widget.companion import _png_from_data_url
+from rot4d_widget.view.companion import _png_from_data_url
 from test_widget import front_end_view_count
 
 pytestmark = pytest.mark.usefixtures("recording_comms")

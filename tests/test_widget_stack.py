@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rot4d_widget.tomography import StackSource
+from rot4d_widget.sources.tomography import StackSource
 from test_widget import down, up
 from test_widget_scene import drawn, run_ticker
 

@@ -46,7 +46,7 @@ SETUP_CELL = '''\
 import math, os, time
 import numpy as np
 from rot4d_widget import Rot4DWidget
-from rot4d_widget.datasets import moving_sphere
+from rot4d_widget.sources.datasets import moving_sphere
 
 
 class SlowSource:

@@ -7,10 +7,10 @@ view from the paper's viewpoint, the point (x, y, z) = (0, 0, ``distance``) look
     x' = x d / (d - z),    y' = y d / (d - z),
 
 and every radius at that point is multiplied by the same factor ``d / (d - z)``.  The frame is the
-live view's camera (:mod:`rot4d_widget.look`): a vertical field of view of ``fov`` = 40 degrees, so
+live view's camera (:mod:`rot4d_widget.core.look`): a vertical field of view of ``fov`` = 40 degrees, so
 the axes span ``|y'| <= d tan(fov / 2)`` and ``|x'| <=`` that times the panel's aspect, and a point
 sits in the panel where a three.js ``PerspectiveCamera`` at (0, 0, 5) with that fov and aspect puts
-it.  Palette, scale, default radii and colours come from :mod:`rot4d_widget.look` too, so a 4-D
+it.  Palette, scale, default radii and colours come from :mod:`rot4d_widget.core.look` too, so a 4-D
 cell has the same colour here and in the widget.  Artists are
 painted back to front (painter's algorithm, by the depth of a ball's centre, a bar's midpoint, a
 face's centroid), so nearer things cover farther ones.
@@ -45,12 +45,12 @@ from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from . import look
-from .look import REFERENCE_RADIUS
-from .polytopes import Polytope, pentachoron
-from .polytopes import polytope as _named_polytope
-from .slicing import Slice, slice_polytope
-from .state import PAPER_ALPHA_RATIO, RotationState
+from ..core import look
+from ..core.look import REFERENCE_RADIUS
+from ..geometry.polytopes import Polytope, pentachoron
+from ..geometry.polytopes import polytope as _named_polytope
+from ..geometry.slicing import Slice, slice_polytope
+from ..core.state import PAPER_ALPHA_RATIO, RotationState
 
 __all__ = [
     "CAMERA_DISTANCE",
@@ -869,7 +869,7 @@ def render_tomography(
     ``source`` is a polytope name, a Polytope or any source (a `Field4D` ...), ``matrix`` the
     (4, 4) orientation (identity by default); ``slices``, ``spacing`` (None: 2 size / N),
     ``arrangement`` ("oval", "grid", "stack") and ``color_by`` ("w" or "cell") as in
-    :class:`rot4d_widget.tomography.StackSource`, whose slice this draws: each slice is placed
+    :class:`rot4d_widget.sources.tomography.StackSource`, whose slice this draws: each slice is placed
     at its arrangement's centre and scale, the whole scene scaled to the live view's displayed
     size and seen through its camera (``width`` / ``height`` inches: the default 6 x 5 has the
     canvas's 600 x 500 aspect).  Slices are painted back to front by the depth of their centres
@@ -893,8 +893,8 @@ def render_tomography(
     a stack's slices' w, and a legend of the levels' or slices' colours: `annotation`), or a
     string written as the first line of that text.
     """
-    from .source import as_source
-    from .tomography import StackSource
+    from ..sources.protocol import as_source
+    from ..sources.tomography import StackSource
 
     src = source if isinstance(source, StackSource) else None
     if src is None:
@@ -1400,8 +1400,8 @@ def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=
     `StackSource` (N = 1 is today's single slice, point for point).  The source given is not
     changed: a field whose ``levels`` differ is copied (shallowly, sharing its array), a stack is
     rebuilt around its inner source."""
-    from .source import as_source
-    from .tomography import StackSource
+    from ..sources.protocol import as_source
+    from ..sources.tomography import StackSource
 
     src = as_source(source)
     inner, color_by, n, spc, arr = src, "w", 1, None, "oval"
@@ -1460,7 +1460,7 @@ def render_state(
 
     ``state`` is a `RotationState` (its matrix and c0 are used); ``source`` a polytope name, a
     Polytope, a `Field4D`, a `StackSource` or any source.  The keywords are the widget's
-    settings, by the names of its traits (`rot4d_widget.export.save_state` stores them so):
+    settings, by the names of its traits (`rot4d_widget.keep.export.save_state` stores them so):
     ``levels`` (a field's iso levels), ``slices``, ``spacing``, ``arrangement`` (parallel
     slices: `state_source`), ``color_by`` (``"group"`` or one colour), ``group_colors``,
     ``face_opacity``, ``ball_radius`` / ``bar_radius`` (displayed units; default as the widget

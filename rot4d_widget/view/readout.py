@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .look import number_text
+from ..core.look import number_text
 
 __all__ = ["readout_html", "help_html", "gizmo_svg", "gauge_html", "angle_text", "number_text", "STYLE"]
 

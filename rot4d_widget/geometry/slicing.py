@@ -68,7 +68,7 @@ Scale: the slicer cuts the polytope's *unit vertices* (its vertices divided by
 a power of two, so the largest |coordinate| is in [1, 2); exact) at
 ``c0 / unit`` and multiplies the slice's vertices by ``unit`` (exact) and its
 volume by ``unit**3``: a polytope scaled by ``s`` (any scale in
-`rot4d_widget.polytopes.COORDINATE_RANGE`, 1e-150 to 1e150) has the slices
+`rot4d_widget.geometry.polytopes.COORDINATE_RANGE`, 1e-150 to 1e150) has the slices
 of the unscaled one at ``c0 / s``, scaled by ``s``.  Only the volume can leave
 float64's range (coordinates beyond about 5e102 give ``inf``, below about
 2e-103 it underflows towards 0; ``dim`` still says the slice is solid).
@@ -90,10 +90,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._arrays import sealed as _sealed
+from ..core._arrays import sealed as _sealed
 
 from .polytopes import Polytope, _owner, polytope as _get_polytope
-from .rotation import as_rotation_matrix
+from ..core.rotation import as_rotation_matrix
 
 __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
 

@@ -25,7 +25,7 @@ nothing: a ball with flag 0 is moved outside the clip volume, a bar of length
 row is a hidden row, and hidden rows cost bytes but never pixels.
 
 Positions are multiplied by the scene's ``scale`` here (the 3-D view shows
-every source the size of the pentachoron, `rot4d_widget.look.REFERENCE_RADIUS`).  A 24-bit colour packed into a
+every source the size of the pentachoron, `rot4d_widget.core.look.REFERENCE_RADIUS`).  A 24-bit colour packed into a
 float32 is exact (float32 holds every integer below 2**24); the face shader
 unpacks it with ``floor``.
 
@@ -39,7 +39,7 @@ import math
 
 import numpy as np
 
-from .look import as_rgb, cell_palette, group_palette
+from ..core.look import as_rgb, cell_palette, group_palette
 
 __all__ = [
     "ROW_FLOATS",
@@ -109,7 +109,7 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
     It is a starting size, not a bound: the scene grows the table safely if a
     larger slice ever comes.
     """
-    from .rotation import random_rotation
+    from ..core.rotation import random_rotation
 
     rng = np.random.default_rng(seed)
     most = 0
@@ -121,7 +121,7 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
 def slice_rows(
     data, *, scale: float = 1.0, group_rgb=None, capacity: int | None = None, eye=None, single_rgb=None
 ) -> np.ndarray:
-    """The row table of a slice (`rot4d_widget.source.SliceData`): (capacity, 20) float32, C-contiguous.
+    """The row table of a slice (`rot4d_widget.sources.protocol.SliceData`): (capacity, 20) float32, C-contiguous.
 
     Parameters
     ----------
@@ -281,7 +281,7 @@ def surface_arrays(data, *, scale: float = 1.0, group_rgb=None, eye=None, single
             "lo": [float(x) for x in lo], "span": [float(x) for x in span]}
 
 
-# -- colours (the palette itself lives in rot4d_widget.look) --------------------
+# -- colours (the palette itself lives in rot4d_widget.core.look) --------------------
 
 
 def pack_rgb(rgb) -> np.ndarray:

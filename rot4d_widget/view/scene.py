@@ -10,11 +10,11 @@ Layers
 ------
 Balls at a slice's points, bars along its segments and translucent faces
 coloured by group, seen by a perspective camera at (0, 0, 5) looking down -z
-(the paper's view; `rot4d_widget.look`), turned with the mouse by
+(the paper's view; `rot4d_widget.core.look`), turned with the mouse by
 OrbitControls (keys disabled).  Every source is scaled by
 ``REFERENCE_RADIUS / source.size`` so it appears the size of the pentachoron.
 Each layer is one instanced mesh with its own `ShaderMaterial` (GLSL in
-``rot4d_widget/glsl/``): balls and bars are ray-cast impostors (exact
+``rot4d_widget/view/glsl/``): balls and bars are ray-cast impostors (exact
 perspective silhouette, depth written), faces are instanced triangles lit at
 their corners.  A new layer (an isosurface with normals, labels) is one more
 mesh reading its own columns.
@@ -22,7 +22,7 @@ mesh reading its own columns.
 One update = one message, never drawn half-applied
 --------------------------------------------------
 All layers read ONE `InstancedInterleavedBuffer` holding the row table of
-`rot4d_widget.buffers`.  ``show(data)`` assigns a new array to it and, in the
+`rot4d_widget.view.buffers`.  ``show(data)`` assigns a new array to it and, in the
 same ``hold_sync`` message, the update's sequence number (a synced trait the
 companion reads).  Balls, bars and faces come from the same buffer, so a
 frame can never show parts of two updates.
@@ -72,7 +72,7 @@ import pythreejs as p3
 from traitlets import CFloat, CInt, Dict, List
 
 from . import buffers as bf
-from . import look
+from ..core import look
 
 __all__ = ["Scene", "shader_source"]
 
@@ -82,7 +82,7 @@ _INCLUDE = re.compile(r"^// @include (\S+)$", re.M)
 
 @functools.lru_cache(maxsize=None)
 def shader_source(name: str) -> str:
-    """The GLSL of ``rot4d_widget/glsl/<name>`` with its ``// @include FILE`` lines expanded."""
+    """The GLSL of ``rot4d_widget/view/glsl/<name>`` with its ``// @include FILE`` lines expanded."""
     text = (_GLSL / name).read_text()
     return _INCLUDE.sub(lambda m: shader_source(m.group(1)), text)
 
@@ -181,7 +181,7 @@ class Scene:
     n_groups : int >= 1
         Colour groups (sets the palette's size).
     capacity : int >= 1
-        Initial row capacity (`rot4d_widget.buffers.estimate_capacity`).
+        Initial row capacity (`rot4d_widget.view.buffers.estimate_capacity`).
     width, height : int
         Canvas size in CSS pixels, 16 ... 8192.  Default 600 x 500.
     ball_radius, bar_radius : float > 0
@@ -189,7 +189,7 @@ class Scene:
     face_opacity : float in [0, 1]
     background, ball_color, bar_color : '#rgb', '#rrggbb' or (r, g, b) in [0, 1]
     group_colors : sequence of such colours, at least one per group, optional
-        Default `rot4d_widget.look.group_palette`.
+        Default `rot4d_widget.core.look.group_palette`.
     show_balls, show_bars, show_faces : bool
     antialias : bool
         WebGL multisampling (default False).
@@ -492,7 +492,7 @@ class Scene:
 
     def palette(self, n_groups: int) -> np.ndarray:
         """(n, 3) colours for ``n_groups`` groups: the ``group_colors`` given, followed where they
-        run out by `rot4d_widget.look.group_palette` (a source's group count may change at run
+        run out by `rot4d_widget.core.look.group_palette` (a source's group count may change at run
         time: a stack taken down to one slice shows its inner source's cells)."""
         n = max(int(n_groups), 1)
         if self._user_rgb is None:
@@ -503,7 +503,7 @@ class Scene:
 
     # -- the update --------------------------------------------------------
     def show(self, data, *, single_rgb=None, group_rgb=None, force=False) -> bool:
-        """Show a slice (`rot4d_widget.source.SliceData`); True if an update was sent.
+        """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
         buffer plus the new `update_id`.  Sends nothing and returns False if

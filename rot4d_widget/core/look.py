@@ -1,7 +1,7 @@
 """How things look: the one place for the palette, reference scale, camera, default radii and colours.
 
-The static figures (`rot4d_widget.figures`, matplotlib) and the live view (`rot4d_widget.scene` and
-`rot4d_widget.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
+The static figures (`rot4d_widget.keep.figures`, matplotlib) and the live view (`rot4d_widget.view.scene` and
+`rot4d_widget.view.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
 same in both.  numpy only: no widget library, no matplotlib.
 
 Scale
@@ -148,7 +148,7 @@ def group_palette(n_cells: int) -> np.ndarray:
     return np.clip(rgb, 0.0, 1.0).astype(np.float32)
 
 
-#: The name the live view has used (``rot4d_widget.buffers.cell_palette``).
+#: The name the live view has used (``rot4d_widget.view.buffers.cell_palette``).
 cell_palette = group_palette
 
 

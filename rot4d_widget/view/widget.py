@@ -7,12 +7,12 @@ The only module that imports ipyevents.  A key travels one way::
 
 The widget wires small units together and owns the public API and traits:
 
-* `rot4d_widget.keyhold.KeyRepeater` -- which steps held keys make when
+* `rot4d_widget.view.keyhold.KeyRepeater` -- which steps held keys make when
   (hold delay, tick rate, no burst after a stall);
-* `rot4d_widget.pump.UpdatePump` -- one update in flight, the "drawn"
+* `rot4d_widget.view.pump.UpdatePump` -- one update in flight, the "drawn"
   acknowledgement, the timeout, the ticker thread, the lock;
-* `rot4d_widget.readout` -- the readout and help HTML;
-* `rot4d_widget.scene.Scene` -- everything pythreejs.
+* `rot4d_widget.view.readout` -- the readout and help HTML;
+* `rot4d_widget.view.scene.Scene` -- everything pythreejs.
 
 Rotation stops on keyup, on mouseleave, and when the companion reports that
 the page or window lost focus (a keyup after that never arrives).  A widget
@@ -48,13 +48,13 @@ import numpy as np
 import traitlets
 from ipyevents import Event
 
-from . import look
+from ..core import look
 from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
-from .keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
+from ..core.keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
-from .source import BadSlice, as_source, check_slice, data_w_text, w_frame
-from .state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
+from ..sources.protocol import BadSlice, as_source, check_slice, data_w_text, w_frame
+from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta, _finite, _theta0, without_source_keys
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION", "READOUT_PERIOD"]
 
@@ -106,12 +106,12 @@ class Rot4DWidget(widgets.HBox):
         A polytope name (``"5-cell"`` default, ``"8-cell"``, ``"16-cell"``,
         ``"24-cell"``, ``"600-cell"``, ``"120-cell"`` or an alias), a
         `Polytope`, or any object following the source protocol
-        (`rot4d_widget.source`).
+        (`rot4d_widget.sources.protocol`).
     theta0, alpha, c0 :
         Initial step angle (radians, in (0, pi]), double-rotation angle alpha
         (default: the paper's ratio, ``beta = theta0 - alpha``) and slice level
         c0 in the source's w units (a field's data w: seconds for a time in
-        seconds; `rot4d_widget.source.w_frame`), as in `RotationState`; default
+        seconds; `rot4d_widget.sources.protocol.w_frame`), as in `RotationState`; default
         the source's centre (0 for a polytope, the middle time for a field).
     keymap : Keymap
         Key bindings (default: the paper's tables plus r, +/-, ?).
@@ -122,7 +122,7 @@ class Rot4DWidget(widgets.HBox):
         Canvas size in pixels (default 600 x 500).
     ball_radius, bar_radius : float, optional
         In displayed units (every source is drawn with circumradius
-        `rot4d_widget.look.REFERENCE_RADIUS`).  Default from the source's edge
+        `rot4d_widget.core.look.REFERENCE_RADIUS`).  Default from the source's edge
         length (polytopes) or its first slice.
     face_opacity : float in [0, 1]
     background : colour ('#rrggbb', '#rgb' or three floats in [0, 1])
@@ -134,7 +134,7 @@ class Rot4DWidget(widgets.HBox):
         WebGL multisampling (default False).
     slices, spacing, arrangement : int, float, str, optional
         Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
-        `rot4d_widget.tomography.StackSource`), placed "oval" (on a parabola, the slice at
+        `rot4d_widget.sources.tomography.StackSource`), placed "oval" (on a parabola, the slice at
         c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the
         spacing (default 2 * size / N).  Also traits: setting `slices` (or pressing n) on a
         single view turns it into parallel slices (oval, default spacing).
@@ -229,7 +229,7 @@ class Rot4DWidget(widgets.HBox):
                 raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {_title(src)}")
             src.levels = levels
         if slices is not None:  # parallel slices (4-D tomography): a source that wraps the source
-            from .tomography import StackSource
+            from ..sources.tomography import StackSource
 
             src = StackSource(src, slices=slices, spacing=spacing, arrangement=arrangement)
         elif spacing is not None:
@@ -291,7 +291,7 @@ class Rot4DWidget(widgets.HBox):
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
             name=f"rot4d-ticker-{id(self):x}",
         )
-        from .recording import Recorder
+        from ..keep.recording import Recorder
 
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
         self._recorder = Recorder(state, clock=self._pump.clock, source_settings=_source_settings(src))
@@ -399,7 +399,7 @@ class Rot4DWidget(widgets.HBox):
 
     @property
     def stats(self):
-        """Counters of the update pump (`rot4d_widget.pump.PumpStats`): ``updates`` sent, ``acks``
+        """Counters of the update pump (`rot4d_widget.view.pump.PumpStats`): ``updates`` sent, ``acks``
         and the updates they ``acknowledged``, ``timeouts``."""
         return self._pump.stats
 
@@ -623,7 +623,7 @@ class Rot4DWidget(widgets.HBox):
     @property
     def recording(self):
         """What was applied since the widget was made (or `start_recording`): a
-        `rot4d_widget.recording.Recording` of every step (keys, key pad, `press`, repeats) and
+        `rot4d_widget.keep.recording.Recording` of every step (keys, key pad, `press`, repeats) and
         every parameter set (sliders, traits, `refresh`), time-stamped.  Save it
         (``.save(path)``), replay it (`replay`) or render it (`render_animation`)."""
         return self._recorder.recording()
@@ -637,7 +637,7 @@ class Rot4DWidget(widgets.HBox):
         """Apply a `Recording` (or a path to a saved one) to this widget: its starting state,
         then every event, ending where the recording ended (to rounding; a source's own
         actions, e.g. a stack's n / b, are replayed on this widget's source).  Redraws once."""
-        from .recording import Recording
+        from ..keep.recording import Recording
 
         if not isinstance(recording, Recording):
             import os
@@ -670,9 +670,9 @@ class Rot4DWidget(widgets.HBox):
         (Pillow) or MP4 (imageio-ffmpeg), by ``path``'s extension; one frame per step
         (``per="step"``) or per 1/fps s of recorded time (``per="time"``); the widget's look
         (`render` settings).  Returns the number of frames.  See
-        `rot4d_widget.recording.render_animation` for ``options`` (size, dpi, max_frames ...)."""
-        from .export import settings_of
-        from .recording import render_animation
+        `rot4d_widget.keep.recording.render_animation` for ``options`` (size, dpi, max_frames ...)."""
+        from ..keep.export import settings_of
+        from ..keep.recording import render_animation
 
         rec = self.recording if recording is None else recording
         kwargs = {**settings_of(self), **options}
@@ -683,8 +683,8 @@ class Rot4DWidget(widgets.HBox):
         display settings, the live view's camera, palette and scale; written to ``path`` (PNG,
         SVG or PDF by extension) if given.  ``size`` in pixels, default the canvas's.  Returns
         the `matplotlib.figure.Figure`."""
-        from .export import settings_of
-        from .figures import render_state
+        from ..keep.export import settings_of
+        from ..keep.figures import render_state
 
         with self._pump.lock:
             state = self.state.copy()
@@ -697,8 +697,8 @@ class Rot4DWidget(widgets.HBox):
         field, all slices of a stack, placed as shown), in the source's own units, with each
         face's group (cell / level / slice) in ``mesh.face_attributes["group"]`` and the
         view's colours.  ``.export("slice.ply")`` writes OBJ, PLY, STL or GLB by extension.
-        See `rot4d_widget.export.slice_mesh` for ``options``."""
-        from .export import slice_mesh
+        See `rot4d_widget.keep.export.slice_mesh` for ``options``."""
+        from ..keep.export import slice_mesh
 
         with self._pump.lock:
             data = self._current_slice()
@@ -710,10 +710,10 @@ class Rot4DWidget(widgets.HBox):
 
     def save_state(self, path) -> dict:
         """Write the state (orientation, θ0, α, c0, c0 step, key bindings), what the source is
-        and the widget's settings to the JSON file ``path`` (`rot4d_widget.export.save_state`).
+        and the widget's settings to the JSON file ``path`` (`rot4d_widget.keep.export.save_state`).
         A source that cannot be rebuilt from the file (an in-memory array) is described with a
         warning; `load_state` into a widget showing it still works.  Returns the dict written."""
-        from .export import save_state, settings_of
+        from ..keep.export import save_state, settings_of
 
         with self._pump.lock:
             state = self.state.copy()
@@ -724,7 +724,7 @@ class Rot4DWidget(widgets.HBox):
         """Read a `save_state` file into this widget: its state (which `r` now resets to), key
         bindings and settings.  The file's source must be of this widget's kind
         (``ValueError`` otherwise; `from_state` builds a widget for the file's own source)."""
-        from .export import load_state
+        from ..keep.export import load_state
 
         loaded = load_state(path, source=self.source)
         self._apply_loaded(loaded.state, loaded.settings)
@@ -736,7 +736,7 @@ class Rot4DWidget(widgets.HBox):
 
         A file is data: a field made from a function is refused unless ``allow_code=True``
         (then the module the file names is imported) or the source is passed in."""
-        from .export import load_state
+        from ..keep.export import load_state
 
         loaded = load_state(path, source=source, allow_code=allow_code)
         if loaded.source is None:
@@ -753,8 +753,8 @@ class Rot4DWidget(widgets.HBox):
         return w
 
     def _apply_loaded(self, state, settings) -> None:
-        from .export import SETTING_NAMES
-        from .state import without_source_keys
+        from ..keep.export import SETTING_NAMES
+        from ..core.state import without_source_keys
 
         d = state.to_dict()
         d.pop("keymap")
@@ -964,11 +964,11 @@ class Rot4DWidget(widgets.HBox):
     def _wrap_in_stack(self, slices) -> None:
         """Show ``slices`` parallel slices of the current source from now on (the lock is held).
 
-        The source is wrapped in a `rot4d_widget.tomography.StackSource` (oval, default
+        The source is wrapped in a `rot4d_widget.sources.tomography.StackSource` (oval, default
         spacing), its keys n / b / g / f join the keymap and the help.  Raises before any
         change if ``slices`` is not allowed.
         """
-        from .tomography import StackSource
+        from ..sources.tomography import StackSource
 
         stack = StackSource(self.source, slices=slices)
         # the stack brings the inner source's keys too: rebind them from the reserved ones
@@ -1108,7 +1108,7 @@ class Rot4DWidget(widgets.HBox):
         """Key (or key pad button) ``key_id`` went down: one step now, repeats while held (lock held).
 
         ``page_time``: the page's time of the keydown (s), against which the keyup's corrects
-        the number of steps (`rot4d_widget.keyhold`)."""
+        the number of steps (`rot4d_widget.view.keyhold`)."""
         if action.kind == "help":
             self.help_visible = not self.help_visible
             return
@@ -1368,13 +1368,13 @@ class Rot4DWidget(widgets.HBox):
 
 # ------------------------------------------------------------------ helpers
 def _is_stack(source) -> bool:
-    """True for parallel slices (`rot4d_widget.tomography.StackSource`) without importing it."""
+    """True for parallel slices (`rot4d_widget.sources.tomography.StackSource`) without importing it."""
     return type(source).__name__ == "StackSource" and hasattr(source, "levels_at")
 
 
 def _source_settings(source) -> dict:
     """The settings a recording starts from: a source's iso levels, a stack's N, Δ (None while
-    it follows N) and arrangement (`rot4d_widget.recording.Recorder`'s ``source_settings``)."""
+    it follows N) and arrangement (`rot4d_widget.keep.recording.Recorder`'s ``source_settings``)."""
     out = {}
     stack = _is_stack(source)
     inner = source.source if stack else source
@@ -1430,7 +1430,7 @@ def _w_units(source):
 
 
 def _checked_slice(source, matrix, c0, coarse, lock):
-    """``source.slice`` validated once (`rot4d_widget.source.check_slice`): a bad slice (None,
+    """``source.slice`` validated once (`rot4d_widget.sources.protocol.check_slice`): a bad slice (None,
     non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
     or TypeError naming the source and the member that is wrong, and is never drawn."""
     with lock:

@@ -26,7 +26,7 @@ slice keys) and the source's settings are replayed on a source when one is given
 (`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
 view into a stack replaces its source), else skipped.
 
-`render_animation` draws a recording with `rot4d_widget.figures.render_state` -- one frame
+`render_animation` draws a recording with `rot4d_widget.keep.figures.render_state` -- one frame
 per step, or one per 1/fps seconds of the recorded time -- into an animated GIF (Pillow) or an
 MP4 (imageio with imageio-ffmpeg's ffmpeg).  `paper_animation(3)` / `paper_animation(4)` are
 the paper's Figs. 3 and 4 (the key sequences of `figures.paper_figure_3` / ``_4``) as animations.
@@ -48,8 +48,8 @@ from typing import Iterator, Mapping
 
 import numpy as np
 
-from .keymap import Action
-from .state import RotationState, action_from_data, action_to_data
+from ..core.keymap import Action
+from ..core.state import RotationState, action_from_data, action_to_data
 
 __all__ = [
     "RECORDING_FORMAT",
@@ -153,7 +153,7 @@ def _check_setting(name, value):
     if name not in SETTABLE:
         raise ValueError(f"Expected a setting among {', '.join(map(repr, SETTABLE))}, got {name!r}")
     if name == "matrix":
-        from .rotation import as_rotation_matrix
+        from ..core.rotation import as_rotation_matrix
 
         return as_rotation_matrix(value).tolist()
     if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
@@ -191,7 +191,7 @@ def _check_source_setting(name, value):
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real) or not (math.isfinite(value) and value > 0):
             raise ValueError(f"Expected 'spacing' to be set to a finite number > 0 or None (the default), got {value!r}")
         return float(value)
-    from .tomography import ARRANGEMENTS
+    from ..sources.tomography import ARRANGEMENTS
 
     if value not in ARRANGEMENTS:
         raise ValueError(f"Expected 'arrangement' to be set to one of {', '.join(map(repr, ARRANGEMENTS))}, "
@@ -240,7 +240,7 @@ def _source_action(source, name: str):
 
 
 def _is_stack(source) -> bool:
-    from .tomography import StackSource
+    from ..sources.tomography import StackSource
 
     return isinstance(source, StackSource)
 
@@ -266,7 +266,7 @@ def _with_source_setting(source, name: str, value):
     """``source`` with a source setting applied: in place, or (``slices`` of a single view) a new
     `StackSource` around it, as the widget does."""
     if name == "slices" and not _is_stack(source):
-        from .tomography import StackSource
+        from ..sources.tomography import StackSource
 
         return StackSource(source, slices=value)
     _set_on_source(source, name, value)
@@ -333,9 +333,9 @@ class Recording:
         """This recording with c0 in ``source``'s w units: a recording made before c0 followed
         the data's units (its starting state of format 1) has its c0, initial c0, c0 step and
         every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
-        (`rot4d_widget.source.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
+        (`rot4d_widget.sources.protocol.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
         source whose frame is (0, 1) (a polytope), gives ``self``."""
-        from .source import w_frame
+        from ..sources.protocol import w_frame
 
         if source is None or self._initial.get("format", 2) >= 2:
             return self
@@ -561,8 +561,8 @@ class Recorder:
 # ============================================================================ animations
 def _own_copy(source):
     """A copy of ``source`` that replaying its own actions may change (the original stays)."""
-    from .source import as_source
-    from .tomography import StackSource
+    from ..sources.protocol import as_source
+    from ..sources.tomography import StackSource
 
     src = as_source(source)
     if isinstance(src, StackSource):
@@ -655,7 +655,7 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
                   **settings) -> Iterator[np.ndarray]:
     """The frames of `render_animation`, one (H, W, 3) uint8 array at a time.
 
-    ``settings`` go to `rot4d_widget.figures.render_state` (``size``, ``dpi``, ``levels``,
+    ``settings`` go to `rot4d_widget.keep.figures.render_state` (``size``, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...).  ``titles``: a callable ``(k, t, state) -> str`` giving each
     frame a title, or None.  More than ``max_frames`` frames raises ``ValueError`` before any is drawn.
     When the recording has source settings (``levels``, ``slices``, ``spacing``,
@@ -738,7 +738,7 @@ def _pil_rgb(frame):
 def _progress_sink(progress, total: int):
     """``(update(done), close())`` for render_animation's ``progress=`` (True, False or a callable)."""
     if progress is True:
-        from .progress import progress as make_progress
+        from ..view.progress import progress as make_progress
 
         bar = make_progress(total, "rendering frames")
         return (lambda done: bar.update(done - bar.count)), bar.close
@@ -759,11 +759,11 @@ def render_animation(recording: Recording, initial_state=None, source="5-cell", 
     octree); ``.mp4``: H.264 (imageio with imageio-ffmpeg's ffmpeg), ``fps`` frames per second,
     streamed to ffmpeg as they are drawn.  One frame per step (``per="step"``, plus the
     starting state) or per 1/``fps`` s of the recorded time (``per="time"``).  ``settings``
-    are `rot4d_widget.figures.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
+    are `rot4d_widget.keep.figures.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...; an MP4's size is rounded up to even numbers of pixels).
     ``frame`` and ``annotate`` as `render_frames` (default: every frame framed alike to fill
     the picture, and annotated).  ``progress``: True (default) shows a progress bar
-    (`rot4d_widget.progress`: a widget in a notebook, a line on a terminal's stderr, only after
+    (`rot4d_widget.view.progress`: a widget in a notebook, a line on a terminal's stderr, only after
     a second), False nothing, a callable ``progress(done, total)`` is called after each frame.
     Returns the number of frames drawn.
     """
@@ -905,8 +905,8 @@ def paper_recording(figure: int, frames: int = 16, fps: float = 4.0) -> tuple:
     ``frames - 1`` presses 1/fps s apart, the sequences of `figures.paper_figure_3` / ``_4``
     (frame k is panel k)."""
     from .figures import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0
-    from .polytopes import pentachoron
-    from .source import PolytopeSource
+    from ..geometry.polytopes import pentachoron
+    from ..sources.protocol import PolytopeSource
 
     if figure == 3:
         state, key = RotationState(theta0=FIG3_THETA0), "4"

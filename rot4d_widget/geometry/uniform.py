@@ -10,7 +10,7 @@ What is here
   the p-antiprismatic prisms for 3 <= p, q <= 32.
 
 Every one has edge length 2 and is centred on the origin, like the regular six of
-:mod:`rot4d_widget.polytopes` — and the regular six *are* those objects: ``build("x3o3o3o")``
+:mod:`rot4d_widget.geometry.polytopes` — and the regular six *are* those objects: ``build("x3o3o3o")``
 returns ``polytope("5-cell")`` itself (its vertex array unchanged).
 
 Combinatorics from the group, not from the geometry
@@ -53,7 +53,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull
 
 from . import polytopes as _polytopes
-from ._arrays import sealed as _sealed
+from ..core._arrays import sealed as _sealed
 
 __all__ = ["build", "canonical_name", "polytope_names", "dynkin_symbol", "Combinatorics", "combinatorics"]
 
@@ -688,7 +688,7 @@ def _canonical_or_raise(name) -> str:
     canon = canonical_name(name)
     if canon is None:
         raise ValueError(
-            f"Unknown polychoron {name!r}; rot4d_widget.uniform.polytope_names() lists the accepted names "
+            f"Unknown polychoron {name!r}; rot4d_widget.geometry.uniform.polytope_names() lists the accepted names "
             "by family (e.g. 'rectified 5-cell', 'truncated tesseract', 'omnitruncated 120-cell', "
             "'snub 24-cell', 'grand antiprism', '5-7 duoprism', 'truncated cubic prism', "
             "'7-antiprismatic prism'), and linear Dynkin symbols such as 'o3x3o3o', 'x4x3o3o', 'x5x3x3x' "
@@ -771,7 +771,7 @@ def _built(canon: str):
 
 
 def build(name):
-    """The polychoron called ``name`` as a `rot4d_widget.polytopes.Polytope` (edge 2, centred).
+    """The polychoron called ``name`` as a `rot4d_widget.geometry.polytopes.Polytope` (edge 2, centred).
 
     ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see the module
     docstring; `polytope_names` lists the canonical names).  The regular six are the core's own

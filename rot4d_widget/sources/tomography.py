@@ -63,8 +63,8 @@ from numbers import Integral, Real
 
 import numpy as np
 
-from . import look
-from .source import SliceData, SourceAction, as_source, census_text, data_w_text, w_frame
+from ..core import look
+from .protocol import SliceData, SourceAction, as_source, census_text, data_w_text, w_frame
 
 __all__ = [
     "ARRANGEMENTS",
@@ -225,7 +225,7 @@ def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS)
 
     Slice k of an object of circumradius ``radius`` is drawn at ``centres[k] + scales[k] * p``.
     Designed for ``radius = look.REFERENCE_RADIUS`` (what the widget shows) and the camera of
-    `rot4d_widget.look`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
+    `rot4d_widget.core.look`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
     picture is the same once the widget scales the source to its displayed size.  See the
     module docstring for each arrangement's constants.  ``n = 1``: centre 0, scale 1.
     """
@@ -391,7 +391,7 @@ class StackSource:
 
     @property
     def w_frame(self) -> tuple:
-        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.source.w_frame`): c0 and the
+        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0 and the
         levels are in its w units, Δ in the drawn units (a level is Δ * per_unit from the next)."""
         return w_frame(self.source)
 
@@ -457,7 +457,7 @@ class StackSource:
     # -- work -------------------------------------------------------------------------
     def _inner_slices(self, matrix, levels, coarse):
         if self._polytope is not None:
-            from .slicing import slice_polytope
+            from ..geometry.slicing import slice_polytope
 
             if len(levels) == 1:  # today's single slice, bit for bit
                 return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])), self._polytope.convex)]
@@ -467,7 +467,7 @@ class StackSource:
         return [self.source.slice(matrix, float(w)) for w in levels]
 
     def _slice(self, matrix, c0, coarse) -> StackSliceData:
-        from .rotation import as_rotation_matrix
+        from ..core.rotation import as_rotation_matrix
 
         m = as_rotation_matrix(matrix)
         if isinstance(c0, (bool, np.bool_)) or not isinstance(c0, Real) or not math.isfinite(c0):
@@ -570,7 +570,7 @@ class _PolytopePiece:
 
 
 def _is_polytope_source(src) -> bool:
-    from .source import PolytopeSource
+    from .protocol import PolytopeSource
 
     return isinstance(src, PolytopeSource)
 

@@ -190,7 +190,7 @@ def data_w_text(source, w: float, matrix=None) -> str:
     """A cut's label in the source's own w, c0's units: ``"w 30 s"`` for a field (its time, in its
     ``w_units``), ``"w +0.5"`` for a polytope.  ``w`` is a c0 (`w_frame`); ``matrix`` is unused
     (kept for callers of the older form)."""
-    from .look import number_text
+    from ..core.look import number_text
 
     inner = getattr(source, "source", source)
     extent = getattr(inner, "extent", None)
@@ -294,7 +294,7 @@ class PolytopeSource:
     """A 4-polytope (convex or not) as a source: groups are its cells, the slice is exact."""
 
     def __init__(self, polytope):
-        from .polytopes import polytope as get_polytope
+        from ..geometry.polytopes import polytope as get_polytope
 
         self.polytope = get_polytope(polytope)
 
@@ -321,7 +321,7 @@ class PolytopeSource:
         return float(w.min()), float(w.max())
 
     def slice(self, matrix, c0) -> PolytopeSlice:
-        from .slicing import slice_polytope
+        from ..geometry.slicing import slice_polytope
 
         s = slice_polytope(self.polytope, matrix, c0)
         return PolytopeSlice(
@@ -337,7 +337,7 @@ class PolytopeSource:
         )
 
     def describe(self) -> dict:
-        from .polytopes import POLYTOPE_NAMES
+        from ..geometry.polytopes import POLYTOPE_NAMES
 
         d = {"kind": "polytope", "name": self.polytope.name}
         if self.polytope.name not in POLYTOPE_NAMES:
@@ -353,7 +353,7 @@ def as_source(obj):
 
     Raises TypeError naming what is allowed.
     """
-    from .polytopes import Polytope
+    from ..geometry.polytopes import Polytope
 
     if isinstance(obj, (str, Polytope)):
         return PolytopeSource(obj)

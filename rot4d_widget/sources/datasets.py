@@ -253,7 +253,7 @@ def moving_sphere(v: float = 0.75, radius: float = 0.5, *, t_max: float = 1.0, m
     The box: w in [-t_max, t_max], x in +-(|v| t_max + radius + margin), y and z in
     +-(radius + margin).  Further keyword arguments go to `Field4D.from_function`
     (``resolution``, ``levels`` ...); ``levels`` defaults to ``[0.0]``.
-    Returns a `rot4d_widget.fields.Field4D`.
+    Returns a `rot4d_widget.sources.fields.Field4D`.
     """
     from .fields import Field4D
 

@@ -43,7 +43,7 @@ Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
 
 Scale: the box's half widths (slice units) and the ends of ``extent`` must lie
-in `rot4d_widget.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
+in `rot4d_widget.geometry.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
 ValueError naming it).  Within it a field scaled by ``s`` (extent times s, the
 same samples) slices as the unscaled one at ``c0 / s`` (extent's w scaled too), its surfaces scaled by
 s: the box cut is the exact slicer's (normalised), the resampling works in
@@ -66,10 +66,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._arrays import sealed as _sealed
-from .polytopes import COORDINATE_RANGE, _power_of_two_unit, check_scale
-from .rotation import as_rotation_matrix
-from .source import SliceData
+from ..core._arrays import sealed as _sealed
+from ..geometry.polytopes import COORDINATE_RANGE, _power_of_two_unit, check_scale
+from ..core.rotation import as_rotation_matrix
+from .protocol import SliceData
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "AxesWarning", "NonFiniteWarning",
            "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
@@ -280,7 +280,7 @@ def _check_resolution(resolution, name: str = "resolution") -> int:
         raise ValueError(
             f"`{name}`={r} would need up to {_bytes_text(need)} of samples ({r}^3 points x "
             f"{BYTES_PER_SAMPLE} bytes); the limit is {_bytes_text(MAX_SAMPLE_BYTES)} "
-            f"(rot4d_widget.fields.MAX_SAMPLE_BYTES), i.e. resolution <= {r_max}"
+            f"(rot4d_widget.sources.fields.MAX_SAMPLE_BYTES), i.e. resolution <= {r_max}"
         )
     return r
 
@@ -311,7 +311,7 @@ def _check_extent(extent) -> tuple:
         end = float(np.abs(e[d]).max())
         if end > hi:
             raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
-                             f"{lo:g} to {hi:g} (rot4d_widget.polytopes.COORDINATE_RANGE; rescale the coordinates, "
+                             f"{lo:g} to {hi:g} (rot4d_widget.geometry.polytopes.COORDINATE_RANGE; rescale the coordinates, "
                              f"e.g. to other units)")
         check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")
     return tuple((float(a), float(b)) for a, b in e)
@@ -952,7 +952,7 @@ class Field4D:
              isel=None, sel=None, load: bool = False, **kwargs) -> "Field4D":
         """`from_xarray` of ``variable`` in the netCDF file or zarr store at ``path``, remembering
         where it came from (``field.origin``), so that a state file reopens it
-        (`rot4d_widget.export.save_state`, `Rot4DWidget.save_state` / ``from_state``).
+        (`rot4d_widget.keep.export.save_state`, `Rot4DWidget.save_state` / ``from_state``).
 
         ``variable`` may be omitted when the file has one data variable.  ``engine`` goes to
         ``xarray.open_dataset`` (None: xarray's guess; a directory opens with ``"zarr"``).
@@ -1182,7 +1182,7 @@ class Field4D:
     @property
     def actions(self) -> dict:
         """``{"o": level up, "i": level down}`` (`SourceAction`), repeating while held."""
-        from .source import SourceAction
+        from .protocol import SourceAction
 
         return {
             "o": SourceAction("level up", "raise the iso level(s) by 1/50 of the data range",
@@ -1318,7 +1318,7 @@ class Field4D:
         """Start building the coarse copy (`coarse`) on a daemon thread and return at once.
 
         The build reads the array chunk by chunk (memory: the copy plus a few chunks), counting
-        chunks on a progress bar (`rot4d_widget.progress`, shown after a second: a widget in a
+        chunks on a progress bar (`rot4d_widget.view.progress`, shown after a second: a widget in a
         kernel, a line on a terminal) when ``progress`` is true; `coarse_progress` holds
         (chunks done, chunks in all).  Until `coarse_ready`, held keys meanwhile slice at full
         resolution (``slice(..., coarse=True)`` returns the full-resolution slice and says so), the
@@ -1426,7 +1426,7 @@ class Field4D:
         self.coarse_progress = (0, total)
         bar = None
         if progress_bar:
-            from .progress import progress
+            from ..view.progress import progress
 
             bar = progress(total, f"coarse copy of {self.name or 'the field'} (chunks)")
         done = 0
@@ -1644,7 +1644,7 @@ def _turned_slice(s: FieldSlice, t: np.ndarray) -> FieldSlice:
 
 class FieldSliceData(SliceData):
     """`SliceData` of a `Field4D`: ``extra["levels"]`` holds one `FieldSlice` per level and
-    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.slicing.Slice`);
+    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.geometry.slicing.Slice`);
     ``extra["data_frame"]`` the cut's matrix and c0 and the field's centre and units (`Field4D.slice`)."""
 
     def turned(self, t) -> "FieldSliceData":
@@ -1688,7 +1688,7 @@ _BOX_CACHE: dict = {}
 
 
 def _box_polytope(hw):
-    from .polytopes import Polytope
+    from ..geometry.polytopes import Polytope
 
     key = tuple(float(v) for v in hw)
     p = _BOX_CACHE.get(key)
@@ -1702,7 +1702,7 @@ def _box_polytope(hw):
 
 
 def _box_slice(field, m, c0):
-    from .slicing import slice_polytope
+    from ..geometry.slicing import slice_polytope
 
     return slice_polytope(_box_polytope(field._hw), m, c0)
 

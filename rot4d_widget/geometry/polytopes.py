@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from ._arrays import sealed as _sealed
+from ..core._arrays import sealed as _sealed
 from scipy.spatial import ConvexHull
 
 __all__ = ["Polytope", "MeshError", "polytope", "pentachoron", "POLYTOPE_NAMES", "MESH_TOLERANCE",
@@ -182,7 +182,7 @@ def check_scale(scale: float, what: str) -> None:
     """ValueError unless ``COORDINATE_RANGE[0] <= scale <= COORDINATE_RANGE[1]`` (``what`` names it)."""
     lo, hi = COORDINATE_RANGE
     if not lo <= scale <= hi:
-        raise ValueError(f"{what} is {scale:.3g}; expected {lo:g} to {hi:g} (rot4d_widget.polytopes.COORDINATE_RANGE: "
+        raise ValueError(f"{what} is {scale:.3g}; expected {lo:g} to {hi:g} (rot4d_widget.geometry.polytopes.COORDINATE_RANGE: "
                          f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
                          f"other units)")
 
@@ -507,7 +507,7 @@ class Polytope:
     # -- files -------------------------------------------------------------
     @classmethod
     def from_off(cls, path_or_text, name: str | None = None, *, validate: bool = True) -> "Polytope":
-        """A polytope from Stella4D's 4OFF format: a path, or the file's text (see `rot4d_widget.offfile`).
+        """A polytope from Stella4D's 4OFF format: a path, or the file's text (see `rot4d_widget.geometry.offfile`).
 
         The faces and cells are taken as written and checked as by ``Polytope(vertices, faces,
         cells)``; every error is a ValueError naming the file's line.  Colours are read and
@@ -776,7 +776,7 @@ def polytope(name) -> Polytope:
 
     The six regular ones by name, alias or Schläfli symbol: ``"5-cell"`` (pentachoron,
     ``"{3,3,3}"``), ``"8-cell"`` (tesseract), ``"16-cell"``, ``"24-cell"``, ``"120-cell"``,
-    ``"600-cell"``; every other uniform one (`rot4d_widget.uniform`: the Wythoff families,
+    ``"600-cell"``; every other uniform one (`rot4d_widget.geometry.uniform`: the Wythoff families,
     the snub 24-cell, the grand antiprism, prisms, duoprisms, antiprismatic prisms) by its
     common name (``"rectified 5-cell"``, ``"5-7 duoprism"``) or linear Dynkin symbol
     (``"o3x3o3o"``, ``"x5x3x3x"``); ``rot4d_widget.polytope_names()`` lists them.  A

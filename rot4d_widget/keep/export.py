@@ -9,7 +9,7 @@ Meshes
     each face keeping its colour group
     (``mesh.face_attributes["group"]``: a polytope's 4-D cell, a field's level index, a stack's
     slice index when coloured by w) and its colour (``mesh.visual.face_colors``, the live view's
-    palette from `rot4d_widget.look`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
+    palette from `rot4d_widget.core.look`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
     extension (trimesh's own writers); what each keeps is listed in `MESH_FORMATS`.
     `load_mesh(path)` reads one back with the groups a PLY file carries.
 
@@ -53,8 +53,8 @@ from typing import Mapping, NamedTuple
 
 import numpy as np
 
-from . import look
-from .state import RotationState
+from ..core import look
+from ..core.state import RotationState
 
 __all__ = [
     "MESH_FORMATS",
@@ -76,7 +76,7 @@ __all__ = [
 ]
 
 #: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
-#: `rot4d_widget.figures.render_state` takes them as keywords).
+#: `rot4d_widget.keep.figures.render_state` takes them as keywords).
 SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity", "ball_radius",
                  "bar_radius", "background", "show_balls", "show_bars", "show_faces")
 
@@ -155,9 +155,9 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
 
 def _as_slice_data(obj):
     """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; else as is."""
-    from .fields import FieldSlice
-    from .slicing import Slice
-    from .source import SliceData
+    from ..sources.fields import FieldSlice
+    from ..geometry.slicing import Slice
+    from ..sources.protocol import SliceData
 
     if isinstance(obj, Slice):
         return SliceData.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells, volume=float(obj.volume),
@@ -284,7 +284,7 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
     frame : "data" (default) or "view"
         Where a slice that knows its data coordinates (a `Field4D`'s, a stack of them: any slice
         data whose ``extra["data_frame"]`` gives the cut's ``matrix``, offset ``d`` and the data's
-        ``centre`` and ``unit``, see `rot4d_widget.fields.Field4D.slice`) puts its vertices.
+        ``centre`` and ``unit``, see `rot4d_widget.sources.fields.Field4D.slice`) puts its vertices.
         ``"data"``: in the data's units at the data's place -- the view's 3-D picture scaled by
         the data's units of x, y, z (1 for a field) and moved by the data box's centre, so at
         rest (identity orientation) a vertex is at its data (x, y, z).  After a turn the 3
@@ -438,9 +438,9 @@ def describe_source(source) -> dict:
     ``"module:qualname"``, or the file `open_field` read); a stack describes its inner source the
     same way.
     """
-    from .fields import Field4D
-    from .source import PolytopeSource
-    from .tomography import StackSource
+    from ..sources.fields import Field4D
+    from ..sources.protocol import PolytopeSource
+    from ..sources.tomography import StackSource
 
     if isinstance(source, StackSource):
         d = dict(source.describe())
@@ -449,7 +449,7 @@ def describe_source(source) -> dict:
         return d
     d = dict(source.describe())
     if isinstance(source, PolytopeSource):
-        from .polytopes import POLYTOPE_NAMES, polytope
+        from ..geometry.polytopes import POLYTOPE_NAMES, polytope
 
         p = source.polytope
         if "vertices" in d or p.name not in POLYTOPE_NAMES or not np.array_equal(
@@ -475,7 +475,7 @@ def describe_source(source) -> dict:
         else:
             d["rebuild"] = (f"its values are a {d.get('array', 'array').replace(' (not recordable)', '')} held in "
                             "memory, not written into a state file; open the file with Field4D.open(path, variable, "
-                            "w=...) (or rot4d_widget.export.open_field) to record where it comes from -- "
+                            "w=...) (or rot4d_widget.keep.export.open_field) to record where it comes from -- "
                             "the only way for a zarr store or a file xarray read with the scipy engine")
     else:
         d["rebuild"] = f"a source of kind {d.get('kind', type(source).__name__)!r} cannot be rebuilt from its description"
@@ -501,8 +501,8 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
     kind = description["kind"]
     why = description.get("rebuild", True)
     if kind == "polytope":
-        from .polytopes import Polytope, polytope
-        from .source import PolytopeSource
+        from ..geometry.polytopes import Polytope, polytope
+        from ..sources.protocol import PolytopeSource
 
         if "vertices" in description:
             faces, cells = description.get("faces"), description.get("cells")
@@ -512,7 +512,7 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
                                            name=str(description.get("name", "polytope"))))
         return PolytopeSource(polytope(description["name"]))
     if kind == "stack":
-        from .tomography import StackSource
+        from ..sources.tomography import StackSource
 
         inner = rebuild_source(description["source"], allow_code=allow_code, function=function, base=base)
         return StackSource(inner, slices=description["slices"], spacing=description.get("spacing"),
@@ -558,7 +558,7 @@ def _origin_path(origin, base):
 
 
 def _open_origin(origin, base):
-    from .fields import Field4D, _selection_from_json
+    from ..sources.fields import Field4D, _selection_from_json
 
     origin = dict(origin)
     if origin.get("kind", "xarray") != "xarray":
@@ -592,7 +592,7 @@ def _open_origin(origin, base):
 
 
 def _rebuild_field(d, allow_code=False, function=None, base=None):
-    from .fields import Field4D
+    from ..sources.fields import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
     if d.get("w_units") is not None:
@@ -668,7 +668,7 @@ def open_field(path, variable=None, *, engine=None, **kwargs):
     ``chunks=``, ``isel=``, ``sel=`` and the keywords of `Field4D.from_xarray`
     (``x=, y=, z=, w=, w_per_unit=`` ...) as in `Field4D.open`.
     """
-    from .fields import Field4D
+    from ..sources.fields import Field4D
 
     return Field4D.open(path, variable, engine=engine, **kwargs)
 
@@ -735,7 +735,7 @@ def _jsonable(value, where: str):
 
 def settings_of(widget) -> dict:
     """The `SETTING_NAMES` a widget (or any object) has, as JSON-able values: what `save_state`
-    stores and `rot4d_widget.figures.render_state` takes (``render_state(w.state, w.source,
+    stores and `rot4d_widget.keep.figures.render_state` takes (``render_state(w.state, w.source,
     **settings_of(w))``).  A stack's ``spacing`` is None while it follows its default."""
     out = {}
     for name in SETTING_NAMES:
@@ -761,7 +761,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     ``settings`` is any dict of JSON-able values (tuples and numpy numbers are converted), for
     the widget: its traits (``levels``, ``slices``, ``spacing``, ``arrangement``,
     ``face_opacity``, ``ball_radius``, ``bar_radius``, ``background``, ``show_balls``,
-    ``show_bars``, ``show_faces``, ``color_by``) -- `rot4d_widget.figures.render_state` takes the
+    ``show_bars``, ``show_faces``, ``color_by``) -- `rot4d_widget.keep.figures.render_state` takes the
     same names.  A source that cannot be rebuilt (an in-memory array, a lambda) is described
     anyway, with a `SourceNotRebuildable` warning saying so.  Returns the dict written.
     The file is replaced atomically (written beside it, then renamed).
@@ -770,7 +770,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
     src = None
     if source is not None:
-        from .source import as_source
+        from ..sources.protocol import as_source
 
         src = describe_source(as_source(source))
         if src["rebuild"] is not True:
@@ -786,7 +786,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         "source": src,
         "settings": _jsonable(dict(settings or {}), "settings"),
     }
-    from . import __version__
+    from .. import __version__
 
     doc["rot4d_widget"] = __version__
     text = json.dumps(doc, indent=1, allow_nan=False)
@@ -902,7 +902,7 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
         raise ValueError(f"{path!r}: expected 'settings' to be a dict, got {type(settings).__name__}")
     desc = doc["source"]
     if source is not None:
-        from .source import as_source
+        from ..sources.protocol import as_source
 
         source = as_source(source)
         if desc is not None:

@@ -65,7 +65,7 @@ __all__ = [
 ]
 
 #: The version of `RotationState.to_dict`'s layout (``d["format"]``).  2: c0 and its step are in
-#: the source's w units (a field's data w, `rot4d_widget.source.w_frame`); 1 had them in the drawn
+#: the source's w units (a field's data w, `rot4d_widget.sources.protocol.w_frame`); 1 had them in the drawn
 #: (slice) units -- `RotationState.from_dict` converts them given the source's ``w_frame``.
 STATE_FORMAT = 2
 #: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
@@ -351,7 +351,7 @@ class RotationState:
         unknown fields, or a newer ``format``, are refused.  ``keymap`` replaces the stored
         bindings.  The state read is what `reset` returns to (unless ``d`` has ``"initial"``).
 
-        ``w_frame``: the source's ``(origin, per_unit)`` (`rot4d_widget.source.w_frame`); a
+        ``w_frame``: the source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`); a
         format-1 state (c0 in slice units) has its c0 (and initial c0) converted to ``origin +
         per_unit * c0`` and its c0 step multiplied by ``per_unit``.  Without it a format-1 state is
         read as it is (right for a polytope, whose frame is (0, 1)).

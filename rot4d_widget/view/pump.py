@@ -37,7 +37,7 @@ The rules that keep a slow kernel from freezing the keys:
   always waits at least `MIN_WAIT`), so a keyup waiting on the lock is
   handled after at most one tick.  A tick that overruns drops the ticks it
   missed (the owner's ``tick`` reschedules them; see
-  `rot4d_widget.keyhold.KeyRepeater.drop_missed`).
+  `rot4d_widget.view.keyhold.KeyRepeater.drop_missed`).
 * **Expensive work runs outside the lock, and ticks go on meanwhile.**  ``send``
   may be a generator: it yields a callable (the slow part: slicing) after
   reading the state under the lock; with the ticker running, a worker thread

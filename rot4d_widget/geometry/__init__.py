@@ -1,0 +1,1 @@
+"""The geometry wing of rot4d_widget (see docs/design.md)."""

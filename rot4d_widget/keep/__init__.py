@@ -1,0 +1,1 @@
+"""The keep wing of rot4d_widget (see docs/design.md)."""

@@ -1,0 +1,1 @@
+"""The view wing of rot4d_widget (see docs/design.md)."""
