@@ -81,7 +81,7 @@ _MOVED = {
     "pump": "view.pump",
     "keyhold": "view.keyhold",
     "readout": "view.readout",
-    "progress": "view.progress",
+    "progress": "core.progress",
 }
 
 #: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
@@ -137,7 +137,19 @@ def __getattr__(name: str):
                              f"(there is no module {__name__}.{module or name})") from None
     value = mod if module is None else getattr(mod, name)
     globals()[name] = value  # resolved once
+    _kernel_bar()
     return value
+
+
+def _kernel_bar() -> None:
+    """In a kernel, the view's progress bar is registered with the core's `Progress` as soon as
+    the package is used (a field's coarse copy shows it in a notebook that never made a widget);
+    elsewhere nothing is imported."""
+    if "ipykernel" in _sys.modules and f"{__name__}.view.progress" not in _sys.modules:
+        try:
+            importlib.import_module(".view.progress", __name__)
+        except ImportError:  # no ipywidgets: no bar, the work goes on
+            pass
 
 
 def __dir__():

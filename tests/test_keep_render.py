@@ -93,7 +93,7 @@ def test_progress_callback_counts_up_to_the_frames(tmp_path):
 
 
 def test_progress_shows_only_after_a_second_and_only_on_a_terminal():
-    from rot4d_widget.view.progress import progress
+    from rot4d_widget.core.progress import progress
 
     class Tty(io.StringIO):
         def isatty(self):
@@ -120,7 +120,7 @@ def test_progress_does_not_import_pythreejs():
     import subprocess
     import sys
 
-    code = "import sys, rot4d_widget.view.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
+    code = "import sys, rot4d_widget.core.progress; print('pythreejs' in sys.modules, 'ipywidgets' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
 
@@ -207,3 +207,34 @@ def test_an_error_while_drawing_leaves_no_gif_and_no_encoder(tmp_path, monkeypat
     with pytest.raises(OSError):
         render_animation(_held_4(2), None, "5-cell", tmp_path / "no" / "such" / "dir.gif", size=(120, 100),
                          dpi=40, progress=False)
+
+
+def test_in_a_kernel_the_bar_the_view_registered_is_shown(monkeypatch):
+    from rot4d_widget.core import progress as core_progress
+
+    shown = []
+
+    class Bar:
+        def __init__(self, total, description):
+            shown.append(("new", total, description))
+
+        def show(self, count, text):
+            shown.append(("show", count))
+
+        def close(self, done):
+            shown.append(("close", done))
+
+    monkeypatch.setattr(core_progress, "in_kernel", lambda: True)
+    monkeypatch.setattr(core_progress, "_widget_bar", None)
+    assert core_progress.progress(3).mode == "none"  # nothing registered: no bar, no error
+    core_progress.register_widget_bar(Bar)
+    now = [0.0]
+    bar = core_progress.progress(3, "work", clock=lambda: now[0])
+    assert bar.mode == "widget"
+    bar.update()
+    now[0] = 2.0
+    bar.update(2)
+    bar.close()
+    assert shown == [("new", 3, "work"), ("show", 3), ("show", 3), ("close", True)]
+    with pytest.raises(TypeError, match="callable"):
+        core_progress.register_widget_bar("bar")

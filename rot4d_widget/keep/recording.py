@@ -738,7 +738,7 @@ def _pil_rgb(frame):
 def _progress_sink(progress, total: int):
     """``(update(done), close())`` for render_animation's ``progress=`` (True, False or a callable)."""
     if progress is True:
-        from ..view.progress import progress as make_progress
+        from ..core.progress import progress as make_progress
 
         bar = make_progress(total, "rendering frames")
         return (lambda done: bar.update(done - bar.count)), bar.close

@@ -1426,7 +1426,7 @@ class Field4D:
         self.coarse_progress = (0, total)
         bar = None
         if progress_bar:
-            from ..view.progress import progress
+            from ..core.progress import progress
 
             bar = progress(total, f"coarse copy of {self.name or 'the field'} (chunks)")
         done = 0

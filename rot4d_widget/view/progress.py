@@ -1,147 +1,33 @@
-"""A progress bar for long work, shown only once the work has taken more than a second.
+"""The progress bar a kernel shows: an ipywidgets ``IntProgress`` and a label ("12/33, 4 s").
 
-    bar = progress(total, "rendering frames")
-    for item in work:
-        ...
-        bar.update()      # one more done (update(n): n more)
-    bar.close()
-
-or ``with progress(total, "...") as bar:``.  Where it shows:
-
-* in a Jupyter kernel with a front end (IPython's ``get_ipython()`` has a ``kernel``): an
-  ipywidgets ``IntProgress`` and a label ("12 / 33, 4 s"), displayed in the cell's output;
-* elsewhere, when stderr is a terminal: one text line on stderr, rewritten in place
-  ("rendering frames  12/33 [#####     ] 4 s"), ended by a new line on `Progress.close`;
-* otherwise (a pipe, a log file, a CI run): nothing.
-
-Nothing appears before ``delay`` seconds (default 1) have passed since `progress` was called, so
-quick work stays silent.  `Progress.update` may be called from any thread (a background job);
-it costs a clock reading and, at most every 0.1 s, a redraw.  This module imports neither
-pythreejs nor ipywidgets at import time (ipywidgets only when a bar is first shown in a kernel).
+`rot4d_widget.core.progress` counts and decides when to show; this module draws in a kernel and
+registers itself there on import (`rot4d_widget.core.progress.register_widget_bar`).
 """
 
 from __future__ import annotations
 
-import sys
-import threading
-import time
+import ipywidgets
+from IPython.display import display
 
-__all__ = ["Progress", "progress", "in_kernel"]
+from ..core.progress import register_widget_bar
 
-#: Seconds of work before a bar appears.
-DELAY = 1.0
-#: Seconds between redraws of a text line.
-_REDRAW = 0.1
+__all__ = ["WidgetBar"]
 
 
-def in_kernel() -> bool:
-    """True when running in an IPython kernel that has a front end to show widgets in."""
-    ip_mod = sys.modules.get("IPython")
-    if ip_mod is None:
-        return False
-    try:
-        ip = ip_mod.get_ipython()
-    except Exception:  # an IPython too old or half imported
-        return False
-    return getattr(ip, "kernel", None) is not None
+class WidgetBar:
+    """An ``IntProgress`` with a label, displayed in the cell's output when first shown."""
+
+    def __init__(self, total: int, description: str = ""):
+        self.bar = ipywidgets.IntProgress(value=0, min=0, max=max(int(total), 1), description=description[:20])
+        self.label = ipywidgets.Label()
+        display(ipywidgets.HBox([self.bar, self.label]))
+
+    def show(self, count: int, text: str) -> None:
+        self.bar.value = count
+        self.label.value = text
+
+    def close(self, done: bool) -> None:
+        self.bar.bar_style = "success" if done else ""
 
 
-class Progress:
-    """Counts done items out of ``total`` and shows it (see the module docstring).
-
-    ``update(n=1)`` adds ``n`` done items; ``close()`` ends the display (a bar left full at the
-    end, a text line ended); ``count`` is the number done so far.  ``mode`` is ``"widget"``,
-    ``"text"`` or ``"none"`` (None: chosen from where the code runs); ``file`` the text stream
-    (default ``sys.stderr``; text is written only if it is a terminal unless ``mode="text"``
-    is asked for); ``clock`` the time source (``time.monotonic``).
-    """
-
-    def __init__(self, total: int, description: str = "", *, delay: float = DELAY, mode: str | None = None,
-                 file=None, clock=time.monotonic):
-        if isinstance(total, bool) or not isinstance(total, int) or total < 0:
-            raise ValueError(f"Expected `total` to be an int >= 0, got {total!r}")
-        if mode not in (None, "widget", "text", "none"):
-            raise ValueError(f"Expected `mode` to be 'widget', 'text', 'none' or None, got {mode!r}")
-        self.total = total
-        self.description = str(description)
-        self.count = 0
-        self._delay = float(delay)
-        self._clock = clock
-        self._t0 = clock()
-        self._file = sys.stderr if file is None else file
-        if mode is None:
-            if in_kernel():
-                mode = "widget"
-            else:
-                isatty = getattr(self._file, "isatty", None)
-                mode = "text" if isatty is not None and isatty() else "none"
-        self.mode = mode
-        self._lock = threading.Lock()
-        self._shown = False
-        self._closed = False
-        self._last = -1.0
-        self._bar = self._label = None
-
-    # -- the public API ----------------------------------------------------------------------
-    def update(self, n: int = 1) -> None:
-        """``n`` more items done; shows or redraws the bar when due."""
-        with self._lock:
-            if self._closed:
-                return
-            self.count = min(self.total, self.count + int(n)) if self.total else self.count + int(n)
-            now = self._clock()
-            if self.mode == "none" or now - self._t0 < self._delay:
-                return
-            if self._shown and now - self._last < _REDRAW and self.count < self.total:
-                return
-            self._draw(now)
-
-    def close(self) -> None:
-        """End the display; a bar shown stays, showing the final count."""
-        with self._lock:
-            if self._closed:
-                return
-            self._closed = True
-            if self._shown:
-                self._draw(self._clock())
-                if self.mode == "text":
-                    self._file.write("\n")
-                    self._file.flush()
-                elif self._bar is not None:
-                    self._bar.bar_style = "success" if self.count >= self.total else ""
-
-    def __enter__(self) -> "Progress":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-    # -- drawing -----------------------------------------------------------------------------
-    def _text(self, now: float) -> str:
-        return f"{self.count}/{self.total}, {now - self._t0:.0f} s"
-
-    def _draw(self, now: float) -> None:
-        self._last = now
-        if self.mode == "widget":
-            if not self._shown:
-                import ipywidgets
-                from IPython.display import display
-
-                self._bar = ipywidgets.IntProgress(value=0, min=0, max=max(self.total, 1),
-                                                   description=self.description[:20])
-                self._label = ipywidgets.Label()
-                display(ipywidgets.HBox([self._bar, self._label]))
-            self._bar.value = self.count
-            self._label.value = self._text(now)
-        else:
-            width = 24
-            full = int(width * self.count / self.total) if self.total else width
-            line = f"\r{self.description}  [{'#' * full}{' ' * (width - full)}] {self._text(now)}"
-            self._file.write(line)
-            self._file.flush()
-        self._shown = True
-
-
-def progress(total: int, description: str = "", **options) -> Progress:
-    """A `Progress` for ``total`` items (``options``: ``delay``, ``mode``, ``file``, ``clock``)."""
-    return Progress(total, description, **options)
+register_widget_bar(WidgetBar)

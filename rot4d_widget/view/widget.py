@@ -49,6 +49,7 @@ import traitlets
 from ipyevents import Event
 
 from ..core import look
+from . import progress as _progress  # noqa: F401 - registers the kernel's progress bar with the core
 from . import readout as ro
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from ..core.keymap import DEFAULT_KEYMAP, RESERVED_KINDS, REPEATING_KINDS, Action, Keymap
