@@ -435,3 +435,27 @@ def test_render_tomography_field_grid_and_bad_path(tmp_path):
     assert any(c.get_gid() == "surface" for c in fig.axes[0].collections)
     with pytest.raises(ValueError, match=r"\.png, \.pdf, \.svg"):
         render_tomography("5-cell", None, 0.0, 3, None, "stack", tmp_path / "x.gif")
+
+
+def test_a_stack_tells_the_protocol_what_it_wraps_its_settings_and_copies_its_inner_source():
+    import copy
+
+    from rot4d_widget import Field4D
+    from rot4d_widget.sources.protocol import apply_setting, inner_source, settings_of, takes_coarse
+
+    f = Field4D.from_function(lambda x, y, z, w: x + w, ((-1, 1),) * 4, levels=[0.1])
+    st = StackSource(f, slices=3)
+    assert inner_source(st) is f and inner_source(f) is f and takes_coarse(st) and takes_coarse(f)
+    assert settings_of(st) == {"slices": 3, "spacing": None, "arrangement": "oval", "levels": [0.1],
+                               "inside": "above", "caps": True}
+    apply_setting(st, "levels", [0.2, 0.3])
+    apply_setting(st, "slices", 5)
+    assert f.levels == (0.2, 0.3) and st.slices == 5
+    with pytest.raises(ValueError, match="no setting 'thickness'"):
+        apply_setting(st, "thickness", 1.0)
+    twin = copy.copy(st)
+    assert twin.source is not f and settings_of(twin) == settings_of(st)
+    twin.source.levels = [0.5]
+    assert f.levels == (0.2, 0.3)  # the original's inner source is untouched
+    poly = StackSource("5-cell", slices=2)
+    assert not takes_coarse(poly) and settings_of(poly) == {"slices": 2, "spacing": None, "arrangement": "oval"}

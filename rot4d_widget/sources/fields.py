@@ -1191,6 +1191,20 @@ class Field4D:
                               lambda sign=1: self.step_levels(-sign)),
         }
 
+    #: the source protocol's ``coarse_steps``: held keys slice the coarse copy
+    coarse_steps = True
+
+    @property
+    def settings(self) -> dict:
+        """The source protocol's ``settings``: the iso levels, which side is inside, the caps."""
+        return {"levels": tuple(self.levels), "inside": self.inside, "caps": self.caps}
+
+    def apply_setting(self, name: str, value) -> None:
+        """Set one of `settings` (ValueError for another name; the setters validate the values)."""
+        if name not in ("levels", "inside", "caps"):
+            raise ValueError(f"A field's settings are 'levels', 'inside' and 'caps', not {name!r}")
+        setattr(self, name, tuple(value) if name == "levels" else value)
+
     @property
     def w_frame(self) -> tuple:
         """``(origin, per_unit)`` = (the data's w at the box's centre, `w_per_unit`): c0 =

@@ -35,6 +35,31 @@ A source has
     at rest c0 = 30 cuts the data at t = 30.  The widget's l/h step, c0 bounds
     and gauge follow it; `w_frame` reads it, validated.
 
+What the widget, exports, figures and recordings need to know of a source beyond
+that comes from these optional members, never from its class (`inner_source`,
+`settings_of`, `apply_setting`, `takes_coarse` read them):
+
+``wraps`` (optional)
+    The source this one cuts in its own way, for a source made around another
+    (parallel slices: `rot4d_widget.sources.tomography.StackSource`); absent or
+    None for every other.  Levels, units and frames are then the inner source's.
+``settings`` (optional)
+    A dict ``{name: JSON-able value}`` of the settings a recording keeps and a
+    state file restores (a field's ``levels``, ``inside``, ``caps``; a stack's
+    ``slices``, ``spacing``, ``arrangement`` and its inner source's); with
+    ``apply_setting(name, value)`` to set one (ValueError naming the allowed
+    names and values).  A user's source declares its own (a thickness ...): the
+    widget records them when they change (`Rot4DWidget.refresh`) and a replay
+    sets them again.
+``coarse_steps`` (optional)
+    True when ``slice(matrix, c0, coarse=True)`` gives a cheaper slice for held
+    keys (a field's coarse copy); by default read from ``slice``'s signature.
+``describe()`` returns everything a state file needs to rebuild the source: its
+``"kind"`` and, when it cannot be rebuilt from the description, ``"rebuild"``:
+the reason (a string; True or absent when it can).  A copy of a source
+(``copy.copy``) is one that replaying its own actions may change without
+changing the original (a stack copies its inner source too).
+
 Rotations in the planes xy, xz and yz never change which part of a source
 the hyperplane cuts, only how the cut is turned in 3-D: the slice at
 ``matrix`` equals the slice at ``R3 @ matrix`` turned by the 3-D rotation R3.
@@ -60,6 +85,10 @@ __all__ = [
     "BadSlice",
     "data_w_text",
     "w_frame",
+    "inner_source",
+    "settings_of",
+    "apply_setting",
+    "takes_coarse",
 ]
 
 
@@ -184,6 +213,46 @@ def w_frame(source) -> tuple:
     if not (math.isfinite(origin) and math.isfinite(per) and per > 0):
         raise ValueError(f"Expected a source's `w_frame` (origin, per_unit) finite with per_unit > 0, got {frame!r}")
     return origin, per
+
+
+def inner_source(source):
+    """The source whose geometry ``source`` shows: its ``wraps`` (a stack's inner source), else itself."""
+    inner = getattr(source, "wraps", None)
+    return source if inner is None else inner
+
+
+def settings_of(source) -> dict:
+    """A copy of ``source``'s ``settings`` ({} for a source without), JSON-able values (tuples as lists)."""
+    settings = getattr(source, "settings", None)
+    if settings is None:
+        return {}
+    if not isinstance(settings, Mapping):
+        raise TypeError(f"Expected a source's `settings` to be a dict of name -> value, got {type(settings).__name__}")
+    return {str(k): list(v) if isinstance(v, tuple) else v for k, v in settings.items()}
+
+
+def apply_setting(source, name: str, value) -> None:
+    """Set one of ``source``'s `settings` (its ``apply_setting``); ValueError for a source without
+    that setting, naming the ones it has."""
+    names = settings_of(source)
+    apply = getattr(source, "apply_setting", None)
+    if name not in names or apply is None:
+        title = getattr(source, "name", None) or type(source).__name__
+        raise ValueError(f"{title} has no setting {name!r}; its settings: {', '.join(sorted(names)) or 'none'}")
+    apply(name, value)
+
+
+def takes_coarse(source) -> bool:
+    """True when ``source.slice`` takes ``coarse=`` (its ``coarse_steps``, else its signature)."""
+    declared = getattr(source, "coarse_steps", None)
+    if declared is not None:
+        return bool(declared)
+    import inspect
+
+    try:
+        return "coarse" in inspect.signature(source.slice).parameters
+    except (TypeError, ValueError):
+        return False
 
 
 def data_w_text(source, w: float, matrix=None) -> str:

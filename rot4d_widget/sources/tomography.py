@@ -64,7 +64,8 @@ from numbers import Integral, Real
 import numpy as np
 
 from ..core import look
-from .protocol import SliceData, SourceAction, as_source, census_text, data_w_text, w_frame
+from .protocol import (SliceData, SourceAction, apply_setting, as_source, census_text, data_w_text,
+                       settings_of, takes_coarse, w_frame)
 
 __all__ = [
     "ARRANGEMENTS",
@@ -308,7 +309,7 @@ class StackSource:
         self.arrangement = arrangement
         self.color_by = color_by
         self._polytope = getattr(self.source, "polytope", None) if _is_polytope_source(self.source) else None
-        if not _takes_coarse(self.source):
+        if not takes_coarse(self.source):
             self.slice = self._slice_exact  # same signature as the inner source: (matrix, c0)
 
     # -- validated settings -------------------------------------------------------
@@ -388,6 +389,37 @@ class StackSource:
     def w_range(self, matrix) -> tuple:
         f = getattr(self.source, "w_range", None)
         return tuple(f(matrix)) if f is not None else (-self.size, self.size)
+
+    @property
+    def wraps(self):
+        """The inner source (the source protocol's ``wraps``)."""
+        return self.source
+
+    @property
+    def coarse_steps(self) -> bool:
+        """Held keys get a coarse slice exactly when the inner source has one."""
+        return takes_coarse(self.source)
+
+    @property
+    def settings(self) -> dict:
+        """The protocol's ``settings``: N, Δ (None while it follows N) and the arrangement, then
+        the inner source's (a field's levels, inside, caps)."""
+        own = {"slices": self._slices, "spacing": self._spacing, "arrangement": self._arrangement}
+        return {**own, **settings_of(self.source)}
+
+    def apply_setting(self, name: str, value) -> None:
+        """Set one of `settings`: the stack's own, or the inner source's (`apply_setting`)."""
+        if name in ("slices", "spacing", "arrangement"):
+            setattr(self, name, value)
+        else:
+            apply_setting(self.source, name, value)
+
+    def __copy__(self) -> "StackSource":
+        """A stack around a copy of the inner source (replaying its actions changes the copy only)."""
+        import copy
+
+        return StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
+                           arrangement=self._arrangement, color_by=self._color_by)
 
     @property
     def w_frame(self) -> tuple:
@@ -574,11 +606,3 @@ def _is_polytope_source(src) -> bool:
 
     return isinstance(src, PolytopeSource)
 
-
-def _takes_coarse(source) -> bool:
-    import inspect
-
-    try:
-        return "coarse" in inspect.signature(source.slice).parameters
-    except (TypeError, ValueError):
-        return False
