@@ -1,0 +1,495 @@
+"""What the widget shows, without a browser: `render_state`, `render_tomography`, `state_source`.
+
+:func:`render_state` draws a `RotationState` and any source (polytope, field, stack, a user's
+own) with the widget's display settings at a chosen size in pixels; :func:`render_tomography`
+draws N parallel slices as the live view lays them out.  Part of `rot4d_widget.keep.figures`,
+which re-exports every public name.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+from matplotlib.colors import ListedColormap, to_rgba
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from ..core import look
+from ..core.look import REFERENCE_RADIUS
+from ..core.state import RotationState
+from ..geometry.slicing import Slice
+from .drawing import (
+    _REFERENCE_EDGE,
+    _Z_BASE,
+    CAMERA_FOV,
+    TITLE_HEIGHT,
+    _add_patch,
+    _real,
+    _save,
+    _slice_collection,
+    draw_slice,
+    perspective,
+)
+from .framing import _as_box, _draw_annotation, _frame_limits, _level_colors, annotation, frame_extent
+
+
+def render_tomography(
+    source="24-cell",
+    matrix=None,
+    c0: float = 0.0,
+    slices: int = 5,
+    spacing: float | None = None,
+    arrangement: str = "oval",
+    path=None,
+    *,
+    color_by: str = "w",
+    width: float = 6.0,
+    height: float = 5.0,
+    dpi: float = 100,
+    title: str | bool | None = True,
+    labels: bool = True,
+    face_alpha: float = look.FACE_OPACITY,
+    ball_radius: float | None = None,
+    bar_radius: float | None = None,
+    show_balls: bool = True,
+    show_bars: bool = True,
+    show_faces: bool = True,
+    face_color=None,
+    group_colors=None,
+    background=look.BACKGROUND,
+    frame="camera",
+    annotate=False,
+    _data=None,
+    _theta0=None,
+    _canvas=None,
+) -> Figure:
+    """N parallel slices w_k = c0 + (k - (N-1)/2) Δ of ``source``, in one scene, as the live view lays them out.
+
+    ``source`` is a polytope name, a Polytope or any source (a `Field4D` ...), ``matrix`` the
+    (4, 4) orientation (identity by default); ``slices``, ``spacing`` (None: 2 size / N),
+    ``arrangement`` ("oval", "grid", "stack") and ``color_by`` ("w" or "cell") as in
+    :class:`rot4d_widget.sources.tomography.StackSource`, whose slice this draws: each slice is placed
+    at its arrangement's centre and scale, the whole scene scaled to the live view's displayed
+    size and seen through its camera (``width`` / ``height`` inches: the default 6 x 5 has the
+    canvas's 600 x 500 aspect).  Slices are painted back to front by the depth of their centres
+    (they never intersect), each slice's own faces, bars and balls by depth as in
+    :func:`draw_slice`.  ``labels``: each slice's w under it; the slice at w = c0 (or the first
+    above it, for even N) is ringed and its label bold.  Saved to ``path`` (.png, .svg or .pdf)
+    if given.  Returns the Figure.
+
+    The live view's display options: ``ball_radius`` / ``bar_radius`` in displayed units, the
+    same for every slice (default: the widest slice's, shrunk with each slice's scale),
+    ``show_balls`` / ``show_bars`` / ``show_faces``, ``face_color`` one colour for every face
+    (the widget's ``color_by`` when it is a colour), ``group_colors`` one colour per group,
+    ``background``.
+
+    ``frame``: ``"camera"`` (default) the live camera's frustum; ``"fit"`` the same eye and
+    perspective, zoomed so that the projected bounding box of what is drawn (every point of
+    the slice, balls included) fills `FIT_FILL` of the picture, centred on it (`frame_extent`);
+    or ``(x0, x1, y0, y1)``, a box in the picture plane to fit the same way (an animation passes
+    the union of its frames' boxes so that the framing does not jump).  ``annotate``: False,
+    True (a corner text naming the source, c0, a field's level(s) and w span with their units,
+    a stack's slices' w, and a legend of the levels' or slices' colours: `annotation`), or a
+    string written as the first line of that text.
+    """
+    from ..sources.protocol import as_source
+    from ..sources.tomography import StackSource
+
+    src = source if isinstance(source, StackSource) else None
+    if src is None:
+        inner = as_source(source)
+        src = StackSource(inner, slices=slices, spacing=spacing, arrangement=arrangement, color_by=color_by)
+    matrix = np.eye(4) if matrix is None else matrix
+    c0 = _real("c0", c0)
+    width = _real("width", width, minimum=0.0, inclusive=False)
+    height = _real("height", height, minimum=0.0, inclusive=False)
+    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    if ball_radius is not None:
+        ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+    if bar_radius is not None:
+        bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
+    palette = None  # an override of the group colours: one colour, or the caller's
+    if face_color is not None:
+        palette = np.asarray([look.as_rgb(face_color, "face_color")], dtype=np.float64)
+    elif group_colors is not None:
+        palette = np.asarray([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
+                             dtype=np.float64).reshape(-1, 3)
+    background = to_rgba(background)
+    data = src.slice(matrix, c0) if _data is None else _data
+    ex = data.extra
+    n = src.slices
+    scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
+    centres = np.asarray(ex["centres"]) * scale
+    scales = np.asarray(ex["scales"])
+    levels = np.asarray(ex["levels"])
+    hi = int(ex["highlighted"])
+    group_rgb = ex.get("group_rgb")
+
+    top = TITLE_HEIGHT if title else 0.0
+    if _canvas is None:
+        fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
+        ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
+        ax.set_axis_off()
+        ax.set_facecolor(background)
+    else:  # an animation's next frame: the same figure, this frame's artists only
+        fig, ax = _canvas.begin(width, height, top, dpi, background)
+    aspect = width / height
+    edge = getattr(src.source, "edge_length", None)
+    base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
+    if isinstance(frame, str) and frame == "fit":
+        box = frame_extent(data, src, ball_radius=(ball_radius if ball_radius is not None else base_ball)
+                           if show_balls else 0.0)
+    elif isinstance(frame, str) and frame == "camera":
+        box = None
+    else:
+        box = _as_box(frame)
+    (x0, x1), (y0, y1) = _frame_limits(box, aspect)
+    limit = 0.5 * (y1 - y0)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    if _canvas is None:
+        ax.set_aspect("equal")
+
+    poly = getattr(src.source, "polytope", None)
+    offs = np.asarray(ex["point_offsets"])
+    toff = np.asarray(ex["triangle_offsets"])
+    soff = np.asarray(ex["segment_offsets"])
+    # back to front by the depth of each slice's centre; zorders of slices never interleave
+    jobs = []  # labels, placed after every slice is drawn
+    for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
+        z_shift = 1e3 * rank
+        ball = base_ball * scales[k] if ball_radius is None else ball_radius
+        bar = look.default_bar_radius(ball) if bar_radius is None else bar_radius
+        if poly is not None:
+            s = ex["slices"][k]
+            placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
+                           s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
+                           s.volume, s.dim)
+            if palette is not None:
+                cmap = ListedColormap(palette)
+            else:
+                cmap = None if group_rgb is None else ListedColormap([group_rgb[k]])
+            if not show_faces:
+                placed = Slice(placed.vertices, placed.edges, placed.polygon_indices[:0], placed.polygon_offsets[:1],
+                               placed.cell_ids[:0], placed.triangles[:0], placed.triangle_cells[:0], placed.volume,
+                               placed.dim)
+            if _canvas is not None:  # one collection per slice, in draw_slice's painter's order
+                coll = _slice_collection(placed, scale=scale, ball_radius=ball if show_balls else 0.0,
+                                         bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap,
+                                         z_shift=z_shift)
+                if coll is not None:
+                    ax.add_collection(coll, autolim=False)
+            else:
+                drawing = draw_slice(ax, placed, scale=scale, fov=CAMERA_FOV,
+                                     ball_radius=ball if show_balls else 0.0,
+                                     bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap)
+                for a in (*drawing.faces, *drawing.bars, *drawing.balls, *drawing.highlights):
+                    a.set_zorder(a.get_zorder() + z_shift)
+        else:
+            bar_width = (0.35 * bar if bar_radius is None else bar) if show_bars else 0.0  # a field's box: thin
+            _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
+                          src.source, face_alpha, z_shift, bar_width, show_faces=show_faces)
+        if labels:
+            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift))
+    # labels that would overlap one already placed are left out: the highlighted slice's first,
+    # then the nearer (bigger) slices' (far, small slices of the oval crowd together)
+    placed: list = []
+    point = 2.0 * limit / (height * 72.0)  # data units per typographic point
+    for job in sorted(jobs, key=lambda j: (not j[3], -j[1] * perspective(np.asarray(j[0])[None, :])[1][0])):
+        _label_slice(ax, *job, point=point, placed=placed)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    if annotate:
+        lines, legend = annotation(src, data, c0, theta0=_theta0)
+        if isinstance(annotate, str):
+            lines = [annotate, *lines]
+        _draw_annotation(ax, lines, legend, height, _canvas)
+    if title:
+        name = getattr(src.source, "name", None) or type(src.source).__name__
+        text = title if isinstance(title, str) else (
+            f"{name}: {n} slice{'s' if n != 1 else ''} w = c0 + (k \u2212 {(n - 1) / 2:g})\u0394, "
+            f"c0 = {c0:.3g}, \u0394 = {src.spacing:.3g}, {src.arrangement}")
+        if _canvas is not None and _canvas.title is not None:
+            _canvas.title.set_text(text)
+        else:
+            t = fig.text(0.5, 1.0 - 0.5 * top / (height + top), text, ha="center", va="center", fontsize=9)
+            if _canvas is not None:
+                _canvas.title = t
+        if _canvas is not None:
+            _canvas.keep.add(_canvas.title)
+    if _canvas is not None:
+        _canvas.end()
+    _save(fig, path)
+    return fig
+
+
+
+def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
+    """'w = ...' at the upper left of a slice's projected bounding circle (inside its square, like a
+    CT film's corner text), painted with its slice (nearer slices cover it); the highlighted slice
+    ringed, its label bold.  With ``point`` (data units per point) and ``placed`` (boxes of the
+    labels drawn so far), a label overlapping one of them is left out (not the highlighted one)."""
+    (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
+    r = radius * f
+    fs = max(5.0, min(9.0, 30.0 * r))
+    z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
+    text = f"w = {w:.3g}"
+    x0, y1 = xy[0] - 0.98 * r, xy[1] + 0.98 * r
+    if point is not None and placed is not None:
+        # the upper left corner of the slice's square, else its upper right, else just above it
+        wd, ht = 0.62 * fs * point * len(text), 1.7 * fs * point  # a line and a gap
+        for cx, cy in ((x0, y1), (xy[0] + 0.98 * r - wd, y1), (xy[0] - wd / 2, y1 + ht)):
+            box = (cx, cy - ht, cx + wd, cy)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+                break
+        else:
+            if not highlighted:
+                return  # nowhere free: left out
+            cx, cy, box = x0, y1, (x0, y1 - ht, x0 + wd, y1)
+        placed.append(box)
+        x0, y1 = cx, cy
+    ax.text(x0, y1, text, ha="left", va="top", fontsize=fs,
+            fontweight="bold" if highlighted else "normal", zorder=z, gid="label")
+    if highlighted:
+        _add_patch(ax, Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
+                            zorder=z, gid="highlight-ring"))
+
+
+def _triangles_class():
+    """`_Triangles`, made on first use (matplotlib's collections imported lazily)."""
+    from matplotlib.collections import PolyCollection
+
+    class Triangles(PolyCollection):
+        """Flat-coloured triangles drawn in the order given with one renderer call
+        (``draw_gouraud_triangles``, each corner the triangle's colour) instead of one path per
+        triangle: a field's surface of thousands of triangles draws several times faster.  It is
+        a `PolyCollection` for everything but drawing (``ax.collections``, its gid, colours)."""
+
+        def __init__(self, verts, rgba, **kwargs):
+            self._tri_verts = np.asarray(verts, dtype=np.float64).reshape(-1, 3, 2)
+            self._tri_rgba = np.asarray(rgba, dtype=np.float64).reshape(-1, 4)
+            super().__init__([], facecolors=self._tri_rgba, edgecolors="none", **kwargs)
+
+        def get_paths(self):  # lazily, for anything that asks (hit tests, extents)
+            if not self._paths and len(self._tri_verts):
+                self.set_verts(self._tri_verts)
+            return self._paths
+
+        def draw(self, renderer):
+            if not self.get_visible() or not len(self._tri_verts):
+                return
+            renderer.open_group("surface", gid=self.get_gid())
+            gc = renderer.new_gc()
+            self._set_gc_clip(gc)
+            gc.set_linewidth(0.0)
+            colors = np.repeat(self._tri_rgba[:, None, :], 3, axis=1)
+            renderer.draw_gouraud_triangles(gc, self._tri_verts, colors, self.get_transform().frozen())
+            gc.restore()
+            renderer.close_group("surface")
+            self.stale = False
+
+    return Triangles
+
+
+def _Triangles(verts, rgba, **kwargs):
+    global _TRIANGLES
+    if _TRIANGLES is None:
+        _TRIANGLES = _triangles_class()
+    return _TRIANGLES(verts, rgba, **kwargs)
+
+
+_TRIANGLES = None
+
+
+def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width,
+                  show_faces=True):
+    """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines."""
+    from matplotlib.collections import LineCollection
+
+    p0, p1 = offs[k], offs[k + 1]
+    pts = np.asarray(data.points[p0:p1]) * scale
+    tri = np.asarray(data.triangles[toff[k]:toff[k + 1]]) - p0
+    seg = np.asarray(data.segments[soff[k]:soff[k + 1]]) - p0
+    if not len(pts):
+        return
+    xy, _ = perspective(pts)
+    z_base = _Z_BASE + float(pts[:, 2].mean()) + z_shift
+    if len(tri) and show_faces:
+        groups = np.asarray(data.groups[toff[k]:toff[k + 1]])
+        if group_rgb is not None:
+            pal = np.asarray(group_rgb, dtype=np.float64)
+            rgb = pal[np.minimum(groups, len(pal) - 1)] if len(pal) == 1 else pal[groups]
+        else:
+            levels = getattr(inner, "levels", None)
+            if levels:
+                lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
+                rgb = _level_colors(levels, lo, hi)[groups]
+            else:
+                rgb = look.group_palette(int(groups.max()) + 1)[groups].astype(np.float64)
+        # a triangle's mean normal and depth as (c0 + c1 + c2) / 3: the sums and the division of
+        # ``[tri].mean(axis=1)``, bit for bit, from three gathers instead of one (T, 3, 3) reduction
+        t0, t1, t2 = tri[:, 0], tri[:, 1], tri[:, 2]
+        nrm = data.normals
+        if nrm is not None:
+            nv = np.asarray(nrm[p0:p1])
+            n = (nv[t0] + nv[t1] + nv[t2]) / 3.0
+            n /= np.maximum(np.sqrt(np.add.reduce(n * n, axis=1, keepdims=True)), 1e-12)  # norm's arithmetic
+            light = np.array([-0.35, 0.45, 0.82])
+            shade = 0.45 + 0.55 * np.abs(n @ (light / np.linalg.norm(light)))
+            rgb = np.clip(rgb * shade[:, None], 0.0, 1.0)
+        z = pts[:, 2]
+        depth = (z[t0] + z[t1] + z[t2]) / 3.0
+        order = np.argsort(depth, kind="stable")
+        alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, look.SURFACE_OPACITY)
+        coll = _Triangles(xy[tri[order]], np.column_stack([rgb[order], np.full(len(order), alpha)]),
+                          zorder=z_base, gid="surface")
+        ax.add_collection(coll, autolim=False)
+    if len(seg) and bar_width > 0:
+        lines = LineCollection(xy[seg], colors=look.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
+                               zorder=z_base + 1e-3, gid="bar")
+        ax.add_collection(lines, autolim=False)
+
+
+# --------------------------------------------------------------------------- the live view's picture
+def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=None, inside=None, caps=None):
+    """``source`` (a name, a Polytope or any source) with a widget's source settings applied, as a
+    `StackSource` (N = 1 is today's single slice, point for point).  The source given is not
+    changed: a field whose ``levels`` differ is copied (shallowly, sharing its array), a stack is
+    rebuilt around its inner source."""
+    from ..sources.protocol import as_source
+    from ..sources.tomography import StackSource
+
+    src = as_source(source)
+    inner, color_by, n, spc, arr = src, "w", 1, None, "oval"
+    if isinstance(src, StackSource):
+        inner, color_by, n, arr = src.source, src.color_by, src.slices, src.arrangement
+        spc = None if src.spacing_is_default else src.spacing
+    if slices is not None:
+        n = slices
+    if spacing is not None:
+        spc = spacing
+    if arrangement is not None:
+        arr = arrangement
+    if levels is not None:
+        if not hasattr(inner, "levels"):
+            raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {type(inner).__name__}")
+        if tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist()) != tuple(inner.levels):
+            inner = copy.copy(inner)
+            inner.levels = levels
+    for name, value in (("inside", inside), ("caps", caps)):  # a field's other settings, likewise
+        if value is not None and getattr(inner, name, value) != value:
+            inner = copy.copy(inner)
+            setattr(inner, name, value)
+    return StackSource(inner, slices=n, spacing=spc, arrangement=arr, color_by=color_by)
+
+
+def render_state(
+    state: RotationState,
+    source="5-cell",
+    path=None,
+    *,
+    levels=None,
+    slices: int | None = None,
+    spacing: float | None = None,
+    arrangement: str | None = None,
+    inside: str | None = None,
+    caps: bool | None = None,
+    color_by="group",
+    group_colors=None,
+    face_opacity: float = look.FACE_OPACITY,
+    ball_radius: float | None = None,
+    bar_radius: float | None = None,
+    background=look.BACKGROUND,
+    show_balls: bool = True,
+    show_bars: bool = True,
+    show_faces: bool = True,
+    size=(600, 500),
+    dpi: float = 100,
+    labels: bool = False,
+    title: str | None = None,
+    frame="fit",
+    annotate=False,
+    _prepared=None,
+    _canvas=None,
+) -> Figure:
+    """The picture the widget shows for ``state`` and ``source``, without a browser.
+
+    ``state`` is a `RotationState` (its matrix and c0 are used); ``source`` a polytope name, a
+    Polytope, a `Field4D`, a `StackSource` or any source.  The keywords are the widget's
+    settings, by the names of its traits (`rot4d_widget.keep.export.save_state` stores them so):
+    ``levels`` (a field's iso levels), ``slices``, ``spacing``, ``arrangement`` (parallel
+    slices: `state_source`), ``color_by`` (``"group"`` or one colour), ``group_colors``,
+    ``face_opacity``, ``ball_radius`` / ``bar_radius`` (displayed units; default as the widget
+    chooses them: from the polytope's edge, the same for every slice), ``background``,
+    ``show_balls`` / ``show_bars`` / ``show_faces``.
+
+    The scene is the live view's: every source scaled to the displayed circumradius
+    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z with the vertical
+    field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
+    widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
+    `look.level_colors`; a stack coloured by w: its levels' colormap).  It does not follow a
+    camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
+
+    ``frame="fit"`` (the default) keeps that eye and perspective but zooms so that the projected
+    bounding box of what is drawn fills `FIT_FILL` (90 %) of the picture's width or height;
+    ``frame="camera"`` is the live view's frame exactly (an object there fills about a third of
+    the picture); a box ``(x0, x1, y0, y1)`` in the picture plane is fitted like "fit" (see
+    `render_tomography`).  ``annotate``: True writes θ0, c0 and what the source tells of itself
+    (`annotation`: name, units, levels, w span, a stack's w) in the upper left corner and a
+    legend of the levels' or slices' colours in the lower left; a string is written first.
+    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels (plus the
+    title's strip when ``title`` is given).
+    Returns the Figure.
+    """
+    if not isinstance(state, RotationState):
+        raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+    try:
+        w_px, h_px = (float(v) for v in size)
+    except (TypeError, ValueError):
+        raise TypeError(f"Expected `size` to be (width, height) in pixels, got {size!r}") from None
+    w_px = _real("size[0]", w_px, minimum=1.0)
+    h_px = _real("size[1]", h_px, minimum=1.0)
+    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    if title is not None and not isinstance(title, str):
+        raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
+    face_color = None
+    if color_by != "group":
+        face_color = look.as_rgb(color_by, "color_by")
+    if _prepared is None:
+        _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
+                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps)
+    stack, data, ball_radius, box = _prepared
+    if isinstance(frame, str) and frame == "fit":
+        frame = "camera" if box is None else box
+    return render_tomography(
+        stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi, dpi=dpi,
+        title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
+        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
+        face_color=face_color, group_colors=group_colors, background=background, frame=frame,
+        annotate=annotate, _data=data, _theta0=state.theta0, _canvas=_canvas,
+    )
+
+
+def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
+             show_balls=True, data=None, inside=None, caps=None, **_ignored):
+    """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
+    source with the settings applied (`state_source`), its slice at ``state``, the ball radius
+    in displayed units (None: the stack's default) and the projected bounding box of the
+    drawing (`frame_extent`; None when empty).  ``data``: the slice, computed before.  An
+    animation takes the boxes of all its frames first to frame them alike, and draws each frame
+    from the slice computed then."""
+    stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
+                         inside=inside, caps=caps)
+    if ball_radius is None:
+        edge = getattr(stack, "edge_length", None)
+        if edge:
+            ball_radius = look.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
+    if data is None:
+        data = stack.slice(state.matrix, state.c0)
+    if show_balls:
+        ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
+    else:
+        ball = 0.0
+    return stack, data, ball_radius, frame_extent(data, stack, ball_radius=ball)
