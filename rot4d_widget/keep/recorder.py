@@ -1,0 +1,538 @@
+"""Recorded key sequences: the events, a `Recording` and the `Recorder` that makes one.
+
+A `Recorder` is the widget's hook: created with the `RotationState` as it is when recording
+starts, it is told every action the widget applies (``recorder.record(key, shift, action,
+inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
+(``recorder.record_set("c0", 0.3)``, a slider) and every setting of the source
+(``recorder.record_source("levels", (2.0, 3.0))``: ``levels``, ``slices``, ``spacing``,
+``arrangement``), with a time stamp.  It keeps at most
+``max_events``; older events are folded into the starting state, so a recording always replays
+to the live state.  ``recorder.recording()`` is an immutable `Recording`:
+
+* ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
+  so a recorded ``r`` resets where the live one did);
+* ``initial_source``: the source settings the events start from (``{"levels": [...], ...}``, those
+  the recorder was told with ``source_settings=``, and those folded in), possibly empty;
+* ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value) and
+  `SourceSetting` (t, name, value);
+* ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
+
+A recording is data: loading one imports nothing and runs nothing it names (a source's own
+action is looked up by name among the actions of the source the caller passes).
+
+Replaying applies the same floating-point operations in the same order, so the final state is
+the recorded one bit for bit (tested).  A source's own actions (a field's level keys, a stack's
+slice keys) and the source's settings are replayed on a source when one is given
+(`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
+view into a stack replaces its source), else skipped.
+Part of `rot4d_widget.keep.recording`, which re-exports every public name; the animations are
+`rot4d_widget.keep.animation`'s.
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import json
+import math
+import os
+import threading
+import time
+from dataclasses import dataclass
+from numbers import Integral, Real
+from typing import Mapping
+
+import numpy as np
+
+from ..core.keymap import Action
+from ..core.state import RotationState, action_from_data, action_to_data
+
+RECORDING_FORMAT = "rot4d_widget recording"
+#: Version 2 adds `SourceSetting` events; a recording without them is written as version 1
+#: (so that an older rot4d_widget still reads it).
+RECORDING_VERSION = 2
+#: Default bound of a `Recorder`: 100 000 events is about 55 minutes of a key held at 30 Hz
+#: (some 10 MB of JSON).
+MAX_EVENTS = 100_000
+#: What `Recorder.record_set` accepts: the state's settable parameters.
+SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
+#: What `Recorder.record_source` accepts: the source's settings the widget has as traits.
+SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement")
+#: The settings of a field (a stack's inner source).
+_FIELD_SETTINGS = ("levels", "inside", "caps")
+#: The settings that need parallel slices (a `StackSource`).
+_STACK_SETTINGS = ("slices", "spacing", "arrangement")
+
+
+# ============================================================================ events
+@dataclass(frozen=True)
+class Step:
+    """One applied action: ``t`` seconds after the recording started, the ``key`` pressed (None for
+    a step not from a key), ``shift``, the `Action` and whether it was ``inverted``."""
+
+    t: float
+    key: str | None
+    shift: bool
+    action: Action
+    inverted: bool
+
+    @property
+    def label(self) -> str:
+        """``"R_xw"``, ``"R_xz,yw⁻¹"``, ``"c0+"`` ... (`Action.label`)."""
+        return self.action.label(self.inverted)
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, "key": self.key, "shift": self.shift, "action": action_to_data(self.action),
+                "inverted": self.inverted, "label": self.label}
+
+
+@dataclass(frozen=True)
+class _NamedValue:
+    """A value set by name at time ``t``; saved as ``{"t", <_KEY>: name, "value"}``."""
+
+    t: float
+    name: str
+    value: object
+    _KEY = "set"
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} set"
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, self._KEY: self.name, "value": self.value}
+
+
+@dataclass(frozen=True)
+class Setting(_NamedValue):
+    """A parameter set from outside the keys (a slider, code): ``name`` in `SETTABLE` and its
+    ``value`` (a float, or a 4 x 4 list for ``"matrix"``)."""
+
+
+@dataclass(frozen=True)
+class SourceSetting(_NamedValue):
+    """A setting of the source (the widget's traits): ``name`` in `SOURCE_SETTINGS` and its
+    ``value`` -- ``levels`` a list of floats (a field's iso levels; a stack's inner source's),
+    ``inside`` ``"above"`` or ``"below"`` and ``caps`` a bool (a field's, likewise),
+    ``slices`` an int >= 1, ``spacing`` a number > 0 or None (the default), ``arrangement``
+    ``"oval"``, ``"grid"`` or ``"stack"``.  Not a `Setting` (the state's): a sibling."""
+
+    _KEY = "source"
+
+
+def _time(t) -> float:
+    if isinstance(t, bool) or not isinstance(t, Real) or not math.isfinite(t) or t < 0:
+        raise ValueError(f"Expected a time stamp >= 0 (seconds), got {t!r}")
+    return float(t)
+
+
+def _check_setting(name, value):
+    if name not in SETTABLE:
+        raise ValueError(f"Expected a setting among {', '.join(map(repr, SETTABLE))}, got {name!r}")
+    if name == "matrix":
+        from ..core.rotation import as_rotation_matrix
+
+        return as_rotation_matrix(value).tolist()
+    if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
+        raise ValueError(f"Expected {name!r} to be set to a finite number, got {value!r}")
+    return float(value)
+
+
+def _check_source_setting(name, value):
+    """``value`` as a `SourceSetting` holds it (JSON-able); ValueError naming what is allowed."""
+    if name not in SOURCE_SETTINGS:
+        raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
+    if name == "levels":
+        values = [value] if isinstance(value, Real) else value
+        ok = isinstance(values, (list, tuple, np.ndarray)) and len(values) > 0 and all(
+            isinstance(v, Real) and not isinstance(v, bool) and math.isfinite(v) for v in values)
+        if not ok:
+            raise ValueError(f"Expected 'levels' to be set to a finite number or a non-empty sequence of them, "
+                             f"got {value!r}")
+        return [float(v) for v in values]
+    if name == "inside":
+        if value not in ("above", "below"):
+            raise ValueError(f"Expected 'inside' to be set to 'above' or 'below', got {value!r}")
+        return str(value)
+    if name == "caps":
+        if not isinstance(value, (bool, np.bool_)):
+            raise ValueError(f"Expected 'caps' to be set to True or False, got {value!r}")
+        return bool(value)
+    if name == "slices":
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral) or value < 1:
+            raise ValueError(f"Expected 'slices' to be set to an int >= 1, got {value!r}")
+        return int(value)
+    if name == "spacing":
+        if value is None:
+            return None
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real) or not (
+                math.isfinite(value) and value > 0):
+            raise ValueError("Expected 'spacing' to be set to a finite number > 0 or None (the default), "
+                             f"got {value!r}")
+        return float(value)
+    from ..sources.tomography import ARRANGEMENTS
+
+    if value not in ARRANGEMENTS:
+        raise ValueError(f"Expected 'arrangement' to be set to one of {', '.join(map(repr, ARRANGEMENTS))}, "
+                         f"got {value!r}")
+    return str(value)
+
+
+def _check_source_settings(settings) -> dict:
+    """A ``{name: value}`` of source settings, checked (`_check_source_setting`), in `SOURCE_SETTINGS` order."""
+    if settings is None:
+        return {}
+    if not isinstance(settings, Mapping):
+        raise ValueError(f"Expected the source settings as a dict {{name: value}}, got {settings!r}")
+    for name in settings:
+        if name not in SOURCE_SETTINGS:
+            raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
+    return {name: _check_source_setting(name, settings[name]) for name in SOURCE_SETTINGS if name in settings}
+
+
+def _event_from_dict(d):
+    if not isinstance(d, Mapping) or "t" not in d:
+        raise ValueError(f"Expected a recorded event with a time 't', got {d!r}")
+    t = _time(d["t"])
+    if "set" in d:
+        return Setting(t, d["set"], _check_setting(d["set"], d.get("value")))
+    if "source" in d:
+        return SourceSetting(t, d["source"], _check_source_setting(d["source"], d.get("value")))
+    if "action" not in d:
+        raise ValueError(f"Expected a recorded event with an 'action', a 'set' or a 'source', got {dict(d)!r}")
+    key = d.get("key")
+    if key is not None and not isinstance(key, str):
+        raise ValueError(f"Expected an event's 'key' to be a string or null, got {key!r}")
+    shift, inverted = d.get("shift", False), d.get("inverted", False)
+    if not isinstance(shift, bool) or not isinstance(inverted, bool):
+        raise ValueError(f"Expected 'shift' and 'inverted' to be true or false in {dict(d)!r}")
+    return Step(t, key, shift, action_from_data(d["action"]), inverted)
+
+
+# ============================================================================ applying
+def _source_action(source, name: str):
+    actions = getattr(source, "actions", None) or {}
+    for sa in actions.values():
+        if getattr(sa, "name", None) == name:
+            return sa
+    return None
+
+
+def _is_stack(source) -> bool:
+    from ..sources.tomography import StackSource
+
+    return isinstance(source, StackSource)
+
+
+def _set_on_source(source, name: str, value) -> None:
+    """Set a source setting on ``source`` in place: ``levels`` on a field (a stack's inner one),
+    the others on a stack.  ValueError if ``source`` has no such setting."""
+    if name in _FIELD_SETTINGS:
+        target = source.source if _is_stack(source) else source
+        if not hasattr(target, name):
+            raise ValueError(f"A recorded {name!r} applies to a source that has it (a field), not "
+                             f"{type(target).__name__}")
+        setattr(target, name, tuple(value) if name == "levels" else value)
+        return
+    if not _is_stack(source):
+        raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a single "
+                         "view: replay with set_source= (Rot4DWidget.replay turns its view into a stack), or "
+                         "on a StackSource")
+    setattr(source, name, value)
+
+
+def _with_source_setting(source, name: str, value):
+    """``source`` with a source setting applied: in place, or (``slices`` of a single view) a new
+    `StackSource` around it, as the widget does."""
+    if name == "slices" and not _is_stack(source):
+        from ..sources.tomography import StackSource
+
+        return StackSource(source, slices=value)
+    _set_on_source(source, name, value)
+    return source
+
+
+def _apply(state: RotationState, event, source=None, set_source=None) -> bool:
+    """Apply one event to ``state`` (a source's own action and a source setting to ``source``, or
+    a source setting through ``set_source(name, value)``); True if applied."""
+    if isinstance(event, SourceSetting):
+        if set_source is not None:
+            set_source(event.name, event.value)
+            return True
+        if source is None:
+            return False
+        _set_on_source(source, event.name, event.value)
+        return True
+    if isinstance(event, Setting):
+        setattr(state, event.name, np.asarray(event.value) if event.name == "matrix" else event.value)
+        return True
+    action = event.action
+    if action.kind == "custom":
+        sa = _source_action(source, action.name) if source is not None else None
+        if sa is None:
+            return False
+        sa.run(-1 if event.inverted else 1)
+        return True
+    state.apply(action, event.inverted)
+    return True
+
+
+# ============================================================================ recordings
+class Recording:
+    """A starting state and the events applied to it (immutable; see the module docstring)."""
+
+    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0, initial_source: Mapping | None = None):
+        RotationState.from_dict(initial)  # validates
+        self._initial_source = _check_source_settings(initial_source)
+        self._initial = json.loads(json.dumps(dict(initial)))  # a private, JSON-clean copy
+        self.events = tuple(events)
+        for e in self.events:
+            if not isinstance(e, (Step, Setting, SourceSetting)):
+                raise TypeError(f"Expected Step, Setting or SourceSetting events, got {type(e).__name__}")
+        if isinstance(dropped, (bool, np.bool_)) or not isinstance(dropped, Integral) or dropped < 0:
+            raise ValueError("Expected `dropped` (how many events were folded into the starting state) to be an "
+                             f"int >= 0, got {dropped!r}")
+        self.dropped = int(dropped)
+
+    @property
+    def initial_source(self) -> dict:
+        """The source settings at the start (``{name: value}`` of `SOURCE_SETTINGS`; a copy)."""
+        return json.loads(json.dumps(self._initial_source))
+
+    @property
+    def initial(self) -> dict:
+        """The starting state as `RotationState.to_dict(initial=True)` data (a copy)."""
+        return json.loads(json.dumps(self._initial))
+
+    def initial_state(self, keymap=None) -> RotationState:
+        """A fresh `RotationState` at the start of the recording (its reset point as recorded)."""
+        return RotationState.from_dict(self._initial, keymap=keymap)
+
+    def for_source(self, source) -> "Recording":
+        """This recording with c0 in ``source``'s w units: a recording made before c0 followed
+        the data's units (its starting state of format 1) has its c0, initial c0, c0 step and
+        every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
+        (`rot4d_widget.sources.protocol.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
+        source whose frame is (0, 1) (a polytope), gives ``self``."""
+        from ..sources.protocol import w_frame
+
+        if source is None or self._initial.get("format", 2) >= 2:
+            return self
+        frame = w_frame(source)
+        if frame == (0.0, 1.0):
+            return self
+        origin, per = frame
+        initial = RotationState.from_dict(self._initial, w_frame=frame).to_dict(initial=True)
+
+        def converted(e):
+            if isinstance(e, Setting) and e.name == "c0":
+                return Setting(e.t, "c0", origin + per * float(e.value))
+            if isinstance(e, Setting) and e.name == "c0_step":
+                return Setting(e.t, "c0_step", per * float(e.value))
+            return e
+
+        return Recording(initial, [converted(e) for e in self.events], dropped=self.dropped,
+                         initial_source=self._initial_source)
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the start to the last event (0 without events)."""
+        return self.events[-1].t if self.events else 0.0
+
+    def __len__(self) -> int:
+        return len(self.events)
+
+    def __repr__(self) -> str:
+        return f"Recording({len(self.events)} events over {self.duration:.3g} s, {self.dropped} dropped)"
+
+    # -- data ------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        # version 1 unless a source setting needs 2: older readers keep reading what they can
+        version = 2 if self._initial_source or any(isinstance(e, SourceSetting) for e in self.events) else 1
+        d = {"format": RECORDING_FORMAT, "version": version, "initial": self.initial}
+        if self._initial_source:
+            d["initial_source"] = self.initial_source
+        d.update(dropped=self.dropped, events=[e.to_dict() for e in self.events])
+        return d
+
+    @classmethod
+    def from_dict(cls, d) -> "Recording":
+        if not isinstance(d, Mapping) or d.get("format") != RECORDING_FORMAT:
+            raise ValueError(f"Not a rot4d_widget recording (no \"format\": \"{RECORDING_FORMAT}\")")
+        v = d.get("version")
+        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= RECORDING_VERSION:
+            raise ValueError(f"A recording of version {v!r}; this rot4d_widget reads versions 1 ... "
+                             f"{RECORDING_VERSION}")
+        if "initial" not in d or not isinstance(d.get("events"), list):
+            raise ValueError("A recording needs its 'initial' state and a list of 'events'")
+        events = [_event_from_dict(e) for e in d["events"]]
+        if any(b.t < a.t for a, b in zip(events, events[1:])):
+            raise ValueError("Expected a recording's events in time order")
+        return cls(d["initial"], events, dropped=d.get("dropped", 0), initial_source=d.get("initial_source"))
+
+    def save(self, path) -> None:
+        """Write the recording as JSON to ``path``."""
+        with open(os.fspath(path), "w", encoding="utf-8") as fh:
+            json.dump(self.to_dict(), fh, allow_nan=False)
+            fh.write("\n")
+
+    @classmethod
+    def load(cls, path) -> "Recording":
+        """Read a recording `save` wrote; ``ValueError`` naming what is wrong otherwise."""
+        try:
+            with open(os.fspath(path), encoding="utf-8") as fh:
+                d = json.load(fh)
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{os.fspath(path)!r} is not a rot4d_widget recording: not JSON ({exc})") from None
+        return cls.from_dict(d)
+
+    # -- replay ----------------------------------------------------------------------------
+    def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True,
+               set_source=None) -> RotationState:
+        """Apply the events to ``state`` (in place; default a fresh state) and return it.
+
+        ``restart``: set ``state`` to the recording's starting state first (its orientation,
+        parameters and reset point; its keymap is kept) and the source to its `initial_source`
+        settings.  ``source``: a source whose own actions
+        (``source.actions``, matched by name) are replayed on it, changing it; without one they
+        are skipped.  The result equals the recorded final state bit for bit.
+
+        Source settings (`SourceSetting`: ``levels``, ``slices``, ``spacing``, ``arrangement``)
+        are applied by calling ``set_source(name, value)`` when given (the widget's own setter:
+        setting ``slices`` on a single view replaces its source with a stack, which only the
+        widget can do), else set on ``source`` in place (``levels`` on a stack's inner source);
+        a single-view ``source`` given a stack setting is refused (``ValueError``) before
+        anything changes.  Without ``source`` or ``set_source`` they are skipped.
+        """
+        if set_source is not None and not callable(set_source):
+            raise TypeError(f"Expected `set_source` to be a callable (name, value), got {type(set_source).__name__}")
+        if source is not None and self._initial.get("format", 2) < 2:
+            return self.for_source(source).replay(state, source, restart=restart, set_source=set_source)
+        if set_source is None and source is not None:
+            self._check_source_settings(source, restart)
+        if state is None:
+            state = self.initial_state()
+        elif not isinstance(state, RotationState):
+            raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+        elif restart:
+            d = dict(self._initial)
+            d.pop("keymap", None)
+            state.restore(d)  # with the recorded reset point ("initial")
+        if restart:
+            for e in self._start_settings():
+                _apply(state, e, source, set_source)
+        for e in self.events:
+            _apply(state, e, source, set_source)
+        return state
+
+    def _start_settings(self) -> list:
+        """`initial_source` as `SourceSetting` events at t = 0."""
+        return [SourceSetting(0.0, name, value) for name, value in self.initial_source.items()]
+
+    def _check_source_settings(self, source, restart: bool = True) -> None:
+        """ValueError now if ``source`` cannot take the recording's source settings in place."""
+        names = {e.name for e in self.events if isinstance(e, SourceSetting)}
+        if restart:
+            names |= set(self._initial_source)
+        inner = source.source if _is_stack(source) else source
+        missing = [n for n in _FIELD_SETTINGS if n in names and not hasattr(inner, n)]
+        if missing:
+            raise ValueError(f"The recording sets {', '.join(map(repr, missing))}, which apply to a field "
+                             f"(a source with iso levels), not {type(inner).__name__}")
+        stack_names = sorted(names & set(_STACK_SETTINGS))
+        if stack_names and not _is_stack(source):
+            raise ValueError(f"The recording sets {', '.join(map(repr, stack_names))}, which apply to parallel "
+                             f"slices, and {type(source).__name__} is a single view: replay with set_source= "
+                             "(Rot4DWidget.replay turns its view into a stack), or on a StackSource")
+
+
+class Recorder:
+    """The widget's hook: collects the actions it applies, bounded to ``max_events``.
+
+    ``Recorder(state)`` starts from ``state`` as it is now (copied).  Call ``record(key, shift,
+    action, inverted)`` after each applied action and ``record_set(name, value)`` after a
+    parameter set from outside the keys; ``t`` defaults to the seconds since the recorder was
+    made (``clock``, default `time.monotonic`).  Thread-safe (the widget's ticker thread records
+    while the kernel's thread may read).  Past ``max_events`` the oldest event is folded into
+    the starting state, so `recording` always replays to the live state (custom source actions
+    that fall out are lost: count in ``dropped``; a source setting that falls out becomes the
+    recording's `Recording.initial_source`).  ``record_source(name, value)`` records a source
+    setting (``levels``, ``slices``, ``spacing``, ``arrangement``); ``source_settings`` (here and
+    in `restart`) are the source's settings when recording starts, ``{name: value}``.
+    """
+
+    def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic,
+                 source_settings: Mapping | None = None):
+        if not isinstance(state, RotationState):
+            raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
+        if isinstance(max_events, bool) or not isinstance(max_events, int) or max_events < 1:
+            raise ValueError(f"Expected `max_events` to be an int >= 1, got {max_events!r}")
+        if not callable(clock):
+            raise TypeError("Expected `clock` to be a callable returning seconds")
+        self.max_events = max_events
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._start(state, source_settings)
+
+    def _start(self, state, source_settings=None):
+        settings = _check_source_settings(source_settings)
+        self._t0 = self._clock()
+        self._shadow = state.copy()  # the state before the oldest kept event
+        self._shadow_source = settings  # the source settings before the oldest kept event
+        self._events = collections.deque()
+        self.dropped = 0
+
+    def restart(self, state: RotationState, source_settings: Mapping | None = None) -> None:
+        """Forget everything; record from ``state`` (and the source's ``source_settings``) as they are now."""
+        with self._lock:
+            self._start(state, source_settings)
+
+    def _stamp(self, t):
+        return max(0.0, self._clock() - self._t0) if t is None else _time(t)
+
+    def _push(self, event):
+        with self._lock:
+            if self._events and event.t < self._events[-1].t:  # a clock that stepped back: keep the order
+                event = dataclasses.replace(event, t=self._events[-1].t)
+            self._events.append(event)
+            while len(self._events) > self.max_events:
+                old = self._events.popleft()
+                if isinstance(old, SourceSetting):  # folded into the starting source settings
+                    self._shadow_source[old.name] = old.value
+                else:
+                    _apply(self._shadow, old)
+                self.dropped += 1
+
+    def record(self, key, shift, action, inverted: bool | None = None, t=None) -> Step:
+        """One applied ``action`` (an `Action` or its name, ``"xw"``), from ``key`` with ``shift``;
+        ``inverted`` defaults to ``shift`` for rotations (as `Keymap.resolve`)."""
+        action = Action.parse(action)
+        if key is not None and not isinstance(key, str):
+            raise TypeError(f"Expected `key` to be a string or None, got {type(key).__name__}")
+        shift = bool(shift)
+        inverted = (shift and action.is_rotation) if inverted is None else bool(inverted)
+        step = Step(self._stamp(t), key, shift, action, inverted)
+        self._push(step)
+        return step
+
+    def record_set(self, name: str, value, t=None) -> Setting:
+        """A parameter (``"theta0"``, ``"alpha"``, ``"c0"``, ``"c0_step"``, ``"matrix"``) set to ``value``."""
+        setting = Setting(self._stamp(t), name, _check_setting(name, value))
+        self._push(setting)
+        return setting
+
+    def record_source(self, name: str, value, t=None) -> SourceSetting:
+        """A source setting (``"levels"``, ``"slices"``, ``"spacing"``, ``"arrangement"``) set to
+        ``value`` -- what the widget calls after its trait changed the source."""
+        setting = SourceSetting(self._stamp(t), name, _check_source_setting(name, value))
+        self._push(setting)
+        return setting
+
+    def recording(self) -> Recording:
+        """The events so far as an immutable `Recording`."""
+        with self._lock:
+            return Recording(self._shadow.to_dict(initial=True), tuple(self._events), dropped=self.dropped,
+                             initial_source=self._shadow_source)
+
+    def __len__(self) -> int:
+        return len(self._events)
