@@ -425,13 +425,19 @@ def test_the_source_settings_at_the_start_are_kept_and_replayed_first(tmp_path):
     rec.restart(st, {"spacing": None})
     assert rec.recording().initial_source == {"spacing": None} and len(rec.recording()) == 0
     with pytest.raises(ValueError, match="a source setting among"):
-        Recorder(st, source_settings={"colour": 1})
+        Recorder(st, source_settings={"no name": 1})
+    # a source's own setting (a name its protocol `settings` may have) is kept as given, after the built-in ones
+    assert Recorder(st, source_settings={"colour": 1, "levels": 2.0}).recording().initial_source == {
+        "levels": [2.0], "colour": 1}
     with pytest.raises(ValueError, match="as a dict"):
         Recording(st.to_dict(initial=True), initial_source=[("levels", 1.0)])
 
 
 @pytest.mark.parametrize("name, value, match", [
-    ("colour", 1, "a source setting among 'levels', 'inside', 'caps', 'slices', 'spacing', 'arrangement'"),
+    ("no name", 1, "a source setting among 'levels', 'inside', 'caps', 'slices', 'spacing', 'arrangement'"),
+    (3, 1, "a source setting among .* or a source's own setting"),
+    ("colour", object(), "to be JSON"),
+    ("colour", float("nan"), "to be JSON"),
     ("levels", (), "non-empty sequence"),
     ("levels", ("a",), "finite number or a non-empty sequence"),
     ("levels", float("nan"), "finite number"),

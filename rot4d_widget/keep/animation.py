@@ -19,6 +19,7 @@ from typing import Iterator
 import numpy as np
 
 from ..core.state import RotationState
+from ..sources.protocol import as_source
 from .recorder import SOURCE_SETTINGS, Recorder, Recording, SourceSetting, _apply, _with_source_setting
 
 ANIMATION_FORMATS = (".gif", ".mp4")
@@ -26,16 +27,9 @@ ANIMATION_FORMATS = (".gif", ".mp4")
 
 # ============================================================================ animations
 def _own_copy(source):
-    """A copy of ``source`` that replaying its own actions may change (the original stays)."""
-    from ..sources.protocol import as_source
-    from ..sources.tomography import StackSource
-
-    src = as_source(source)
-    if isinstance(src, StackSource):
-        return StackSource(_own_copy(src.source), slices=src.slices,
-                           spacing=None if src.spacing_is_default else src.spacing,
-                           arrangement=src.arrangement, color_by=src.color_by)
-    return copy.copy(src)
+    """A copy of ``source`` that replaying its own actions may change (the original stays): the
+    protocol's copy semantics, ``copy.copy`` (a stack copies its inner source too)."""
+    return copy.copy(as_source(source))
 
 
 def animation_states(recording: Recording, initial_state: RotationState | None = None, source=None, *,

@@ -5,7 +5,7 @@ starts, it is told every action the widget applies (``recorder.record(key, shift
 inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
 (``recorder.record_set("c0", 0.3)``, a slider) and every setting of the source
 (``recorder.record_source("levels", (2.0, 3.0))``: ``levels``, ``slices``, ``spacing``,
-``arrangement``), with a time stamp.  It keeps at most
+``arrangement``, or any of a source's own ``settings``: the source protocol's), with a time stamp.  It keeps at most
 ``max_events``; older events are folded into the starting state, so a recording always replays
 to the live state.  ``recorder.recording()`` is an immutable `Recording`:
 
@@ -46,6 +46,9 @@ import numpy as np
 
 from ..core.keymap import Action
 from ..core.state import RotationState, action_from_data, action_to_data
+from ..sources.protocol import apply_setting, inner_source, settings_of
+from ..sources.tomography import StackSource
+from .rebuild import _jsonable
 
 RECORDING_FORMAT = "rot4d_widget recording"
 #: Version 2 adds `SourceSetting` events; a recording without them is written as version 1
@@ -56,7 +59,8 @@ RECORDING_VERSION = 2
 MAX_EVENTS = 100_000
 #: What `Recorder.record_set` accepts: the state's settable parameters.
 SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
-#: What `Recorder.record_source` accepts: the source's settings the widget has as traits.
+#: The built-in source settings (the widget's traits), whose values `Recorder.record_source` checks;
+#: it also takes a source's own settings (any name in its protocol ``settings``, a JSON value).
 SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement")
 #: The settings of a field (a stack's inner source).
 _FIELD_SETTINGS = ("levels", "inside", "caps")
@@ -115,7 +119,9 @@ class SourceSetting(_NamedValue):
     ``value`` -- ``levels`` a list of floats (a field's iso levels; a stack's inner source's),
     ``inside`` ``"above"`` or ``"below"`` and ``caps`` a bool (a field's, likewise),
     ``slices`` an int >= 1, ``spacing`` a number > 0 or None (the default), ``arrangement``
-    ``"oval"``, ``"grid"`` or ``"stack"``.  Not a `Setting` (the state's): a sibling."""
+    ``"oval"``, ``"grid"`` or ``"stack"``; or a source's own setting (a name in its protocol
+    ``settings``, a JSON value, set again with its ``apply_setting``).  Not a `Setting` (the
+    state's): a sibling."""
 
     _KEY = "source"
 
@@ -138,10 +144,25 @@ def _check_setting(name, value):
     return float(value)
 
 
+def _check_setting_name(name) -> None:
+    if name not in SOURCE_SETTINGS and not (isinstance(name, str) and name.isidentifier()):
+        raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))} or a "
+                         f"source's own setting (a name in its `settings`, a Python identifier), got {name!r}")
+
+
 def _check_source_setting(name, value):
-    """``value`` as a `SourceSetting` holds it (JSON-able); ValueError naming what is allowed."""
+    """``value`` as a `SourceSetting` holds it (JSON-able); ValueError naming what is allowed.
+
+    The built-in settings' values are checked here; a source's own setting (any other name, as
+    its protocol ``settings`` has it) only needs a JSON value: the source checks it when the
+    recording is replayed on it (its ``apply_setting``)."""
+    _check_setting_name(name)
     if name not in SOURCE_SETTINGS:
-        raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
+        try:
+            return _jsonable(value, f"the source setting {name!r}")
+        except TypeError as exc:
+            raise ValueError(f"Expected a source setting's value to be JSON (numbers, strings, lists, dicts): "
+                             f"{exc}") from None
     if name == "levels":
         values = [value] if isinstance(value, Real) else value
         ok = isinstance(values, (list, tuple, np.ndarray)) and len(values) > 0 and all(
@@ -179,15 +200,16 @@ def _check_source_setting(name, value):
 
 
 def _check_source_settings(settings) -> dict:
-    """A ``{name: value}`` of source settings, checked (`_check_source_setting`), in `SOURCE_SETTINGS` order."""
+    """A ``{name: value}`` of source settings, checked (`_check_source_setting`): the built-in ones in
+    `SOURCE_SETTINGS` order, then a source's own in the order given."""
     if settings is None:
         return {}
     if not isinstance(settings, Mapping):
         raise ValueError(f"Expected the source settings as a dict {{name: value}}, got {settings!r}")
     for name in settings:
-        if name not in SOURCE_SETTINGS:
-            raise ValueError(f"Expected a source setting among {', '.join(map(repr, SOURCE_SETTINGS))}, got {name!r}")
-    return {name: _check_source_setting(name, settings[name]) for name in SOURCE_SETTINGS if name in settings}
+        _check_setting_name(name)
+    order = [n for n in SOURCE_SETTINGS if n in settings] + [n for n in settings if n not in SOURCE_SETTINGS]
+    return {name: _check_source_setting(name, settings[name]) for name in order}
 
 
 def _event_from_dict(d):
@@ -219,34 +241,29 @@ def _source_action(source, name: str):
 
 
 def _is_stack(source) -> bool:
-    from ..sources.tomography import StackSource
-
-    return isinstance(source, StackSource)
+    """A source made around another (the protocol's ``wraps``): parallel slices."""
+    return getattr(source, "wraps", None) is not None
 
 
 def _set_on_source(source, name: str, value) -> None:
-    """Set a source setting on ``source`` in place: ``levels`` on a field (a stack's inner one),
-    the others on a stack.  ValueError if ``source`` has no such setting."""
-    if name in _FIELD_SETTINGS:
-        target = source.source if _is_stack(source) else source
-        if not hasattr(target, name):
+    """Set a source setting on ``source`` in place, by the protocol (`apply_setting`: a stack passes
+    its inner source's on).  ValueError if ``source`` has no such setting: a field's on another
+    kind, parallel slices' on a single view (say how to replay then), or any other name it lacks."""
+    if name not in settings_of(source):
+        if name in _FIELD_SETTINGS:
             raise ValueError(f"A recorded {name!r} applies to a source that has it (a field), not "
-                             f"{type(target).__name__}")
-        setattr(target, name, tuple(value) if name == "levels" else value)
-        return
-    if not _is_stack(source):
-        raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a single "
-                         "view: replay with set_source= (Rot4DWidget.replay turns its view into a stack), or "
-                         "on a StackSource")
-    setattr(source, name, value)
+                             f"{type(inner_source(source)).__name__}")
+        if name in _STACK_SETTINGS and not _is_stack(source):
+            raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a "
+                             "single view: replay with set_source= (Rot4DWidget.replay turns its view into a "
+                             "stack), or on a StackSource")
+    apply_setting(source, name, value)
 
 
 def _with_source_setting(source, name: str, value):
     """``source`` with a source setting applied: in place, or (``slices`` of a single view) a new
     `StackSource` around it, as the widget does."""
-    if name == "slices" and not _is_stack(source):
-        from ..sources.tomography import StackSource
-
+    if name == "slices" and not _is_stack(source) and name not in settings_of(source):
         return StackSource(source, slices=value)
     _set_on_source(source, name, value)
     return source
@@ -296,7 +313,7 @@ class Recording:
 
     @property
     def initial_source(self) -> dict:
-        """The source settings at the start (``{name: value}`` of `SOURCE_SETTINGS`; a copy)."""
+        """The source settings at the start (``{name: value}``: `SOURCE_SETTINGS` or a source's own; a copy)."""
         return json.loads(json.dumps(self._initial_source))
 
     @property
@@ -434,16 +451,21 @@ class Recording:
         names = {e.name for e in self.events if isinstance(e, SourceSetting)}
         if restart:
             names |= set(self._initial_source)
-        inner = source.source if _is_stack(source) else source
-        missing = [n for n in _FIELD_SETTINGS if n in names and not hasattr(inner, n)]
+        have = settings_of(source)
+        missing = [n for n in _FIELD_SETTINGS if n in names and n not in have]
         if missing:
             raise ValueError(f"The recording sets {', '.join(map(repr, missing))}, which apply to a field "
-                             f"(a source with iso levels), not {type(inner).__name__}")
-        stack_names = sorted(names & set(_STACK_SETTINGS))
+                             f"(a source with iso levels), not {type(inner_source(source)).__name__}")
+        stack_names = sorted(n for n in names & set(_STACK_SETTINGS) if n not in have)
         if stack_names and not _is_stack(source):
             raise ValueError(f"The recording sets {', '.join(map(repr, stack_names))}, which apply to parallel "
                              f"slices, and {type(source).__name__} is a single view: replay with set_source= "
                              "(Rot4DWidget.replay turns its view into a stack), or on a StackSource")
+        other = sorted(n for n in names if n not in have)
+        if other:
+            title = getattr(source, "name", None) or type(source).__name__
+            raise ValueError(f"The recording sets {', '.join(map(repr, other))}, which {title} does not have; "
+                             f"its settings: {', '.join(sorted(have)) or 'none'}")
 
 
 class Recorder:
@@ -457,7 +479,8 @@ class Recorder:
     the starting state, so `recording` always replays to the live state (custom source actions
     that fall out are lost: count in ``dropped``; a source setting that falls out becomes the
     recording's `Recording.initial_source`).  ``record_source(name, value)`` records a source
-    setting (``levels``, ``slices``, ``spacing``, ``arrangement``); ``source_settings`` (here and
+    setting (``levels``, ``slices``, ``spacing``, ``arrangement``, or the source's own);
+    ``source_settings`` (here and
     in `restart`) are the source's settings when recording starts, ``{name: value}``.
     """
 
@@ -522,8 +545,9 @@ class Recorder:
         return setting
 
     def record_source(self, name: str, value, t=None) -> SourceSetting:
-        """A source setting (``"levels"``, ``"slices"``, ``"spacing"``, ``"arrangement"``) set to
-        ``value`` -- what the widget calls after its trait changed the source."""
+        """A source setting (``"levels"``, ``"slices"``, ``"spacing"``, ``"arrangement"``, or a name
+        in the source's own protocol ``settings``) set to ``value`` -- what the widget calls after
+        its trait changed the source."""
         setting = SourceSetting(self._stamp(t), name, _check_source_setting(name, value))
         self._push(setting)
         return setting
