@@ -19,6 +19,8 @@ from ..core import look
 from ..core.look import REFERENCE_RADIUS
 from ..core.state import RotationState
 from ..geometry.slicing import Slice
+from ..sources.protocol import apply_setting, as_source, settings_of
+from ..sources.tomography import StackSource
 from .drawing import (
     _REFERENCE_EDGE,
     _Z_BASE,
@@ -93,10 +95,8 @@ def render_tomography(
     a stack's slices' w, and a legend of the levels' or slices' colours: `annotation`), or a
     string written as the first line of that text.
     """
-    from ..sources.protocol import as_source
-    from ..sources.tomography import StackSource
-
-    src = source if isinstance(source, StackSource) else None
+    # a source that wraps another is parallel slices already (the protocol's ``wraps``)
+    src = source if getattr(source, "wraps", None) is not None else None
     if src is None:
         inner = as_source(source)
         src = StackSource(inner, slices=slices, spacing=spacing, arrangement=arrangement, color_by=color_by)
@@ -357,31 +357,32 @@ def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=
     """``source`` (a name, a Polytope or any source) with a widget's source settings applied, as a
     `StackSource` (N = 1 is today's single slice, point for point).  The source given is not
     changed: a field whose ``levels`` differ is copied (shallowly, sharing its array), a stack is
-    rebuilt around its inner source."""
-    from ..sources.protocol import as_source
-    from ..sources.tomography import StackSource
-
+    rebuilt around its inner source.  What a source is and has is read through the source
+    protocol (``wraps``, ``settings``, ``apply_setting``), never from its class."""
     src = as_source(source)
     inner, color_by, n, spc, arr = src, "w", 1, None, "oval"
-    if isinstance(src, StackSource):
-        inner, color_by, n, arr = src.source, src.color_by, src.slices, src.arrangement
-        spc = None if src.spacing_is_default else src.spacing
+    if getattr(src, "wraps", None) is not None:
+        own = settings_of(src)
+        inner, color_by = src.wraps, getattr(src, "color_by", "w")
+        n, spc, arr = own.get("slices", n), own.get("spacing", spc), own.get("arrangement", arr)
     if slices is not None:
         n = slices
     if spacing is not None:
         spc = spacing
     if arrangement is not None:
         arr = arrangement
+    have = settings_of(inner)
     if levels is not None:
-        if not hasattr(inner, "levels"):
+        if "levels" not in have:
             raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {type(inner).__name__}")
-        if tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist()) != tuple(inner.levels):
+        wanted = tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist())
+        if wanted != tuple(have["levels"]):
             inner = copy.copy(inner)
-            inner.levels = levels
+            apply_setting(inner, "levels", wanted)
     for name, value in (("inside", inside), ("caps", caps)):  # a field's other settings, likewise
-        if value is not None and getattr(inner, name, value) != value:
+        if value is not None and have.get(name, value) != value:
             inner = copy.copy(inner)
-            setattr(inner, name, value)
+            apply_setting(inner, name, value)
     return StackSource(inner, slices=n, spacing=spc, arrangement=arr, color_by=color_by)
 
 
