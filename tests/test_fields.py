@@ -233,7 +233,7 @@ def test_uneven_coordinates_interpolate_exactly_a_multilinear_function():
     assert field.axes == "wzyx" and field._coords[0] is not None and field._coords[3] is not None
     ext = field.extent
     ref = Field4D.from_function(f, ext, w_per_unit=4.0)
-    ref._stats = field._statistics()  # the same K for the caps (K comes from each field's own probe)
+    ref._stat.set_statistics(field._statistics())  # the same K for the caps (K comes from each field's own probe)
     m = random_rotation(rng)
     a, b = slice_field(field, m, at(field, 0.1), 0.02, 40), slice_field(ref, m, at(ref, 0.1), 0.02, 40)
     assert len(a.triangles) > 100

@@ -1,0 +1,225 @@
+"""What a `Field4D` knows of its values: the data range and where it comes from, K (a typical
+|grad f|, the scale of the caps on the box's faces) and the report of +-inf samples.
+
+`FieldStatistics` keeps them for one field, computed once when first needed: from the metadata,
+the array in memory, the coarse copy (a chunked or lazy array), the chunks read so far (the
+"first cut", until the coarse copy is ready) or a function's probe grid.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ..geometry.polytopes import _power_of_two_unit
+from .field_checks import NonFiniteWarning, _axes_text, _call
+from .field_slicing import _sample_raw
+
+#: Nodes per axis of the grid a function field is sampled on for its range.
+_FUNCTION_PROBE = 21
+
+
+def _count_infinite(a, block_bytes: int = 64 * 1024**2):
+    """(n +inf, n -inf, first index as a tuple or None) of an array in memory, read in blocks
+    along its first axis (at most ``block_bytes`` of booleans at a time)."""
+    npos = nneg = 0
+    first = None
+    per = max(1, int(block_bytes // max(1, math.prod(int(n) for n in a.shape[1:]))))
+    for i in range(0, int(a.shape[0]), per):
+        b = np.asarray(a[i:i + per])
+        inf = np.isinf(b)
+        if not inf.any():
+            continue
+        pos = int(np.count_nonzero(inf & (b > 0)))
+        npos += pos
+        nneg += int(np.count_nonzero(inf)) - pos
+        if first is None:
+            j = np.unravel_index(int(np.flatnonzero(inf.ravel())[0]), inf.shape)
+            first = (i + int(j[0]),) + tuple(int(v) for v in j[1:])
+    return npos, nneg, first
+
+
+def _finite_range(a, block_bytes: int = 64 * 1024**2) -> tuple:
+    """(min, max) of the finite values of an array in memory, read in blocks along its first axis;
+    (nan, nan) when none is finite."""
+    lo, hi = math.inf, -math.inf
+    per = max(1, int(block_bytes // max(1, 8 * math.prod(int(n) for n in a.shape[1:]))))
+    for i in range(0, int(a.shape[0]), per):
+        b = np.asarray(a[i:i + per])
+        if b.dtype.kind == "f":
+            b = b[np.isfinite(b)]
+        if b.size:
+            lo, hi = min(lo, float(b.min())), max(hi, float(b.max()))
+    return (lo, hi) if lo <= hi else (math.nan, math.nan)
+
+
+class FieldStatistics:
+    """The data range, K and the +-inf report of one `Field4D` (``field``), each found once.
+
+    ``meta_range``: (lo, hi, where) from the data's metadata, or None; ``infinite``: (n +inf,
+    n -inf, first index or None) once counted (the coarse copy's pass counts them for a chunked
+    array: `counted`); ``infinite_reported``: the warning was given (or is the original
+    field's, for a coarse copy)."""
+
+    def __init__(self, field, meta_range=None):
+        self._field = field
+        self.meta_range = meta_range
+        self._range = None  # ((lo, hi), where the range comes from), once known
+        self._stats = None  # ((lo, hi), K), once known (K is per slice unit)
+        self._k_first = None  # K from the first cut's samples, until the coarse copy is ready
+        self._probe = None
+        self.infinite = None
+        self.infinite_reported = False
+
+    def counted(self, infinite) -> None:
+        """The coarse copy's pass counted the +-inf samples: ``(n +inf, n -inf, None)``."""
+        self.infinite = infinite
+
+    def forget_k(self) -> None:
+        """K is per slice unit: forgotten when `Field4D.w_per_unit` changes."""
+        self._stats = None
+        self._k_first = None
+
+    def set_statistics(self, stats) -> None:
+        """Use ``((lo, hi), K)`` as this field's (a test comparing two fields with the same caps)."""
+        self._stats = stats
+
+    def _first_cut_range(self, first_cut: bool):
+        """((lo, hi), "first cut") from the chunks read so far while the coarse copy is not ready
+        (with ``first_cut``, reading the cut at rest when nothing was read yet), else None."""
+        f = self._field
+        if self._range is not None or self.meta_range is not None or f.kind in ("function", "numpy"):
+            return None
+        if f.coarse_ready:
+            return None
+        rd = f.reader
+        if (rd is None or rd.reads == 0) and first_cut:
+            _sample_raw(f, np.eye(4), 0.0, f.resolution)  # the picture at rest: its chunks only
+            rd = f.reader
+        if rd is None or rd.reads == 0:
+            return None
+        lo, hi = rd.seen
+        return ((lo, hi) if lo <= hi else (math.nan, math.nan)), "first cut"
+
+    def range_info(self, first_cut: bool = False):
+        """((lo, hi), where): `Field4D.data_range` and `Field4D.data_range_source`."""
+        prov = self._first_cut_range(first_cut)
+        if prov is not None:
+            return prov
+        f = self._field
+        if self._range is None:
+            if self.meta_range is not None:
+                lo, hi, where = self.meta_range
+                self._range = ((lo, hi), where)
+            elif f.kind == "function":
+                a = self.probe_values()
+                finite = np.isfinite(a)
+                rng = (float(a[finite].min()), float(a[finite].max())) if finite.any() else (math.nan, math.nan)
+                self._range = (rng, "probe grid")
+            elif f.kind == "numpy":
+                self.report_infinite()
+                self._range = (_finite_range(f.values), "data")
+            else:
+                c = f.coarse()
+                self.report_infinite()
+                self._range = (c.data_range, "coarse copy")
+        return self._range
+
+    def probe_values(self):
+        """A function field's values on a `_FUNCTION_PROBE`^4 grid over its box, float64 (x, y, z, w)."""
+        if self._probe is None:
+            m = _FUNCTION_PROBE
+            grids = np.meshgrid(*[np.linspace(a, b, m) for a, b in self._field.extent], indexing="ij")
+            self._probe = _call(self._field.function, *grids)
+        return self._probe
+
+    def cap_scale(self, s=None, first_cut: bool = False) -> float:
+        """K for one step's samples ``s``: the field's (`statistics`), or, for a chunked or lazy array
+        whose coarse copy is not ready, the 95th percentile of |grad f| within the first cut's
+        samples (kept until the coarse copy is ready, so the pictures agree) -- with ``first_cut``
+        (`Field4D.slice`; `slice_field` builds the coarse copy) or once K was taken so."""
+        f = self._field
+        if ((first_cut or self._k_first is not None) and self._stats is None
+                and f.kind not in ("numpy", "function") and not f.coarse_ready):
+            if self._k_first is None:
+                u = _power_of_two_unit(f.size)
+                inner = s.g > s.spacing  # both neighbours inside the box: no step to the zeros outside
+                with np.errstate(invalid="ignore", over="ignore"):
+                    grads = np.gradient(np.asarray(s.f, dtype=np.float32), s.spacing / u)
+                    gm = np.sqrt(sum(g * g for g in grads))
+                ok = np.isfinite(gm) & (gm > 0) & inner
+                if ok.any():
+                    self._k_first = float(np.percentile(gm[ok], 95)) / u
+                else:
+                    lo, hi = self.range_info()[0] if f.reader is not None and f.reader.reads else (0.0, 0.0)
+                    span = hi - lo if math.isfinite(lo) and math.isfinite(hi) else 0.0
+                    self._k_first = max(span, abs(hi) if math.isfinite(hi) else 0.0, 1.0) / (2 * f.size)
+            return self._k_first
+        return self.statistics()[1]
+
+    def statistics(self):
+        """((min, max), K): `Field4D.data_range` and a typical |grad f| (level units per slice unit)."""
+        if self._stats is None:
+            self._stats = (self._field.data_range, self._gradient_scale())
+        return self._stats
+
+    def _gradient_scale(self) -> float:
+        """K, the 95th percentile of |grad f| in level units per slice unit, from `Field4D.coarse` (a
+        function's probe grid); from the data range when f is flat."""
+        f = self._field
+        if f.kind == "function":
+            m = _FUNCTION_PROBE
+            a = self.probe_values()
+            spacing = [(b - a_) / (m - 1) / u for (a_, b), u in zip(f.extent, f.unit)]
+        else:
+            c = f.coarse()
+            self.report_infinite()
+            if c is not f:  # the same numbers: computed on the coarse copy
+                return c.cap_scale()
+            a = np.asarray(c.values, dtype=np.float32).transpose(c.axis_of)  # x, y, z, w order
+            spacing = []
+            for d in range(4):
+                cd = c.coords[d]
+                if cd is None:
+                    lo, hi = c.extent[d]
+                    spacing.append((hi - lo) / (a.shape[d] - 1) / c.unit[d])
+                else:
+                    spacing.append(np.asarray(cd) / c.unit[d])
+        with np.errstate(invalid="ignore"):
+            # spacings in units of the box's size (a power of two: exact), so a float32 gradient
+            # neither overflows nor underflows at any scale; K is scaled back below
+            u = _power_of_two_unit(f.size)
+            grads = np.gradient(a, *[sp / u for sp in spacing])
+            gm = np.sqrt(sum(g * g for g in grads))
+        ok = np.isfinite(gm) & (gm > 0)
+        if ok.any():
+            return float(np.percentile(gm[ok], 95)) / u  # steep places: a phase field's plateaus must not set it
+        rng = f.data_range
+        span = rng[1] - rng[0] if math.isfinite(rng[0]) else 0.0
+        return max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * f.size)
+
+    def report_infinite(self) -> None:
+        """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf: how many, and where
+        (the first, for an array in memory).  Counted over the whole array: in blocks for numpy,
+        alongside the coarse copy's pass for chunked and lazy arrays."""
+        if self.infinite_reported:
+            return
+        self.infinite_reported = True
+        f = self._field
+        if self.infinite is None:
+            a = f.values
+            self.infinite = _count_infinite(a) if np.dtype(a.dtype).kind == "f" else (0, 0, None)
+        npos, nneg, first = self.infinite
+        if npos == 0 and nneg == 0:
+            return
+        what = " and ".join(t for t in (f"{npos} +inf" if npos else "", f"{nneg} -inf" if nneg else "") if t)
+        where = f" (the first at index {first} of {_axes_text(f.axes)})" if first is not None else ""
+        warnings.warn(
+            f"Field4D{' ' + repr(f.name) if f.name else ''}: the data hold {what} of "
+            f"{math.prod(int(n) for n in f.values.shape)} samples{where}. They are kept: +inf lies above "
+            f"and -inf below every level, the data range ignores them, and a point interpolated in a cell "
+            f"that holds one is +-inf, or NaN (below every level) where two meet or its weight is 0. To draw them otherwise, mask or clip first, "
+            f"e.g. np.where(np.isfinite(a), a, np.nan) or np.clip(a, lo, hi)",
+            NonFiniteWarning, stacklevel=4)
