@@ -18,7 +18,8 @@ triangle ``i`` at once::
 Rows ``0 .. n_points-1`` hold the slice's points (balls), rows
 ``0 .. n_segments-1`` its segments (bars, as end points), rows
 ``0 .. n_triangles-1`` its triangles (corners counter-clockwise seen from
-outside, and the colour of the group -- a polytope's 4-D cell -- each comes from).  R, the *capacity*, is at least the largest of
+outside, and the colour of the group -- a polytope's 4-D cell -- each comes
+from).  R, the *capacity*, is at least the largest of
 the three counts; everything past a count is zero, which the shaders draw as
 nothing: a ball with flag 0 is moved outside the clip volume, a bar of length
 0 likewise, a triangle with three equal corners has no area.  So an all-zero
@@ -173,7 +174,8 @@ def slice_rows(
             group_rgb = group_palette(int(tc.max()) + 1 if nt else 1)
         packed = pack_rgb(group_rgb)
         if nt and tc.max() >= len(packed):
-            raise ValueError(f"Expected `group_rgb` to have a colour for group {int(tc.max())}, got {len(packed)} colours")
+            raise ValueError(f"Expected `group_rgb` to have a colour for group {int(tc.max())}, "
+                             f"got {len(packed)} colours")
 
     if eye is not None:
         try:
@@ -258,7 +260,8 @@ def surface_arrays(data, *, scale: float = 1.0, group_rgb=None, eye=None, single
     else:
         palette = np.asarray(group_palette(int(g.max()) + 1) if group_rgb is None else group_rgb, dtype=np.float64)
         if g.max() >= len(palette):
-            raise ValueError(f"Expected `group_rgb` to have a colour for group {int(g.max())}, got {len(palette)} colours")
+            raise ValueError(f"Expected `group_rgb` to have a colour for group {int(g.max())}, "
+                             f"got {len(palette)} colours")
     if eye is not None:
         o = np.asarray(eye, dtype=np.float64)
         d = v[t].sum(axis=1) / 3.0 - o

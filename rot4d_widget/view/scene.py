@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import math
 import pathlib
 import re
 import uuid
@@ -71,8 +70,11 @@ import numpy as np
 import pythreejs as p3
 from traitlets import CFloat, CInt, Dict, List
 
-from . import buffers as bf
 from ..core import look
+from . import buffers as bf
+from .traits import check_flag as _flag
+from .traits import check_fraction as _unit
+from .traits import check_positive as _positive
 
 __all__ = ["Scene", "shader_source"]
 
@@ -112,31 +114,12 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
 # -- option validation -------------------------------------------------------
 
 
-def _positive(name, value, *, upper=None):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"Expected `{name}` to be a positive number, got {value!r}")
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0) or (upper is not None and v > upper):
-        allowed = f"in (0, {upper}]" if upper is not None else "> 0 and finite"
-        raise ValueError(f"Expected `{name}` {allowed}, got {value!r}")
-    return v
-
-
 def _pixels(name, value):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"Expected `{name}` to be an int number of pixels in [16, 8192], got {value!r}")
     if not 16 <= int(value) <= 8192:
         raise ValueError(f"Expected `{name}` to be an int number of pixels in [16, 8192], got {value!r}")
     return int(value)
-
-
-def _unit(name, value):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"Expected `{name}` to be a number in [0, 1], got {value!r}")
-    v = float(value)
-    if not 0.0 <= v <= 1.0:
-        raise ValueError(f"Expected `{name}` to be a number in [0, 1], got {value!r}")
-    return v
 
 
 def _group_colors(value, n_groups):
@@ -149,19 +132,14 @@ def _group_colors(value, n_groups):
     except TypeError:
         raise TypeError(f"Expected `group_colors` to be a sequence of colours, got {value!r}") from None
     if len(items) < n_groups:
-        raise ValueError(f"Expected `group_colors` to have at least {n_groups} colours (one per group), got {len(items)}")
+        raise ValueError(f"Expected `group_colors` to have at least {n_groups} colours (one per group), "
+                         f"got {len(items)}")
     rgb = [look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(items)]
     return np.asarray(rgb, dtype=np.float32)
 
 
 def _hex(rgb):
     return "#" + "".join(f"{int(round(255 * c)):02x}" for c in rgb)
-
-
-def _flag(name, value):
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"Expected `{name}` to be True or False, got {value!r}")
-    return bool(value)
 
 
 #: Display options `set_display` accepts, with their validators.
@@ -252,123 +230,7 @@ class Scene:
 
     # -- construction ------------------------------------------------------
     def _build(self, antialias, display):
-        self._rows = np.zeros((self.capacity, bf.ROW_FLOATS), dtype=np.float32)
-        self._buffer = _RowBuffer(array=self._rows, meshPerAttribute=1)
-        attrs = {
-            name: p3.InterleavedBufferAttribute(data=self._buffer, itemSize=size, offset=col)
-            for name, (col, size) in bf.COLUMNS.items()
-        }
-        templates = {
-            "ball": {"position": p3.BufferAttribute(array=bf.quad_template())},
-            "bar": {"position": p3.BufferAttribute(array=bf.quad_template())},
-            "face": {"position": p3.BufferAttribute(array=bf.triangle_template())},
-        }
-        uses = {
-            "ball": ("ball",),
-            "bar": ("bar_a", "bar_b"),
-            "face": ("tri_a", "tri_b", "tri_c", "tri_rgb"),
-        }
-        self._geometries = {}
-        for part, names in uses.items():
-            a = dict(templates[part])
-            a.update({n: attrs[n] for n in names})
-            self._geometries[part] = p3.InstancedBufferGeometry(attributes=a, maxInstancedCount=self.capacity)
-
-        self._light = {
-            "u_ambient": {"value": [0.28, 0.28, 0.28]},
-            "u_sky": {"value": [0.30, 0.30, 0.32]},
-            "u_ground": {"value": [0.08, 0.07, 0.06]},
-            "u_light_color": {"value": [0.62, 0.62, 0.60]},
-            "u_light_position": {"value": [-3.0, 4.0, 2.0]},
-            "u_specular": {"value": 0.35},
-            "u_shininess": {"value": 40.0},
-        }
-        self._materials = {
-            "ball": p3.ShaderMaterial(
-                vertexShader=shader_source("ball.vert"),
-                fragmentShader=shader_source("ball.frag"),
-                uniforms=self._ball_uniforms(display["ball_radius"]),
-                extensions={"fragDepth": True},
-                side="DoubleSide",
-            ),
-            "bar": p3.ShaderMaterial(
-                vertexShader=shader_source("bar.vert"),
-                fragmentShader=shader_source("bar.frag"),
-                uniforms=self._bar_uniforms(display["bar_radius"]),
-                extensions={"fragDepth": True},
-                side="DoubleSide",
-            ),
-            "face": p3.ShaderMaterial(
-                vertexShader=shader_source("face.vert"),
-                fragmentShader=shader_source("face.frag"),
-                uniforms=self._face_uniforms(display["face_opacity"]),
-                side="DoubleSide",
-                transparent=True,
-                depthWrite=False,
-            ),
-        }
-        # the smooth surface (a field's isosurfaces): indexed, quantised; the companion
-        # replaces these placeholder arrays (their types stay) as it applies an update
-        self._surface_attrs = {
-            "position": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint16), normalized=True),
-            "normal": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.int8), normalized=True),
-            "a_rgb": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint8), normalized=True),
-        }
-        self._surface_index = p3.BufferAttribute(array=np.zeros(0, dtype=np.uint32))
-        self._surface_geometry = p3.BufferGeometry(attributes=self._surface_attrs, index=self._surface_index)
-        self._materials["surface"] = p3.ShaderMaterial(
-            vertexShader=shader_source("surface.vert"),
-            fragmentShader=shader_source("surface.frag"),
-            uniforms=self._surface_uniforms(),
-            side="DoubleSide",
-            transparent=True,
-            depthWrite=True,
-        )
-        names = {"ball": "balls", "bar": "bars", "face": "faces"}
-        self._meshes = {
-            part: p3.Mesh(
-                geometry=self._geometries[part], material=self._materials[part], frustumCulled=False,
-                name=names[part], visible=display[f"show_{names[part]}"],
-            )
-            for part in ("ball", "bar", "face")
-        }
-        self._meshes["surface"] = p3.Mesh(
-            geometry=self._surface_geometry, material=self._materials["surface"], frustumCulled=False,
-            name="surface", visible=display["show_faces"],
-        )
-        self._camera = p3.PerspectiveCamera(
-            position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=self.width / self.height,
-            near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
-        )
-        self._three_scene = p3.Scene(children=[*self._meshes.values(), self._camera], background=None)
-        self._controls = p3.OrbitControls(controlling=self._camera, enableKeys=False)
-        background = _hex(look.as_rgb(display["background"], "background"))
-        self._renderer = p3.Renderer(
-            camera=self._camera,
-            scene=self._three_scene,
-            controls=[self._controls],
-            width=self.width,
-            height=self.height,
-            antialias=antialias,
-            background=background,
-            background_opacity=1.0,
-            clearColor=background,
-        )
-        self._renderer.add_class("rot4d-canvas")
-        self._renderer.add_class(self.canvas_class)
-        self._display = display
-        self._widgets = [
-            self._renderer, self._controls, self._three_scene, self._camera, *self._meshes.values(),
-            *self._materials.values(), *self._geometries.values(), *attrs.values(), self._buffer,
-            *(a for t in templates.values() for a in t.values()),
-            self._surface_geometry, *self._surface_attrs.values(), self._surface_index,
-        ]  # fmt: skip
-        self._surface_shown = False
-        # ipywidgets' view count, kept by the front end on request (None: not requested)
-        if self._renderer._view_count is None:
-            self._renderer._view_count = 0
-        self._renderer.observe(self._view_count_changed, names="_view_count")
-        self._camera.observe(self._camera_moved, names="position")
+        _build_three(self, antialias, display)
 
     def _ball_uniforms(self, radius):
         return dict(self._light, u_ball_radius={"value": radius}, u_ball_color={"value": list(self.ball_color)})
@@ -499,7 +361,8 @@ class Scene:
             return look.group_palette(n) if n != len(self.group_rgb) else self.group_rgb
         if len(self._user_rgb) >= n:
             return self._user_rgb
-        return np.concatenate([self._user_rgb, np.asarray(look.group_palette(n), dtype=np.float32)[len(self._user_rgb):]])
+        more = np.asarray(look.group_palette(n), dtype=np.float32)[len(self._user_rgb):]
+        return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
     def show(self, data, *, single_rgb=None, group_rgb=None, force=False) -> bool:
@@ -536,7 +399,8 @@ class Scene:
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
-        counts = [len(data.points) if getattr(data, "show_points", True) else 0, len(data.segments), len(data.triangles)]
+        n_points = len(data.points) if getattr(data, "show_points", True) else 0
+        counts = [n_points, len(data.segments), len(data.triangles)]
         self._assign(rows, self.update_id, counts, surface=surface)
         return True
 
@@ -638,6 +502,128 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"
+
+
+def _build_three(scene, antialias, display):
+    """The pythreejs objects of ``scene``: one row buffer read by balls, bars and faces, the smooth
+    surface, camera, controls, renderer (built once; updates assign new arrays)."""
+    scene._rows = np.zeros((scene.capacity, bf.ROW_FLOATS), dtype=np.float32)
+    scene._buffer = _RowBuffer(array=scene._rows, meshPerAttribute=1)
+    attrs = {
+        name: p3.InterleavedBufferAttribute(data=scene._buffer, itemSize=size, offset=col)
+        for name, (col, size) in bf.COLUMNS.items()
+    }
+    templates = {
+        "ball": {"position": p3.BufferAttribute(array=bf.quad_template())},
+        "bar": {"position": p3.BufferAttribute(array=bf.quad_template())},
+        "face": {"position": p3.BufferAttribute(array=bf.triangle_template())},
+    }
+    uses = {
+        "ball": ("ball",),
+        "bar": ("bar_a", "bar_b"),
+        "face": ("tri_a", "tri_b", "tri_c", "tri_rgb"),
+    }
+    scene._geometries = {}
+    for part, names in uses.items():
+        a = dict(templates[part])
+        a.update({n: attrs[n] for n in names})
+        scene._geometries[part] = p3.InstancedBufferGeometry(attributes=a, maxInstancedCount=scene.capacity)
+
+    scene._light = {
+        "u_ambient": {"value": [0.28, 0.28, 0.28]},
+        "u_sky": {"value": [0.30, 0.30, 0.32]},
+        "u_ground": {"value": [0.08, 0.07, 0.06]},
+        "u_light_color": {"value": [0.62, 0.62, 0.60]},
+        "u_light_position": {"value": [-3.0, 4.0, 2.0]},
+        "u_specular": {"value": 0.35},
+        "u_shininess": {"value": 40.0},
+    }
+    scene._materials = {
+        "ball": p3.ShaderMaterial(
+            vertexShader=shader_source("ball.vert"),
+            fragmentShader=shader_source("ball.frag"),
+            uniforms=scene._ball_uniforms(display["ball_radius"]),
+            extensions={"fragDepth": True},
+            side="DoubleSide",
+        ),
+        "bar": p3.ShaderMaterial(
+            vertexShader=shader_source("bar.vert"),
+            fragmentShader=shader_source("bar.frag"),
+            uniforms=scene._bar_uniforms(display["bar_radius"]),
+            extensions={"fragDepth": True},
+            side="DoubleSide",
+        ),
+        "face": p3.ShaderMaterial(
+            vertexShader=shader_source("face.vert"),
+            fragmentShader=shader_source("face.frag"),
+            uniforms=scene._face_uniforms(display["face_opacity"]),
+            side="DoubleSide",
+            transparent=True,
+            depthWrite=False,
+        ),
+    }
+    # the smooth surface (a field's isosurfaces): indexed, quantised; the companion
+    # replaces these placeholder arrays (their types stay) as it applies an update
+    scene._surface_attrs = {
+        "position": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint16), normalized=True),
+        "normal": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.int8), normalized=True),
+        "a_rgb": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint8), normalized=True),
+    }
+    scene._surface_index = p3.BufferAttribute(array=np.zeros(0, dtype=np.uint32))
+    scene._surface_geometry = p3.BufferGeometry(attributes=scene._surface_attrs, index=scene._surface_index)
+    scene._materials["surface"] = p3.ShaderMaterial(
+        vertexShader=shader_source("surface.vert"),
+        fragmentShader=shader_source("surface.frag"),
+        uniforms=scene._surface_uniforms(),
+        side="DoubleSide",
+        transparent=True,
+        depthWrite=True,
+    )
+    names = {"ball": "balls", "bar": "bars", "face": "faces"}
+    scene._meshes = {
+        part: p3.Mesh(
+            geometry=scene._geometries[part], material=scene._materials[part], frustumCulled=False,
+            name=names[part], visible=display[f"show_{names[part]}"],
+        )
+        for part in ("ball", "bar", "face")
+    }
+    scene._meshes["surface"] = p3.Mesh(
+        geometry=scene._surface_geometry, material=scene._materials["surface"], frustumCulled=False,
+        name="surface", visible=display["show_faces"],
+    )
+    scene._camera = p3.PerspectiveCamera(
+        position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=scene.width / scene.height,
+        near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
+    )
+    scene._three_scene = p3.Scene(children=[*scene._meshes.values(), scene._camera], background=None)
+    scene._controls = p3.OrbitControls(controlling=scene._camera, enableKeys=False)
+    background = _hex(look.as_rgb(display["background"], "background"))
+    scene._renderer = p3.Renderer(
+        camera=scene._camera,
+        scene=scene._three_scene,
+        controls=[scene._controls],
+        width=scene.width,
+        height=scene.height,
+        antialias=antialias,
+        background=background,
+        background_opacity=1.0,
+        clearColor=background,
+    )
+    scene._renderer.add_class("rot4d-canvas")
+    scene._renderer.add_class(scene.canvas_class)
+    scene._display = display
+    scene._widgets = [
+        scene._renderer, scene._controls, scene._three_scene, scene._camera, *scene._meshes.values(),
+        *scene._materials.values(), *scene._geometries.values(), *attrs.values(), scene._buffer,
+        *(a for t in templates.values() for a in t.values()),
+        scene._surface_geometry, *scene._surface_attrs.values(), scene._surface_index,
+    ]  # fmt: skip
+    scene._surface_shown = False
+    # ipywidgets' view count, kept by the front end on request (None: not requested)
+    if scene._renderer._view_count is None:
+        scene._renderer._view_count = 0
+    scene._renderer.observe(scene._view_count_changed, names="_view_count")
+    scene._camera.observe(scene._camera_moved, names="position")
 
 
 def _surface_message(arrays: dict, opacity) -> dict:
