@@ -88,7 +88,7 @@ def test_a_late_keyup_of_l_takes_back_the_c0_steps_and_mouseleave_corrects_too(m
 
 def test_a_key_pad_click_the_kernel_sees_late_is_one_step(make, clock):
     w = make(keypad=True)
-    [button_4] = [ev for ev in w._pad_events if ev.source.description == "R_xw"]
+    [button_4] = [ev for ev in w._keypad.events if ev.source.description == "R_xw"]
 
     def send(event):  # as the front end does: a custom message on the button's Event comm
         button_4.comm.handler({"content": {"data": {"method": "custom", "content": event}}, "buffers": []})
@@ -164,7 +164,7 @@ def test_taps_queued_behind_a_slow_source_coalesce():
             time.sleep(0.05)
         assert c0_steps(w) == 10
         assert src.calls - calls <= 3, src.calls - calls  # the first, then the latest (not all ten)
-        np.testing.assert_allclose(w._rows_data.points, w.slice.points)  # what is shown is the latest
+        np.testing.assert_allclose(w._painter.rows_data.points, w.slice.points)  # what is shown is the latest
     finally:
         w.close()
 
@@ -182,19 +182,19 @@ def test_a_stack_taken_down_to_one_slice_keeps_working(make):
     w.release_keys()
     assert w.errors.outputs == ()
     groups = int(np.max(w.slice.groups)) + 1
-    assert len(w._group_colors()) >= groups  # a colour for each of the 24-cell's cells
+    assert len(w._painter.group_colors()) >= groups  # a colour for each of the 24-cell's cells
 
 
 def test_a_field_stack_down_to_one_slice_takes_new_levels_and_keeps_its_colours(make):
     w = make(ball_field(), levels=(0.0, 0.3))
-    colours = w._group_colors().copy()
+    colours = w._painter.group_colors().copy()
     w.press("n")
     w.press("b")
     w.levels = (0.2, 0.4, 0.6)
     assert w.levels == (0.2, 0.4, 0.6) and w.source.source.levels == (0.2, 0.4, 0.6)
     assert w.errors.outputs == ()
     w.levels = (0.0, 0.3)
-    np.testing.assert_allclose(w._group_colors(), colours)  # level colours, not the cells' cyan
+    np.testing.assert_allclose(w._painter.group_colors(), colours)  # level colours, not the cells' cyan
     assert "colours" in w.readout.value  # the legend is still there
 
 
@@ -205,7 +205,7 @@ def test_p_with_no_view_does_not_pile_up(make, tmp_path, monkeypatch):
     for _ in range(1000):
         down(w, "p", code="KeyP")
         up(w, "p", code="KeyP")
-    assert len(w._screenshots) <= 8
+    assert len(w._shots.pending) <= 8
     assert os.listdir(tmp_path) == []
 
 
@@ -361,7 +361,7 @@ def test_p_never_writes_through_a_dangling_link_and_screenshot_refuses_a_link(ma
     front_end_view_count(w, 1)
     down(w, "p", code="KeyP")
     up(w, "p", code="KeyP")
-    rid = w._screenshot_seq
+    rid = w._shots.seq
     _answer(w, rid, png=_data_url(_png()))
     assert not target.exists()
     assert (tmp_path / "rot4d-002.png").is_file()

@@ -770,6 +770,6 @@ def test_a_widget_whose_views_are_all_gone_acts_on_nothing(make, clock):
 
 def test_a_front_end_that_does_not_count_views_still_gets_keys(make):
     w = make()
-    assert w.scene.view_count == 0 and not w._was_displayed
+    assert w.scene.view_count == 0 and not w._keys.was_displayed
     down(w, "4")
     assert xw_steps(w) == 1

@@ -86,7 +86,7 @@ def test_a_held_key_samples_coarsely_and_the_release_brings_full_resolution(make
     settle(w, clock, 0.5)
     assert calls[-1] is False and calls.count(False) == 1  # one full step, at rest
     assert w.scene.surface["n_vertices"] > coarse_n  # finer
-    assert w._shown[5] is False
+    assert w._painter.shown.coarse is False
 
 
 @pytest.mark.parametrize("key", ["2", "3", "6"])
@@ -109,8 +109,8 @@ def test_rotations_that_leave_w_alone_never_resample(make, clock, key):
     assert np.all(np.abs(np.linalg.norm(after, axis=1) - r) < 0.03)
     assert not np.allclose(np.sort(after, axis=0), np.sort(before, axis=0), atol=1e-3)
     # and it is what slicing again would show: the same volume (the ball's)
-    assert w._rows_data.volume == pytest.approx(vol)
-    assert w._rows_data.volume == pytest.approx(4 / 3 * math.pi * r**3, rel=0.05)
+    assert w._painter.rows_data.volume == pytest.approx(vol)
+    assert w._painter.rows_data.volume == pytest.approx(4 / 3 * math.pi * r**3, rel=0.05)
 
 
 def test_rotations_that_move_w_resample_at_full_resolution_at_rest(make, clock):

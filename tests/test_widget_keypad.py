@@ -18,30 +18,30 @@ pytestmark = pytest.mark.usefixtures("recording_comms")
 
 
 def _button(w, label):
-    for row in w._pad.children:
+    for row in w._keypad.box.children:
         for b in row.children[1:]:
             if b.description == label:
                 return b
-    raise AssertionError(f"no key pad button {label!r}: {[b.description for r in w._pad.children for b in r.children[1:]]}")
+    raise AssertionError(f"no key pad button {label!r}: {[b.description for r in w._keypad.box.children for b in r.children[1:]]}")
 
 
 def pad(w, key, kind, shift=False, **extra):
-    w._handle_pad_event(key, shift, {"type": kind, "button": 0, **extra})
+    w._keypad.handle(key, shift, {"type": kind, "button": 0, **extra})
 
 
 def test_off_by_default_on_by_keyword_or_trait(make):
     w = make("5-cell")
-    assert w.keypad is False and w._pad is None
+    assert w.keypad is False and w._keypad.box is None
     w.keypad = True
-    assert w._pad is not None and w._pad in w._canvas_box.children and w._pad.layout.display is None
-    labels = [b.description for row in w._pad.children for b in row.children[1:]]
+    assert w._keypad.box is not None and w._keypad.box in w._canvas_box.children and w._keypad.box.layout.display is None
+    labels = [b.description for row in w._keypad.box.children for b in row.children[1:]]
     for want in ("R_xy", "R_zw", "R_xy\u207b\u00b9", "R_xw,yz", "R_xz,yw\u207b\u00b9", "\u03b1+", "c0\u2212",
                  "\u03b80+", "reset"):
         assert want in labels, labels
     assert "Shift+4" in _button(w, "R_xw\u207b\u00b9").tooltip
     w.keypad = False
-    assert w._pad.layout.display == "none"
-    assert make("5-cell", keypad=True)._pad is not None
+    assert w._keypad.box.layout.display == "none"
+    assert make("5-cell", keypad=True)._keypad.box is not None
     with pytest.raises(TypeError, match="keypad"):
         make("5-cell", keypad="yes")
 
@@ -103,6 +103,6 @@ def test_hiding_the_pad_releases_its_buttons_and_bad_events_are_harmless(make):
     assert w.held_keys == ("pad:2",)
     w.keypad = False
     assert w.held_keys == ()
-    w._handle_pad_event("2", False, None)
-    w._handle_pad_event("2", False, {"type": "wheel"})
+    w._keypad.handle("2", False, None)
+    w._keypad.handle("2", False, {"type": "wheel"})
     assert w.errors.outputs == ()

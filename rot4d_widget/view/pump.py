@@ -106,7 +106,7 @@ class PumpStats:
 
 
 class UpdatePump:
-    """One update in flight.
+    """At most ``max_in_flight`` updates in flight (`MAX_IN_FLIGHT`: three), each acknowledged by the page.
 
     Parameters
     ----------

@@ -93,7 +93,7 @@ def test_phase_separation_field_held_key_then_full_resolution(jupyter_server, pa
     x0, y0, x1, y1 = before_px["bbox"]
     stats = jp.canvas_stats(sel)
     assert 0 < x0 < x1 < stats["width"] - 1 and 0 < y0 < y1 < stats["height"] - 1, (before_px, stats)
-    info = jp.kernel_json("dict(n=w.scene.surface.get('n_vertices', 0), shown=bool(w._shown[5]))")
+    info = jp.kernel_json("dict(n=w.scene.surface.get('n_vertices', 0), shown=bool(w._painter.shown.coarse))")
     assert info["n"] > 1000 and info["shown"] is False, info  # a full-resolution surface at rest
 
     # 2. this run's round trip: isolated taps of 2 (a turn in space; no resampling)
@@ -128,7 +128,7 @@ def test_phase_separation_field_held_key_then_full_resolution(jupyter_server, pa
     np.testing.assert_allclose(r, simple_rotation("xw", angle), atol=1e-9)  # a pure x-w turn
     assert abs(angle) > 2 * before["theta0"], angle
     calls = jp.kernel_json("calls")
-    shown = jp.kernel_json("dict(coarse=bool(w._shown[5]), rows=w._shown is w._rows_key, held=len(w.held_keys))")
+    shown = jp.kernel_json("dict(coarse=bool(w._painter.shown.coarse), rows=w._painter.shown is w._painter.rows_key, held=len(w.held_keys))")
     assert True in calls, f"no coarse slice while held: {calls}"
     assert calls[-1] is False, f"the last slice was coarse: {calls}"
     assert shown == {"coarse": False, "rows": True, "held": 0}, shown

@@ -73,7 +73,7 @@ def test_a_stack_down_to_one_slice_and_a_bad_user_slice_in_the_page(jupyter_serv
     assert _errors_text(jp, "w") == ""
     stats = jp.canvas_stats(sel)
     assert stats and stats["count"] > 500  # the one slice is drawn
-    n_colours = int(jp.kernel("print(len(set(map(tuple, np.round(w._group_colors(), 3)))))").strip())
+    n_colours = int(jp.kernel("print(len(set(map(tuple, np.round(w._painter.group_colors(), 3)))))").strip())
     assert n_colours >= 24  # a colour for each of the 24-cell's cells, not the stack's five
     jp.page.locator(sel).screenshot(path=str(artifacts / "hostile-stack-down-to-one.png"))
 

@@ -42,20 +42,20 @@ def test_screenshot_and_key_p_give_the_view_as_a_png(jupyter_server, page, artif
     rid = jp.kernel_json("w.screenshot('view.png')")
     assert isinstance(rid, int), rid
     got = jp.wait_for(lambda: jp.kernel_json("w.last_screenshot is not None"), timeout=20)
-    assert got, f"no PNG arrived; readout: {jp.kernel_json('w._note')}"
+    assert got, f"no PNG arrived; readout: {jp.kernel_json('w._painter.note')}"
     shot = jp.kernel_json("png_stats(w.last_screenshot)")
     assert (shot["width"], shot["height"]) == (canvas["width"], canvas["height"]), (shot, canvas)
     assert shot["bbox"] is not None and canvas["bbox"] is not None
     assert all(abs(a - b) <= 2 for a, b in zip(shot["bbox"], canvas["bbox"])), (shot, canvas)
     assert abs(shot["count"] - canvas["count"]) <= 0.02 * canvas["count"], (shot, canvas)
     assert (jupyter_server.root / "view.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "saved view.png" in jp.kernel_json("w._note")
+    assert "saved view.png" in jp.kernel_json("w._painter.note")
 
     # 2. key p over the view: a numbered file next to the notebook, said in the readout
     _hover(jp, sel)
     page.keyboard.press("p")
     target = jupyter_server.root / "rot4d-001.png"
-    assert jp.wait_for(lambda: target.exists(), timeout=20), f"no rot4d-001.png; readout: {jp.kernel_json('w._note')}"
+    assert jp.wait_for(lambda: target.exists(), timeout=20), f"no rot4d-001.png; readout: {jp.kernel_json('w._painter.note')}"
     assert jp.kernel_json("png_stats(open('rot4d-001.png', 'rb').read())")["width"] == canvas["width"]
     assert jp.wait_for(lambda: "saved rot4d-001.png" in jp.kernel_json("w.readout.value"), timeout=10)
     (artifacts / "screenshot-24-cell.png").write_bytes((jupyter_server.root / "view.png").read_bytes())

@@ -1,0 +1,174 @@
+"""Keep what you see: the widget's façade over `rot4d_widget.keep` (figures, meshes, state files,
+recordings).
+
+`Keeper` renders the view without a browser, exports its slice as a mesh, saves and loads the
+state, records every step and setting (also a user's source's own settings, read through the
+source protocol's ``settings``) and replays recordings onto the widget.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+
+from ..core.state import without_source_keys
+from ..keep.export import SETTING_NAMES, load_state, save_state, slice_mesh
+from ..keep.export import settings_of as widget_settings
+from ..keep.recording import Recorder, Recording, render_animation
+from ..sources.protocol import apply_setting, inner_source, settings_of
+
+__all__ = ["Keeper"]
+
+
+class Keeper:
+    """One widget's recorder and the keep-what-you-see methods it delegates to."""
+
+    def __init__(self, widget, state, clock):
+        self.w = widget
+        self.recorder = Recorder(state, clock=clock, source_settings=settings_of(widget.source))
+        self.recorded_settings = settings_of(widget.source)  # the source's settings as last recorded
+
+    # -- recording --------------------------------------------------------------------------
+    def restart(self) -> None:
+        """Forget what was recorded; record from the current state and source settings on."""
+        w = self.w
+        self.recorder.restart(w.state, settings_of(w.source))
+        self.recorded_settings = settings_of(w.source)
+
+    def record_source(self, name, value) -> None:
+        """A source setting changed (a trait, a key): recorded, and remembered as recorded."""
+        self.recorder.record_source(name, value)
+        self.recorded_settings = settings_of(self.w.source)
+
+    def note_settings(self) -> None:
+        """The source changed through a recorded step (its own key): its settings are as recorded."""
+        self.recorded_settings = settings_of(self.w.source)
+
+    def record_changed_settings(self) -> list:
+        """The source's settings that changed since last recorded (a user's source changed in
+        code, then `refresh`), recorded as source settings; returns their names."""
+        now = settings_of(self.w.source)
+        changed = [k for k, v in now.items() if self.recorded_settings.get(k, _MISSING) != v]
+        for name in changed:
+            self.recorder.record_source(name, now[name])
+        self.recorded_settings = now
+        return changed
+
+    def replay(self, recording) -> None:
+        w = self.w
+        if not isinstance(recording, Recording):
+            if not isinstance(recording, (str, os.PathLike)):
+                raise TypeError(f"Expected a Recording or a path to one, got {type(recording).__name__}")
+            recording = Recording.load(recording)
+        with w._pump.lock:
+            w._check_open()
+            recording.replay(w.state, _LiveSource(w), set_source=self.set_source_setting)
+            w._source_version += 1
+            w._sync.source_traits()
+            self.restart()
+            w._sync.state_traits()
+            w._pump.mark_dirty()
+            w._pump.flush()
+
+    def set_source_setting(self, name, value) -> None:
+        """A recorded source setting, applied as its trait would be (a stack made if needed); a
+        setting with no trait of that name goes to the source (`apply_setting`)."""
+        w = self.w
+        if isinstance(value, list):
+            value = tuple(value)
+        w._sync.source_traits()  # the replay's steps changed the source: the traits must say what it is
+        if w.has_trait(name):
+            setattr(w, name, value)
+            return
+        with w._source_lock:
+            apply_setting(w.source, name, value)
+        w._source_version += 1
+
+    # -- figures, meshes, animations ------------------------------------------------------------
+    def render_animation(self, path, *, recording=None, fps: float = 10.0, per: str = "step", **options) -> int:
+        w = self.w
+        rec = w.recording if recording is None else recording
+        kwargs = {**widget_settings(w), **options}
+        return render_animation(rec, None, inner_source(w.source), path, fps=fps, per=per, **kwargs)
+
+    def render(self, path=None, *, size=None, dpi: float = 100, **options):
+        w = self.w
+        with w._pump.lock:
+            state = w.state.copy()
+            kwargs = {**widget_settings(w), **options}
+        size = (w.scene.width, w.scene.height) if size is None else size
+        from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
+
+        return render_state(state, inner_source(w.source), path, size=size, dpi=dpi, **kwargs)
+
+    def slice_mesh(self, **options):
+        w = self.w
+        with w._pump.lock:
+            data = w._painter.current_slice()
+            colors = w._painter.group_colors()
+        kwargs = {"color_by": w.color_by, **options}
+        if colors is not None and "group_colors" not in options:
+            kwargs["group_colors"] = colors
+        return slice_mesh(data, **kwargs)
+
+    # -- state files ------------------------------------------------------------------------
+    def save_state(self, path) -> dict:
+        w = self.w
+        with w._pump.lock:
+            state = w.state.copy()
+            settings = widget_settings(w)
+        return save_state(path, state, w.source, settings)
+
+    def load_state(self, path) -> None:
+        loaded = load_state(path, source=self.w.source)
+        self.apply_loaded(loaded.state, loaded.settings)
+
+    @staticmethod
+    def from_state(cls, path, source=None, *, allow_code: bool = False, **kwargs):
+        """A widget of class ``cls`` for a `save_state` file (`Rot4DWidget.from_state`)."""
+        loaded = load_state(path, source=source, allow_code=allow_code)
+        if loaded.source is None:
+            raise ValueError(f"{path!r} does not say how to rebuild its source: pass it, "
+                             "Rot4DWidget.from_state(path, source=...)")
+        settings = dict(loaded.settings)
+        if inner_source(loaded.source) is not loaded.source:  # already parallel slices: not wrapped twice
+            for name in ("slices", "spacing", "arrangement"):
+                settings.pop(name, None)
+        allowed = set(inspect.signature(cls.__init__).parameters)
+        init = {k: v for k, v in settings.items() if k in allowed and v is not None}
+        w = cls(loaded.source, **{**init, **kwargs})
+        w._keeper.apply_loaded(loaded.state, {})
+        return w
+
+    def apply_loaded(self, state, settings) -> None:
+        w = self.w
+        d = state.to_dict()
+        d.pop("keymap")
+        with w._pump.lock:
+            w._check_open()
+            w.state.restore(d)  # the loaded state becomes what r resets to
+            w._keys.use_keymap(without_source_keys(state.keymap), w.source)
+        for name in SETTING_NAMES:  # slices before spacing and arrangement
+            value = settings.get(name)
+            if value is None or not w.has_trait(name):
+                continue
+            if isinstance(value, list):
+                value = tuple(value)
+            if getattr(w, name) != value:
+                setattr(w, name, value)
+        w.refresh()
+        with w._pump.lock:
+            self.restart()
+
+
+_MISSING = object()
+
+
+class _LiveSource:
+    """The widget's source as it is at each moment (a replay may turn it into a stack midway)."""
+
+    def __init__(self, widget):
+        self._widget = widget
+
+    def __getattr__(self, name):
+        return getattr(self._widget.source, name)

@@ -1,0 +1,143 @@
+"""The on-screen key pad: a button per bound action, for a mouse or a touch screen.
+
+A click is one step; a button held down repeats exactly like a held key (the same
+`rot4d_widget.view.keyhold.KeyRepeater`) and stops on release or on leaving it.  Built when
+first shown, under the canvas.
+"""
+
+from __future__ import annotations
+
+import html
+import logging
+from collections.abc import Mapping
+
+import ipywidgets as widgets
+from ipyevents import Event
+
+from .keys import page_time
+
+__all__ = ["KeyPad", "PAD_ROWS", "PAD_EVENTS", "close_quietly"]
+
+log = logging.getLogger(__name__)
+
+#: The key pad: (row title, ((key, shift), ...)); keys not bound in the keymap are left out.
+PAD_ROWS = (
+    ("simple", tuple((k, False) for k in "23468c")),
+    ("inverse", tuple((k, True) for k in "23468c")),
+    ("double", (("y", False), ("z", False), ("w", False), ("y", True), ("z", True), ("w", True))),
+    ("\u03b1, c0", (("k", False), ("j", False), ("l", False), ("h", False))),
+    ("step", (("+", False), ("-", False), ("r", False))),
+)
+PAD_EVENTS = ("mousedown", "mouseup", "mouseleave", "touchstart", "touchend", "touchcancel")
+
+
+class KeyPad:
+    """One widget's key pad: ``box`` (None until first shown) and its buttons' ``events``."""
+
+    def __init__(self, widget):
+        self.w = widget
+        self.box = None
+        self.events = []
+
+    def show(self, visible: bool) -> None:
+        """Show (building it the first time) or hide the pad; hiding releases held keys."""
+        w = self.w
+        if visible and self.box is None:
+            self.box = self.build()
+            w._canvas_box.children = (*w._canvas_box.children, self.box)
+        if self.box is not None:
+            self.box.layout.display = None if visible else "none"
+            if not visible:
+                w.release_keys()
+
+    def build(self):
+        """Rows of buttons, one per bound action in `PAD_ROWS`; each button's presses feed the
+        same repeater as keys (ipyevents mouse and touch events on the button).  If building
+        fails halfway (a comm that raises), every widget made for it is closed again."""
+        from ipywidgets.widgets.widget import _instances
+
+        before = set(_instances)
+        try:
+            return self._make()
+        except BaseException:
+            made = [x for k, x in list(_instances.items()) if k not in before]
+            self.events = [ev for ev in self.events if ev not in made]
+            for x in made:
+                close_quietly(x)
+            raise
+
+    def _make(self):
+        keymap = self.w.state.keymap
+        rows = []
+        for title, row in PAD_ROWS:
+            buttons = []
+            for key, shift in row:
+                found = keymap.resolve(key, shift)
+                if found is None:
+                    continue
+                action, inverted = found
+                b = widgets.Button(
+                    description=action.label(inverted),
+                    tooltip=f"{'Shift+' if shift else ''}{key}: {action.describe()}",
+                    layout=widgets.Layout(width="auto", min_width="3.6em", height="2.2em", padding="0 0.3em"),
+                )
+                b.add_class("rot4d-pad-button")
+                ev = Event(source=b, watched_events=list(PAD_EVENTS), prevent_default_action=True)
+                ev.on_dom_event(lambda event, key=key, shift=shift: self.handle(key, shift, event))
+                self.events.append(ev)
+                buttons.append(b)
+            if buttons:
+                label = widgets.HTML(f"<small>{html.escape(title)}</small>", layout=widgets.Layout(width="4.5em"))
+                rows.append(widgets.HBox([label, *buttons], layout=widgets.Layout(flex_flow="row wrap")))
+        box = widgets.VBox(rows, layout=widgets.Layout(margin="0.3em 0 0 0"))
+        box.add_class("rot4d-keypad")
+        return box
+
+    def handle(self, key, shift, event) -> None:
+        """A key pad button: mousedown / touchstart press its key, the rest release it. Never raises."""
+        w = self.w
+        try:
+            etype = event.get("type") if isinstance(event, Mapping) else None
+            key_id = f"pad:{key}{'+shift' if shift else ''}"
+            if etype in ("mousedown", "touchstart"):
+                if etype == "mousedown" and event.get("button", 0) != 0:
+                    return  # the main button only (a right click opens no repeat)
+                found = w.state.keymap.resolve(key, shift)
+                if found is None or w._keys.no_view():
+                    return
+                action, inverted = found
+                with w._pump.lock:
+                    if w._closed or key_id in w._repeater.held_keys:
+                        return  # a touch's emulated mousedown: one press only
+                    w._keys.press(key_id, action, inverted, page_time(event))
+            elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):
+                w._keys.release(key_id, page_time(event))
+        except Exception as exc:  # shown, never lost, never raised into the kernel
+            w._report_error(exc)
+
+    def close(self) -> None:
+        """Close the buttons' Events first (their document listeners go before the buttons), then
+        every widget of the pad; never raises."""
+        for ev in self.events:
+            close_quietly(ev)
+        if self.box is not None:
+            for row in self.box.children:
+                for x in row.children:
+                    close_quietly(x)
+                close_quietly(row)
+            close_quietly(self.box)
+
+
+def close_quietly(w) -> None:
+    """Close a widget and its own Layout / Style widgets; never raises (close() must not stop halfway)."""
+    subs = [getattr(w, name, None) for name in ("layout", "style")] if isinstance(w, widgets.Widget) else []
+    try:
+        w.close()
+    except Exception:
+        log.debug("closing %r failed", w, exc_info=True)
+    for sub in subs:
+        if isinstance(sub, widgets.Widget):
+            try:
+                sub.close()
+            except Exception:
+                log.debug("closing %r failed", sub, exc_info=True)

@@ -1,0 +1,296 @@
+"""The key path: an ipyevents dict (or a key pad button) -> keymap -> one step -> the pump.
+
+`KeyPath` handles the canvas's key events, presses and releases held keys (the
+`rot4d_widget.view.keyhold.KeyRepeater` says when they repeat), applies one step of an action
+(the state's, the source's own, a screenshot, or the first added slice that makes the view a
+stack), records it and marks the picture dirty.  It never raises into the event loop: errors
+go to the widget's ``errors`` area.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+
+from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, Action, Keymap
+from .readout import help_html
+
+__all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
+
+
+class KeyPath:
+    """Keys and key pad buttons of one widget, from the event to the pump (the pump's lock held
+    where it says so)."""
+
+    def __init__(self, widget):
+        self.w = widget
+        self.last_label = None  # the readout's "last" row: the last step and how many times
+        self.last_count = 0
+        self.was_displayed = False  # a view of the canvas was counted once
+
+    # -- events ----------------------------------------------------------------------------
+    def handle_event(self, event) -> None:
+        """ipyevents callback: never raises."""
+        w = self.w
+        try:
+            if not isinstance(event, Mapping):
+                return
+            etype = event.get("type", event.get("event"))
+            if etype == "keydown":
+                self.key_down(event)
+            elif etype == "keyup":
+                kid = key_id(event)
+                if kid is not None:
+                    self.release(kid, page_time(event))
+            elif etype == "mouseleave":
+                w.release_keys(page_time(event))
+        except Exception as exc:  # shown, never lost, never raised into the kernel
+            w._report_error(exc)
+
+    def key_down(self, event: Mapping) -> None:
+        w = self.w
+        if event.get("repeat") is True:
+            return  # browser auto-repeat: the ticker repeats, not the browser
+        if self.no_view():
+            return  # a listener leaked by a destroyed view (ipyevents): act on nothing
+        found = w.state.keymap.lookup(event)
+        kid = key_id(event)
+        if found is None or kid is None:
+            return
+        action, inverted = found
+        with w._pump.lock:
+            if w._closed:
+                return
+            w._repeater.release(kid)
+            self.press(kid, action, inverted, page_time(event))
+
+    def press(self, kid, action: Action, inverted: bool, when=None) -> None:
+        """Key (or key pad button) ``kid`` went down: one step now, repeats while held (lock held).
+
+        ``when``: the page's time of the keydown (s), against which the keyup's corrects the
+        number of steps (`rot4d_widget.view.keyhold`)."""
+        w = self.w
+        if action.kind == "help":
+            w.help_visible = not w.help_visible
+            return
+        now = w._pump.clock()
+        changed = self.step(action, inverted)
+        if action.kind in REPEATING_KINDS or (action.kind == "custom" and w._custom[action.name][1]):
+            w._repeater.press(kid, action, inverted, now, page_time=when, applied=changed)
+        w._pump.flush(now)
+
+    def release(self, kid, when=None) -> None:
+        """Key (or key pad button) ``kid`` went up at the page's ``when`` (s): no more repeats,
+        its steps corrected to what the page says the hold was; at rest, settle."""
+        w = self.w
+        with w._pump.lock:
+            held = w._repeater.held(kid)
+            correction = w._repeater.release(kid, when)
+            if held is not None:
+                self.correct(*held, correction)
+            self.settle()
+
+    def release_all(self, when=None) -> None:
+        """Every held key up (mouseleave, focus lost, no view left)."""
+        w = self.w
+        with w._pump.lock:
+            for action, inverted, correction in w._repeater.release_all(when):
+                self.correct(action, inverted, correction)
+            self.settle()
+
+    def settle(self) -> None:
+        """At rest (no key held): bring the readout up to date and the rows into the turned frame,
+        and send a picture still owed (one whose send failed)."""
+        w = self.w
+        if w._closed or len(w._repeater):
+            return
+        if w._painter.readout_stale or not w._painter.settled:
+            w._pump.mark_dirty()
+        w._pump.flush()
+
+    def correct(self, action: Action, inverted: bool, correction: int) -> None:
+        """Take back (``correction`` < 0) or add (> 0) steps of a released key (lock held).
+
+        A late keyup lets the ticker repeat a key the user had already released; the page's
+        timestamps say how many steps the hold made, and this makes the state agree.  Each
+        step taken back is the opposite step, recorded like any other."""
+        w = self.w
+        if correction < 0:  # however many (a keyup 80 s late): the traits are synced once
+            opposite = _opposite(action, inverted)
+            undone = sum(self.apply_step(*opposite) for _ in range(-correction))
+            if undone:
+                if self.last_label == action.label(inverted):
+                    self.last_count = max(self.last_count - undone, 1)
+                self.after_steps(action)
+        clock = w._pump.clock
+        start = clock()
+        for _ in range(max(correction, 0)):  # missing steps: within one tick's time, like a tick
+            if clock() - start > w._repeater.period:
+                break
+            self.step(action, inverted)
+
+    def focus_lost(self, *args, **kwargs) -> None:
+        """Companion: the page or window lost focus (no keyup will come): every key up."""
+        try:
+            self.w.release_keys()
+        except Exception as exc:
+            self.w._report_error(exc)
+
+    def view_count(self, n) -> None:
+        """Scene: the canvas has ``n`` views; none left: every key up (no keyup will come)."""
+        try:
+            if n > 0:
+                self.was_displayed = True
+            else:
+                self.w.release_keys()
+        except Exception as exc:
+            self.w._report_error(exc)
+
+    def no_view(self) -> bool:
+        """True when the canvas was displayed and every view of it is gone.
+
+        Front ends that do not count views leave the count at 0 and never set
+        ``was_displayed``: their keys are always accepted.
+        """
+        return self.was_displayed and self.w.scene.view_count == 0
+
+    def use_keymap(self, keymap, source) -> None:
+        """Bind ``keymap`` plus ``source``'s own keys (its actions runnable), and show them in the help."""
+        w = self.w
+        actions = source_actions(source)
+        if actions:
+            keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
+        w._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
+        w.state.keymap = keymap
+        w.help_panel.value = help_html(help_groups(keymap), w._repeater.hold_delay, w._repeater.tick_rate)
+
+    # -- steps -----------------------------------------------------------------------------
+    def tick(self, now: float) -> None:
+        """Pump callback: the held keys' steps due by ``now``; a tick that overran (slow
+        observers, a loaded machine) drops the ticks it missed instead of bursting."""
+        w = self.w
+        rep = w._repeater
+        clock = w._pump.clock
+        for kid, action, inverted in rep.due_keys(now):
+            if self.step(action, inverted):
+                rep.note_applied(kid)
+            if clock() - now > rep.period:
+                break  # over budget: the rest of this catch-up is dropped, the lock let go
+        after = clock()
+        if after - now > rep.period:
+            rep.drop_missed(after)
+
+    def step(self, action: Action, inverted: bool) -> bool:
+        """One step of ``action``: applied, recorded, counted in the readout, traits synced."""
+        changed = self.apply_step(action, inverted)
+        if changed:
+            label = action.label(inverted)
+            if label == self.last_label:
+                self.last_count += 1
+            else:
+                self.last_label, self.last_count = label, 1
+            self.after_steps(action)
+        return changed
+
+    def apply_step(self, action: Action, inverted: bool) -> bool:
+        """Apply and record one step (no trait sync: `after_steps` does it once); True if it changed."""
+        w = self.w
+        if action.kind == "custom":
+            run = w._custom.get(action.name)
+            if run is None:
+                return False
+            with w._source_lock:
+                result = run[0](-1 if inverted else 1)
+            if result is False:  # refused (at a bound): nothing changed, nothing recorded
+                return False
+            w._source_version += 1
+            w._recorder.record(None, False, action, inverted)
+            w._keeper.note_settings()
+            return True
+        if action.kind == "screenshot":
+            w._shots.key_p()
+            return False
+        if action.kind == "slices" and not w._stacking.is_stack:
+            # n on a single slice: the first added slice makes the view a stack of two (recorded
+            # as the source setting it is; the stack's own keys are steps from here on)
+            if (-1 if inverted else 1) * action.sign <= 0:
+                return False
+            w._stacking.wrap(2)
+            w._recorder.record_source("slices", 2)
+            return True
+        changed = w.state.apply(action, inverted)
+        if changed:
+            w._recorder.record(None, False, action, inverted)
+        return changed
+
+    def after_steps(self, action: Action) -> None:
+        """After steps of ``action`` changed something: redraw, and the traits say what it is."""
+        w = self.w
+        w._pump.mark_dirty()
+        if action.kind in ("custom", "slices"):
+            w._sync.source_traits()
+        w._sync.state_traits()
+
+
+def _opposite(action: Action, inverted: bool):
+    """``(action, inverted)`` of the step that undoes one step of ``action``."""
+    if action.is_rotation or action.kind == "custom":
+        return action, not inverted
+    return dataclasses.replace(action, sign=-action.sign), inverted
+
+
+def page_time(event) -> float | None:
+    """The page's time of an ipyevents event in seconds (its ``timeStamp``, ms), or None."""
+    t = event.get("timeStamp") if isinstance(event, Mapping) else None
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        return None
+    return float(t) / 1000.0
+
+
+def key_id(event: Mapping):
+    """A held key's identity: its ``code`` (physical key), else its lower-cased ``key``."""
+    code = event.get("code")
+    if isinstance(code, str) and code:
+        return code
+    key = event.get("key")
+    if isinstance(key, str) and key:
+        return "key:" + key.lower()
+    return None
+
+
+def source_actions(source) -> dict:
+    """``{key: (Action, run, repeat)}`` for the source's optional ``actions`` mapping."""
+    actions = getattr(source, "actions", None)
+    if not actions:
+        return {}
+    if not isinstance(actions, Mapping):
+        raise TypeError(f"Expected `source.actions` to be a mapping of key -> SourceAction, "
+                        f"got {type(actions).__name__}")
+    out = {}
+    for key, sa in actions.items():
+        for attr in ("name", "description", "run"):
+            if not hasattr(sa, attr):
+                raise TypeError(f"Expected source action {key!r} to have `{attr}` (see rot4d_widget.SourceAction)")
+        if not callable(sa.run):
+            raise TypeError(f"Expected source action {key!r}.run to be callable")
+        action = Action("custom", name=str(sa.name), text=str(sa.description), sign=1)
+        out[key] = (action, sa.run, bool(getattr(sa, "repeat", True)))
+    return out
+
+
+def help_groups(keymap: Keymap) -> list:
+    """The key table, one row per action; reserved keys that do nothing here yet in one honest row."""
+    rows, reserved = [], []
+    for keys, label, text in keymap.help_groups():
+        acts = [keymap[k] for k in keys.split() if k in keymap]
+        kinds = {a.kind for a in acts}
+        adds_slice = kinds == {"slices"} and all(a.sign > 0 for a in acts)  # n: makes the view a stack
+        if kinds and kinds <= RESERVED_KINDS and not adds_slice and kinds != {"screenshot"}:
+            reserved.append(keys)
+        else:
+            rows.append((keys, label, text))
+    if reserved:
+        rows.append((" ".join(reserved), "reserved",
+                     "iso levels (fields), fewer slices and spacing (parallel slices): not active in this view"))
+    return rows

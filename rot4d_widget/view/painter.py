@@ -1,0 +1,269 @@
+"""What the view shows, and when: the pump's ``send`` callback, the slice cache, the readout.
+
+`Painter` turns the widget's state into pictures: it slices the source (or turns the rows
+already shown when only x, y, z turned), hands the slice to the scene and keeps the readout
+in step.  `ViewKey` says which state a picture shows.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core import look
+from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source
+from . import readout as ro
+
+__all__ = ["ViewKey", "Painter", "READOUT_PERIOD", "checked_slice", "title"]
+
+#: While keys repeat, the readout (an HTML relayout on the page) changes at most this often (s);
+#: it is exact again as soon as no key is held.
+READOUT_PERIOD = 0.25
+
+
+@dataclass(frozen=True, eq=False)
+class ViewKey:
+    """The state a picture shows: the rotation, the cut, the camera, the source's version, the
+    colouring and whether the slice was the coarse one (held keys)."""
+
+    matrix: np.ndarray
+    c0: float
+    eye: tuple
+    version: int
+    color_by: object
+    coarse: bool
+
+    def same_cut(self, other: "ViewKey") -> bool:
+        """The same hyperplane level, camera, source version and colours (the rotation aside)."""
+        return (self.c0, self.eye, self.version, self.color_by) == (other.c0, other.eye, other.version,
+                                                                    other.color_by)
+
+    def same(self, other: "ViewKey") -> bool:
+        """Everything equal, the rotation too (the same matrix object, or equal entries)."""
+        return (self.same_cut(other) and self.coarse == other.coarse
+                and (self.matrix is other.matrix or np.array_equal(self.matrix, other.matrix)))
+
+    def turn_from(self, other: "ViewKey"):
+        """The 3-D rotation (3, 3) taking ``other``'s rows to this key's, or None when it moves w."""
+        t = np.asarray(self.matrix) @ np.asarray(other.matrix).T
+        return t[:3, :3] if abs(t[3, 3] - 1.0) < 1e-12 else None
+
+
+def title(source) -> str:
+    name = getattr(source, "name", None)
+    return str(name) if name else type(source).__name__
+
+
+def checked_slice(source, matrix, c0, coarse, lock):
+    """``source.slice`` validated once (`rot4d_widget.sources.protocol.check_slice`): a bad slice (None,
+    non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
+    or TypeError naming the source and the member that is wrong, and is never drawn."""
+    with lock:
+        data = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
+        n_groups = int(source.n_groups)
+    try:
+        check_slice(data, n_groups)
+    except (TypeError, ValueError) as exc:
+        raise BadSlice(f"{title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
+    return data
+
+
+class Painter:
+    """The widget's pictures: ``send`` (the pump's callback), the slice cache, the readout.
+
+    ``shown`` is the `ViewKey` the scene shows; ``rows_key`` the one its rows were sliced for
+    (the view may be turned from it); ``rows_data`` the slice those rows show.
+    """
+
+    def __init__(self, widget, coarse_ok: bool):
+        self.w = widget
+        #: sources whose slice(matrix, c0, coarse=...) has a cheaper coarse version (fields):
+        #: coarse while keys repeat, full at rest; their rows are turned, not re-sliced, at rest
+        self.coarse_ok = coarse_ok
+        self.cache = None  # (matrix, c0, version, coarse, data)
+        self.shown = None
+        self.rows_key = None
+        self.rows_data = None
+        self.note = None  # one line for the readout: what a screenshot did
+        self.readout_at = -math.inf  # when the readout was last computed
+        self.readout_stale = False  # the readout lags the state (keys were repeating)
+
+    # -- slices -----------------------------------------------------------------------------
+    def current_slice(self, coarse: bool = False):
+        w = self.w
+        st = w.state
+        m, c0, version = st.matrix, st.c0, w._source_version
+        coarse = bool(coarse and self.coarse_ok)
+        cached = self.cached_slice(m, c0, version, coarse)
+        if cached is not None:
+            return cached
+        data = checked_slice(w.source, m, c0, coarse, w._source_lock)
+        self.cache = (m, c0, version, coarse, data)
+        return data
+
+    def cached_slice(self, m, c0, version, coarse):
+        cache = self.cache
+        if cache is not None and cache[0] is m and cache[1] == c0 and cache[2] == version and cache[3] == coarse:
+            return cache[4]
+        return None
+
+    @property
+    def settled(self) -> bool:
+        """True when the scene shows the rows of the exact (not coarse, not turned) state."""
+        return self.shown is None or (self.shown is self.rows_key and not self.shown.coarse)
+
+    def send(self):
+        """Pump callback: show the latest state; the update's id, or None if nothing was sent.
+
+        While keys are held, a change that only turns the slice in 3-D (the
+        rotation since the rows shown leaves w alone, nothing else changed) is
+        sent as a turn, a few bytes, without slicing; at rest the rows are
+        re-sent in the new frame (the faces' order is exact again).
+        """
+        w = self.w
+        st, scene = w.state, w.scene
+        held = bool(len(w._repeater))
+        coarse = held and self.coarse_ok
+        shown, rows = self.shown, self.rows_key
+        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse)
+        sent = None
+        same_cut = rows is not None and key.same_cut(rows)
+        # a stack turns each slice about its own centre: never turned as a whole
+        turn = key.turn_from(rows) if same_cut and inner_source(w.source) is w.source else None
+        if shown is not None and key.same(shown) and (shown is rows or held):
+            pass  # the view shows this state (turned rows only while keys are held)
+        elif held and turn is not None and (key.coarse or not rows.coarse):
+            if scene.turn(turn):
+                sent = scene.update_id
+            self.shown = key
+        else:
+            single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+            rows_turn = key.turn_from(rows) if same_cut else None
+            if (self.coarse_ok and rows_turn is not None and not rows.coarse and not coarse
+                    and self.rows_data is not None):
+                # the same cut turned in 3-D: turn the full-resolution slice shown, no resampling
+                data = self.rows_data.turned(rows_turn)
+            else:
+                m, c0, version, coarse_ = key.matrix, key.c0, key.version, bool(coarse and self.coarse_ok)
+                data = self.cached_slice(m, c0, version, coarse_)
+                if data is None:
+                    source, lock = w.source, w._source_lock
+                    # the slow part: on the ticker thread it runs with the pump's lock free, so
+                    # keys go on changing the state meanwhile (the next picture takes the latest)
+                    data = yield (lambda: checked_slice(source, m, c0, coarse_, lock))
+                    if w._closed:
+                        return None
+                    if w._source_version != version or w.source is not source:
+                        w._pump.mark_dirty()  # the source changed meanwhile: never show the old one
+                        return None
+                    self.cache = (m, c0, version, coarse_, data)
+            colors = self.group_colors()
+            extra = {} if colors is None else {"group_rgb": colors}
+            if scene.show(data, single_rgb=single, **extra):
+                sent = scene.update_id
+            self.rows_data = data
+            self.shown = self.rows_key = key
+        now = w._pump.clock()
+        w._error_area.clear_update_errors()  # a good picture: the widget has recovered
+        if not len(w._repeater) or now - self.readout_at >= READOUT_PERIOD:
+            w.readout.value = self.readout_html()
+            self.readout_at, self.readout_stale = now, False
+        else:
+            self.readout_stale = True
+        return sent
+
+    def eye_moved(self, eye) -> None:
+        """Scene: the camera moved (a mouse orbit ended): send the faces in the order for the new eye."""
+        w = self.w
+        try:
+            with w._pump.lock:
+                if not w._closed:
+                    w._pump.mark_dirty()
+                    w._pump.flush()
+        except Exception as exc:
+            w._report_error(exc)
+
+    # -- the readout ------------------------------------------------------------------------
+    def set_note(self, text: str) -> None:
+        self.note = text
+        self.w.readout.value = self.readout_html()
+
+    def readout_html(self) -> str:
+        w = self.w
+        st, source = w.state, w.source
+        # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
+        data = self.rows_data if self.rows_data is not None else self.current_slice()
+        label, count = w._keys.last_label, w._keys.last_count
+        if label is None:
+            last = "\u2014"
+        else:
+            last = html.escape(label) + (f" \u00d7{count}" if count > 1 else "")
+        w_range = getattr(source, "w_range", None)
+        lo, hi = w_range(st.matrix) if w_range is not None else (-source.size, source.size)
+        rows = [
+            ("\u03b80", ro.angle_text(st.theta0)),
+            ("\u03b1", ro.angle_text(st.alpha)),
+            ("\u03b2", ro.angle_text(st.beta)),
+            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None))),
+            ("last", last),
+        ]
+        rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
+        colors, labels = self.colours()
+        if labels is not None and w.color_by == "group":  # the legend: what each colour is
+            rows.append(("colours", " ".join(
+                f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
+                f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
+                for t, rgb in zip(labels, colors))))
+        volume = getattr(data, "volume", None)
+        if volume is not None and math.isfinite(float(volume)):
+            rows.append(("volume", volume_text(source, float(volume), st.matrix)))
+        if self.note:
+            rows.append(("picture", html.escape(self.note)))
+        return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
+
+    def group_colors(self):
+        """The colour of every group of the source as it is now (`colours`)."""
+        return self.colours()[0]
+
+    def colours(self):
+        """``(rgb (G, 3), labels or None)``: a stack's colours by w, else a field's by level (also
+        inside a stack of one slice), else the scene's palette sized to the source's groups
+        now (labels None: cells need no legend).  Follows the source when it changes."""
+        w = self.w
+        src = w.source
+        inner = inner_source(src)
+        if inner is not src:  # parallel slices: coloured by their w (`group_colors`, `levels_at`)
+            rgb = src.group_colors()
+            if rgb is not None:
+                return rgb, [data_w_text(inner, lv) for lv in src.levels_at(w.state.c0)]
+        rgb = level_colors(inner)
+        if rgb is not None:
+            return rgb, [f"{lv:.4g}" for lv in inner.levels]
+        return w.scene.palette(int(src.n_groups)), None
+
+
+def level_colors(source):
+    """Colours of a source's iso levels (a matplotlib colormap over its data range), or None."""
+    levels = getattr(source, "levels", None)
+    if not levels:
+        return None
+    lo, hi = getattr(source, "data_range", (min(levels), max(levels)))
+    return look.level_colors(levels, lo, hi)
+
+
+def volume_text(source, volume: float, matrix) -> str:
+    """The slice's 3-volume in the source's own units (a field's space units cubed when it names
+    them, ``space_units``); a field turned so that w is mixed in counts w at ``w_per_unit`` data
+    w per unit of space, and says so."""
+    inner = inner_source(source)
+    unit = getattr(inner, "space_units", None)
+    text = ro.number_text(volume) + (f" {unit}³" if unit else "")
+    wpu = getattr(inner, "w_per_unit", None)
+    if wpu is not None and abs(abs(float(np.asarray(matrix)[3, 3])) - 1.0) > 1e-12:
+        wu = getattr(inner, "w_units", None)
+        text += (f" (w counted at {ro.number_text(wpu)}{' ' + wu if wu else ''} per "
+                 f"{unit if unit else 'unit of space'})")
+    return text

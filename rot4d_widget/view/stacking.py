@@ -1,0 +1,70 @@
+"""Parallel slices at run time: a single view becomes a stack when `slices` is set (or n pressed).
+
+A stack is a source whose ``wraps`` is not None (the source protocol); this module is where
+the view makes one (`rot4d_widget.sources.tomography.StackSource`, oval, default spacing), binds
+its keys and keeps its traits in step.  Nothing else in the view asks what kind a source is.
+"""
+
+from __future__ import annotations
+
+from ..core.state import without_source_keys
+from ..sources.protocol import inner_source
+from ..sources.tomography import StackSource
+
+__all__ = ["Stacking", "make_stack", "is_stack"]
+
+
+def is_stack(source) -> bool:
+    """True for a source made around another (its ``wraps`` is not None): parallel slices."""
+    return inner_source(source) is not source
+
+
+def make_stack(source, slices, spacing=None, arrangement="oval"):
+    """``slices`` parallel slices of ``source`` (raises before anything changes if not allowed)."""
+    return StackSource(source, slices=slices, spacing=spacing, arrangement=arrangement)
+
+
+class Stacking:
+    """One widget's single view <-> stack: wraps the source when asked, applies the stack's traits."""
+
+    def __init__(self, widget):
+        self.w = widget
+
+    @property
+    def is_stack(self) -> bool:
+        return is_stack(self.w.source)
+
+    def wrap(self, slices) -> None:
+        """Show ``slices`` parallel slices of the current source from now on (the lock is held).
+
+        The source is wrapped in a stack (oval, default spacing), its keys n / b / g / f join the
+        keymap and the help.  Raises before any change if ``slices`` is not allowed.
+        """
+        w = self.w
+        stack = make_stack(w.source, slices)
+        # the stack brings the inner source's keys too: rebind them from the reserved ones
+        w._keys.use_keymap(without_source_keys(w.state.keymap), stack)
+        with w._source_lock:
+            w.source = stack
+        w._source_version += 1
+        w._painter.cache = None
+        w._sync.source_traits()
+
+    def on_stack_trait(self, change) -> None:
+        """``slices``, ``spacing``, ``arrangement``: a stack's settings; ``slices`` on a single
+        view wraps it first."""
+        w = self.w
+        sync = w._sync
+        if change["name"] == "slices" and not sync.syncing and not self.is_stack and change["new"] is not None:
+            with w._pump.lock:  # parallel slices asked for at run time: wrap the source now
+                try:
+                    self.wrap(change["new"])
+                except Exception:
+                    sync.set_quietly("slices", change["old"])
+                    raise
+                w._keeper.record_source("slices", change["new"])
+                w._pump.mark_dirty()
+                w._pump.flush()
+            return
+        sync.source_setting(change, w.source if self.is_stack else None,
+                            f"`{change['name']}` applies to parallel slices: set `slices` (or press n) first")
