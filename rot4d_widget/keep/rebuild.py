@@ -47,57 +47,31 @@ def _function_path(f):
 
 
 def describe_source(source) -> dict:
-    """``source.describe()`` plus what `rebuild_source` needs, and ``"rebuild"``: True, or the reason
-    it cannot be rebuilt.
+    """``source.describe()`` -- everything `rebuild_source` needs (the source protocol's ``describe``)
+    -- with ``"rebuild"``: True, or the reason it cannot be rebuilt.
 
-    A polytope that is not one of the six named ones as `polytope(name)` builds them (a scaled
-    pentachoron, a uniform polychoron, one read from 4OFF, possibly non-convex) keeps its
-    vertices, faces and cells; a field keeps its resolution, w units and how to reopen it (a module-level function
-    ``"module:qualname"``, or the file `open_field` read); a stack describes its inner source the
-    same way.
+    Nothing here depends on the source's class: a polytope's description keeps the vertices, faces
+    and cells of one that is not a named polytope as `polytope(name)` builds it, a field's its
+    resolutions, w units and how to reopen it -- each source says so itself.  A source that wraps
+    another (a stack: the protocol's ``wraps``) has its inner source described the same way and
+    is rebuildable exactly when that one is.  A description without ``"rebuild"`` can be rebuilt
+    when `rebuild_source` knows its kind (a polytope, a stack, a field), else it carries the reason.
     """
-    from ..sources.fields import Field4D
-    from ..sources.protocol import PolytopeSource
-    from ..sources.tomography import StackSource
-
-    if isinstance(source, StackSource):
-        d = dict(source.describe())
-        d["source"] = describe_source(source.source)
+    d = dict(source.describe())
+    inner = getattr(source, "wraps", None)
+    if inner is not None:
+        d["source"] = describe_source(inner)
         d["rebuild"] = d["source"]["rebuild"]
         return d
-    d = dict(source.describe())
-    if isinstance(source, PolytopeSource):
-        from ..geometry.polytopes import POLYTOPE_NAMES, polytope
-
-        p = source.polytope
-        if "vertices" in d or p.name not in POLYTOPE_NAMES or not np.array_equal(
-                np.asarray(p.vertices), np.asarray(polytope(p.name).vertices)):
-            # not one of the named six as `polytope(name)` builds it: its vertices, faces and
-            # cells (a non-convex polytope is not the hull of its vertices)
-            d["vertices"] = np.asarray(p.vertices).tolist()
-            d["faces"] = [np.asarray(f).tolist() for f in p.faces]
-            d["cells"] = [np.asarray(c).tolist() for c in p.cells]
-        d["rebuild"] = True
-    elif isinstance(source, Field4D):
-        d.update(resolution=source.resolution, coarse_resolution=source.coarse_resolution, w_units=source.w_units,
-                 chunk_cache_bytes=source.chunk_cache_bytes)
-        origin = getattr(source, "origin", None)
-        if source._kind == "function":
-            path, why = _function_path(source._function)
-            d["function"] = path or d.get("function")
-            d["rebuild"] = True if path else f"its function cannot be imported again: {why}"
-        elif isinstance(origin, Mapping):
-            d["origin"] = dict(origin)
-            d["array"] = f"read from {origin.get('path')!r} (reopened from there)"
-            d["rebuild"] = True
-        else:
-            d["rebuild"] = (f"its values are a {d.get('array', 'array').replace(' (not recordable)', '')} held in "
-                            "memory, not written into a state file; open the file with Field4D.open(path, variable, "
-                            "w=...) (or rot4d_widget.keep.export.open_field) to record where it comes from -- "
-                            "the only way for a zarr store or a file xarray read with the scipy engine")
-    else:
-        d["rebuild"] = f"a source of kind {d.get('kind', type(source).__name__)!r} cannot be rebuilt from its description"
+    if "rebuild" not in d:
+        kind = d.get("kind", type(source).__name__)
+        d["rebuild"] = (True if kind in _KNOWN_KINDS
+                        else f"a source of kind {kind!r} cannot be rebuilt from its description")
     return _jsonable(d, "source.describe()")
+
+
+#: The kinds of description `rebuild_source` can make a source from.
+_KNOWN_KINDS = ("polytope", "stack", "field")
 
 
 def rebuild_source(description: Mapping, *, allow_code: bool = False, function=None, base=None):
