@@ -233,7 +233,8 @@ def _parse(lines: _Lines, size: int | None) -> OffData:
         try:
             vertices[k] = [float(t) for t in tok]
         except ValueError:
-            raise ValueError(f"line {no}: vertex {k} has a coordinate that is not a number: {' '.join(tok)!r}") from None
+            raise ValueError(f"line {no}: vertex {k} has a coordinate that is not a number: "
+                             f"{' '.join(tok)!r}") from None
         if not np.all(np.isfinite(vertices[k])):
             raise ValueError(f"line {no}: vertex {k} is not finite: {' '.join(tok)!r}")
         vertex_lines.append(no)

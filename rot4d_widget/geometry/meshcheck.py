@@ -1,0 +1,279 @@
+"""The checks of an explicit mesh given to `Polytope(vertices, faces, cells)`, and its orientation.
+
+`index_lists` reads the faces and cells (sequences of index sequences) into ragged tables,
+`duplicate_in_rows` finds a repeated index; `mesh_geometry` checks the faces' and cells' geometry
+(planar strictly convex faces, flat 3-D cells, closed and convex cells when asked) and derives
+the outward cell normals from the boundary's orientation (a cavity, found by casting a ray, the
+other way).  Every failure is a `MeshError` naming the first offending face, cell or vertex.
+Lengths are in the scale of the polytope's `Polytope.unit_vertices`; the tolerance is
+`rot4d_widget.core.tolerances.MESH` times their largest extent.  Everything is vectorised.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from ..core import tolerances as tol_
+from ._ragged import _owner, _ptr
+
+__all__ = ["MeshError", "index_lists", "duplicate_in_rows", "mesh_geometry"]
+
+
+class MeshError(ValueError):
+    """An explicit mesh given to `Polytope` is not a valid 4-polytope.
+
+    ``item`` is the offending ``("face" | "cell" | "vertex", index)`` when there is one
+    (the 4OFF reader turns it into a line number), else None.
+    """
+
+    def __init__(self, message: str, item: tuple | None = None):
+        super().__init__(message)
+        self.item = item
+
+
+def index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.ndarray]:
+    """A sequence of sequences of indices -> (sizes (n,) intp, flat (sum,) intp), checked:
+    integers in ``0 .. n_max - 1``.  TypeError / ValueError name the first bad entry."""
+    expected = f"a sequence of sequences of {item} indices (integers 0 to {n_max - 1})"
+    if isinstance(seq, (str, bytes)):
+        raise TypeError(f"Expected `{what}` to be {expected}, got {type(seq).__name__}")
+    if isinstance(seq, np.ndarray) and seq.ndim == 2 and seq.dtype.kind in "iu":
+        sizes = np.full(len(seq), seq.shape[1], dtype=np.intp)
+        flat = seq.astype(np.intp).ravel()
+    else:
+        try:
+            items = list(seq)
+        except TypeError:
+            raise TypeError(f"Expected `{what}` to be {expected}, got {type(seq).__name__}") from None
+        sizes = np.empty(len(items), dtype=np.intp)
+        for i, it in enumerate(items):
+            if isinstance(it, (str, bytes)):
+                raise TypeError(f"Expected `{what}[{i}]` to be a sequence of {item} indices, got {it!r}")
+            try:
+                sizes[i] = len(it)
+            except TypeError:
+                raise TypeError(f"Expected `{what}[{i}]` to be a sequence of {item} indices, "
+                                f"got {type(it).__name__}") from None
+        if items and all(isinstance(it, np.ndarray) and it.ndim == 1 for it in items):
+            flat = np.concatenate(items)  # e.g. a Wythoff construction's cycles: no Python loop over entries
+        else:
+            flat = np.array(list(itertools.chain.from_iterable(items)))
+        if flat.size == 0:
+            flat = np.zeros(0, dtype=np.intp)
+        if flat.ndim != 1 or flat.dtype.kind not in "iu":
+            for i, it in enumerate(items):
+                a = np.asarray(it)
+                if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
+                    raise TypeError(f"Expected `{what}[{i}]` to be a sequence of integer {item} indices, "
+                                    f"got {np.asarray(it).tolist()[:8]!r}")
+            raise TypeError(f"Expected `{what}` to be {expected}")
+        flat = flat.astype(np.intp)
+    bad = np.flatnonzero((flat < 0) | (flat >= n_max))
+    if len(bad):
+        i = int(np.searchsorted(_ptr(sizes), bad[0], side="right") - 1)
+        raise MeshError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}",
+                        item=("face" if what == "faces" else "cell", i))
+    return sizes, flat
+
+
+def duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
+    """First (row, value) that occurs twice in one row of a ragged table, or None."""
+    key = _owner(ptr) * n + flat
+    s = np.sort(key)
+    dup = np.flatnonzero(s[1:] == s[:-1])
+    if len(dup):
+        return int(s[dup[0]] // n), int(s[dup[0]] % n)
+    return None
+
+
+def mesh_geometry(p, validate: bool) -> tuple:
+    """Check an explicit mesh's geometry: (outward cell normals, offsets, cell centres, number of
+    boundary components, the tolerance used); lengths in the scale of ``p.unit_vertices``."""
+    v = p.unit_vertices
+    V, F, C = len(v), len(p.incidence.face_ptr) - 1, len(p.incidence.cell_ptr) - 1
+    tol = tol_.MESH * float(np.ptp(v, axis=0).max())
+    if tol == 0:
+        raise ValueError("`vertices` are all the same point")
+    # distinct vertices
+    key = np.round(v / tol).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    if len(first) < V:
+        i = int(np.flatnonzero(first[inverse.reshape(-1)] != np.arange(V))[0])
+        raise MeshError(f"vertices {int(first[inverse.reshape(-1)[i]])} and {i} coincide", item=("vertex", i))
+    fptr, fv = p.incidence.face_ptr, p.incidence.face_vidx
+    fsize = np.diff(fptr)
+    face_c = np.empty((F, 4))
+    face_e = np.empty((F, 2, 4))
+    face_area = np.empty(F)
+    for k in np.unique(fsize).tolist():
+        fs = np.flatnonzero(fsize == k)
+        P = v[fv[fptr[fs][:, None] + np.arange(k)]]  # (n, k, 4)
+        c = P.mean(axis=1)
+        Q = P - c[:, None]
+        _, s, vt = np.linalg.svd(Q, full_matrices=False)
+        B = vt[:, :2]  # (n, 2, 4) the face's plane
+        xy = np.einsum("nkd,njd->nkj", Q, B)
+        off = np.linalg.norm(Q - np.einsum("nkj,njd->nkd", xy, B), axis=2).max(axis=1)
+        bad = np.flatnonzero(off > tol)
+        if len(bad):
+            f = int(fs[bad[0]])
+            raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]] * p.unit:.3g} from its plane "
+                            f"(tolerance {tol * p.unit:.3g})", item=("face", f))
+        e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
+        e2 = np.roll(e, -1, axis=1)
+        cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
+        dot = (e * e2).sum(axis=2)
+        chord = np.linalg.norm(e + e2, axis=2)
+        dist = np.abs(cross) / np.maximum(chord, tol_.TINY)  # corner k + 1 from the line of its neighbours
+        turning = np.arctan2(cross, dot).sum(axis=1)
+        sign = np.sign(cross)
+        ok = (dist > tol).all(axis=1) & (sign == sign[:, :1]).all(axis=1) & (np.abs(np.abs(turning) - 2 * np.pi) < 1)
+        bad = np.flatnonzero(~ok)
+        if len(bad):
+            f = int(fs[bad[0]])
+            raise MeshError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
+                            f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
+                            f"strictly convex polygons with their vertices in cyclic order", item=("face", f))
+        face_c[fs] = c
+        face_e[fs] = B
+        face_area[fs] = 0.5 * np.abs((xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
+                                      - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1]).sum(axis=1))
+    if validate:  # before the cells' geometry: an open cell is a mistake in the lists, named as such
+        _check_closed(p)
+    # cells: flat, 3-D, normal
+    cptr, cfx = p.incidence.cell_ptr, p.incidence.cell_fidx
+    vptr, cvx = p.incidence.cell_vptr, p.incidence.cell_vidx
+    nv = np.diff(vptr)
+    g = np.empty((C, 4))
+    n = np.empty((C, 4))
+    for k in np.unique(nv).tolist():
+        cs = np.flatnonzero(nv == k)
+        P = v[cvx[vptr[cs][:, None] + np.arange(k)]]
+        gc = P.mean(axis=1)
+        Q = P - gc[:, None]
+        R = np.linalg.qr(Q, mode="r") if k > 4 else Q
+        _, s, vt = np.linalg.svd(R, full_matrices=True)
+        normal = vt[:, 3]
+        off = np.abs(np.einsum("nkd,nd->nk", Q, normal)).max(axis=1)
+        bad = np.flatnonzero(off > tol)
+        if len(bad):
+            c = int(cs[bad[0]])
+            raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]] * p.unit:.3g} "
+                            f"from it (tolerance {tol * p.unit:.3g})", item=("cell", c))
+        bad = np.flatnonzero(s[:, 2] <= tol)
+        if len(bad):
+            raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D",
+                            item=("cell", int(cs[bad[0]])))
+        g[cs] = gc
+        n[cs] = normal
+    pc = _owner(cptr)  # the (cell, face) pairs, cell by cell
+    pf = cfx
+    m = face_c[pf] - g[pc]
+    for basis in (n[pc], face_e[pf, 0], face_e[pf, 1]):
+        m -= np.einsum("id,id->i", m, basis)[:, None] * basis
+    height = np.linalg.norm(m, axis=1)  # the cell's centroid from each face's plane, in the cell
+    bad = np.flatnonzero(height <= tol)
+    if len(bad):
+        raise MeshError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
+                        f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
+    m /= height[:, None]  # each face's outward normal within each of its cells
+    if validate:
+        _check_cells(p, v, tol, pc, pf, m, face_c)
+    # orientation: the sign of det[n_c, m_cf, plane of f] relates the two cells of each face
+    sigma = np.sign(np.linalg.det(np.stack([n[pc], m, face_e[pf, 0], face_e[pf, 1]], axis=1)))
+    order = np.argsort(pf, kind="stable")
+    c1, c2 = pc[order[0::2]], pc[order[1::2]]
+    same = -sigma[order[0::2]] * sigma[order[1::2]] > 0  # s_c1 == s_c2 for a consistent orientation
+    a = np.concatenate([c1, c1 + C])
+    b = np.concatenate([np.where(same, c2, c2 + C), np.where(same, c2 + C, c2)])
+    _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * C, 2 * C)), directed=False)
+    bad = np.flatnonzero(lab[:C] == lab[C:])
+    if len(bad):
+        raise MeshError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
+                        f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
+    s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
+    ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
+    vol3 = np.bincount(pc, weights=face_area[pf] * height, minlength=C) / 3.0
+    offsets = np.einsum("cd,cd->c", n, g)
+    vol4 = np.bincount(comp, weights=s * offsets * vol3, minlength=ncomp) / 4.0
+    small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
+    if len(small):
+        raise MeshError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
+                        f"no 4-volume")
+    flip = vol4 < 0
+    if ncomp > 1:
+        flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
+    s = np.where(flip[comp], -s, s)
+    normals = np.ascontiguousarray(n * s[:, None])
+    return normals, np.ascontiguousarray(offsets * s), g, ncomp, tol
+
+
+def _check_closed(p) -> None:
+    """Every cell closed: each of its edges in exactly two of its faces (MeshError naming the cell)."""
+    open_ = np.flatnonzero(p.incidence.cell_ecount != 2)
+    if len(open_):
+        i = int(open_[0])
+        c = int(np.searchsorted(p.incidence.cell_eptr, i, side="right") - 1)
+        e = p.edges[p.incidence.cell_eidx[i]].tolist()
+        raise MeshError(f"cell {c} is not closed: its edge {tuple(e)} is in {p.incidence.cell_ecount[i]} of its faces; "
+                        f"each edge of a cell must be in exactly two of its faces", item=("cell", c))
+
+
+def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
+    """Every cell strictly convex (MeshError naming the cell)."""
+    cptr, vptr, cvx = p.incidence.cell_ptr, p.incidence.cell_vptr, p.incidence.cell_vidx
+    nf, nv = np.diff(cptr), np.diff(vptr)
+    fsize = np.diff(p.incidence.face_ptr)
+    kinds, kind = np.unique(nf * (nv.max() + 1) + nv, return_inverse=True)
+    for j in range(len(kinds)):
+        cells_j = np.flatnonzero(kind.reshape(-1) == j)
+        q, k = int(nf[cells_j[0]]), int(nv[cells_j[0]])
+        step = max(1, 2_000_000 // (q * k))
+        for lo in range(0, len(cells_j), step):
+            cs = cells_j[lo : lo + step]
+            P = v[cvx[vptr[cs][:, None] + np.arange(k)]]  # (n, k, 4)
+            pairs = cptr[cs][:, None] + np.arange(q)  # (n, q)
+            M = m[pairs]
+            D = M @ P.transpose(0, 2, 1) - np.einsum("nqd,nqd->nq", M, face_c[pf[pairs]])[..., None]
+            out = D > tol
+            if out.any():
+                i, j2, k2 = np.argwhere(out)[0]
+                raise MeshError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
+                                f"outside the plane of its face {int(pf[pairs[i, j2]])}", item=("cell", int(cs[i])))
+            on = (D >= -tol).sum(axis=2)
+            wrong = on != fsize[pf[pairs]]
+            if wrong.any():
+                i, j2 = np.argwhere(wrong)[0]
+                raise MeshError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
+                                f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)",
+                                 item=("cell", int(cs[i])))
+
+
+def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:
+    """(ncomp,) bool: boundary components that lie inside an odd number of the others.
+
+    A ray from a point of each component (a cell's centre) in a fixed generic direction
+    counts the cells of every other component it passes through.
+    """
+    C = len(g)
+    rng = np.random.default_rng(12345)
+    r = rng.normal(size=4)
+    r /= np.linalg.norm(r)
+    first = np.array([np.flatnonzero(comp == k)[0] for k in range(ncomp)])
+    q = g[first]  # (K, 4)
+    depth = np.zeros(ncomp, dtype=np.intp)
+    nr = normals @ r  # (C,)
+    t = (offsets[None, :] - q @ normals.T) / np.where(np.abs(nr) > tol_.TINY, nr, tol_.TINY)[None, :]  # (K, C)
+    hit_pt = q[:, None, :] + t[..., None] * r  # (K, C, 4)
+    for k in range(ncomp):
+        x = hit_pt[k]  # (C, 4)
+        inside_face = np.einsum("id,id->i", x[pc] - face_c[pf], m) <= 0
+        inside = np.logical_and.reduceat(inside_face, np.searchsorted(pc, np.arange(C)))
+        ok = inside & (t[k] > 0) & (comp != k) & (np.abs(nr) > tol_.PARALLEL)
+        crossings = np.bincount(comp[ok], minlength=ncomp)
+        depth[k] = int((crossings % 2).sum())
+    return depth % 2 == 1
