@@ -21,7 +21,8 @@ import numpy as np
 import traitlets
 
 from ..core import look
-from ..core.state import _finite, _theta0
+from ..core.state import _theta0
+from ..core.validate import real
 
 __all__ = [
     "Checked", "Angle", "Finite", "Positive", "Fraction", "Colour", "Flag", "ColorBy", "Count", "Spacing",
@@ -102,7 +103,7 @@ class Finite(Checked):
     info_text = "a finite number"
 
     def check(self, name, value):
-        return _finite(name, value)
+        return real(value, name)
 
 
 class Positive(Checked):
