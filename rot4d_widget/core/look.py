@@ -2,7 +2,8 @@
 
 The static figures (`rot4d_widget.keep.figures`, matplotlib) and the live view (`rot4d_widget.view.scene` and
 `rot4d_widget.view.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
-same in both.  numpy only: no widget library, no matplotlib.
+same in both.  numpy only at import: no widget library; matplotlib only inside `level_colors`
+(for its colormaps), imported when that is called.
 
 Scale
     Every polytope is shown scaled by ``REFERENCE_RADIUS / circumradius``: its displayed
@@ -28,6 +29,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from . import tolerances as tol_
+from .validate import int_in_range
 
 __all__ = [
     "REFERENCE_RADIUS",
@@ -120,9 +124,7 @@ def group_palette(n_cells: int) -> np.ndarray:
     several thousand cells get distinct 8-bit colours.  Prefix-stable: row k
     depends on k only, so group k has one colour whatever ``n_cells`` is.
     """
-    n = int(n_cells)
-    if n < 0:
-        raise ValueError(f"Expected `n_cells` >= 0, got {n}")
+    n = int_in_range(int(n_cells), "n_cells", 0)
     g = 1.32471795724474602596  # plastic number: R2 sequence
     k = np.arange(n, dtype=np.float64)
     hue = np.mod(0.5 + k / g, 1.0)
@@ -167,7 +169,7 @@ def level_colors(levels, lo: float, hi: float, cmap: str = LEVEL_COLORMAP) -> np
     (lowest darkest), so nested surfaces differ clearly whatever their spacing.
     ``lo``/``hi`` bound the values (non-finite levels are refused).
     """
-    from matplotlib import colormaps
+    from matplotlib import colormaps  # here, not at the top: the core imports numpy only
 
     v = np.asarray(levels, dtype=np.float64).ravel()
     if not np.all(np.isfinite(v)):
@@ -191,6 +193,6 @@ def number_text(value: float, scale: float = 0.0, digits: int = 4) -> str:
     value = float(value)
     if not math.isfinite(value):
         return str(value)
-    if abs(value) <= 1e-9 * abs(float(scale)):
+    if abs(value) <= tol_.NOISE * abs(float(scale)):
         return "0"
     return f"{value:.{digits}g}"

@@ -29,6 +29,8 @@ import sys
 import threading
 import time
 
+from .validate import int_in_range
+
 __all__ = ["Progress", "progress", "in_kernel", "register_widget_bar"]
 
 #: ``factory(total, description)`` -> an object with ``show(count, text)`` and ``close(done)``:
@@ -73,8 +75,7 @@ class Progress:
 
     def __init__(self, total: int, description: str = "", *, delay: float = DELAY, mode: str | None = None,
                  file=None, clock=time.monotonic):
-        if isinstance(total, bool) or not isinstance(total, int) or total < 0:
-            raise ValueError(f"Expected `total` to be an int >= 0, got {total!r}")
+        total = int_in_range(total, "total", 0)
         if mode not in (None, "widget", "text", "none"):
             raise ValueError(f"Expected `mode` to be 'widget', 'text', 'none' or None, got {mode!r}")
         self.total = total

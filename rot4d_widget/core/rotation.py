@@ -17,6 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import tolerances as tol_
+from .validate import real
+
 __all__ = [
     "random_rotation",
     "AXES",
@@ -35,17 +38,13 @@ DOUBLE_PLANES = ("xy,zw", "xz,yw", "xw,yz")
 
 _PLANE_AXES = {p: (AXES.index(p[0]), AXES.index(p[1])) for p in PLANES}
 
-#: How far from orthogonal a user-supplied matrix may be (max |M M^T - I|).
-ORTHOGONALITY_TOLERANCE = 1e-6
+#: How far from orthogonal a user-supplied matrix may be (max |M M^T - I|):
+#: `rot4d_widget.core.tolerances.ORTHOGONALITY`.
+ORTHOGONALITY_TOLERANCE = tol_.ORTHOGONALITY
 
 
 def _check_angle(name: str, value) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"Expected `{name}` to be a real number (radians), got {type(value).__name__}")
-    value = float(value)
-    if not np.isfinite(value):
-        raise ValueError(f"Expected `{name}` to be a finite number of radians, got {value}")
-    return value
+    return real(value, name, what="a real number (radians)", finite_what="a finite number of radians")
 
 
 def _plane_axes(plane) -> tuple[int, int]:

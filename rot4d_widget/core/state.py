@@ -38,6 +38,8 @@ from typing import Mapping
 
 import numpy as np
 
+from . import tolerances as tol_
+from ._arrays import sealed
 from .keymap import DEFAULT_KEYMAP, Action, Keymap
 from .rotation import (
     as_rotation_matrix,
@@ -45,6 +47,7 @@ from .rotation import (
     reorthonormalize,
     simple_rotation,
 )
+from .validate import positive, real
 
 __all__ = [
     "RotationState",
@@ -70,7 +73,7 @@ __all__ = [
 STATE_FORMAT = 2
 #: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
 #: further off, up to `rotation.ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
-_EXACT_ENOUGH = 1e-14
+_EXACT_ENOUGH = tol_.ORTHOGONAL_TO_ROUNDING
 
 DEFAULT_THETA0 = math.pi / 64
 PAPER_ALPHA_RATIO = math.pi * math.sqrt(2.0) / (8.0 * math.sqrt(3.0))
@@ -85,23 +88,8 @@ ALPHA_MAX = math.pi
 
 
 def _finite(name: str, value) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"Expected `{name}` to be finite, got {value}")
-    return value
-
-
-def _read_only(m: np.ndarray) -> np.ndarray:
-    """A freshly made array, read-only behind a read-only view (no copy): what is
-    handed out can be neither written, nor resized, nor made writable again."""
-    if m.base is not None:  # a view (not made here): its base could be unlocked
-        m = m.copy()
-    m.flags.writeable = False
-    v = m.view()
-    v.flags.writeable = False
-    return v
+    """`rot4d_widget.core.validate.real` with (name, value): kept for its importers (the view's traits)."""
+    return real(value, name)
 
 
 def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
@@ -112,7 +100,7 @@ def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
 
 
 def _theta0(value) -> float:
-    value = _finite("theta0", value)
+    value = real(value, "theta0")
     if not 0.0 < value <= THETA0_MAX:
         raise ValueError(f"Expected `theta0` in (0, pi] radians, got {value}")
     return value
@@ -147,13 +135,13 @@ class RotationState:
             raise TypeError(f"Expected `keymap` to be a rot4d_widget.Keymap, got {type(keymap).__name__}")
         self.keymap = keymap
         self._theta0 = _theta0(theta0)
-        self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else _finite("alpha", alpha)
+        self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else real(alpha, "alpha")
         _check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
-        self._c0 = _finite("c0", c0)
+        self._c0 = real(c0, "c0")
         self.c0_step = c0_step
         self.c0_limit = c0_limit
         self.c0_origin = c0_origin
-        self._matrix = _read_only(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
+        self._matrix = sealed(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
         self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
         self._steps: dict = {}
 
@@ -168,7 +156,7 @@ class RotationState:
 
     @matrix.setter
     def matrix(self, value) -> None:
-        self._matrix = _read_only(as_rotation_matrix(value))  # validated copy
+        self._matrix = sealed(as_rotation_matrix(value))  # validated copy
 
     @property
     def theta0(self) -> float:
@@ -189,7 +177,7 @@ class RotationState:
 
     @alpha.setter
     def alpha(self, value) -> None:
-        value = _finite("alpha", value)
+        value = real(value, "alpha")
         _check_alpha_beta(value, self._theta0, f"alpha = {value:.6g}")
         self._alpha = value
         self._steps.clear()
@@ -205,7 +193,7 @@ class RotationState:
 
     @c0.setter
     def c0(self, value) -> None:
-        self._c0 = _finite("c0", value)
+        self._c0 = real(value, "c0")
 
     @property
     def c0_step(self) -> float:
@@ -213,10 +201,7 @@ class RotationState:
 
     @c0_step.setter
     def c0_step(self, value) -> None:
-        value = _finite("c0_step", value)
-        if value <= 0:
-            raise ValueError(f"Expected `c0_step` > 0, got {value}")
-        self._c0_step = value
+        self._c0_step = positive(value, "c0_step")
 
     @property
     def c0_limit(self) -> float:
@@ -231,16 +216,12 @@ class RotationState:
 
     @c0_origin.setter
     def c0_origin(self, value) -> None:
-        self._c0_origin = _finite("c0_origin", value)
+        self._c0_origin = real(value, "c0_origin")
 
     @c0_limit.setter
     def c0_limit(self, value) -> None:
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-            raise TypeError(f"Expected `c0_limit` to be a number > 0 (or inf), got {type(value).__name__}")
-        value = float(value)
-        if not value > 0:
-            raise ValueError(f"Expected `c0_limit` > 0 (or inf), got {value}")
-        self._c0_limit = value
+        self._c0_limit = positive(value, "c0_limit", what="a number > 0 (or inf)", finite=False,
+                                  must="> 0 (or inf)")
 
     @property
     def alpha_step(self) -> float:
@@ -258,7 +239,7 @@ class RotationState:
                 m = double_rotation(action.planes, sign * self._alpha, sign * self.beta)
             else:
                 m = simple_rotation(action.planes, sign * self._theta0)
-            m = self._steps[cache_key] = _read_only(m)
+            m = self._steps[cache_key] = sealed(m)
         return m
 
     def apply(self, action: Action, inverted: bool = False) -> bool:
@@ -266,7 +247,7 @@ class RotationState:
         kind = action.kind
         if kind == "rotate":
             # a new array each step: arrays handed out before are never edited
-            self._matrix = _read_only(reorthonormalize(self.step_matrix(action, inverted) @ self._matrix))
+            self._matrix = sealed(reorthonormalize(self.step_matrix(action, inverted) @ self._matrix))
         elif kind == "alpha":
             new = self._alpha + action.sign * self.alpha_step
             if not (abs(new) <= ALPHA_MAX and abs(self._theta0 - new) <= ALPHA_MAX):
@@ -306,14 +287,10 @@ class RotationState:
 
     def reset(self) -> None:
         """Back to the initial state (orientation, theta0, alpha, c0): the state as constructed,
-        as read by `from_dict` / `restore`, or as marked by `set_initial`."""
+        or as read by `from_dict` / `restore`."""
         self._theta0, self._alpha, self._c0, m = self._initial
-        self._matrix = _read_only(m.copy())  # a new object, like every step
+        self._matrix = sealed(m.copy())  # a new object, like every step
         self._steps.clear()
-
-    def set_initial(self) -> None:
-        """Make the current orientation, theta0, alpha and c0 what `reset` returns to."""
-        self._initial = (self._theta0, self._alpha, self._c0, self._matrix)
 
     # -- to and from JSON-able data -------------------------------------------
     def to_dict(self, *, initial: bool = False) -> dict:
@@ -372,17 +349,17 @@ class RotationState:
         kwargs = {k: d[k] for k in ("theta0", "alpha", "c0", "c0_step") if k in d}
         origin, per = _old_units(fmt, w_frame)
         if "c0" in kwargs:
-            kwargs["c0"] = origin + per * _finite("c0", kwargs["c0"])
+            kwargs["c0"] = origin + per * real(kwargs["c0"], "c0")
         if "c0_step" in kwargs:
-            kwargs["c0_step"] = per * _finite("c0_step", kwargs["c0_step"])
+            kwargs["c0_step"] = per * real(kwargs["c0_step"], "c0_step")
         state = cls(keymap=keymap, matrix=_loaded_rotation(d["orientation"], "orientation"), **kwargs)
         if "initial" in d:
             init = d["initial"]
             if not isinstance(init, Mapping) or set(init) != {"orientation", "theta0", "alpha", "c0"}:
                 raise ValueError("Expected 'initial' to hold 'orientation', 'theta0', 'alpha' and 'c0'")
-            state._initial = (_theta0(init["theta0"]), _finite("initial alpha", init["alpha"]),
-                              origin + per * _finite("initial c0", init["c0"]),
-                              _read_only(_loaded_rotation(init["orientation"], "initial orientation")))
+            state._initial = (_theta0(init["theta0"]), real(init["alpha"], "initial alpha"),
+                              origin + per * real(init["c0"], "initial c0"),
+                              sealed(_loaded_rotation(init["orientation"], "initial orientation")))
         return state
 
     def restore(self, d, *, w_frame=None) -> None:
@@ -476,7 +453,8 @@ def action_from_data(data) -> Action:
     if isinstance(data, Mapping):
         unknown = sorted(set(data) - set(_ACTION_FIELDS))
         if unknown or "kind" not in data:
-            raise ValueError(f"Expected an action dict with 'kind' and some of {', '.join(_ACTION_FIELDS)}, got {dict(data)!r}")
+            raise ValueError(f"Expected an action dict with 'kind' and some of {', '.join(_ACTION_FIELDS)}, "
+                             f"got {dict(data)!r}")
         sign = data.get("sign", 0)
         if isinstance(sign, bool) or not isinstance(sign, int):
             raise ValueError(f"Expected an action's 'sign' to be an int, got {sign!r}")
