@@ -118,7 +118,17 @@ class Action:
 
     @classmethod
     def parse(cls, spec) -> "Action":
-        """``"xw"``, ``"xz,yw"``, ``"alpha+"``, ``"c0-"``, ``"reset"`` ... or an Action."""
+        """``"xw"``, ``"xz,yw"``, ``"alpha+"``, ``"c0-"``, ``"reset"`` ... or an Action.
+
+        >>> Action.parse("xw")
+        Action(kind='rotate', planes='xw', sign=0, name='', text='')
+        >>> Action.parse("c0-").label(), Action.parse("xz,yw").describe()
+        ('c0−', 'double rotation R_xz,yw: xz by α and yw by β')
+        >>> Action.parse("sideways")  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Unknown action 'sideways'; expected one of 'xy', 'xz', 'xw', ...
+        """
         if isinstance(spec, Action):
             return spec
         if isinstance(spec, str):
@@ -188,6 +198,16 @@ class Keymap(Mapping):
 
     ``Keymap({"4": "xw", "z": "xz,yw", "l": "c0+"})``.  See the module docstring
     for what a key name binds.
+
+    >>> km = Keymap({"4": "xw", "z": "xz,yw", "l": "c0+"})
+    >>> km["4"].label(), km.resolve("Z")[0].planes, km.resolve("Z")[1]  # upper case: shifted, inverted
+    ('R_xw', 'xz,yw', True)
+    >>> km.lookup({"key": "$", "code": "Digit4", "shiftKey": True})[0].label()  # digits by their physical key
+    'R_xw'
+    >>> Keymap({"T": "xw"})
+    Traceback (most recent call last):
+    ...
+    ValueError: Keymap key 'T': bind the lower-case letter 't'; Shift gives the inverse
     """
 
     def __init__(self, bindings: Mapping):

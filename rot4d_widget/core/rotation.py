@@ -62,6 +62,15 @@ def simple_rotation(plane: str, angle: float) -> np.ndarray:
     Returns a (4, 4) float64 matrix R with ``R[i, i] = R[j, j] = cos(angle)``,
     ``R[i, j] = -sin(angle)``, ``R[j, i] = sin(angle)`` for the plane's axes i < j,
     and the identity elsewhere (the paper's eqs. (3), (5), (6)).
+
+    >>> r = simple_rotation("xw", np.pi / 2)
+    >>> np.round(r, 12) + 0.0
+    array([[ 0.,  0.,  0., -1.],
+           [ 0.,  1.,  0.,  0.],
+           [ 0.,  0.,  1.,  0.],
+           [ 1.,  0.,  0.,  0.]])
+    >>> np.allclose(np.array([1.0, 0, 0, 0]) @ r.T, [0, 0, 0, 1])  # points are rows: x turns to w
+    True
     """
     i, j = _plane_axes(plane)
     angle = _check_angle("angle", angle)
@@ -81,6 +90,12 @@ def double_rotation(planes: str, alpha: float, beta: float) -> np.ndarray:
     plane and ``beta`` the second.  The two factors commute, so the result is
     ``simple_rotation(p1, alpha) @ simple_rotation(p2, beta)`` in either order
     (eq. (4) of the paper for ``"xy,zw"``).
+
+    >>> m = double_rotation("xy,zw", 0.3, 0.5)
+    >>> np.allclose(m, simple_rotation("xy", 0.3) @ simple_rotation("zw", 0.5))
+    True
+    >>> np.allclose(m, simple_rotation("zw", 0.5) @ simple_rotation("xy", 0.3))  # they commute
+    True
     """
     if planes not in DOUBLE_PLANES:
         raise ValueError(
@@ -108,6 +123,18 @@ def as_rotation_matrix(matrix, name: str = "matrix") -> np.ndarray:
     (so neither side can later edit what the other holds).  Raises
     ``TypeError`` for non-numeric input and ``ValueError`` naming what is
     expected otherwise.
+
+    >>> a = np.eye(4)
+    >>> m = as_rotation_matrix(a); m is a, m.dtype, m.shape
+    (False, dtype('float64'), (4, 4))
+    >>> as_rotation_matrix(np.eye(3))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `matrix` to have shape (4, 4), got (3, 3)
+    >>> as_rotation_matrix(np.diag([1.0, 1.0, 1.0, -1.0]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `matrix` to be a rotation (det +1), got a reflection (det -1)
     """
     try:
         m = np.array(matrix, dtype=np.float64, order="C", copy=True)

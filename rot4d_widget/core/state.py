@@ -279,6 +279,14 @@ class RotationState:
         inverted).  Shift inverts rotations and is ignored by parameter keys.
         ``shift`` must be a bool (``True``/``False`` or a numpy bool): a
         ``TypeError`` otherwise.
+
+        >>> st = RotationState(theta0=0.1)
+        >>> st.press("4"), np.allclose(st.matrix, simple_rotation("xw", 0.1))
+        (True, True)
+        >>> st.press("4", shift=True), np.allclose(st.matrix, np.eye(4))  # Shift inverts
+        (True, True)
+        >>> st.press("l"), st.c0, st.press("Q")  # "l" raises c0 by c0_step; "q" is unbound
+        (True, 0.02, False)
         """
         found = self.keymap.resolve(key, shift)
         if found is None:
@@ -302,6 +310,12 @@ class RotationState:
         `Action` fields.  ``initial=True`` adds ``"initial"``: the state `reset` returns to
         (orientation, theta0, alpha, c0) -- recordings keep it so that a recorded reset replays
         the same; state files leave it out, so the state they hold becomes the reset point.
+
+        >>> d = RotationState(theta0=0.1, c0=0.5).to_dict()
+        >>> d["format"], d["theta0"], d["c0"], d["keymap"]["4"], d["orientation"][0]
+        (2, 0.1, 0.5, 'xw', [1.0, 0.0, 0.0, 0.0])
+        >>> RotationState.from_dict(d).c0
+        0.5
         """
         d = {
             "format": STATE_FORMAT,
