@@ -17,7 +17,7 @@ from __future__ import annotations
 
 __all__ = [
     "ON_HYPERPLANE", "ORTHOGONALITY", "ORTHOGONAL_TO_ROUNDING", "MESH", "HULL", "HULL_DECIMALS",
-    "HULL_INCIDENCE", "NUDGE", "NOISE", "PARALLEL", "TINY",
+    "HULL_INCIDENCE", "COINCIDENT", "NUDGE", "NOISE", "PARALLEL", "TINY",
 ]
 
 #: A vertex is on the slicing hyperplane w = c0 when ``|w - c0| <= ON_HYPERPLANE * circumradius``:
@@ -46,6 +46,10 @@ HULL_DECIMALS = 7
 #: A point of a small hull (a snub polyhedron, the 96- and 100-vertex polychora, edge 2) lies in a
 #: facet within this distance (absolute).
 HULL_INCIDENCE = 1e-8
+
+#: In an exact construction of edge 2 (the 600-cell's vertices cut into the grand antiprism), points
+#: closer than this (absolute) are one, and a distance below it is zero.
+COINCIDENT = 1e-9
 
 #: Where a face is almost parallel to the hyperplane and neither the tolerance nor the exact sign
 #: classifies it consistently, the hyperplane is moved by this times the circumradius.

@@ -87,11 +87,11 @@ def _grand_antiprism() -> Combinatorics:
     v = named("600-cell").vertices
     r = np.linalg.norm(v[0])
     d = np.linalg.norm(v - v[0], axis=1)
-    b = int(np.argmin(np.where(d > 1e-9, d, np.inf)))  # a neighbour of vertex 0
+    b = int(np.argmin(np.where(d > tol_.COINCIDENT, d, np.inf)))  # a neighbour of vertex 0
     q, _ = np.linalg.qr(np.stack([v[0], v[b]], axis=1))  # orthonormal basis of their plane
     proj = np.linalg.norm(v @ q, axis=1)
     ring1 = np.isclose(proj, r)
-    ring2 = np.isclose(proj, 0.0, atol=1e-9)
+    ring2 = np.isclose(proj, 0.0, atol=tol_.COINCIDENT)
     assert ring1.sum() == 10 and ring2.sum() == 10
     return _hull_combinatorics(v[~(ring1 | ring2)], {4: "tetrahedron", 12: "pentagonal antiprism"}.get)
 
