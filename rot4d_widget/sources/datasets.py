@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fields import _real
+from .field_checks import _real
 
 __all__ = ["phase_separation", "moving_sphere", "default_cache_dir", "phase_separation_key", "INSTALL_HINT"]
 

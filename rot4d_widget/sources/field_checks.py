@@ -97,7 +97,8 @@ def _check_extent(extent) -> tuple:
         end = float(np.abs(e[d]).max())
         if end > hi:
             raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
-                             f"{lo:g} to {hi:g} (rot4d_widget.geometry.polytopes.COORDINATE_RANGE; rescale the coordinates, "
+                             f"{lo:g} to {hi:g} (rot4d_widget.geometry.polytopes.COORDINATE_RANGE; "
+                             f"rescale the coordinates, "
                              f"e.g. to other units)")
         check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")
     return tuple((float(a), float(b)) for a, b in e)
@@ -118,7 +119,8 @@ def _call(f, *arrays) -> np.ndarray:
     except Exception:
         raise TypeError(f"Expected the field function to return an array, got {type(out).__name__}") from None
     if out.dtype.kind not in "fiub":
-        raise TypeError(f"Expected the field function to return real numbers (float, int or bool), got dtype {out.dtype}")
+        raise TypeError(f"Expected the field function to return real numbers (float, int or bool), "
+                        f"got dtype {out.dtype}")
     if out.shape != arrays[0].shape:
         raise ValueError(
             f"Expected the field function to return one value per point, shape {arrays[0].shape}, got {out.shape} "

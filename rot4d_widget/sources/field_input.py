@@ -165,7 +165,8 @@ def _selection_json(selection, name):
     if not selection:
         return None
     if not isinstance(selection, dict):
-        raise TypeError(f"Expected `{name}` to be a dict {{dim: index or label or slice}}, got {type(selection).__name__}")
+        raise TypeError(f"Expected `{name}` to be a dict {{dim: index or label or slice}}, "
+                        f"got {type(selection).__name__}")
     out = {}
     for dim, v in selection.items():
         where = f"{name}[{dim!r}]"

@@ -220,6 +220,7 @@ class FieldStatistics:
             f"Field4D{' ' + repr(f.name) if f.name else ''}: the data hold {what} of "
             f"{math.prod(int(n) for n in f.values.shape)} samples{where}. They are kept: +inf lies above "
             f"and -inf below every level, the data range ignores them, and a point interpolated in a cell "
-            f"that holds one is +-inf, or NaN (below every level) where two meet or its weight is 0. To draw them otherwise, mask or clip first, "
+            f"that holds one is +-inf, or NaN (below every level) where two meet or its weight is 0. "
+            f"To draw them otherwise, mask or clip first, "
             f"e.g. np.where(np.isfinite(a), a, np.nan) or np.clip(a, lo, hi)",
             NonFiniteWarning, stacklevel=4)

@@ -103,6 +103,33 @@ class FieldSliceData(SliceData):
             normals=None if self.normals is None else self.normals @ t.T, volume=self.volume,
             readout=self.readout, convex=self.convex, show_points=self.show_points, extra=extra)
 
+    @classmethod
+    def assemble(cls, slices, box, readout, frame) -> "FieldSliceData":
+        """The slice a `Field4D` gives the widget: the surfaces of ``slices`` (one `FieldSlice` per
+        level, group = level index) and the box's cut ``box`` as bars; ``frame``: the cut's matrix,
+        offset and the field's centre and units (``extra["data_frame"]``)."""
+        pts, tris, nrm, groups = [], [], [], []
+        off = 0
+        for g, s in enumerate(slices):
+            pts.append(s.vertices)
+            nrm.append(s.normals)
+            tris.append(s.triangles + off)
+            groups.append(np.full(len(s.triangles), g, dtype=np.intp))
+            off += len(s.vertices)
+        bv = np.asarray(box.vertices)
+        r = np.linalg.norm(bv, axis=1, keepdims=True)
+        bn = np.where(r > 0, bv / np.where(r > 0, r, 1.0), np.array([0.0, 0.0, 1.0]))
+        pts.append(bv)
+        nrm.append(bn)
+        segments = np.asarray(box.edges) + off
+        return cls.build(
+            points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
+            groups=np.concatenate(groups), normals=np.concatenate(nrm),
+            volume=_representable(slices[0]) if len(slices) == 1 else None,
+            readout=readout, convex=False, show_points=False,
+            extra={"levels": slices, "box": box, "data_frame": frame},
+        )
+
 
 def _surface(s, level: float, inside: str = "above", caps: bool = True) -> FieldSlice:
     """Marching cubes of min(±(f - level), K g) = 0 on one step's samples (+ for inside="above",

@@ -54,7 +54,6 @@ itself becomes inf (or 0); `Field4D.slice` then gives the widget no volume.
 
 from __future__ import annotations
 
-import math
 import numbers
 
 import numpy as np
@@ -62,20 +61,37 @@ import numpy as np
 from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
 from ..geometry.polytopes import check_scale
-from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _ChunkReader, _chunked_values
+from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
 from .coarse import COARSE_SAMPLES, CoarseCopy
-from .field_checks import (_AXES, BYTES_PER_SAMPLE, MAX_SAMPLE_BYTES, AxesWarning, NonFiniteWarning, _as_levels,
-                           _check_extent, _check_positive, _check_resolution, _real)
-from .field_input import _as_array, _metadata_range, _open_dataarray, _xarray_arguments, _zarr_attrs
+from .field_checks import (
+    _AXES,
+    BYTES_PER_SAMPLE,
+    MAX_SAMPLE_BYTES,
+    AxesWarning,
+    NonFiniteWarning,
+    _as_levels,
+    _check_extent,
+    _check_positive,
+    _check_resolution,
+    _real,
+)
+
+# Names kept reachable here (tests, benchmarks and older code import them from this module).
+from .field_input import (  # noqa: F401,E402  (export reads them)
+    _as_array,
+    _metadata_range,
+    _open_dataarray,
+    _selection_from_json,
+    _selection_json,
+    _xarray_arguments,
+    _zarr_attrs,
+)
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
+from .field_levels import FieldLevels
 from .field_readout import _describe, _order_text, _readout
 from .field_slicing import _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
-from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _representable, _surface
-from .protocol import SourceAction
-
-# Names kept reachable here (tests, benchmarks and older code import them from this module).
-from .field_input import _selection_from_json, _selection_json  # noqa: F401,E402  (export reads them)
+from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "AxesWarning", "NonFiniteWarning",
            "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
@@ -88,7 +104,7 @@ _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINT
 _SORT_PASSES = True
 
 
-class Field4D:
+class Field4D(FieldLevels):
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
 
     Parameters
@@ -279,48 +295,6 @@ class Field4D:
         if c is not None and c is not self:
             c.w_per_unit = value
 
-    @property
-    def inside(self) -> str:
-        """Which side of each level the surface encloses: "above" {f >= level} or "below" {f <= level}."""
-        return self._inside
-
-    @inside.setter
-    def inside(self, value) -> None:
-        if not isinstance(value, str) or value not in ("above", "below"):
-            raise ValueError(f"Expected `inside` to be 'above' (the surface encloses f >= level) or 'below' "
-                             f"(f <= level, e.g. a signed distance negative inside), got {value!r}")
-        self._inside = value
-
-    @property
-    def caps(self) -> bool:
-        """Whether the surface is closed on the box's faces (True) or left open there (False)."""
-        return self._caps
-
-    @caps.setter
-    def caps(self, value) -> None:
-        if not isinstance(value, (bool, np.bool_)):
-            raise TypeError(f"Expected `caps` to be True (close the surface on the box's faces) or False "
-                            f"(leave it open there), got {value!r}")
-        self._caps = bool(value)
-
-    @property
-    def resolution(self) -> int:
-        """Samples along the longest side of a full step's region (int >= 2)."""
-        return self._resolution
-
-    @resolution.setter
-    def resolution(self, value) -> None:
-        self._resolution = _check_resolution(value)
-
-    @property
-    def coarse_resolution(self) -> int:
-        """Samples along the longest side of a coarse step's region (int >= 2)."""
-        return self._coarse_resolution
-
-    @coarse_resolution.setter
-    def coarse_resolution(self, value) -> None:
-        self._coarse_resolution = _check_resolution(value, "coarse_resolution")
-
     # -- source protocol --------------------------------------------------------
     @property
     def size(self) -> float:
@@ -330,18 +304,6 @@ class Field4D:
     @property
     def n_groups(self) -> int:
         return len(self.levels)
-
-    @property
-    def levels(self) -> tuple:
-        """The iso levels (tuple of floats); settable with a number or a sequence."""
-        if self._levels is None:
-            lo, hi = self._stat.range_info(first_cut=True)[0]
-            self._levels = ((lo + hi) / 2,) if math.isfinite(lo) and math.isfinite(hi) else (0.0,)
-        return self._levels
-
-    @levels.setter
-    def levels(self, value) -> None:
-        self._levels = _as_levels(value)
 
     @property
     def values(self):
@@ -375,58 +337,6 @@ class Field4D:
         """K, a typical |grad f| (level units per slice unit): how steeply the caps on the box's faces
         rise, for one step's ``samples`` (`rot4d_widget.sources.field_stats.FieldStatistics.cap_scale`)."""
         return self._stat.cap_scale(samples, first_cut)
-
-    @property
-    def level_step(self) -> float:
-        """How far o / i move the levels: 1/50 of the data range (1/50 of |value| or 0.02 when constant)."""
-        lo, hi = self.data_range
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            return 0.02
-        span = hi - lo
-        return span / 50 if span > 0 else max(abs(hi), 1.0) / 50
-
-    def step_levels(self, sign: int):
-        """Move every level by ``sign * level_step``; returns the levels, or False (no change) when
-        a level would leave the data range widened by one step (refused, not clamped, so the
-        opposite key undoes every step made)."""
-        step = self.level_step
-        lo, hi = self.data_range
-        new = tuple(v + (1 if sign > 0 else -1) * step for v in self.levels)
-        if math.isfinite(lo) and math.isfinite(hi):
-            def outside(v):  # how far beyond the widened range (0 inside)
-                return max(lo - step - v, v - hi - step, 0.0)
-
-            # a level set outside by hand may still step back towards the range
-            if any(outside(v) > 0 and outside(v) >= outside(u) for u, v in zip(self.levels, new)):
-                return False
-        elif not all(math.isfinite(v) for v in new):
-            return False
-        self._levels = new
-        return self._levels
-
-    @property
-    def actions(self) -> dict:
-        """``{"o": level up, "i": level down}`` (`SourceAction`), repeating while held."""
-        return {
-            "o": SourceAction("level up", "raise the iso level(s) by 1/50 of the data range",
-                              lambda sign=1: self.step_levels(sign)),
-            "i": SourceAction("level down", "lower the iso level(s) by 1/50 of the data range",
-                              lambda sign=1: self.step_levels(-sign)),
-        }
-
-    #: the source protocol's ``coarse_steps``: held keys slice the coarse copy
-    coarse_steps = True
-
-    @property
-    def settings(self) -> dict:
-        """The source protocol's ``settings``: the iso levels, which side is inside, the caps."""
-        return {"levels": tuple(self.levels), "inside": self.inside, "caps": self.caps}
-
-    def apply_setting(self, name: str, value) -> None:
-        """Set one of `settings` (ValueError for another name; the setters validate the values)."""
-        if name not in ("levels", "inside", "caps"):
-            raise ValueError(f"A field's settings are 'levels', 'inside' and 'caps', not {name!r}")
-        setattr(self, name, tuple(value) if name == "levels" else value)
 
     @property
     def w_frame(self) -> tuple:
@@ -477,35 +387,14 @@ class Field4D:
             levels = self.levels
             slices = (tuple(_empty_slice(lv, 0.0) for lv in levels) if s is None
                       else tuple(_surface(s, lv, self.inside, self.caps) for lv in levels))
-        pts, tris, nrm, groups = [], [], [], []
-        off = 0
-        for g, s in enumerate(slices):
-            pts.append(s.vertices)
-            nrm.append(s.normals)
-            tris.append(s.triangles + off)
-            groups.append(np.full(len(s.triangles), g, dtype=np.intp))
-            off += len(s.vertices)
-        bv = np.asarray(box.vertices)
-        r = np.linalg.norm(bv, axis=1, keepdims=True)
-        bn = np.where(r > 0, bv / np.where(r > 0, r, 1.0), np.array([0.0, 0.0, 1.0]))
-        pts.append(bv)
-        nrm.append(bn)
-        segments = np.asarray(box.edges) + off
         readout = _readout(self, m, c0, slices, box, coarse and not meanwhile)
         if meanwhile:
             done, total = self._coarse_copy.progress or (0, 0)
             readout = readout + (("resolution", f"{res} (from the full data: the coarse copy is being built, "
                                                 f"{done}/{total} chunks)"),)
-        return FieldSliceData.build(
-            points=np.concatenate(pts), segments=segments, triangles=np.concatenate(tris),
-            groups=np.concatenate(groups), normals=np.concatenate(nrm),
-            volume=_representable(slices[0]) if len(slices) == 1 else None,
-            readout=readout, convex=False, show_points=False,
-            extra={"levels": slices, "box": box, "data_frame": {
-                "matrix": _sealed(m.copy()), "d": c0, "centre": _sealed(self._centre.copy()),
-                "unit": _sealed(self._unit.copy())}},
-        )
-
+        frame = {"matrix": _sealed(m.copy()), "d": c0, "centre": _sealed(self._centre.copy()),
+                 "unit": _sealed(self._unit.copy())}
+        return FieldSliceData.assemble(slices, box, readout, frame)
 
     def describe(self) -> dict:
         """A JSON-able description (the source protocol's ``describe()``): the frame, levels, surface
@@ -603,13 +492,6 @@ class Field4D:
         data range and default level come from the chunks read so far ("first cut"); `coarse`
         waits for the build.  Does nothing when the copy is built or being built."""
         self._coarse_copy.prepare(progress)
-
-    def _report_infinite(self) -> None:
-        """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf."""
-        self._stat.report_infinite()
-
-    def _order_text(self) -> str:
-        return _order_text(self)
 
     def __repr__(self) -> str:
         if self._kind == "function":

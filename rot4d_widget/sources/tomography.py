@@ -64,8 +64,17 @@ from numbers import Integral, Real
 import numpy as np
 
 from ..core import look
-from .protocol import (SliceData, SourceAction, apply_setting, as_source, census_text, data_w_text,
-                       settings_of, takes_coarse, w_frame)
+from .protocol import (
+    SliceData,
+    SourceAction,
+    apply_setting,
+    as_source,
+    census_text,
+    data_w_text,
+    settings_of,
+    takes_coarse,
+    w_frame,
+)
 
 __all__ = [
     "ARRANGEMENTS",
@@ -232,7 +241,8 @@ def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS)
     """
     _check_arrangement(name)
     n = _check_slices(n)
-    if isinstance(radius, (bool, np.bool_)) or not isinstance(radius, Real) or not (math.isfinite(radius) and radius > 0):
+    if (isinstance(radius, (bool, np.bool_)) or not isinstance(radius, Real)
+            or not (math.isfinite(radius) and radius > 0)):
         raise ValueError(f"Expected `radius` to be a finite number > 0, got {radius!r}")
     if n == 1:
         return np.zeros((1, 3)), np.ones(1)
