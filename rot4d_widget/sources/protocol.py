@@ -406,11 +406,19 @@ class PolytopeSource:
         )
 
     def describe(self) -> dict:
-        from ..geometry.polytopes import POLYTOPE_NAMES
+        """``{"kind": "polytope", "name": ...}``; a polytope that is not one of the named six as
+        `polytope(name)` builds them (a scaled pentachoron, a uniform polychoron, one read from 4OFF,
+        possibly non-convex) adds its vertices, faces and cells (a non-convex polytope is not the
+        hull of its vertices).  Always rebuildable: no ``"rebuild"`` key (the protocol's default)."""
+        from ..geometry.polytopes import POLYTOPE_NAMES, polytope
 
-        d = {"kind": "polytope", "name": self.polytope.name}
-        if self.polytope.name not in POLYTOPE_NAMES:
-            d["vertices"] = np.asarray(self.polytope.vertices).tolist()
+        p = self.polytope
+        d = {"kind": "polytope", "name": p.name}
+        if p.name not in POLYTOPE_NAMES or not np.array_equal(np.asarray(p.vertices),
+                                                              np.asarray(polytope(p.name).vertices)):
+            d["vertices"] = np.asarray(p.vertices).tolist()
+            d["faces"] = [np.asarray(f).tolist() for f in p.faces]
+            d["cells"] = [np.asarray(c).tolist() for c in p.cells]
         return d
 
     def __repr__(self) -> str:
