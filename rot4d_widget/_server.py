@@ -55,6 +55,7 @@ def _load_jupyter_server_extension(serverapp) -> None:
     settings = serverapp.web_app.settings
     base = settings.get("kernel_websocket_connection_class")
     if base is None:
+        # jupyter_server: the extension's module imports nothing heavy (a server loads it at start)
         from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
 
         base = ZMQChannelsWebsocketConnection

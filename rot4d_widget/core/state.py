@@ -40,7 +40,7 @@ import numpy as np
 
 from . import tolerances as tol_
 from ._arrays import sealed
-from .keymap import DEFAULT_KEYMAP, Action, Keymap
+from .keymap import ACTION_NAMES, DEFAULT_KEYMAP, Action, Keymap
 from .rotation import (
     as_rotation_matrix,
     double_rotation,
@@ -452,8 +452,6 @@ def action_to_data(action: Action):
 
 
 def _spec_name(action: Action):
-    from .keymap import ACTION_NAMES
-
     for name in ACTION_NAMES:
         if Action.parse(name) == action:
             return name

@@ -18,6 +18,7 @@ by a power of two, the scale every check and slice is computed in).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,7 @@ from ..core import tolerances as tol_
 from ..core._arrays import sealed as _sealed
 from ._ragged import _gather, _owner, _ptr
 from .meshcheck import MeshError, duplicate_in_rows, index_lists, mesh_geometry
+from .offfile import read_off, write_off
 
 __all__ = ["Polytope", "Incidence", "MeshError", "MESH_TOLERANCE", "COORDINATE_RANGE", "check_scale",
            "order_cycle"]
@@ -311,10 +313,6 @@ class Polytope:
         checked, then dropped.  A Geomview 4OFF (homogeneous 3-D coordinates) is refused.
         ``name`` defaults to the file's stem (or "4OFF" for text).
         """
-        import os
-
-        from .offfile import read_off
-
         data = read_off(path_or_text)
         if name is None:
             is_path = isinstance(path_or_text, os.PathLike) or (
@@ -336,8 +334,6 @@ class Polytope:
 
     def to_off(self, path=None) -> str:
         """This polytope in Stella4D's 4OFF format (exact coordinates); also written to ``path`` if given."""
-        from .offfile import write_off
-
         text = write_off(self.vertices, [f.tolist() for f in self.faces], self.cells, comment=self.name)
         if path is not None:
             with open(path, "w", encoding="utf-8") as fh:

@@ -12,14 +12,18 @@ from __future__ import annotations
 import copy
 import math
 import os
+import queue
+import string
 import threading
 from numbers import Real
 from typing import Iterator
 
 import numpy as np
 
+from ..core.progress import progress as make_progress
 from ..core.state import RotationState
-from ..sources.protocol import as_source
+from ..geometry.polytopes import pentachoron
+from ..sources.protocol import PolytopeSource, as_source
 from .recorder import SOURCE_SETTINGS, Recorder, Recording, SourceSetting, _apply, _with_source_setting
 
 ANIMATION_FORMATS = (".gif", ".mp4")
@@ -93,6 +97,7 @@ def _positive(name, value) -> float:
 
 
 def _figure_rgb(fig) -> np.ndarray:
+    # matplotlib: imported when a figure is drawn
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     canvas = FigureCanvasAgg(fig)
@@ -141,6 +146,7 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
     (valid until the next frame is asked for), or (H, W, 3) RGB arrays when `figures.render_state`
     hands back a figure of its own.  Every frame is drawn into ONE figure (`figures._FrameCanvas`):
     its artists replaced, the annotation's text and legend kept and updated."""
+    # figures imports matplotlib: imported when a frame is drawn, not with the recordings
     from . import figures
     from .figures import state_source
 
@@ -186,6 +192,7 @@ def _as_rgb(frame) -> np.ndarray:
 
 def _pil_rgb(frame):
     """A frame of `_frames` as a Pillow RGB image of its own (Pillow drops the alpha in C)."""
+    # Pillow: imported when a frame is encoded
     from PIL import Image
 
     f = np.asarray(frame)
@@ -198,8 +205,6 @@ def _pil_rgb(frame):
 def _progress_sink(progress, total: int):
     """``(update(done), close())`` for render_animation's ``progress=`` (True, False or a callable)."""
     if progress is True:
-        from ..core.progress import progress as make_progress
-
         bar = make_progress(total, "rendering frames")
         return (lambda done: bar.update(done - bar.count)), bar.close
     if progress is False or progress is None:
@@ -264,8 +269,6 @@ class _Encoder:
     _END = object()
 
     def __init__(self, write, path, fps, depth: int = 4):
-        import queue
-
         self._queue = queue.Queue(depth)
         self._error = None
         self._aborted = False
@@ -298,8 +301,6 @@ class _Encoder:
             raise self._error
 
     def put(self, item) -> None:
-        import queue
-
         while True:
             self._check()
             if not self._thread.is_alive():
@@ -330,6 +331,7 @@ class _Encoder:
 def _write_gif(path, fps, images) -> None:
     """An animated GIF from RGB images as they come: each quantized to 256 colours (fast octree)
     and handed to Pillow's writer, which compares each frame with the one before as it goes."""
+    # Pillow: imported when a GIF is written
     from PIL import Image
 
     def quantized():
@@ -345,6 +347,7 @@ def _write_gif(path, fps, images) -> None:
 
 def _write_mp4(path, fps, images) -> None:
     """H.264 (imageio with imageio-ffmpeg's ffmpeg) from RGB images, streamed as they come."""
+    # imageio (optional, with imageio-ffmpeg): imported when an MP4 is written
     import imageio.v2 as imageio
 
     with imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264",
@@ -363,8 +366,7 @@ def paper_recording(figure: int, frames: int = 16, fps: float = 4.0) -> tuple:
     (key "z", R_xz,yw, alpha = pi sqrt2 / (8 sqrt3), beta = 1 - alpha) on the a = 2 pentachoron:
     ``frames - 1`` presses 1/fps s apart, the sequences of `figures.paper_figure_3` / ``_4``
     (frame k is panel k)."""
-    from ..geometry.polytopes import pentachoron
-    from ..sources.protocol import PolytopeSource
+    # figures imports matplotlib: the paper's constants come with it, only when asked for
     from .figures import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0
 
     if figure == 3:
@@ -388,8 +390,6 @@ def paper_animation(figure: int, path, *, frames: int = 16, fps: float = 4.0, si
     """The paper's Fig. 3 or 4 as an animation (GIF or MP4 by ``path``'s extension): frame k is the
     figure's panel k, labelled (a), (b) ... like its panels when ``labels``.  Returns the number of
     frames (``frames``)."""
-    import string
-
     rec, src = paper_recording(figure, frames, fps)
     key = rec.events[0].key
 

@@ -27,6 +27,7 @@ def _glyph_caching_renderer():
     global _GLYPH_RENDERER
     if _GLYPH_RENDERER is not None:
         return _GLYPH_RENDERER
+    # matplotlib's Agg internals: imported when the first frame is drawn
     from matplotlib import ft2font
     from matplotlib.backends import backend_agg
     from matplotlib.backends.backend_agg import RendererAgg
@@ -89,6 +90,7 @@ def _text_caching_canvas(fig):
     drawing the glyphs there: the pixels agree up to rounding).  Glyphs are rendered once too
     (`_glyph_caching_renderer`): a new line is its layout and a blit per glyph.  Rotated text and
     mathtext are drawn as usual."""
+    # matplotlib backend: imported when a frame canvas is made
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     GlyphCachingRenderer = _glyph_caching_renderer()
@@ -218,6 +220,7 @@ class _FrameCanvas:
                 return
             key = (renderer.width, renderer.height, renderer.dpi, type(renderer))
             if key not in kept:
+                # matplotlib backend: imported when a kept picture is drawn
                 from matplotlib.backends.backend_agg import RendererAgg
 
                 if not isinstance(renderer, RendererAgg):

@@ -111,6 +111,7 @@ def _as_colormap(cmap) -> Colormap:
     if isinstance(cmap, Colormap):
         return cmap
     if isinstance(cmap, str):
+        # matplotlib's colormap registry: looked up only for a colormap named by a string
         import matplotlib
 
         try:
@@ -358,6 +359,7 @@ _POLY_CODES: dict = {}  # closed polygon codes by corner count
 def _closed_codes(n: int) -> np.ndarray:
     codes = _POLY_CODES.get(n)
     if codes is None:
+        # matplotlib.path: imported when a polygon is drawn
         from matplotlib.path import Path
 
         codes = np.full(n + 1, Path.LINETO, dtype=Path.code_type)
@@ -374,6 +376,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
     as ONE `PathCollection` (gid "slice"), drawn by a single renderer call.  For animations:
     a frame of the 24-cell is ~100 patches, whose building and drawing was most of its time.
     ``cmap`` a Colormap or None; radii and sizes already checked.  None when nothing is drawn."""
+    # matplotlib collections: imported when a slice is drawn as one collection
     from matplotlib.collections import PathCollection
     from matplotlib.path import Path
 

@@ -142,6 +142,7 @@ def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
     """``lines`` in the upper left corner, ``legend`` swatches in the lower left (gid "annotation").
     With a `_FrameCanvas`, the previous frame's text is given the new lines and its legend is
     kept when the swatches are the same."""
+    # matplotlib patches: imported when a legend is drawn
     from matplotlib.patches import Patch
 
     fs = max(6.0, min(10.0, 1.7 * height))

@@ -24,6 +24,8 @@ from typing import Mapping
 import numpy as np
 
 from ..core import look
+from ..geometry.slicing import Slice
+from ..sources.protocol import SliceData
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
 #: float32 by every format (float64 in none).
@@ -80,9 +82,8 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
 
 def _as_slice_data(obj):
     """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; else as is."""
-    from ..geometry.slicing import Slice
+    # sources.fields imports numba and scikit-image (~0.5 s): only a bare field slice needs it
     from ..sources.fields import FieldSlice
-    from ..sources.protocol import SliceData
 
     # The two class tests left in keep/: they name the slicers' bare results (geometry's `Slice`,
     # `slice_field`'s `FieldSlice`), not source kinds -- any source's own slice is used as it is.
@@ -253,6 +254,7 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
       (a polytope's `Slice.volume`, the sum of a field's level volumes, a stack's
       ``sum scale_k^3 V_k``; None where it has no meaning), for checks against ``mesh.volume``.
     """
+    # trimesh (optional, the export extra): imported when a mesh is written
     import trimesh
 
     opacity = float(opacity)
@@ -327,6 +329,7 @@ def load_mesh(path):
     """Read a mesh file with trimesh (nothing merged), restoring ``face_attributes["group"]``
     (and "slice", "item") from a PLY file's face properties and ``vertex_attributes["data_xyzw"]``
     (n, 4) float64 from its vertex property (a list of 4 doubles)."""
+    # trimesh (optional, the export extra): imported when a mesh is read
     import trimesh
 
     mesh = trimesh.load(os.fspath(path), force="mesh", process=False)

@@ -259,6 +259,7 @@ def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, pla
 
 def _triangles_class():
     """`_Triangles`, made on first use (matplotlib's collections imported lazily)."""
+    # matplotlib collections: imported when a surface is first drawn
     from matplotlib.collections import PolyCollection
 
     class Triangles(PolyCollection):
@@ -306,6 +307,7 @@ _TRIANGLES = None
 def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width,
                   show_faces=True):
     """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines."""
+    # matplotlib collections: imported when a surface is drawn
     from matplotlib.collections import LineCollection
 
     p0, p1 = offs[k], offs[k + 1]

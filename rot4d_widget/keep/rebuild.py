@@ -18,6 +18,10 @@ from typing import Mapping
 
 import numpy as np
 
+from ..geometry.polytopes import Polytope, polytope
+from ..sources.protocol import PolytopeSource
+from ..sources.tomography import StackSource
+
 
 class SourceNotRebuildable(UserWarning):
     """A source that a state file describes but cannot rebuild (an in-memory array, a lambda,
@@ -93,9 +97,6 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
     kind = description["kind"]
     why = description.get("rebuild", True)
     if kind == "polytope":
-        from ..geometry.polytopes import Polytope, polytope
-        from ..sources.protocol import PolytopeSource
-
         if "vertices" in description:
             faces, cells = description.get("faces"), description.get("cells")
             return PolytopeSource(Polytope(np.asarray(description["vertices"], dtype=np.float64),
@@ -104,8 +105,6 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
                                            name=str(description.get("name", "polytope"))))
         return PolytopeSource(polytope(description["name"]))
     if kind == "stack":
-        from ..sources.tomography import StackSource
-
         inner = rebuild_source(description["source"], allow_code=allow_code, function=function, base=base)
         return StackSource(inner, slices=description["slices"], spacing=description.get("spacing"),
                            arrangement=description.get("arrangement", "oval"),
@@ -150,6 +149,7 @@ def _origin_path(origin, base):
 
 
 def _open_origin(origin, base):
+    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
     from ..sources.fields import Field4D, _selection_from_json
 
     origin = dict(origin)
@@ -184,6 +184,7 @@ def _open_origin(origin, base):
 
 
 def _rebuild_field(d, allow_code=False, function=None, base=None):
+    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
     from ..sources.fields import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
@@ -260,6 +261,7 @@ def open_field(path, variable=None, *, engine=None, **kwargs):
     ``chunks=``, ``isel=``, ``sel=`` and the keywords of `Field4D.from_xarray`
     (``x=, y=, z=, w=, w_per_unit=`` ...) as in `Field4D.open`.
     """
+    # sources.fields imports numba and scikit-image (~0.5 s): only opening a field needs it
     from ..sources.fields import Field4D
 
     return Field4D.open(path, variable, engine=engine, **kwargs)

@@ -45,9 +45,10 @@ from typing import Mapping
 import numpy as np
 
 from ..core.keymap import Action
+from ..core.rotation import as_rotation_matrix
 from ..core.state import RotationState, action_from_data, action_to_data
-from ..sources.protocol import apply_setting, inner_source, settings_of
-from ..sources.tomography import StackSource
+from ..sources.protocol import apply_setting, inner_source, settings_of, w_frame
+from ..sources.tomography import ARRANGEMENTS, StackSource
 from .rebuild import _jsonable
 
 RECORDING_FORMAT = "rot4d_widget recording"
@@ -136,8 +137,6 @@ def _check_setting(name, value):
     if name not in SETTABLE:
         raise ValueError(f"Expected a setting among {', '.join(map(repr, SETTABLE))}, got {name!r}")
     if name == "matrix":
-        from ..core.rotation import as_rotation_matrix
-
         return as_rotation_matrix(value).tolist()
     if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
         raise ValueError(f"Expected {name!r} to be set to a finite number, got {value!r}")
@@ -191,7 +190,6 @@ def _check_source_setting(name, value):
             raise ValueError("Expected 'spacing' to be set to a finite number > 0 or None (the default), "
                              f"got {value!r}")
         return float(value)
-    from ..sources.tomography import ARRANGEMENTS
 
     if value not in ARRANGEMENTS:
         raise ValueError(f"Expected 'arrangement' to be set to one of {', '.join(map(repr, ARRANGEMENTS))}, "
@@ -331,8 +329,6 @@ class Recording:
         every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
         (`rot4d_widget.sources.protocol.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
         source whose frame is (0, 1) (a polytope), gives ``self``."""
-        from ..sources.protocol import w_frame
-
         if source is None or self._initial.get("format", 2) >= 2:
             return self
         frame = w_frame(source)

@@ -35,7 +35,9 @@ import stat
 import warnings
 from typing import Mapping, NamedTuple
 
+from .. import __version__
 from ..core.state import RotationState
+from ..sources.protocol import as_source
 from .rebuild import (
     CodeNotAllowed,
     SourceNotRebuildable,
@@ -95,8 +97,6 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
     src = None
     if source is not None:
-        from ..sources.protocol import as_source
-
         src = describe_source(as_source(source))
         if src["rebuild"] is not True:
             warnings.warn(f"The source is described in {os.fspath(path)!r} but cannot be rebuilt from it: "
@@ -111,7 +111,6 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         "source": src,
         "settings": _jsonable(dict(settings or {}), "settings"),
     }
-    from .. import __version__
 
     doc["rot4d_widget"] = __version__
     text = json.dumps(doc, indent=1, allow_nan=False)
@@ -227,8 +226,6 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
         raise ValueError(f"{path!r}: expected 'settings' to be a dict, got {type(settings).__name__}")
     desc = doc["source"]
     if source is not None:
-        from ..sources.protocol import as_source
-
         source = as_source(source)
         if desc is not None:
             want, got = _inner_identity(desc), _inner_identity(describe_source(source))

@@ -26,8 +26,10 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from scipy.ndimage import gaussian_filter
 
 from .field_checks import _real
+from .fields import Field4D
 
 __all__ = ["phase_separation", "moving_sphere", "default_cache_dir", "phase_separation_key", "INSTALL_HINT"]
 
@@ -101,10 +103,10 @@ def phase_separation_key(n: int = 32, steps: int = 36, t_end: float = 35.0, inte
 def _simulate(n: int, steps: int, t_end: float, interface: float, bias: float, seed: int, backend: str):
     """(times (steps,), coordinates (n,), values (steps, n, n, n) float32) from py-pde."""
     try:
+        # py-pde (optional, the notebooks extra): imported when a simulation runs
         import pde
     except ImportError as exc:  # pragma: no cover - py-pde is in the notebooks/test extras
         raise ImportError(f"phase_separation needs py-pde: {INSTALL_HINT}") from exc
-    from scipy.ndimage import gaussian_filter
 
     grid = pde.CartesianGrid([[0.0, float(n)]] * 3, n, periodic=True)  # grid spacing 1
     rng = np.random.default_rng(seed)
@@ -204,6 +206,7 @@ def phase_separation(n: int = 32, steps: int = 36, t_end: float = 35.0, interfac
     if backend not in ("numpy", "numba"):
         raise ValueError(f"Expected `backend` to be 'numpy' or 'numba', got {backend!r}")
     try:
+        # xarray (optional, the data extra): imported when a data set is made
         import xarray as xr
     except ImportError as exc:  # pragma: no cover - in the data/notebooks extras
         raise ImportError(f"phase_separation returns an xarray.DataArray: {INSTALL_HINT}") from exc
@@ -255,8 +258,6 @@ def moving_sphere(v: float = 0.75, radius: float = 0.5, *, t_max: float = 1.0, m
     (``resolution``, ``levels`` ...); ``levels`` defaults to ``[0.0]``.
     Returns a `rot4d_widget.sources.fields.Field4D`.
     """
-    from .fields import Field4D
-
     v = _float(v, "v")
     r = _float(radius, "radius")
     if r <= 0:

@@ -68,12 +68,18 @@ That is geometry, not a promise a source has to make.
 
 from __future__ import annotations
 
+import inspect
 import math
 import sys
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 
 import numpy as np
+
+from ..core.look import number_text
+from ..geometry.polytopes import POLYTOPE_NAMES, Polytope
+from ..geometry.polytopes import polytope as get_polytope
+from ..geometry.slicing import slice_polytope
 
 __all__ = [
     "Source",
@@ -247,7 +253,6 @@ def takes_coarse(source) -> bool:
     declared = getattr(source, "coarse_steps", None)
     if declared is not None:
         return bool(declared)
-    import inspect
 
     try:
         return "coarse" in inspect.signature(source.slice).parameters
@@ -259,8 +264,6 @@ def data_w_text(source, w: float, matrix=None) -> str:
     """A cut's label in the source's own w, c0's units: ``"w 30 s"`` for a field (its time, in its
     ``w_units``), ``"w +0.5"`` for a polytope.  ``w`` is a c0 (`w_frame`); ``matrix`` is unused
     (kept for callers of the older form)."""
-    from ..core.look import number_text
-
     inner = getattr(source, "source", source)
     extent = getattr(inner, "extent", None)
     if extent is None:
@@ -363,8 +366,6 @@ class PolytopeSource:
     """A 4-polytope (convex or not) as a source: groups are its cells, the slice is exact."""
 
     def __init__(self, polytope):
-        from ..geometry.polytopes import polytope as get_polytope
-
         self.polytope = get_polytope(polytope)
 
     @property
@@ -390,8 +391,6 @@ class PolytopeSource:
         return float(w.min()), float(w.max())
 
     def slice(self, matrix, c0) -> PolytopeSlice:
-        from ..geometry.slicing import slice_polytope
-
         s = slice_polytope(self.polytope, matrix, c0)
         return PolytopeSlice(
             points=s.vertices,
@@ -410,12 +409,10 @@ class PolytopeSource:
         `polytope(name)` builds them (a scaled pentachoron, a uniform polychoron, one read from 4OFF,
         possibly non-convex) adds its vertices, faces and cells (a non-convex polytope is not the
         hull of its vertices).  Always rebuildable: no ``"rebuild"`` key (the protocol's default)."""
-        from ..geometry.polytopes import POLYTOPE_NAMES, polytope
-
         p = self.polytope
         d = {"kind": "polytope", "name": p.name}
         if p.name not in POLYTOPE_NAMES or not np.array_equal(np.asarray(p.vertices),
-                                                              np.asarray(polytope(p.name).vertices)):
+                                                              np.asarray(get_polytope(p.name).vertices)):
             d["vertices"] = np.asarray(p.vertices).tolist()
             d["faces"] = [np.asarray(f).tolist() for f in p.faces]
             d["cells"] = [np.asarray(c).tolist() for c in p.cells]
@@ -430,8 +427,6 @@ def as_source(obj):
 
     Raises TypeError naming what is allowed.
     """
-    from ..geometry.polytopes import Polytope
-
     if isinstance(obj, (str, Polytope)):
         return PolytopeSource(obj)
     missing = [m for m in ("slice", "size", "n_groups", "describe") if not hasattr(obj, m)]

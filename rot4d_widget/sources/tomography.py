@@ -58,13 +58,17 @@ Pure numpy; nothing here knows about widgets.
 
 from __future__ import annotations
 
+import copy
 import math
 from numbers import Integral, Real
 
 import numpy as np
 
 from ..core import look
+from ..core.rotation import as_rotation_matrix
+from ..geometry.slicing import slice_polytope
 from .protocol import (
+    PolytopeSource,
     SliceData,
     SourceAction,
     apply_setting,
@@ -426,8 +430,6 @@ class StackSource:
 
     def __copy__(self) -> "StackSource":
         """A stack around a copy of the inner source (replaying its actions changes the copy only)."""
-        import copy
-
         return StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
                            arrangement=self._arrangement, color_by=self._color_by)
 
@@ -499,8 +501,6 @@ class StackSource:
     # -- work -------------------------------------------------------------------------
     def _inner_slices(self, matrix, levels, coarse):
         if self._polytope is not None:
-            from ..geometry.slicing import slice_polytope
-
             if len(levels) == 1:  # today's single slice, bit for bit
                 return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])), self._polytope.convex)]
             return [_PolytopePiece(s, self._polytope.convex) for s in slice_polytope(self._polytope, matrix, levels)]
@@ -509,8 +509,6 @@ class StackSource:
         return [self.source.slice(matrix, float(w)) for w in levels]
 
     def _slice(self, matrix, c0, coarse) -> StackSliceData:
-        from ..core.rotation import as_rotation_matrix
-
         m = as_rotation_matrix(matrix)
         if isinstance(c0, (bool, np.bool_)) or not isinstance(c0, Real) or not math.isfinite(c0):
             raise ValueError(f"Expected `c0` to be a finite real number, got {c0!r}")
@@ -612,7 +610,5 @@ class _PolytopePiece:
 
 
 def _is_polytope_source(src) -> bool:
-    from .protocol import PolytopeSource
-
     return isinstance(src, PolytopeSource)
 

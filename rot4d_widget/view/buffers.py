@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from ..core.look import as_rgb, cell_palette, group_palette
+from ..core.rotation import random_rotation
 
 __all__ = [
     "ROW_FLOATS",
@@ -110,8 +111,6 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
     It is a starting size, not a bound: the scene grows the table safely if a
     larger slice ever comes.
     """
-    from ..core.rotation import random_rotation
-
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 
 import ipywidgets as widgets
 from ipyevents import Event
+from ipywidgets.widgets.widget import _instances
 
 from .keys import page_time
 
@@ -54,8 +55,6 @@ class KeyPad:
         """Rows of buttons, one per bound action in `PAD_ROWS`; each button's presses feed the
         same repeater as keys (ipyevents mouse and touch events on the button).  If building
         fails halfway (a comm that raises), every widget made for it is closed again."""
-        from ipywidgets.widgets.widget import _instances
-
         before = set(_instances)
         try:
             return self._make()

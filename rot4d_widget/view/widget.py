@@ -41,6 +41,7 @@ them short.  The traits live in the kernel only (use ``link``, not
 from __future__ import annotations
 
 import logging
+import os
 import threading
 
 import ipywidgets as widgets
@@ -56,6 +57,8 @@ from ..sources.tomography import ARRANGEMENTS
 from . import progress as _progress  # noqa: F401 - registers the kernel's progress bar with the core
 from . import readout as ro
 from . import traits as t
+from .buffers import estimate_capacity
+from .companion import Companion
 from .errors import MAX_ERRORS_SHOWN, ErrorArea  # noqa: F401 - MAX_ERRORS_SHOWN: part of the module's names
 from .keeping import Keeper
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
@@ -82,7 +85,7 @@ _WATCHED_EVENTS = ["keydown", "keyup", "mouseleave"]
 
 def _scene_classes():
     """Import the rendering path lazily (pythreejs is heavy), once."""
-    from .companion import Companion
+    # the scene imports pythreejs (~0.3 s): imported when the first view is built
     from .scene import Scene
 
     return Scene, Companion
@@ -324,8 +327,6 @@ class Rot4DWidget(widgets.HBox):
         (then None is returned).  Key p does the same with a numbered file in the current
         directory (next to the notebook).
         """
-        import os
-
         if path is not None and not isinstance(path, (str, os.PathLike)):
             raise TypeError(f"Expected `path` to be a str, a path-like or None, got {type(path).__name__}")
         if callback is not None and not callable(callback):
@@ -542,7 +543,6 @@ def _build_children(w, options) -> None:
     """The scene, companion, readout, help, errors, the canvas's Event and the boxes; each widget
     made is closed again if a later one fails."""
     Scene, Companion = _scene_classes()
-    from .buffers import estimate_capacity
 
     Scene.check_display({k: v for k, v in options.items() if k in DISPLAY_TRAITS})
 
