@@ -4,12 +4,17 @@ Parsed from the source (nothing imported): every ``import`` / ``from ... import`
 rot4d_widget module anywhere in a module (at its top or inside a function) is an edge.  The test
 fails on an edge from a lower wing to a higher one, on a cycle between modules, on a widget
 library imported outside the view, and on a module or class larger than the issue allows.
+
+Imports sit at module tops: one inside a function says why (a comment on its line or the line
+above its group), and it names neither a standard-library module nor a module of the package,
+except a package module in `HEAVY_MODULES` and the modules in `LAZY_MODULES`.
 """
 
 from __future__ import annotations
 
 import ast
 import pathlib
+import sys
 
 import pytest
 
@@ -18,6 +23,17 @@ WINGS = ("core", "geometry", "sources", "keep", "view")
 WIDGET_LIBRARIES = ("ipywidgets", "pythreejs", "ipyevents", "traitlets", "anywidget", "IPython")
 MAX_MODULE_LINES = 700
 MAX_CLASS_LINES = 400
+#: package modules that may be imported inside a function: what importing them pulls in
+HEAVY_MODULES = {
+    "rot4d_widget.keep.figures": "matplotlib and Pillow (~0.5 s)",
+    "rot4d_widget.sources.fields": "numba and scikit-image (~0.5 s)",
+    "rot4d_widget.view.scene": "pythreejs (~0.3 s)",
+}
+#: modules whose import must stay cheap (tests/test_server_extension.py): anything inside functions
+LAZY_MODULES = {
+    "rot4d_widget": "resolves every public name on first use; a Jupyter server imports it at start",
+    "rot4d_widget._server": "the server extension, loaded by every Jupyter server at start",
+}
 
 
 def _modules():
@@ -139,6 +155,82 @@ def test_no_module_over_700_lines_and_no_class_over_400():
                 if size > MAX_CLASS_LINES:
                     big.append(f"{name}.{node.name}: class of {size} lines")
     assert not big, "\n".join(big)
+
+
+def _inner_imports(tree):
+    """The import statements inside function bodies (at any depth)."""
+    out = []
+
+    def visit(node, inside):
+        for child in ast.iter_child_nodes(node):
+            if inside and isinstance(child, (ast.Import, ast.ImportFrom)):
+                out.append(child)
+            visit(child, inside or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
+
+    visit(tree, False)
+    return out
+
+
+def _says_why(lines, node) -> bool:
+    """A comment on the import's line, on an import line of its group above it, or on the line
+    above the group."""
+    i = node.lineno - 1
+    while i >= 0:
+        line = lines[i].strip()
+        if "#" in line:
+            return True
+        if i != node.lineno - 1 and not line.startswith(("import ", "from ")):
+            return False
+        i -= 1
+    return False
+
+
+def _inner_import_problems(name: str, text: str, known) -> list:
+    """What is wrong with the imports inside the functions of module ``name`` (source ``text``)."""
+    lines = text.splitlines()
+    problems = []
+    for node in _inner_imports(ast.parse(text)):
+        where = f"{name} (line {node.lineno}) `{ast.unparse(node)}`"
+        if not _says_why(lines, node):
+            problems.append(f"{where}: inside a function without a comment saying why")
+        if name in LAZY_MODULES:
+            continue
+        is_package = name in known and known[name].name == "__init__.py"
+        for target in _resolve(name, is_package, node, known):
+            if target not in HEAVY_MODULES:
+                problems.append(f"{where}: imports the package's {target}, which belongs at the module top")
+        stdlib = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                  else [node.module or ""] if not node.level else [])
+        for n in stdlib:
+            if n.split(".")[0] in sys.stdlib_module_names:
+                problems.append(f"{where}: imports the standard library's {n}, which belongs at the module top")
+    return problems
+
+
+def test_imports_inside_functions_say_why_and_are_not_light():
+    mods = _modules()
+    problems = []
+    for name, path in mods.items():
+        problems += _inner_import_problems(name, path.read_text(), mods)
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("body, problem", [
+    ("    import os\n", "without a comment"),
+    ("    import os  # why not\n", "standard library's os"),
+    ("    # a reason\n    from ..core.look import number_text\n", "package's rot4d_widget.core.look"),
+    ("    import xarray\n", "without a comment"),
+    ("    # optional\n    import xarray\n    from pde import grids\n", None),
+    ("    # numba\n    from .fields import Field4D\n", None),
+])
+def test_the_inner_import_check_sees_a_light_or_silent_import(body, problem):
+    """The checker itself, on a made-up module of the sources wing."""
+    text = f"import math\n\n\ndef f():\n    \"\"\"Doc.\"\"\"\n{body}    return 1\n"
+    found = _inner_import_problems("rot4d_widget.sources.protocol", text, _modules())
+    if problem is None:
+        assert found == []
+    else:
+        assert any(problem in f for f in found), found
 
 
 @pytest.mark.parametrize("bad, why", [
