@@ -60,7 +60,7 @@ from browser_latency import (  # noqa: E402
     median,
     working_tree_description,
 )
-from conftest import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
+from browser_setup import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
 from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
 VARIANTS = {"default": {}, "msaa": {"antialias": True}}

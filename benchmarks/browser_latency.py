@@ -129,13 +129,13 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
 
-from conftest import (  # noqa: E402  (the browser tests' building blocks)
+from browser_setup import (  # noqa: E402  (the browser tests' building blocks, not their conftest)
     CHROMIUM_FLAGS,
     INSTALL_HINT,
     JupyterServer,
-    _apt_install_chromium,
-    _installed_chromium,
-    _playwright_chromium,
+    apt_install_chromium,
+    installed_chromium,
+    playwright_chromium,
 )
 from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
@@ -487,7 +487,7 @@ def mean(xs):
 
 
 def find_chromium() -> str:
-    path = _installed_chromium() or _apt_install_chromium() or _playwright_chromium()
+    path = installed_chromium() or apt_install_chromium() or playwright_chromium()
     if not path:
         sys.exit(INSTALL_HINT)
     return path

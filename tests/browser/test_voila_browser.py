@@ -35,7 +35,7 @@ import urllib.request
 
 import pytest
 
-from conftest import ROOT, _free_port
+from browser_setup import ROOT, free_port
 from jupyter_page import _CANVAS_STATS
 from test_widget_browser import HARMLESS_CONSOLE
 
@@ -58,7 +58,7 @@ _RECORD_KEYS = """
 
 class VoilaServer:
     def __init__(self, workdir):
-        self.port = _free_port()
+        self.port = free_port()
         self.token = secrets.token_hex(16)
         self.root = workdir / "root"
         self.root.mkdir(parents=True)
