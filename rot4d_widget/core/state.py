@@ -51,6 +51,7 @@ from .validate import positive, real
 
 __all__ = [
     "RotationState",
+    "check_theta0",
     "DEFAULT_THETA0",
     "PAPER_ALPHA_RATIO",
     "ALPHA_STEP_FRACTION",
@@ -87,11 +88,6 @@ THETA0_MIN = math.pi / 2**20
 ALPHA_MAX = math.pi
 
 
-def _finite(name: str, value) -> float:
-    """`rot4d_widget.core.validate.real` with (name, value): kept for its importers (the view's traits)."""
-    return real(value, name)
-
-
 def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
     """ValueError unless |alpha| and |beta| = |theta0 - alpha| are within `ALPHA_MAX`."""
     if not (abs(alpha) <= ALPHA_MAX and abs(theta0 - alpha) <= ALPHA_MAX):
@@ -99,7 +95,17 @@ def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
                          f"in [-pi, pi] radians")
 
 
-def _theta0(value) -> float:
+def check_theta0(value) -> float:
+    """A step angle theta0 as a float in (0, `THETA0_MAX`] radians; else TypeError/ValueError naming
+    what is allowed.  The check of `RotationState.theta0` and the view's `Angle` trait.
+
+    >>> check_theta0(0.5)
+    0.5
+    >>> check_theta0(4.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `theta0` in (0, pi] radians, got 4.0
+    """
     value = real(value, "theta0")
     if not 0.0 < value <= THETA0_MAX:
         raise ValueError(f"Expected `theta0` in (0, pi] radians, got {value}")
@@ -134,7 +140,7 @@ class RotationState:
         if not isinstance(keymap, Keymap):
             raise TypeError(f"Expected `keymap` to be a rot4d_widget.Keymap, got {type(keymap).__name__}")
         self.keymap = keymap
-        self._theta0 = _theta0(theta0)
+        self._theta0 = check_theta0(theta0)
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else real(alpha, "alpha")
         _check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
         self._c0 = real(c0, "c0")
@@ -164,7 +170,7 @@ class RotationState:
 
     @theta0.setter
     def theta0(self, value) -> None:
-        value = _theta0(value)
+        value = check_theta0(value)
         alpha = self._alpha * (value / self._theta0)  # keep alpha/theta0
         _check_alpha_beta(alpha, value, f"theta0 = {value:.6g} (alpha keeps its ratio to theta0)")
         self._alpha = alpha
@@ -371,7 +377,7 @@ class RotationState:
             init = d["initial"]
             if not isinstance(init, Mapping) or set(init) != {"orientation", "theta0", "alpha", "c0"}:
                 raise ValueError("Expected 'initial' to hold 'orientation', 'theta0', 'alpha' and 'c0'")
-            state._initial = (_theta0(init["theta0"]), real(init["alpha"], "initial alpha"),
+            state._initial = (check_theta0(init["theta0"]), real(init["alpha"], "initial alpha"),
                               origin + per * real(init["c0"], "initial c0"),
                               sealed(_loaded_rotation(init["orientation"], "initial orientation")))
         return state

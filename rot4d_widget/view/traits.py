@@ -21,7 +21,7 @@ import numpy as np
 import traitlets
 
 from ..core import look
-from ..core.state import _theta0
+from ..core.state import check_theta0
 from ..core.validate import real
 
 __all__ = [
@@ -94,7 +94,7 @@ class Angle(Checked):
     info_text = "an angle in (0, pi] radians"
 
     def check(self, name, value):
-        return _theta0(value)
+        return check_theta0(value)
 
 
 class Finite(Checked):
