@@ -117,8 +117,8 @@ class Source(Protocol):
 class SourceAction:
     """An extra key action a source brings.
 
-    ``run(sign)`` changes the source (+1 for the key, -1 for Shift+key when
-    ``invertible``); the widget then re-slices.  ``run`` returns False when it
+    ``run(sign)`` changes the source (+1 for the key, -1 for Shift+key); the
+    widget then re-slices.  ``run`` returns False when it
     changed nothing (a bound reached: the widget records no step and the key's
     opposite still undoes every step made).  ``repeat``: the action repeats
     while the key is held, like a rotation.
@@ -128,7 +128,6 @@ class SourceAction:
     description: str
     run: Callable[[int], Any]
     repeat: bool = True
-    invertible: bool = True
 
 
 def _readonly(a, dtype, shape_tail, name):
