@@ -103,13 +103,13 @@ def test_a_polytope_s_c0_is_unchanged(make):
     assert f"{w.c0:.4f}<span class='rot4d-gauge'" in w.readout.value  # no unit after a polytope's w
 
 
-def test_stack_levels_and_labels_are_in_the_data_s_time():
+def test_stack_cuts_and_labels_are_in_the_data_s_time():
     src = StackSource(_field(), slices=3, spacing=0.2)
     assert w_frame(src) == (25.0, WPU)
-    levels = src.levels_at(26.0)
-    np.testing.assert_allclose(levels, [25.0, 26.0, 27.0])  # 0.2 slice units = 1 s apart
+    cuts = src.cuts_at(26.0)
+    np.testing.assert_allclose(cuts, [25.0, 26.0, 27.0])  # 0.2 slice units = 1 s apart
     data = src.slice(np.eye(4), 26.0)
-    for k, t in enumerate(levels):
+    for k, t in enumerate(cuts):
         assert np.abs(_radii(data.extra["slices"][k]) - radius(t)).max() < 0.02
     labels = [row[0] for row in data.readout][1:4]
     assert labels == ["w 25 s", "\u25b8 w 26 s", "w 27 s"]

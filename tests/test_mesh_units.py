@@ -194,7 +194,7 @@ def test_data_xyzw_survives_ply(tmp_path):
 def test_a_stack_keeps_its_layout_and_each_slice_s_own_time():
     src = StackSource(_field(resolution=32), slices=3, spacing=0.5, arrangement="grid")
     data = src.slice(np.eye(4), C0)
-    levels = np.asarray(data.extra["levels"])
+    cuts = np.asarray(data.extra["cuts"])
     mesh = slice_mesh(data)
     view = slice_mesh(data, frame="view")
     np.testing.assert_allclose(mesh.vertices, view.vertices + CENTRE[:3], rtol=0, atol=1e-12)  # the layout, moved
@@ -203,8 +203,8 @@ def test_a_stack_keeps_its_layout_and_each_slice_s_own_time():
     sl = mesh.face_attributes["slice"]
     for k in range(3):
         rows = np.unique(mesh.faces[sl == k])
-        np.testing.assert_allclose(xyzw[rows, 3], levels[k], rtol=0, atol=1e-12)  # levels in s
-        assert levels[k] == C0 + (k - 1) * 0.5 * WPU  # spacing 0.5 slice units = 5 s
+        np.testing.assert_allclose(xyzw[rows, 3], cuts[k], rtol=0, atol=1e-12)  # cuts in s
+        assert cuts[k] == C0 + (k - 1) * 0.5 * WPU  # spacing 0.5 slice units = 5 s
         piece = data.extra["slices"][k]
         assert np.abs(np.linalg.norm(xyzw[rows, :3] - CENTRE[:3], axis=1) - R).max() < _spacing(piece)
     assert len(set(np.round(xyzw[:, 3], 9))) == 3

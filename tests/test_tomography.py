@@ -158,10 +158,10 @@ def test_stack_slices_equal_single_slices_placed(arrangement, name):
     c0 = 0.1
     data = src.slice(m, c0)
     ex = data.extra
-    np.testing.assert_allclose(ex["levels"], c0 + (np.arange(7) - 3) * src.spacing)
+    np.testing.assert_allclose(ex["cuts"], c0 + (np.arange(7) - 3) * src.spacing)
     off = ex["point_offsets"]
     toff = ex["triangle_offsets"]
-    for k, w in enumerate(ex["levels"]):
+    for k, w in enumerate(ex["cuts"]):
         single = slice_polytope(name, m, float(w))
         assert_same_slice(ex["slices"][k], single, f"k={k}")
         np.testing.assert_array_equal(data.points[off[k]:off[k + 1]],
@@ -201,11 +201,11 @@ def test_highlighted_slice_is_at_c0():
     for n in (1, 3, 5, 9, 63):
         data = StackSource("16-cell", slices=n, spacing=0.3).slice(m, 0.7)
         hi = data.extra["highlighted"]
-        assert data.extra["levels"][hi] == 0.7  # exactly
+        assert data.extra["cuts"][hi] == 0.7  # exactly
     for n in (2, 4, 64):  # even: no slice at c0, the first above it
         data = StackSource("16-cell", slices=n, spacing=0.3).slice(m, 0.7)
         hi = data.extra["highlighted"]
-        assert data.extra["levels"][hi] == pytest.approx(0.85)
+        assert data.extra["cuts"][hi] == pytest.approx(0.85)
         assert hi == highlighted_index(n) == n // 2
 
 
@@ -293,7 +293,7 @@ def test_field_stack_keeps_normals_and_coarse():
     m = random_rotation(1)
     data = src.slice(m, 0.05)
     off = data.extra["point_offsets"]
-    for k, w in enumerate(data.extra["levels"]):
+    for k, w in enumerate(data.extra["cuts"]):
         single = f.slice(m, float(w))
         np.testing.assert_allclose(data.points[off[k]:off[k + 1]],
                                    single.points * data.extra["scales"][k] + data.extra["centres"][k])
@@ -459,3 +459,13 @@ def test_a_stack_tells_the_protocol_what_it_wraps_its_settings_and_copies_its_in
     assert f.levels == (0.2, 0.3)  # the original's inner source is untouched
     poly = StackSource("5-cell", slices=2)
     assert not takes_coarse(poly) and settings_of(poly) == {"slices": 2, "spacing": None, "arrangement": "oval"}
+
+
+def test_a_stack_s_cuts_keep_their_old_names():
+    """``cuts_at`` / ``extra["cuts"]`` (the w of each slice) were ``levels_at`` / ``extra["levels"]``,
+    a name a field uses for its iso values: the old names still give the same numbers."""
+    src = StackSource("8-cell", slices=5, spacing=0.1)
+    np.testing.assert_array_equal(src.levels_at(0.2), src.cuts_at(0.2))
+    ex = src.slice(np.eye(4), 0.2).extra
+    np.testing.assert_array_equal(ex["levels"], ex["cuts"])
+    np.testing.assert_allclose(ex["cuts"], 0.2 + (np.arange(5) - 2) * 0.1)

@@ -98,7 +98,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     """``(lines, legend)`` describing slice ``data`` of ``source`` (a `StackSource`) at ``c0``:
     ``lines`` of text (θ0 when given and c0; the inner source's ``name`` and ``units``; its
     ``levels``; the w span of the slice from its ``readout`` row "w cut" (in ``w_units``); a
-    polytope slice's census, its readout row "slice"; a stack's slices' w, from ``levels_at``)
+    polytope slice's census, its readout row "slice"; a stack's slices' w, from ``cuts_at``)
     and ``legend``, ``[(rgb, label), ...]``: the colours of a field's levels or of a stack's
     slices.  Only attributes the sources have are read, never their class."""
     inner = getattr(source, "source", source)
@@ -120,7 +120,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     elif "slice" in rows:
         lines.append(str(rows["slice"]))
     n = int(getattr(source, "slices", 1) or 1)
-    ws = np.asarray(source.levels_at(c0)) if n > 1 and hasattr(source, "levels_at") else np.zeros(0)
+    ws = np.asarray(source.cuts_at(c0)) if n > 1 and hasattr(source, "cuts_at") else np.zeros(0)
     if len(ws):
         spacing = getattr(source, "spacing", None)
         per = float(getattr(source, "w_frame", (0.0, 1.0))[1])

@@ -123,7 +123,7 @@ def render_tomography(
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
     centres = np.asarray(ex["centres"]) * scale
     scales = np.asarray(ex["scales"])
-    levels = np.asarray(ex["levels"])
+    cuts = np.asarray(ex["cuts"])
     hi = int(ex["highlighted"])
     group_rgb = ex.get("group_rgb")
 
@@ -192,7 +192,7 @@ def render_tomography(
             _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
                           src.source, face_alpha, z_shift, bar_width, show_faces=show_faces)
         if labels:
-            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, levels[k], k == hi, z_shift))
+            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, cuts[k], k == hi, z_shift))
     # labels that would overlap one already placed are left out: the highlighted slice's first,
     # then the nearer (bigger) slices' (far, small slices of the oval crowd together)
     placed: list = []
@@ -432,7 +432,7 @@ def render_state(
     `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z with the vertical
     field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
-    `look.level_colors`; a stack coloured by w: its levels' colormap).  It does not follow a
+    `look.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
     camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
 
     ``frame="fit"`` (the default) keeps that eye and perspective but zooms so that the projected

@@ -263,11 +263,12 @@ def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS)
 class StackSliceData(SliceData):
     """`SliceData` of a `StackSource`: N slices placed side by side in one scene.
 
-    ``extra`` holds: ``levels`` (N,) the w of each slice; ``centres`` (N, 3) and ``scales``
-    (N,) the placement (source units); ``highlighted`` the index of the slice at w = c0;
-    ``arrangement``; ``spacing``; ``volumes`` (N,) each slice's 3-volume (None where it has
-    none); ``point_offsets``, ``segment_offsets``, ``triangle_offsets`` (N + 1,) where slice
-    k's rows start; ``slices`` the inner source's N slice objects (unplaced, unturned);
+    ``extra`` holds: ``cuts`` (N,) the w of each slice (also under ``levels``, its old name);
+    ``centres`` (N, 3) and ``scales`` (N,) the placement (source units); ``highlighted`` the
+    index of the slice at w = c0; ``arrangement``; ``spacing``; ``volumes`` (N,) each slice's
+    3-volume (None where it has none); ``point_offsets``, ``segment_offsets``,
+    ``triangle_offsets`` (N + 1,) where slice k's rows start; ``slices`` the inner source's N
+    slice objects (unplaced, unturned);
     ``group_rgb`` (n_groups, 3) the colours of the groups when coloured by w, else None.
     """
 
@@ -436,12 +437,17 @@ class StackSource:
     @property
     def w_frame(self) -> tuple:
         """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0 and the
-        levels are in its w units, Δ in the drawn units (a level is Δ * per_unit from the next)."""
+        cuts are in its w units, Δ in the drawn units (a cut is Δ * per_unit from the next)."""
         return w_frame(self.source)
 
-    def levels_at(self, c0: float) -> np.ndarray:
-        """The N levels for the plane w = ``c0``, in c0's units: ``c0 + (k - (N - 1)/2) Δ per_unit``."""
+    def cuts_at(self, c0: float) -> np.ndarray:
+        """The stack's cuts for the plane w = ``c0``: the w of each of the N slices, in c0's units,
+        ``c0 + (k - (N - 1)/2) Δ per_unit`` (N,) float64."""
         return stack_levels(c0, self._slices, self.spacing * w_frame(self.source)[1])
+
+    def levels_at(self, c0: float) -> np.ndarray:
+        """The old name of `cuts_at` (kept for code written before it; "levels" are a field's iso values)."""
+        return self.cuts_at(c0)
 
     def layout(self):
         """``(centres (N, 3), scales (N,))`` in the source's units (`arrangement_layout`)."""
@@ -492,29 +498,29 @@ class StackSource:
         return d
 
     def slice(self, matrix, c0, coarse: bool = False) -> StackSliceData:
-        """The N slices at `levels_at` (``c0``), placed by the arrangement, as one `StackSliceData`."""
+        """The N slices at `cuts_at` (``c0``), placed by the arrangement, as one `StackSliceData`."""
         return self._slice(matrix, c0, bool(coarse))
 
     def _slice_exact(self, matrix, c0) -> StackSliceData:
         return self._slice(matrix, c0, False)
 
     # -- work -------------------------------------------------------------------------
-    def _inner_slices(self, matrix, levels, coarse):
+    def _inner_slices(self, matrix, cuts, coarse):
         if self._polytope is not None:
-            if len(levels) == 1:  # today's single slice, bit for bit
-                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(levels[0])), self._polytope.convex)]
-            return [_PolytopePiece(s, self._polytope.convex) for s in slice_polytope(self._polytope, matrix, levels)]
+            if len(cuts) == 1:  # today's single slice, bit for bit
+                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(cuts[0])), self._polytope.convex)]
+            return [_PolytopePiece(s, self._polytope.convex) for s in slice_polytope(self._polytope, matrix, cuts)]
         if coarse:
-            return [self.source.slice(matrix, float(w), coarse=True) for w in levels]
-        return [self.source.slice(matrix, float(w)) for w in levels]
+            return [self.source.slice(matrix, float(w), coarse=True) for w in cuts]
+        return [self.source.slice(matrix, float(w)) for w in cuts]
 
     def _slice(self, matrix, c0, coarse) -> StackSliceData:
         m = as_rotation_matrix(matrix)
         if isinstance(c0, (bool, np.bool_)) or not isinstance(c0, Real) or not math.isfinite(c0):
             raise ValueError(f"Expected `c0` to be a finite real number, got {c0!r}")
         n = self._slices
-        levels = self.levels_at(float(c0))
-        pieces = self._inner_slices(m, levels, coarse)
+        cuts = self.cuts_at(float(c0))
+        pieces = self._inner_slices(m, cuts, coarse)
         centres, scales = self.layout()
         by_w = self._color_by == "w" and n > 1
         pts, segs, tris, groups, nrms = [], [], [], [], []
@@ -537,7 +543,7 @@ class StackSource:
             t_off.append(t_off[-1] + len(t))
         hi = highlighted_index(n)
         extra = {
-            "levels": levels, "centres": centres, "scales": scales, "highlighted": hi,
+            "cuts": cuts, "levels": cuts, "centres": centres, "scales": scales, "highlighted": hi,
             "arrangement": self._arrangement, "spacing": self.spacing, "volumes": tuple(volumes),
             "point_offsets": np.array(p_off), "segment_offsets": np.array(s_off),
             "triangle_offsets": np.array(t_off), "slices": tuple(getattr(p, "data", p) for p in pieces),
@@ -552,13 +558,13 @@ class StackSource:
         return StackSliceData.build(
             np.concatenate(pts), np.concatenate(segs), np.concatenate(tris), np.concatenate(groups),
             normals=np.concatenate(nrms) if has_normals else None, volume=None,
-            readout=self._readout(levels, pieces, volumes, hi, m), convex=False,
+            readout=self._readout(cuts, pieces, volumes, hi, m), convex=False,
             show_points=any(bool(getattr(p, "show_points", True)) for p in pieces), extra=extra)
 
-    def _readout(self, levels, pieces, volumes, hi, m) -> tuple:
+    def _readout(self, cuts, pieces, volumes, hi, m) -> tuple:
         """Rows for the readout: each slice labelled by its w in the data's own units (a field's
         time, `data_w_text`), its census (polytopes) and volume (the source's own units)."""
-        n = len(levels)
+        n = len(cuts)
         how = "colour by w (viridis, low w dark)" if self._color_by == "w" else "colour by cell"
         wpu = getattr(self.source, "w_per_unit", None)
         unit = getattr(self.source, "w_units", None)
@@ -567,7 +573,7 @@ class StackSource:
         rows = [("stack", f"{n} slices, \u0394 = {delta}, {self._arrangement}, {how}")]
         polytope = self._polytope is not None
         if n <= 12:
-            for k, (w, piece, v) in enumerate(zip(levels, pieces, volumes)):
+            for k, (w, piece, v) in enumerate(zip(cuts, pieces, volumes)):
                 label = ("\u25b8 " if k == hi else "") + data_w_text(self.source, w, m)
                 parts = []
                 if polytope:
@@ -577,9 +583,9 @@ class StackSource:
                     parts.append(f"vol {look.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
-            rows.append(("w", f"{data_w_text(self.source, levels[0], m)[2:]} \u2026 "
-                              f"{data_w_text(self.source, levels[-1], m)[2:]} "
-                              f"(\u25b8 {data_w_text(self.source, levels[hi], m)[2:]})"))
+            rows.append(("w", f"{data_w_text(self.source, cuts[0], m)[2:]} \u2026 "
+                              f"{data_w_text(self.source, cuts[-1], m)[2:]} "
+                              f"(\u25b8 {data_w_text(self.source, cuts[hi], m)[2:]})"))
             if any(v is not None for v in volumes):
                 rows.append(("volumes", " ".join("\u2014" if v is None else f"{v:.3g}" for v in volumes)))
         return tuple(rows)

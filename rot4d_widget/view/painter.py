@@ -235,10 +235,10 @@ class Painter:
         w = self.w
         src = w.source
         inner = inner_source(src)
-        if inner is not src:  # parallel slices: coloured by their w (`group_colors`, `levels_at`)
+        if inner is not src:  # parallel slices: coloured by their w (`group_colors`, `cuts_at`)
             rgb = src.group_colors()
             if rgb is not None:
-                return rgb, [data_w_text(inner, lv) for lv in src.levels_at(w.state.c0)]
+                return rgb, [data_w_text(inner, cut) for cut in src.cuts_at(w.state.c0)]
         rgb = level_colors(inner)
         if rgb is not None:
             return rgb, [f"{lv:.4g}" for lv in inner.levels]
