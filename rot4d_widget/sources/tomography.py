@@ -616,5 +616,9 @@ class _PolytopePiece:
 
 
 def _is_polytope_source(src) -> bool:
+    """One of the package's three class tests, kept for speed, not for meaning: the N slices of
+    our own polytope source come from one batched `slice_polytope` call instead of N ``slice``
+    calls (the same slices); any other source, a user's polytope-like one too, is sliced through
+    the protocol."""
     return isinstance(src, PolytopeSource)
 
