@@ -38,18 +38,6 @@ class _CannotRebuild(ValueError):
     """`rebuild_source`: the description is fine, the source just cannot be made from it."""
 
 # ============================================================================ sources
-def _function_path(f):
-    module = getattr(f, "__module__", None)
-    qual = getattr(f, "__qualname__", None)
-    if not module or not qual:
-        return None, f"{type(f).__name__} has no module-level name"
-    if "<" in qual:
-        return None, f"{module}.{qual} is a lambda or a local function"
-    if module == "__main__":
-        return None, f"{qual} is defined in a notebook or script (__main__)"
-    return f"{module}:{qual}", None
-
-
 def describe_source(source) -> dict:
     """``source.describe()`` -- everything `rebuild_source` needs (the source protocol's ``describe``)
     -- with ``"rebuild"``: True, or the reason it cannot be rebuilt.
