@@ -2,8 +2,8 @@
 
 The static figures (`rot4d_widget.keep.figures`, matplotlib) and the live view (`rot4d_widget.view.scene` and
 `rot4d_widget.view.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
-same in both.  numpy only at import: no widget library; matplotlib only inside `level_colors`
-(for its colormaps), imported when that is called.
+same in both.  numpy only at import: no widget library; matplotlib only inside the colour map
+functions (`level_colors`, `check_cmap`, `cmap_stops`: for its colormaps), imported when called.
 
 Scale
     Every polytope is shown scaled by ``REFERENCE_RADIUS / circumradius``: its displayed
@@ -26,6 +26,7 @@ Colours
 
 from __future__ import annotations
 
+import difflib
 import math
 
 import numpy as np
@@ -49,6 +50,12 @@ __all__ = [
     "as_rgb",
     "group_palette",
     "cell_palette",
+    "LEVEL_COLORMAP",
+    "check_cmap",
+    "check_clim",
+    "level_colors",
+    "cmap_stops",
+    "hex_color",
 ]
 
 # -- scale and camera ----------------------------------------------------------
@@ -157,29 +164,103 @@ cell_palette = group_palette
 #: Opacity of nested iso-surfaces (several levels); one level alone is opaque.
 SURFACE_OPACITY = 0.45
 
-#: The colormap of iso levels (matplotlib's name).
+#: The colormap of iso levels (matplotlib's name): the widget's default `cmap`.
 LEVEL_COLORMAP = "viridis"
 
 
-def level_colors(levels, lo: float, hi: float, cmap: str = LEVEL_COLORMAP) -> np.ndarray:
-    """Colours of iso ``levels`` over the data range [lo, hi]: (n, 3) float64 in [0, 1].
+def check_cmap(cmap, name: str = "cmap") -> str:
+    """A matplotlib colour map name (``"viridis"``, ``"magma_r"`` ...), as given.
 
-    One level alone takes a point of the colormap's brighter half (a readable
-    surface); several are spread over the colormap in the order of their values
-    (lowest darkest), so nested surfaces differ clearly whatever their spacing.
-    ``lo``/``hi`` bound the values (non-finite levels are refused).
+    A TypeError for a non-string, a ValueError naming near matches and how to list them all
+    (``sorted(matplotlib.colormaps)``) for an unknown name.
+    """
+    from matplotlib import colormaps  # here, not at the top: the core imports numpy only
+
+    if not isinstance(cmap, str):
+        raise TypeError(f"Expected `{name}` to be a matplotlib colour map name (a str; list them with "
+                        f"sorted(matplotlib.colormaps)), got {cmap!r}")
+    if cmap not in colormaps:
+        near = difflib.get_close_matches(cmap, list(colormaps), n=3)
+        hint = f" (did you mean {', '.join(map(repr, near))}?)" if near else ""
+        raise ValueError(f"Expected `{name}` to be a matplotlib colour map name such as 'viridis'{hint}; "
+                         f"list them with sorted(matplotlib.colormaps); got {cmap!r}")
+    return cmap
+
+
+def check_clim(clim, name: str = "clim"):
+    """Colour limits: None (the data's range) or (lo, hi), two finite numbers with lo < hi, as a
+    tuple of floats.
+
+    >>> check_clim([0, 2.5]), check_clim(None)
+    ((0.0, 2.5), None)
+    """
+    if clim is None:
+        return None
+    allowed = "None (the data's range) or (lo, hi), two finite numbers with lo < hi"
+    try:
+        pair = tuple(clim)
+    except TypeError:
+        raise TypeError(f"Expected `{name}` to be {allowed}, got {clim!r}") from None
+    if (isinstance(clim, str) or len(pair) != 2
+            or not all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+                       for v in pair)):
+        raise TypeError(f"Expected `{name}` to be {allowed}, got {clim!r}")
+    lo, hi = float(pair[0]), float(pair[1])
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise ValueError(f"Expected `{name}` to be {allowed}, got {clim!r}")
+    return lo, hi
+
+
+def level_colors(levels, lo: float, hi: float, cmap: str = LEVEL_COLORMAP, *, by_value: bool = False) -> np.ndarray:
+    """Colours of iso ``levels`` along the colour map ``cmap``: (n, 3) float64 in [0, 1].
+
+    By rank (the default): one level alone takes a point of the colormap's brighter half (a
+    readable surface); several are spread over the colormap in the order of their values
+    (lowest darkest), so nested surfaces differ clearly whatever their spacing.  ``by_value``:
+    each level takes the colour at its place in [lo, hi] (clamped), as on a colour bar over
+    those limits.  Non-finite levels are refused; ``by_value`` needs finite lo < hi.
+
+    >>> level_colors([0.0, 1.0], 0.0, 1.0, "gray", by_value=True).round(3).tolist()
+    [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
     """
     from matplotlib import colormaps  # here, not at the top: the core imports numpy only
 
     v = np.asarray(levels, dtype=np.float64).ravel()
     if not np.all(np.isfinite(v)):
         raise ValueError(f"Expected finite levels, got {levels!r}")
-    if len(v) == 1:
+    if by_value:
+        lo, hi = check_clim((lo, hi), "(lo, hi)")
+        x = np.clip((v - lo) / (hi - lo), 0.0, 1.0)
+    elif len(v) == 1:
         x = np.array([0.75])
     else:
         rank = np.argsort(np.argsort(v, kind="stable"), kind="stable")
         x = 0.12 + 0.8 * rank / (len(v) - 1)
     return np.asarray(colormaps[cmap](x))[:, :3].astype(np.float64)
+
+
+def hex_color(rgb) -> str:
+    """(r, g, b) floats in [0, 1] -> ``'#rrggbb'``.
+
+    >>> hex_color((1.0, 0.5, 0.0))
+    '#ff8000'
+    """
+    return "#" + "".join(f"{min(255, max(0, round(255 * float(c)))):02x}" for c in rgb)
+
+
+def cmap_stops(cmap: str = LEVEL_COLORMAP, n: int = 11) -> tuple:
+    """``n`` evenly spaced colours of ``cmap`` from its low end to its high end, ``'#rrggbb'``
+    each: the stops of a colour bar's gradient.
+
+    >>> cmap_stops("gray", 3)
+    ('#000000', '#808080', '#ffffff')
+    """
+    from matplotlib import colormaps  # here, not at the top: the core imports numpy only
+
+    check_cmap(cmap)
+    n = int_in_range(int(n), "n", 2)
+    rgb = np.asarray(colormaps[cmap](np.linspace(0.0, 1.0, n)))[:, :3]
+    return tuple(hex_color(c) for c in rgb)
 
 
 # -- numbers for people --------------------------------------------------------
