@@ -75,6 +75,7 @@ from .field_checks import (
     _check_resolution,
     _real,
 )
+from .field_grid import FieldGrid, field_sample, sample_field
 
 # Names kept reachable here (tests, benchmarks and older code import them from this module).
 from .field_input import (  # noqa: F401,E402  (export reads them)
@@ -93,8 +94,8 @@ from .field_slicing import _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
-__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "slice_field", "AxesWarning", "NonFiniteWarning",
-           "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
+           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
 
 _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
                _resample_affine, _sample_raw, _surface)
@@ -395,6 +396,8 @@ class Field4D(FieldLevels):
         frame = {"matrix": _sealed(m.copy()), "d": c0, "centre": _sealed(self._centre.copy()),
                  "unit": _sealed(self._unit.copy())}
         return FieldSliceData.assemble(slices, box, readout, frame)
+
+    sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
 
     def describe(self) -> dict:
         """A JSON-able description (the source protocol's ``describe()``): the frame, levels, surface
