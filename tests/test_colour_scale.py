@@ -54,3 +54,92 @@ def test_good_clim_and_stops():
     assert look.check_clim(None) is None
     assert look.cmap_stops("viridis", 2) == ("#440154", "#fde725")
     assert look.cmap_stops("viridis") != look.cmap_stops("magma")
+
+
+# -- the widget's traits --------------------------------------------------------------------------
+def _field(**kw):
+    from rot4d_widget.sources.fields import Field4D
+
+    x = np.linspace(-1.0, 1.0, 8)
+    X, Y, Z, W = np.meshgrid(x, x, x, x, indexing="ij")
+    return Field4D(X**2 + Y**2 + Z**2 + W**2, axes="xyzw", **{"name": "r2", "units": "m²", **kw})
+
+
+@pytest.fixture
+def widget():
+    from rot4d_widget import Rot4DWidget
+
+    made = []
+
+    def make(source=None, **kw):
+        w = Rot4DWidget(_field() if source is None else source, _autotick=False, **kw)
+        made.append(w)
+        return w
+
+    yield make
+    for w in made:
+        w.close()
+
+
+def test_traits_default_to_todays_colours(widget):
+    w = widget(levels=[0.5, 1.0, 2.0])
+    assert (w.cmap, w.clim) == ("viridis", None)
+    np.testing.assert_allclose(w._painter.colours()[0], look.level_colors([0.5, 1.0, 2.0], *w.source.data_range))
+
+
+def test_cmap_and_clim_recolour_the_surfaces(widget):
+    w = widget(levels=[0.5, 1.0])
+    sent = w.scene.update_id
+    w.cmap = "magma"
+    assert w.scene.update_id > sent  # a new picture
+    np.testing.assert_allclose(w._painter.colours()[0], look.level_colors([0.5, 1.0], 0, 1, "magma"))
+    w.clim = [0.0, 2.0]
+    assert w.clim == (0.0, 2.0)
+    np.testing.assert_allclose(w._painter.colours()[0],
+                               look.level_colors([0.5, 1.0], 0.0, 2.0, "magma", by_value=True))
+
+
+@pytest.mark.parametrize("name, bad, exc, match", [
+    ("cmap", "virdis", ValueError, r"did you mean 'viridis'.*sorted\(matplotlib.colormaps\)"),
+    ("cmap", 7, TypeError, r"colour map name"),
+    ("clim", (1.0, 0.0), ValueError, r"two finite numbers with lo < hi"),
+    ("clim", (0.0, float("inf")), ValueError, r"two finite numbers with lo < hi"),
+    ("clim", "0 1", TypeError, r"None \(the data's range\) or \(lo, hi\)"),
+])
+def test_bad_values_are_refused_and_the_trait_kept(widget, name, bad, exc, match):
+    w = widget(levels=[0.5])
+    before = getattr(w, name)
+    with pytest.raises(exc, match=match):
+        setattr(w, name, bad)
+    assert getattr(w, name) == before
+    from rot4d_widget import Rot4DWidget
+
+    with pytest.raises(exc, match=match):
+        Rot4DWidget(_field(), **{name: bad})
+
+
+def test_saved_and_loaded_with_the_state(widget, tmp_path):
+    import warnings
+
+    w = widget(levels=[0.5], cmap="magma", clim=(0.0, 3.0))
+    path = tmp_path / "s.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an in-memory field: "not rebuildable"
+        doc = w.save_state(path)
+    assert (doc["settings"]["cmap"], doc["settings"]["clim"]) == ("magma", [0.0, 3.0])
+    w.cmap, w.clim = "viridis", None
+    w.load_state(path)
+    assert (w.cmap, w.clim) == ("magma", (0.0, 3.0))
+    from rot4d_widget import Rot4DWidget
+
+    w2 = Rot4DWidget.from_state(path, source=w.source, _autotick=False)
+    try:
+        assert (w2.cmap, w2.clim) == ("magma", (0.0, 3.0))
+        w.clim = None  # None (the data's range) is a value that is saved and loaded too
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            w.save_state(path)
+        w2.load_state(path)
+        assert w2.clim is None
+    finally:
+        w2.close()

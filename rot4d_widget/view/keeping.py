@@ -16,8 +16,22 @@ from ..keep.export import SETTING_NAMES, load_state, save_state, slice_mesh
 from ..keep.export import settings_of as widget_settings
 from ..keep.recording import Recorder, Recording, render_animation
 from ..sources.protocol import apply_setting, inner_source, settings_of
+from .sync import COLOUR_TRAITS
 
-__all__ = ["Keeper"]
+__all__ = ["Keeper", "view_settings"]
+
+#: The widget's settings `keep.export.SETTING_NAMES` does not name yet, saved and loaded here.
+EXTRA_SETTINGS = tuple(n for n in COLOUR_TRAITS if n not in SETTING_NAMES)
+
+
+def view_settings(widget) -> dict:
+    """What a state file keeps of the widget's settings: `keep.export.settings_of`'s and the
+    colour scale (``cmap``, ``clim``; a tuple as a list)."""
+    out = widget_settings(widget)
+    for name in EXTRA_SETTINGS:
+        value = getattr(widget, name)
+        out[name] = list(value) if isinstance(value, tuple) else value
+    return out
 
 
 class Keeper:
@@ -116,7 +130,7 @@ class Keeper:
         w = self.w
         with w._pump.lock:
             state = w.state.copy()
-            settings = widget_settings(w)
+            settings = view_settings(w)
         return save_state(path, state, w.source, settings)
 
     def load_state(self, path) -> None:
@@ -148,10 +162,10 @@ class Keeper:
             w._check_open()
             w.state.restore(d)  # the loaded state becomes what r resets to
             w._keys.use_keymap(without_source_keys(state.keymap), w.source)
-        for name in SETTING_NAMES:  # slices before spacing and arrangement
+        for name in SETTING_NAMES + EXTRA_SETTINGS:  # slices before spacing and arrangement
             value = settings.get(name)
-            if value is None or not w.has_trait(name):
-                continue
+            if not w.has_trait(name) or (value is None and name not in COLOUR_TRAITS) or name not in settings:
+                continue  # a None clim is the data's range: loaded too
             if isinstance(value, list):
                 value = tuple(value)
             if getattr(w, name) != value:

@@ -27,7 +27,8 @@ READOUT_PERIOD = 0.25
 @dataclass(frozen=True, eq=False)
 class ViewKey:
     """The state a picture shows: the rotation, the cut, the camera, the source's version, the
-    colouring and whether the slice was the coarse one (held keys)."""
+    colouring, whether the slice was the coarse one (held keys) and the colour scale
+    ``(cmap, clim)`` of a field's levels."""
 
     matrix: np.ndarray
     c0: float
@@ -35,11 +36,12 @@ class ViewKey:
     version: int
     color_by: object
     coarse: bool
+    scale: tuple = ()
 
     def same_cut(self, other: "ViewKey") -> bool:
         """The same hyperplane level, camera, source version and colours (the rotation aside)."""
-        return (self.c0, self.eye, self.version, self.color_by) == (other.c0, other.eye, other.version,
-                                                                    other.color_by)
+        return (self.c0, self.eye, self.version, self.color_by, self.scale) == (
+            other.c0, other.eye, other.version, other.color_by, other.scale)
 
     def same(self, other: "ViewKey") -> bool:
         """Everything equal, the rotation too (the same matrix object, or equal entries)."""
@@ -128,7 +130,7 @@ class Painter:
         held = bool(len(w._repeater))
         coarse = held and self.coarse_ok
         shown, rows = self.shown, self.rows_key
-        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse)
+        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse, (w.cmap, w.clim))
         sent = None
         same_cut = rows is not None and key.same_cut(rows)
         # a stack turns each slice about its own centre: never turned as a whole
@@ -239,19 +241,22 @@ class Painter:
             rgb = src.group_colors()
             if rgb is not None:
                 return rgb, [data_w_text(inner, cut) for cut in src.cuts_at(w.state.c0)]
-        rgb = level_colors(inner)
+        rgb = level_colors(inner, w.cmap, w.clim)
         if rgb is not None:
             return rgb, [f"{lv:.4g}" for lv in inner.levels]
         return w.scene.palette(int(src.n_groups)), None
 
 
-def level_colors(source):
-    """Colours of a source's iso levels (a matplotlib colormap over its data range), or None."""
+def level_colors(source, cmap: str = look.LEVEL_COLORMAP, clim=None):
+    """Colours of a source's iso levels along the colour map ``cmap``, or None: spread over it by
+    rank (``clim`` None: the data's range, today's look), else each at its value in ``clim``."""
     levels = getattr(source, "levels", None)
     if not levels:
         return None
+    if clim is not None:
+        return look.level_colors(levels, clim[0], clim[1], cmap, by_value=True)
     lo, hi = getattr(source, "data_range", (min(levels), max(levels)))
-    return look.level_colors(levels, lo, hi)
+    return look.level_colors(levels, lo, hi, cmap)
 
 
 def volume_text(source, volume: float, matrix) -> str:

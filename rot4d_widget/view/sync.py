@@ -12,7 +12,7 @@ from __future__ import annotations
 from ..sources.protocol import inner_source
 from .painter import title
 
-__all__ = ["TraitSync", "STATE_TRAITS", "DISPLAY_TRAITS", "FIELD_TRAITS", "STACK_TRAITS"]
+__all__ = ["TraitSync", "STATE_TRAITS", "DISPLAY_TRAITS", "FIELD_TRAITS", "STACK_TRAITS", "COLOUR_TRAITS"]
 
 STATE_TRAITS = ("theta0", "alpha", "c0")
 DISPLAY_TRAITS = ("ball_radius", "bar_radius", "face_opacity", "background", "show_balls", "show_bars", "show_faces")
@@ -20,6 +20,8 @@ DISPLAY_TRAITS = ("ball_radius", "bar_radius", "face_opacity", "background", "sh
 FIELD_TRAITS = ("levels", "inside", "caps")
 #: A stack's settings, each a trait of the same name.
 STACK_TRAITS = ("slices", "spacing", "arrangement")
+#: The colour scale of a field's surfaces and colour bar (display settings: saved, not recorded).
+COLOUR_TRAITS = ("cmap", "clim")
 
 
 class TraitSync:
@@ -34,7 +36,7 @@ class TraitSync:
         w = self.w
         w.observe(self.on_state_trait, names=list(STATE_TRAITS))
         w.observe(self.on_display_trait, names=list(DISPLAY_TRAITS))
-        w.observe(self.on_color_by, names="color_by")
+        w.observe(self.on_color_by, names=["color_by", *COLOUR_TRAITS])
         w.observe(self.on_field_trait, names=list(FIELD_TRAITS))
         w.observe(w._stacking.on_stack_trait, names=list(STACK_TRAITS))
 
@@ -131,6 +133,7 @@ class TraitSync:
                 w.scene.set_display(**{change["name"]: change["new"]})
 
     def on_color_by(self, change) -> None:
+        """``color_by``, ``cmap``, ``clim``: the same slice in other colours (and the colour bar)."""
         w = self.w
         with w._pump.lock:
             if not w._closed:

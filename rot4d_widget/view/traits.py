@@ -10,6 +10,8 @@ on unchanged.  The checks are plain functions too (`check_positive`, `check_frac
     face_opacity = Fraction(0.4)                      # [0, 1]
     background = Colour("#ffffff")                    # '#rrggbb', '#rgb', three floats in [0, 1]
     arrangement = Choice(None, ("oval", "grid", "stack"), allow_none=True)
+    cmap = Cmap("viridis")                            # a matplotlib colour map name
+    clim = Clim(None, allow_none=True)                # (lo, hi) finite, lo < hi; None: the data's range
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from ..core.validate import real
 
 __all__ = [
     "Checked", "Angle", "Finite", "Positive", "Fraction", "Colour", "Flag", "ColorBy", "Count", "Spacing",
-    "Choice", "Levels", "check_positive", "check_fraction", "check_flag", "check_color_by",
+    "Choice", "Levels", "Cmap", "Clim", "check_positive", "check_fraction", "check_flag", "check_color_by",
 ]
 
 
@@ -217,3 +219,25 @@ class Levels(Checked):
             if items and all(isinstance(v, (Real, np.number)) and not isinstance(v, (bool, np.bool_)) for v in items):
                 return tuple(float(v) for v in items)
         raise TypeError(f"Expected `{name}` to be {self.info_text} (iso levels), got {value!r}")
+
+
+class Cmap(Checked):
+    """A matplotlib colour map name (`rot4d_widget.core.look.check_cmap`: the message says how to
+    list them)."""
+
+    info_text = "a matplotlib colour map name"
+
+    def check(self, name, value):
+        return look.check_cmap(value, name)
+
+
+class Clim(Checked):
+    """Colour limits (lo, hi): two finite numbers, lo < hi, kept as a tuple of floats; None (when
+    ``allow_none``) for the data's range (`rot4d_widget.core.look.check_clim`)."""
+
+    info_text = "(lo, hi), two finite numbers with lo < hi"
+
+    def check(self, name, value):
+        if value is None:  # None is refused here only when the trait does not allow it
+            raise TypeError(f"Expected `{name}` to be {self.info_text}, got None")
+        return look.check_clim(value, name)

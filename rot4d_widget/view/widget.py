@@ -139,6 +139,9 @@ class Rot4DWidget(widgets.HBox):
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
+    cmap, clim : str; (lo, hi) or None
+        A field's colour scale (also traits): a matplotlib colour map name and its limits (None: the
+        data's range, the levels spread over the map by rank), for its surfaces and colour bar.
     keypad : bool
         An on-screen key pad under the canvas (default False; also the `keypad` trait): a
         button per action (simple and double rotations and their inverses, alpha, c0, the
@@ -181,6 +184,8 @@ class Rot4DWidget(widgets.HBox):
                      help="parallel slices shown; None for a single view until set (or n pressed)")
     spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's units")
     arrangement = t.Choice(None, ARRANGEMENTS, allow_none=True, help="where the parallel slices are placed")
+    cmap = t.Cmap(look.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
+    clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
 
     def __init__(
         self, source="5-cell", theta0: float = DEFAULT_THETA0, alpha: float | None = None, c0: float | None = None,
@@ -188,6 +193,7 @@ class Rot4DWidget(widgets.HBox):
         ball_radius: float | None = None, bar_radius: float | None = None, face_opacity: float = look.FACE_OPACITY,
         background=look.BACKGROUND, show_balls: bool = True, show_bars: bool = True, show_faces: bool = True,
         color_by="group", group_colors=None, levels=None, slices=None, spacing=None, arrangement="oval",
+        cmap: str = look.LEVEL_COLORMAP, clim=None,
         antialias: bool = False, keypad: bool = False, hold_delay: float = HOLD_DELAY, tick_rate: float = TICK_RATE,
         ack_timeout: float = ACK_TIMEOUT, _clock=None, _autotick: bool = True,
     ):
@@ -200,7 +206,7 @@ class Rot4DWidget(widgets.HBox):
         ack_timeout = positive_seconds("ack_timeout", ack_timeout)
         if _clock is not None and not callable(_clock):
             raise TypeError(f"Expected `_clock` to be a callable returning seconds, got {type(_clock).__name__}")
-        color_by = t.check_color_by(color_by)
+        color_by, cmap, clim = t.check_color_by(color_by), look.check_cmap(cmap), look.check_clim(clim)
         scale = look.REFERENCE_RADIUS / float(src.size)
         coarse_ok = takes_coarse(src)
         if ball_radius is None:
@@ -246,7 +252,7 @@ class Rot4DWidget(widgets.HBox):
             [self._canvas_box, self._side_box],
             layout=widgets.Layout(flex_flow="row wrap", align_items="flex-start"),
             **self.scene.display,
-            color_by=color_by,
+            color_by=color_by, cmap=cmap, clim=clim,
         )
         try:
             _wire(self, keypad)
@@ -277,17 +283,9 @@ class Rot4DWidget(widgets.HBox):
         """The keys (browser ``code``s) held now, in the order pressed."""
         return self._repeater.held_keys
 
-    @property
-    def hold_delay(self) -> float:
-        return self._repeater.hold_delay
-
-    @property
-    def tick_rate(self) -> float:
-        return self._repeater.tick_rate
-
-    @property
-    def ack_timeout(self) -> float:
-        return self._pump.ack_timeout
+    hold_delay = property(lambda self: self._repeater.hold_delay, doc="Seconds before a held key repeats.")
+    tick_rate = property(lambda self: self._repeater.tick_rate, doc="Repeats per second while a key is held.")
+    ack_timeout = property(lambda self: self._pump.ack_timeout, doc="Seconds to wait for a drawn acknowledgement.")
 
     @property
     def in_flight(self) -> bool:
