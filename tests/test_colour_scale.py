@@ -143,3 +143,74 @@ def test_saved_and_loaded_with_the_state(widget, tmp_path):
         assert w2.clim is None
     finally:
         w2.close()
+
+
+# -- the colour bar in the readout ----------------------------------------------------------------
+def _bar(w) -> str:
+    html = w.readout.value
+    assert html.count("class='rot4d-cbar'") == 1
+    return html[html.index("<div class='rot4d-cbar'"):html.index("</td>", html.index("<div class='rot4d-cbar'"))]
+
+
+def _marks(bar):
+    import re
+
+    found = re.findall(r"class='rot4d-cbar-mark' style='left:([0-9.]+)%;border-color:(#[0-9a-f]{6})'", bar)
+    return [(float(a), b) for a, b in found]
+
+
+def test_the_bar_names_the_variable_its_units_the_limits_and_marks_each_level(widget):
+    w = widget(levels=[1.0, 2.0, 3.0], clim=(0.0, 4.0))
+    bar = _bar(w)
+    assert "r2 [m²]" in bar
+    assert "<span>0</span><span>4 m²</span>" in bar  # ticks at lo and hi, in the data's units
+    marks = _marks(bar)
+    assert [m[0] for m in marks] == [25.0, 50.0, 75.0]  # (level - lo) / (hi - lo)
+    assert [m[1] for m in marks] == [look.hex_color(c) for c in w._painter.colours()[0]]  # the surfaces' colours
+    assert "title='level 2 m²'" in bar
+
+
+def test_the_bar_spans_the_data_range_when_clim_is_none(widget):
+    w = widget(levels=[1.0])
+    lo, hi = w.source.data_range
+    bar = _bar(w)
+    assert f"<span>{look.number_text(lo, hi)}</span><span>{look.number_text(hi, hi)} m²</span>" in bar
+    assert _marks(bar)[0][0] == pytest.approx(100 * (1.0 - lo) / (hi - lo), abs=0.01)
+
+
+def test_a_level_outside_clim_is_marked_at_the_end_and_says_so(widget):
+    w = widget(levels=[0.5, 3.5], clim=(1.0, 3.0))
+    bar = _bar(w)
+    assert [m[0] for m in _marks(bar)] == [0.0, 100.0]
+    assert "(below the scale)" in bar and "(above the scale)" in bar
+
+
+def test_cmap_changes_the_gradient_stops(widget):
+    w = widget(levels=[1.0])
+    before = _bar(w)
+    assert "data-cmap='viridis'" in before and "#440154 0.0%" in before and "#fde725 100.0%" in before
+    w.cmap = "gray"
+    after = _bar(w)
+    assert "data-cmap='gray'" in after and "#000000 0.0%" in after and "#ffffff 100.0%" in after
+    assert "#440154" not in after
+
+
+def test_long_name_when_the_field_keeps_it(widget):
+    f = _field()
+    f.long_name = "squared radius"  # what from_xarray would keep of attrs["long_name"]
+    assert "squared radius [m²]" in _bar(widget(f, levels=[1.0]))
+
+
+def test_polytopes_have_no_bar(widget):
+    from rot4d_widget import Rot4DWidget
+
+    w = Rot4DWidget("24-cell", _autotick=False)
+    try:
+        assert "rot4d-cbar" not in w.readout.value
+    finally:
+        w.close()
+
+
+def test_a_stack_of_a_field_keeps_the_scale_with_black_marks(widget):
+    w = widget(levels=[1.0, 2.0], slices=3, clim=(0.0, 4.0))
+    assert [m for m in _marks(_bar(w))] == [(25.0, "#000000"), (50.0, "#000000")]

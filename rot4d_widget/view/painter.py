@@ -219,12 +219,35 @@ class Painter:
                 f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
                 f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
                 for t, rgb in zip(labels, colors))))
+        bar = self.colourbar(colors if labels is not None and inner_source(source) is source else None)
+        if bar:
+            rows.append(("colour", bar))
         volume = getattr(data, "volume", None)
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
         if self.note:
             rows.append(("picture", html.escape(self.note)))
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
+
+    def colourbar(self, level_rgb=None) -> str:
+        """The colour bar of a field's values (`readout.colourbar_html`): ``cmap`` over ``clim`` (or
+        the data's range), its name (xarray's ``long_name`` when the field keeps it) and units, a
+        mark per iso level in its surface's colour (``level_rgb``; black when the surfaces are
+        coloured otherwise: a stack by w, one colour).  "" for a source without levels."""
+        w = self.w
+        inner = inner_source(w.source)
+        levels = getattr(inner, "levels", None)
+        if not levels:
+            return ""
+        lo, hi = w.clim if w.clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            return "no colour scale (the data's range is " + html.escape(f"{lo:.4g} \u2026 {hi:.4g})")
+        if level_rgb is None or w.color_by != "group":
+            level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
+        label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
+        marks = [(float(v), look.hex_color(c)) for v, c in zip(levels, level_rgb)]
+        return ro.colourbar_html(look.cmap_stops(w.cmap), lo, hi, str(label), getattr(inner, "units", None),
+                                 marks, cmap=w.cmap)
 
     def group_colors(self):
         """The colour of every group of the source as it is now (`colours`)."""

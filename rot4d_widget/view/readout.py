@@ -17,7 +17,8 @@ import numpy as np
 
 from ..core.look import number_text
 
-__all__ = ["readout_html", "help_html", "gizmo_svg", "gauge_html", "angle_text", "number_text", "STYLE"]
+__all__ = ["readout_html", "help_html", "gizmo_svg", "gauge_html", "colourbar_html", "angle_text", "number_text",
+           "STYLE"]
 
 #: Compact tables (Jupyter's rendered-HTML CSS pads cells generously).  Sent
 #: once, with the help panel (a <style> applies while its container is hidden).
@@ -30,7 +31,12 @@ STYLE = (
     ".rot4d-side .rot4d-help{font-size:90%}"
     ".rot4d-gauge{display:inline-block;position:relative;width:8em;height:0.6em;"
     "background:#ddd;vertical-align:middle;margin-left:0.4em}"
-    ".rot4d-gauge i{position:absolute;top:-0.2em;width:2px;height:1em;background:#c8102e}</style>"
+    ".rot4d-gauge i{position:absolute;top:-0.2em;width:2px;height:1em;background:#c8102e}"
+    ".rot4d-cbar{font-family:sans-serif;font-size:90%;width:14em}"
+    ".rot4d-cbar-bar{position:relative;height:0.9em;margin:0.15em 0;border:1px solid #888}"
+    ".rot4d-cbar-bar i{position:absolute;top:-4px;bottom:-4px;width:0;margin-left:-2px;"
+    "border-left:4px solid;box-shadow:0 0 0 1px #fff}"
+    ".rot4d-cbar-ticks{display:flex;justify-content:space-between}</style>"
 )
 
 #: The colours of the object's axes x, y, z, w in the gizmo.
@@ -59,6 +65,35 @@ def gauge_html(c0: float, lo: float, hi: float, unit: str | None = None) -> str:
     return (
         f"{text}{u}<span class='rot4d-gauge' title='w from {lo:.4g} to {hi:.4g}{u}'>"
         f"<i style='left:{pos:.0f}%'></i></span>{note}"
+    )
+
+
+def colourbar_html(stops, lo: float, hi: float, label: str, units: str | None = None, marks=(),
+                   cmap: str = "") -> str:
+    """A horizontal colour bar: the gradient through ``stops`` ('#rrggbb', low to high) over
+    [``lo``, ``hi``] (finite, lo < hi), ticks at both ends in the data's ``units``, the variable's
+    ``label`` and units above, and a mark per ``(value, '#rrggbb')`` of ``marks`` (an iso level and
+    its surface's colour) at the value's place (clamped to the ends; its tooltip says so).
+
+    >>> 'left:25.00%' in colourbar_html(("#000000", "#ffffff"), 0.0, 4.0, "T", "K", [(1.0, "#123456")])
+    True
+    """
+    big = max(abs(lo), abs(hi))
+    u = f" {html.escape(units)}" if units else ""
+    n = len(stops) - 1
+    gradient = ",".join(f"{c} {100.0 * i / n:.1f}%" for i, c in enumerate(stops))
+    parts = []
+    for value, colour in marks:
+        frac = (value - lo) / (hi - lo)
+        where = " (below the scale)" if frac < 0 else " (above the scale)" if frac > 1 else ""
+        parts.append(f"<i class='rot4d-cbar-mark' style='left:{100.0 * min(max(frac, 0.0), 1.0):.2f}%;"
+                     f"border-color:{colour}' title='level {number_text(value, big)}{u}{where}'></i>")
+    return (
+        f"<div class='rot4d-cbar' data-cmap='{html.escape(cmap)}'>"
+        f"<div class='rot4d-cbar-label'>{html.escape(label)}{f' [{html.escape(units)}]' if units else ''}</div>"
+        f"<div class='rot4d-cbar-bar' style='background:linear-gradient(to right,{gradient})'>{''.join(parts)}</div>"
+        f"<div class='rot4d-cbar-ticks'><span>{number_text(lo, big)}</span><span>{number_text(hi, big)}{u}</span>"
+        "</div></div>"
     )
 
 
