@@ -34,6 +34,7 @@ from .drawing import (
     perspective,
 )
 from .framing import _as_box, _draw_annotation, _frame_limits, _level_colors, annotation, frame_extent
+from .volume import check_rendering, draw_volume
 
 
 def render_tomography(
@@ -414,6 +415,9 @@ def render_state(
     title: str | None = None,
     frame="fit",
     annotate=False,
+    rendering: str = "surface",
+    cmap="viridis",
+    clim=None,
     _prepared=None,
     _canvas=None,
 ) -> Figure:
@@ -442,10 +446,19 @@ def render_state(
     `render_tomography`).  ``annotate``: True writes θ0, c0 and what the source tells of itself
     (`annotation`: name, units, levels, w span, a stack's w) in the upper left corner and a
     legend of the levels' or slices' colours in the lower left; a string is written first.
+    ``rendering`` (a field's): ``"surface"`` (the default: the isosurfaces, as ever), ``"mip"``
+    (maximum intensity projection) or ``"volume"`` (emission-absorption with a transfer function:
+    colour ``cmap``, opacity rising linearly over ``clim``), ray-cast in numpy through the cut
+    sampled on a grid (`rot4d_widget.keep.volume`; the box's edges drawn over it).  ``cmap``: a
+    matplotlib colour map name; ``clim``: (lo, hi), default the 1st-99th percentile of the finite
+    values of the cut (of all the cuts of a stack): robust to a few outliers.
     Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels (plus the
     title's strip when ``title`` is given).
     Returns the Figure.
     """
+    rendering = check_rendering(rendering)
+    if rendering != "surface":
+        cmap, clim = look.check_cmap(cmap), look.check_clim(clim)
     if not isinstance(state, RotationState):
         raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
     try:
@@ -466,13 +479,19 @@ def render_state(
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
-    return render_tomography(
-        stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi, dpi=dpi,
-        title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
-        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
+    volume = rendering != "surface"
+    fig = render_tomography(
+        stack, state.matrix, state.c0, path=None if volume else path, width=w_px / dpi, height=h_px / dpi,
+        dpi=dpi, title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
+        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces and not volume,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
         annotate=annotate, _data=data, _theta0=state.theta0, _canvas=_canvas,
     )
+    if volume:
+        draw_volume(fig.axes[0], stack, data, state.matrix, rendering, size=(round(w_px), round(h_px)), cmap=cmap,
+                    clim=clim)
+        _save(fig, path)
+    return fig
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,

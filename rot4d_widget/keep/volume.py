@@ -1,0 +1,323 @@
+"""Volume renderings of a field's cut without a browser: numpy ray casting through a `FieldGrid`.
+
+The camera is the static renders' and the live view's (`rot4d_widget.keep.drawing`): the eye at
+(0, 0, ``distance``) looking down -z, the picture plane z = 0 with its limits ``(x0, x1)``,
+``(y0, y1)`` (what `render_state` sets on its axes).  Pixel (row r, column c) of an H x W picture
+looks along the ray from the eye through its centre,
+
+    X = x0 + (c + 1/2) (x1 - x0) / W,    Y = y1 - (r + 1/2) (y1 - y0) / H,
+
+so a point (x, y, z) lands where `perspective` puts it: (x, y) d / (d - z).  The grid is placed in
+that scene as ``shift + scale * p`` (p its slice coordinates: a stack's slice k has its centre and
+scale, the widget its displayed size).
+
+Rays are sampled every ``step`` grid spacings between where they enter and leave the grid's box,
+all pixels at once (a loop over depth, never over pixels); the value at a sample is the trilinear
+interpolant of the nodes (``scipy.ndimage.map_coordinates``, order 1).  A sample counts only in a
+cell whose eight nodes are finite: the rendered medium is the cells inside the data's box (it
+ends within one spacing inside the box's faces where they cut the grid obliquely).
+
+* ``"mip"`` -- maximum intensity projection: the largest value along each ray, coloured by
+  ``cmap`` over ``clim`` (clamped); rays that meet no cell are transparent.
+* ``"volume"`` -- emission-absorption, composited front to back: a sample of value v emits the
+  colour ``cmap(v)`` and absorbs with extinction ``density * ramp(v) / L`` per unit length, ramp
+  rising linearly from 0 at ``clim[0]`` to 1 at ``clim[1]`` (clamped), L the grid's longest side.
+  A uniform medium at the top of the ramp crossed over a length ``l`` is opaque by
+  ``1 - exp(-density l / L)`` (Beer-Lambert); each sample is weighted by the length of its piece
+  of the ray, so that holds up to the cells' edges.
+
+Results are straight (not premultiplied) RGBA, (H, W, 4) float64 in [0, 1].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.ndimage import map_coordinates
+
+from ..core import look
+from ..core.look import REFERENCE_RADIUS
+from .drawing import _Z_BASE, CAMERA_DISTANCE
+
+__all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "default_clim", "check_rendering", "pixel_rays",
+           "render_grid", "composite", "draw_volume"]
+
+#: What `render_state` draws for a field: ``"surface"`` (the isosurfaces), ``"volume"``, ``"mip"``.
+RENDERINGS = ("surface", "volume", "mip")
+#: The renderings ray-cast here.
+VOLUME_RENDERINGS = ("volume", "mip")
+#: Optical depth across the grid's longest side of a medium at the top of the opacity ramp.
+DEFAULT_DENSITY = 4.0
+#: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).
+_BATCH_POINTS = 400_000
+#: A ray this transparent no longer changes a pixel (front-to-back compositing stops for it).
+_OPAQUE = 1e-4
+
+
+def default_clim(values) -> tuple:
+    """(lo, hi): the 1st and 99th percentiles of the finite ``values`` (robust to a few outliers).
+    A constant gives (v - 1/2 |v|, v + 1/2 |v|) (1/2 around 0), so it takes the middle of the
+    colour map; no finite value gives (0, 1).
+
+    >>> default_clim(np.r_[np.arange(101.0), np.nan, 1e9])
+    (1.02, 99.98)
+    """
+    v = np.asarray(values, dtype=np.float64).ravel()
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return 0.0, 1.0
+    lo, hi = (float(x) for x in np.percentile(v, [1.0, 99.0]))
+    if not hi > lo:
+        half = 0.5 * abs(lo) if lo != 0 else 0.5
+        lo, hi = lo - half, lo + half
+    return lo, hi
+
+
+def check_rendering(rendering, name: str = "rendering") -> str:
+    """``rendering`` when it is one of `RENDERINGS`, else an error naming them."""
+    if not isinstance(rendering, str) or rendering not in RENDERINGS:
+        allowed = ", ".join(repr(r) for r in RENDERINGS)
+        raise ValueError(f"Expected `{name}` to be one of {allowed}, got {rendering!r}")
+    return rendering
+
+
+def pixel_rays(size, limits, distance: float = CAMERA_DISTANCE):
+    """``(eye, directions)``: the eye (3,) and the unit direction (H, W, 3) float64 of each pixel's
+    ray for a picture of ``size`` = (W, H) pixels whose picture plane spans ``limits`` =
+    ((x0, x1), (y0, y1)) (row 0 at the top, y1)."""
+    w, h = (int(v) for v in size)
+    (x0, x1), (y0, y1) = limits
+    X = x0 + (np.arange(w) + 0.5) * ((x1 - x0) / w)
+    Y = y1 - (np.arange(h) + 0.5) * ((y1 - y0) / h)
+    d = np.empty((h, w, 3))
+    d[..., 0] = X[None, :]
+    d[..., 1] = Y[:, None]
+    d[..., 2] = -float(distance)
+    d /= np.linalg.norm(d, axis=2, keepdims=True)
+    return np.array([0.0, 0.0, float(distance)]), d
+
+
+def _cell_flags(values):
+    """(nx, ny, nz) bool: True at node (i, j, k) when the cell it is the lowest corner of has eight
+    finite nodes (the last layer along each axis, which starts no cell, is False)."""
+    ok = np.isfinite(values)
+    out = np.zeros(values.shape, dtype=bool)
+    out[:-1, :-1, :-1] = (ok[:-1, :-1, :-1] & ok[1:, :-1, :-1] & ok[:-1, 1:, :-1] & ok[:-1, :-1, 1:]
+                          & ok[1:, 1:, :-1] & ok[1:, :-1, 1:] & ok[:-1, 1:, 1:] & ok[1:, 1:, 1:])
+    return out
+
+
+def _trilinear(flat, shape, x, y, z):
+    """(values, cell): the trilinear interpolant of the C-ordered array ``flat`` of ``shape`` at the
+    index coordinates x, y, z (1-D float64, each within [0, n - 1]) -- `map_coordinates` of order 1,
+    by eight gathers -- and the flat index of each point's cell (its lowest corner)."""
+    nx, ny, nz = shape
+    ix = np.minimum(x.astype(np.intp), nx - 2)
+    iy = np.minimum(y.astype(np.intp), ny - 2)
+    iz = np.minimum(z.astype(np.intp), nz - 2)
+    fx, fy, fz = x - ix, y - iy, z - iz
+    cell = (ix * ny + iy) * nz + iz
+    sx, sy = ny * nz, nz
+
+    def lerp_z(off):
+        lo = flat.take(cell + off)
+        return lo + (flat.take(cell + (off + 1)) - lo) * fz
+
+    c0 = lerp_z(0)
+    c0 += (lerp_z(sy) - c0) * fy
+    c1 = lerp_z(sx)
+    c1 += (lerp_z(sx + sy) - c1) * fy
+    c0 += (c1 - c0) * fx
+    return c0, cell
+
+
+def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
+    """Pixels per ray side: ``pixels_per_ray``, or (None) the most that keeps two rays per grid
+    spacing where the grid is nearest the eye (a ray per pixel for a small picture)."""
+    if pixels_per_ray is not None:
+        return max(1, int(pixels_per_ray))
+    w_px = int(size[0])
+    (x0, x1), _ = limits
+    near = float(shift[2]) + scale * (float(grid.origin[2]) + grid.spacing * (grid.values.shape[2] - 1))
+    if near >= distance:
+        return 1
+    voxel_px = scale * grid.spacing * distance / (distance - near) * w_px / (x1 - x0)
+    return max(1, int(voxel_px // 2))
+
+
+def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None, scale: float = 1.0,
+                shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
+                step: float = 0.5, pixels_per_ray=None) -> np.ndarray:
+    """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
+    ``rendering`` (``"mip"`` or ``"volume"``, see the module) for a picture of ``size`` = (W, H)
+    pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid placed at
+    ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi), default
+    `default_clim` of the grid's values (1st-99th percentile); ``density``: the volume's optical
+    depth across the grid's longest side at the top of the ramp; ``step``: samples every ``step``
+    spacings along a ray.  ``pixels_per_ray``: one ray for every p x p pixels, the picture between
+    the rays' pixels bilinear in premultiplied colour (1: a ray through every pixel's centre);
+    None: two rays per grid spacing where the grid is nearest, at most one per pixel."""
+    # matplotlib's colour map registry: the keep wing's, looked up by name
+    from matplotlib import colormaps
+
+    if rendering not in VOLUME_RENDERINGS:
+        raise ValueError(f"Expected `rendering` to be one of {', '.join(map(repr, VOLUME_RENDERINGS))}, "
+                         f"got {rendering!r}")
+    colormap = colormaps[look.check_cmap(cmap)]
+    vals = np.asarray(grid.values)
+    clim = default_clim(vals) if clim is None else look.check_clim(clim)
+    w_px, h_px = (int(v) for v in size)
+    if grid.empty or min(vals.shape) < 2:
+        return np.zeros((h_px, w_px, 4))
+    scale = float(scale)
+    shift = np.asarray(shift, dtype=np.float64)
+    pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
+    if pitch == 1:
+        return _cast(grid, rendering, colormap, clim, (w_px, h_px), limits, scale, shift, distance, density, step)
+    # rays through the centres of p x p blocks (the last block may hang over the picture's edge)
+    (x0, x1), (y0, y1) = limits
+    cw, ch = -(-w_px // pitch), -(-h_px // pitch)
+    coarse_limits = ((x0, x0 + (x1 - x0) * cw * pitch / w_px), (y1 - (y1 - y0) * ch * pitch / h_px, y1))
+    small = _cast(grid, rendering, colormap, clim, (cw, ch), coarse_limits, scale, shift, distance, density, step)
+    pre = np.concatenate([small[..., :3] * small[..., 3:4], small[..., 3:4]], axis=-1)
+    r = (np.arange(h_px) + 0.5) / pitch - 0.5  # a pixel's centre in the rays' picture, in rays
+    c = (np.arange(w_px) + 0.5) / pitch - 0.5
+    rr, cc = np.meshgrid(r, c, indexing="ij")
+    big = np.stack([map_coordinates(pre[..., i], [rr, cc], order=1, mode="nearest") for i in range(4)], axis=-1)
+    a = big[..., 3:4]
+    rgb = np.where(a > 0, big[..., :3] / np.where(a > 0, a, 1.0), 0.0)
+    return np.clip(np.concatenate([rgb, a], axis=-1), 0.0, 1.0)
+
+
+def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step):
+    """`render_grid` with a ray through every pixel's centre."""
+    vals = np.asarray(grid.values)
+    spacing = float(grid.spacing)
+    w_px, h_px = size
+    out = np.zeros((h_px, w_px, 4))
+    shape = vals.shape
+    lo_box = shift + scale * np.asarray(grid.origin, dtype=np.float64)
+    hi_box = lo_box + scale * spacing * (np.asarray(shape) - 1)
+    eye, dirs = pixel_rays(size, limits, distance)
+    dirs = dirs.reshape(-1, 3)
+    # where each ray enters and leaves the grid's box (slabs; a zero component never crosses its pair)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / dirs
+        t1, t2 = (lo_box - eye) * inv, (hi_box - eye) * inv
+    flat_dir = dirs == 0.0
+    inside = (eye >= lo_box) & (eye <= hi_box)
+    t1 = np.where(flat_dir, np.where(inside, -np.inf, np.inf), t1)
+    t2 = np.where(flat_dir, np.where(inside, np.inf, -np.inf), t2)
+    t_in = np.maximum(np.minimum(t1, t2).max(axis=1), 0.0)
+    t_out = np.maximum(t1, t2).min(axis=1)
+    hit = np.flatnonzero(t_out > t_in)
+    if not len(hit):
+        return out
+    flat = np.where(np.isfinite(vals), vals, 0.0).astype(np.float64).ravel()
+    cells = _cell_flags(vals).ravel()
+    t_in, t_out = t_in[hit], t_out[hit]
+    a0 = ((eye - shift) / scale - np.asarray(grid.origin, dtype=np.float64)) / spacing  # the eye, grid indices
+    b = dirs[hit] / (scale * spacing)  # grid indices per scene unit along each ray
+    upper = np.asarray(shape, dtype=np.float64) - 1
+    dt = step * spacing * scale  # scene units per sample
+    n_steps = int(math.ceil(float((t_out - t_in).max()) / dt))
+    lo, hi = clim
+    mip = rendering == "mip"
+    best = np.full(len(hit), -np.inf)
+    colour = np.zeros((len(hit), 3))
+    trans = np.ones(len(hit))
+    live = np.arange(len(hit))  # rays still worth sampling
+    extinction = float(density) / (scale * spacing * (max(shape) - 1))  # per scene unit at ramp 1
+    k = 0
+    while k < n_steps and len(live):
+        batch = max(1, min(n_steps - k, _BATCH_POINTS // len(live)))
+        start = t_in[live][None, :] + (k + np.arange(batch))[:, None] * dt
+        piece = np.clip(t_out[live][None, :] - start, 0.0, dt)  # the ray's length in each step
+        t_mid = (start + 0.5 * piece).ravel()
+        bl = b[live]
+        xyz = [np.clip(a0[c] + t_mid * np.tile(bl[:, c], batch), 0.0, upper[c]) for c in range(3)]
+        v, cell = _trilinear(flat, shape, *xyz)
+        v = v.reshape(piece.shape)
+        ok = (piece > 0) & cells.take(cell).reshape(piece.shape)
+        if mip:
+            best[live] = np.maximum(best[live], np.where(ok, v, -np.inf).max(axis=0))
+        else:
+            x = np.clip((v - lo) / (hi - lo), 0.0, 1.0)
+            alpha = np.where(ok, -np.expm1(-extinction * x * piece), 0.0)  # (batch, rays)
+            rgb = np.asarray(colormap(x))[..., :3]
+            # front to back within the batch: what reaches sample j is T times the (1 - alpha) before it
+            before = np.cumprod(np.vstack([np.ones((1, len(live))), 1.0 - alpha[:-1]]), axis=0)
+            colour[live] += trans[live][:, None] * np.einsum("br,brc->rc", before * alpha, rgb)
+            trans[live] *= before[-1] * (1.0 - alpha[-1])
+            live = live[trans[live] > _OPAQUE]
+        k += batch
+    rgba = np.zeros((len(hit), 4))
+    if mip:
+        seen = np.isfinite(best)
+        rgba[seen] = colormap(np.clip((best[seen] - lo) / (hi - lo), 0.0, 1.0))
+        rgba[seen, 3] = 1.0
+    else:
+        a = 1.0 - trans
+        rgba[:, :3] = np.where(a[:, None] > 0, colour / np.where(a > 0, a, 1.0)[:, None], 0.0)
+        rgba[:, 3] = a
+    out.reshape(-1, 4)[hit] = np.clip(rgba, 0.0, 1.0)
+    return out
+
+
+def composite(images) -> np.ndarray:
+    """Straight RGBA pictures (H, W, 4), listed back to front, painted over one another (the
+    "over" operator): one straight RGBA picture."""
+    images = list(images)
+    acc = np.zeros_like(images[0]) if images else None
+    for im in images:
+        a = im[..., 3:4]
+        rgb = im[..., :3] * a + acc[..., :3] * acc[..., 3:4] * (1.0 - a)
+        alpha = a + acc[..., 3:4] * (1.0 - a)
+        acc = np.concatenate([np.where(alpha > 0, rgb / np.where(alpha > 0, alpha, 1.0), 0.0), alpha], axis=-1)
+    return acc
+
+
+def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis", clim=None,
+                density: float = DEFAULT_DENSITY):
+    """Paint the cut(s) of ``stack``'s field (a `StackSource` whose inner source has ``sample``,
+    like `Field4D.sample`) on ``ax`` as ``rendering`` ("mip" or "volume"): every slice of
+    ``data`` (the stack's slice at ``matrix``) sampled at its cut and placed as the live view
+    places it, ray-cast at ``size`` = (W, H) pixels over the axes' limits, slices composited back
+    to front by the depth of their centres, one image under the box's bars.  ``clim`` None: the
+    1st-99th percentile of the finite values of all the cuts (`default_clim`).  Returns the
+    ``AxesImage`` (None when no cut meets the data)."""
+    inner = getattr(stack, "source", stack)
+    sample = getattr(inner, "sample", None)
+    if not callable(sample):
+        raise TypeError(f"rendering={rendering!r} needs a source sampled on a grid (a Field4D: `sample`), "
+                        f"got {type(inner).__name__}")
+    ex = data.extra
+    cuts = np.asarray(ex["cuts"], dtype=np.float64)
+    n = len(cuts)
+    scale = REFERENCE_RADIUS / stack.size  # source units -> displayed units (the live view's)
+    centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
+    scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+    grids = [sample(matrix, float(w)) for w in cuts]
+    if clim is None:
+        finite = [np.asarray(g.values)[np.isfinite(g.values)] for g in grids if not g.empty]
+        clim = default_clim(np.concatenate(finite)) if finite else (0.0, 1.0)
+    limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
+    order = np.argsort(centres[:, 2], kind="stable") if n > 1 else np.arange(n)
+    images = []
+    for k in order:
+        if grids[k].empty:
+            continue
+        shift = scale * centres[k] if n > 1 else np.zeros(3)
+        sc = scale * scales[k] if n > 1 else scale
+        images.append(render_grid(grids[k], rendering, size=size, limits=limits, cmap=cmap, clim=clim, scale=sc,
+                                  shift=shift, density=density))
+    if not images:
+        return None
+    (x0, x1), (y0, y1) = limits
+    image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",
+                      aspect="auto", zorder=_Z_BASE - 5.0)
+    image.set_gid(rendering)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    return image
