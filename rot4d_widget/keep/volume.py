@@ -61,7 +61,7 @@ def default_clim(values) -> tuple:
     colour map; no finite value gives (0, 1).
 
     >>> default_clim(np.r_[np.arange(101.0), np.nan, 1e9])
-    (1.02, 99.98)
+    (1.01, 99.99)
     """
     v = np.asarray(values, dtype=np.float64).ravel()
     v = v[np.isfinite(v)]
