@@ -12,6 +12,8 @@ The names live in the modules that do one job each, and are all importable from 
 * `rot4d_widget.keep.picture` -- `render_state` (what a widget shows: a `RotationState` and any
   source, polytope, field, stack or a user's own, with the widget's display settings, at a size in
   pixels), `render_tomography` (parallel slices) and `state_source`;
+* `rot4d_widget.keep.volume` -- a field's cut ray-cast in numpy (`render_grid`: ``"mip"`` and
+  ``"volume"``, what ``render_state(..., rendering=...)`` draws; `default_clim`);
 * `rot4d_widget.keep.canvas` -- the one reused figure an animation's frames are drawn into, with
   its glyph cache.
 
@@ -44,6 +46,7 @@ from .framing import _level_colors as _level_colors
 from .paper import panel_style, paper_figure_3, paper_figure_4, render_key_sequence, render_slice
 from .picture import _prepare as _prepare
 from .picture import render_state, render_tomography, state_source
+from .volume import RENDERINGS, default_clim, render_grid
 
 __all__ = [
     "CAMERA_DISTANCE",
@@ -67,4 +70,7 @@ __all__ = [
     "frame_extent",
     "union_extent",
     "annotation",
+    "RENDERINGS",
+    "render_grid",
+    "default_clim",
 ]
