@@ -53,7 +53,7 @@ from .rebuild import (
 #: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
 #: `rot4d_widget.keep.figures.render_state` takes them as keywords).
 SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity",
-                 "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces")
+                 "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces", "cmap", "clim")
 
 #: ``"format"`` and ``"version"`` of a state file.
 STATE_FILE_FORMAT = "rot4d_widget state"

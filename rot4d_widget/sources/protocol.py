@@ -54,6 +54,10 @@ that comes from these optional members, never from its class (`inner_source`,
 ``coarse_steps`` (optional)
     True when ``slice(matrix, c0, coarse=True)`` gives a cheaper slice for held
     keys (a field's coarse copy); by default read from ``slice``'s signature.
+``sample(matrix, c0, resolution=None, *, coarse=False)`` (optional)
+    The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
+    spacing, units, data range): what the volume and maximum-intensity renderings
+    draw (`rot4d_widget.keep.volume`); a source without it has only surfaces.
 ``describe()`` returns everything a state file needs to rebuild the source: its
 ``"kind"`` and, when it cannot be rebuilt from the description, ``"rebuild"``:
 the reason (a string; True or absent when it can).  A copy of a source
