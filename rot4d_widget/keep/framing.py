@@ -14,6 +14,7 @@ import numpy as np
 
 from ..core import look
 from ..core.look import REFERENCE_RADIUS
+from ..sources.protocol import w_frame
 from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
@@ -123,7 +124,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None):
     ws = np.asarray(source.cuts_at(c0)) if n > 1 and hasattr(source, "cuts_at") else np.zeros(0)
     if len(ws):
         spacing = getattr(source, "spacing", None)
-        per = float(getattr(source, "w_frame", (0.0, 1.0))[1])
+        per = w_frame(source)[1]  # the protocol's reader: a stack answers for its inner source
         lines.append(f"{n} slices w = {ws[0]:+.4g} \u2026 {ws[-1]:+.4g}{wu}"
                      + (f", \u0394 = {spacing * per:.3g}{wu}" if spacing else ""))
     legend = []

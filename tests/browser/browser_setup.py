@@ -77,6 +77,13 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def jupyter_env(home: pathlib.Path, **extra) -> dict:
+    """The environment of a server of our own: its Jupyter and IPython dirs under ``home``."""
+    return dict(os.environ, JUPYTER_CONFIG_DIR=str(home / "config"), JUPYTER_DATA_DIR=str(home / "data"),
+                JUPYTER_RUNTIME_DIR=str(home / "runtime"), IPYTHONDIR=str(home / "ipython"),
+                JUPYTER_PLATFORM_DIRS="1", PYTHONUNBUFFERED="1", **extra)
+
+
 class JupyterServer:
     """A JupyterLab or Notebook 7 server in a temp dir with its own config."""
 
@@ -87,15 +94,7 @@ class JupyterServer:
         self.root = workdir / "root"
         self.root.mkdir(parents=True)
         home = workdir / "jupyter"
-        self.env = dict(
-            os.environ,
-            JUPYTER_CONFIG_DIR=str(home / "config"),
-            JUPYTER_DATA_DIR=str(home / "data"),
-            JUPYTER_RUNTIME_DIR=str(home / "runtime"),
-            IPYTHONDIR=str(home / "ipython"),
-            JUPYTER_PLATFORM_DIRS="1",
-            PYTHONUNBUFFERED="1",
-        )
+        self.env = jupyter_env(home)
         # outputs scrolled off-screen stay rendered; no news/announcements pop-ups
         settings = home / "config" / "lab" / "user-settings" / "@jupyterlab"
         (settings / "notebook-extension").mkdir(parents=True)

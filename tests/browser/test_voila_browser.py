@@ -22,7 +22,6 @@ so it runs once, not once per JupyterLab / Notebook 7 parameter.
 
 from __future__ import annotations
 
-import os
 import re
 import secrets
 import shutil
@@ -35,7 +34,7 @@ import urllib.request
 
 import pytest
 
-from browser_setup import ROOT, free_port
+from browser_setup import ROOT, free_port, jupyter_env
 from jupyter_page import _CANVAS_STATS
 from test_widget_browser import HARMLESS_CONSOLE
 
@@ -63,16 +62,7 @@ class VoilaServer:
         self.root = workdir / "root"
         self.root.mkdir(parents=True)
         home = workdir / "jupyter"
-        self.env = dict(
-            os.environ,
-            JUPYTER_CONFIG_DIR=str(home / "config"),
-            JUPYTER_DATA_DIR=str(home / "data"),
-            JUPYTER_RUNTIME_DIR=str(home / "runtime"),
-            IPYTHONDIR=str(home / "ipython"),
-            JUPYTER_PLATFORM_DIRS="1",
-            PYTHONUNBUFFERED="1",
-            MPLBACKEND="Agg",
-        )
+        self.env = jupyter_env(home, MPLBACKEND="Agg")
         self.log_path = workdir / "voila.log"
         self.log = open(self.log_path, "w")
         self.proc = None
