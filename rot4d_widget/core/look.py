@@ -53,6 +53,10 @@ __all__ = [
     "LEVEL_COLORMAP",
     "check_cmap",
     "check_clim",
+    "RENDERINGS",
+    "DEFAULT_SECTIONS",
+    "check_rendering",
+    "check_sections",
     "level_colors",
     "cmap_stops",
     "hex_color",
@@ -209,6 +213,53 @@ def check_clim(clim, name: str = "clim"):
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise ValueError(f"Expected `{name}` to be {allowed}, got {clim!r}")
     return lo, hi
+
+
+#: How a field's cut is drawn (the widget's `rendering`, napari's name): ``"surface"`` its
+#: isosurfaces (the default), ``"volume"`` emission-absorption ray casting of the cut's values,
+#: ``"mip"`` their maximum along each ray, ``"sections"`` three orthogonal colour-mapped planes
+#: through the cut.  The rendering key cycles them in this order (Shift: backwards).
+RENDERINGS = ("surface", "volume", "mip", "sections")
+#: Where the three planes of ``"sections"`` cross the cut's grid: a fraction of its extent along
+#: each of x, y, z (0 the first node, 1 the last).
+DEFAULT_SECTIONS = (0.5, 0.5, 0.5)
+
+
+def check_rendering(rendering, name: str = "rendering") -> str:
+    """``rendering`` when it is one of `RENDERINGS`, else a ValueError (TypeError for a
+    non-string) naming them.
+
+    >>> check_rendering("mip")
+    'mip'
+    """
+    allowed = ", ".join(repr(r) for r in RENDERINGS)
+    if not isinstance(rendering, str):
+        raise TypeError(f"Expected `{name}` to be one of {allowed}, got {rendering!r}")
+    if rendering not in RENDERINGS:
+        raise ValueError(f"Expected `{name}` to be one of {allowed}, got {rendering!r}")
+    return rendering
+
+
+def check_sections(sections, name: str = "sections") -> tuple:
+    """The positions of the three section planes: (fx, fy, fz), each a finite number in [0, 1]
+    (a fraction of the cut grid's extent along x, y, z), as a tuple of floats.
+
+    >>> check_sections([0, 0.25, 1])
+    (0.0, 0.25, 1.0)
+    """
+    allowed = "(fx, fy, fz): three numbers in [0, 1], fractions of the cut's extent along x, y, z"
+    try:
+        triple = tuple(sections)
+    except TypeError:
+        raise TypeError(f"Expected `{name}` to be {allowed}, got {sections!r}") from None
+    if (isinstance(sections, str) or len(triple) != 3
+            or not all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+                       for v in triple)):
+        raise TypeError(f"Expected `{name}` to be {allowed}, got {sections!r}")
+    out = tuple(float(v) for v in triple)
+    if not all(math.isfinite(v) and 0.0 <= v <= 1.0 for v in out):
+        raise ValueError(f"Expected `{name}` to be {allowed}, got {sections!r}")
+    return out
 
 
 def level_colors(levels, lo: float, hi: float, cmap: str = LEVEL_COLORMAP, *, by_value: bool = False) -> np.ndarray:
