@@ -265,10 +265,10 @@ def _as_array(values, axes):
 
 
 def _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs):
-    """``(values, arguments, dims, meta_range, origin)`` for `Field4D.from_xarray`: the DataArray's
-    values (`_xarray_values`), the field's keyword arguments (``kwargs`` given for it are consumed:
-    name, units, w_units, space_units), its dim names, its data range from metadata and the
-    file it came from (`_encoding_origin`)."""
+    """``(values, arguments, dims, meta_range, origin, long_name)`` for `Field4D.from_xarray`: the
+    DataArray's values (`_xarray_values`), the field's keyword arguments (``kwargs`` given for it
+    are consumed: name, units, w_units, space_units), its dim names, its data range from metadata,
+    the file it came from (`_encoding_origin`) and its ``long_name`` attribute (`_long_name`)."""
     if _is_xarray(da, "Dataset") or (hasattr(da, "data_vars") and hasattr(da, "dims")):
         raise _dataset_error(da)
     if not (hasattr(da, "dims") and hasattr(da, "coords") and hasattr(da, "isel")):
@@ -346,7 +346,18 @@ def _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs):
     space_units = kwargs.pop("space_units", space.pop() if len(space) == 1 else None)
     args = dict(axes=axes, extent=extent, name=kwargs.pop("name", da.name), units=kwargs.pop("units", units),
                 w_per_unit=w_per_unit, w_units=w_units, _coords=coords, space_units=space_units)
-    return values, args, dims, meta_range, origin
+    return values, args, dims, meta_range, origin, _long_name(getattr(da, "attrs", None))
+
+
+def _long_name(attrs):
+    """A variable's descriptive name, CF's ``long_name`` attribute ("sea surface temperature"), as
+    `Field4D.long_name` keeps it for the colour bar (its label; ``name`` is the short variable
+    name): a string, or None when the attribute is absent or blank."""
+    v = (attrs or {}).get("long_name")
+    if v is None:
+        return None
+    v = v.decode() if isinstance(v, bytes) else str(v)
+    return v if v.strip() else None
 
 
 def _open_dataarray(path, variable, engine, chunks, isel, sel, load):

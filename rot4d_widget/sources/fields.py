@@ -243,9 +243,9 @@ class Field4D(FieldLevels):
         value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
         mean w spacing over the mean spatial spacing (voxels are cubes).
         """
-        values, args, dims, meta_range, origin = _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs)
+        values, args, dims, meta_range, origin, long_name = _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs)
         field = cls(values, **args, **kwargs)
-        field._dims = dims
+        field._dims, field.long_name = dims, long_name
         field._stat.meta_range = meta_range
         field.origin = origin
         return field
@@ -398,6 +398,7 @@ class Field4D(FieldLevels):
         return FieldSliceData.assemble(slices, box, readout, frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
+    long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
 
     def describe(self) -> dict:
         """A JSON-able description (the source protocol's ``describe()``): the frame, levels, surface
