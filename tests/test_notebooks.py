@@ -36,6 +36,7 @@ PROJECT_NOTEBOOKS = [
     "05_tomography.ipynb",
     "06_uniform_polychora.ipynb",
     "07_your_data.ipynb",
+    "08_real_fmri.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
