@@ -25,6 +25,17 @@ ends within one spacing inside the box's faces where they cut the grid obliquely
   A uniform medium at the top of the ramp crossed over a length ``l`` is opaque by
   ``1 - exp(-density l / L)`` (Beer-Lambert); each sample is weighted by the length of its piece
   of the ray, so that holds up to the cells' edges.
+* ``"sections"`` -- three orthogonal colour-mapped planes through the grid's box, at fractions
+  ``sections`` = (fx, fy, fz) of its extent: x = x0 + fx (x1 - x0), y = y0 + fy (y1 - y0),
+  z = z0 + fz (z1 - z0), with (x0, x1) ... the grid's extent (first to last node, slice
+  coordinates), placed at ``shift + scale * p`` like the rest.  A pixel shows the *nearest*
+  crossing of its ray with any of the three planes that is in the box (t_in <= t <= t_out, t_in
+  where the ray enters the box, never behind the eye; a millionth of a spacing of slack for
+  rounding) and lies in a cell with eight finite nodes (the rule above): the trilinear value v
+  there, coloured ``cmap(clip((v - lo) / (hi - lo), 0, 1))``, opaque (alpha 1).  A ray with no
+  such crossing is transparent, so a NaN cell leaves a hole through which a farther plane shows.
+  No shading and no blending: the same definition as the page's shader, so both show one picture.
+  One ray per pixel (the planes' edges stay sharp).
 
 Results are straight (not premultiplied) RGBA, (H, W, 4) float64 in [0, 1].
 """
@@ -37,16 +48,16 @@ import numpy as np
 from scipy.ndimage import map_coordinates
 
 from ..core import look
-from ..core.look import REFERENCE_RADIUS
+from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering
+from ..core.progress import progress as make_progress
 from .drawing import _Z_BASE, CAMERA_DISTANCE
 
-__all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "default_clim", "check_rendering", "pixel_rays",
-           "render_grid", "composite", "draw_volume"]
+__all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
+           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
 
-#: What `render_state` draws for a field: ``"surface"`` (the isosurfaces), ``"volume"``, ``"mip"``.
-RENDERINGS = ("surface", "volume", "mip")
+# RENDERINGS (what `render_state` draws for a field) and check_rendering are core.look's, named here too.
 #: The renderings ray-cast here.
-VOLUME_RENDERINGS = ("volume", "mip")
+VOLUME_RENDERINGS = ("volume", "mip", "sections")
 #: Optical depth across the grid's longest side of a medium at the top of the opacity ramp.
 DEFAULT_DENSITY = 4.0
 #: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).
@@ -72,14 +83,6 @@ def default_clim(values) -> tuple:
         half = 0.5 * abs(lo) if lo != 0 else 0.5
         lo, hi = lo - half, lo + half
     return lo, hi
-
-
-def check_rendering(rendering, name: str = "rendering") -> str:
-    """``rendering`` when it is one of `RENDERINGS`, else an error naming them."""
-    if not isinstance(rendering, str) or rendering not in RENDERINGS:
-        allowed = ", ".join(repr(r) for r in RENDERINGS)
-        raise ValueError(f"Expected `{name}` to be one of {allowed}, got {rendering!r}")
-    return rendering
 
 
 def pixel_rays(size, limits, distance: float = CAMERA_DISTANCE):
@@ -146,18 +149,34 @@ def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
     return max(1, int(voxel_px // 2))
 
 
+def _progress_sink(progress, description: str):
+    """``(tick(fraction), close())`` for ``progress``: True a bar (`rot4d_widget.core.progress`,
+    shown once the work took a second), False nothing, a callable ``progress(fraction)``."""
+    if progress is True:
+        bar = make_progress(1000, description)
+        return (lambda f: bar.update(int(round(1000 * min(1.0, f))) - bar.count)), bar.close
+    if progress is False or progress is None:
+        return (lambda f: None), (lambda: None)
+    if callable(progress):
+        return progress, (lambda: None)
+    raise TypeError(f"Expected `progress` to be True, False or a callable (fraction done), got {progress!r}")
+
+
 def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None, scale: float = 1.0,
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
-                step: float = 0.5, pixels_per_ray=None) -> np.ndarray:
+                step: float = 0.5, pixels_per_ray=None, sections=DEFAULT_SECTIONS, progress=True) -> np.ndarray:
     """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
-    ``rendering`` (``"mip"`` or ``"volume"``, see the module) for a picture of ``size`` = (W, H)
-    pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid placed at
-    ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi), default
-    `default_clim` of the grid's values (1st-99th percentile); ``density``: the volume's optical
-    depth across the grid's longest side at the top of the ramp; ``step``: samples every ``step``
-    spacings along a ray.  ``pixels_per_ray``: one ray for every p x p pixels, the picture between
+    ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
+    ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
+    placed at ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
+    default `default_clim` of the grid's values (1st-99th percentile); ``density``: the volume's
+    optical depth across the grid's longest side at the top of the ramp; ``step``: samples every
+    ``step`` spacings along a ray; ``sections``: (fx, fy, fz), the planes' places as fractions of
+    the grid's extent.  ``pixels_per_ray``: one ray for every p x p pixels, the picture between
     the rays' pixels bilinear in premultiplied colour (1: a ray through every pixel's centre);
-    None: two rays per grid spacing where the grid is nearest, at most one per pixel."""
+    None: two rays per grid spacing where the grid is nearest, at most one per pixel (sections:
+    always one per pixel).  ``progress``: True a progress bar once the casting took a second
+    (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1)."""
     # matplotlib's colour map registry: the keep wing's, looked up by name
     from matplotlib import colormaps
 
@@ -165,6 +184,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
         raise ValueError(f"Expected `rendering` to be one of {', '.join(map(repr, VOLUME_RENDERINGS))}, "
                          f"got {rendering!r}")
     colormap = colormaps[look.check_cmap(cmap)]
+    fractions = np.asarray(look.check_sections(sections), dtype=np.float64)
     vals = np.asarray(grid.values)
     clim = default_clim(vals) if clim is None else look.check_clim(clim)
     w_px, h_px = (int(v) for v in size)
@@ -172,26 +192,54 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
         return np.zeros((h_px, w_px, 4))
     scale = float(scale)
     shift = np.asarray(shift, dtype=np.float64)
-    pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
-    if pitch == 1:
-        return _cast(grid, rendering, colormap, clim, (w_px, h_px), limits, scale, shift, distance, density, step)
-    # rays through the centres of p x p blocks (the last block may hang over the picture's edge)
-    (x0, x1), (y0, y1) = limits
-    cw, ch = -(-w_px // pitch), -(-h_px // pitch)
-    coarse_limits = ((x0, x0 + (x1 - x0) * cw * pitch / w_px), (y1 - (y1 - y0) * ch * pitch / h_px, y1))
-    small = _cast(grid, rendering, colormap, clim, (cw, ch), coarse_limits, scale, shift, distance, density, step)
-    pre = np.concatenate([small[..., :3] * small[..., 3:4], small[..., 3:4]], axis=-1)
-    r = (np.arange(h_px) + 0.5) / pitch - 0.5  # a pixel's centre in the rays' picture, in rays
-    c = (np.arange(w_px) + 0.5) / pitch - 0.5
-    rr, cc = np.meshgrid(r, c, indexing="ij")
-    big = np.stack([map_coordinates(pre[..., i], [rr, cc], order=1, mode="nearest") for i in range(4)], axis=-1)
-    a = big[..., 3:4]
-    rgb = np.where(a > 0, big[..., :3] / np.where(a > 0, a, 1.0), 0.0)
-    return np.clip(np.concatenate([rgb, a], axis=-1), 0.0, 1.0)
+    tick, close = _progress_sink(progress, f"ray casting ({rendering})")
+    try:
+        if rendering == "sections":
+            pitch = 1 if pixels_per_ray is None else max(1, int(pixels_per_ray))
+        else:
+            pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
+        args = (grid, rendering, colormap, clim)
+        rest = (scale, shift, distance, density, step, fractions, tick)
+        if pitch == 1:
+            out = _cast(*args, (w_px, h_px), limits, *rest)
+            tick(1.0)
+            return out
+        # rays through the centres of p x p blocks (the last block may hang over the picture's edge)
+        (x0, x1), (y0, y1) = limits
+        cw, ch = -(-w_px // pitch), -(-h_px // pitch)
+        coarse_limits = ((x0, x0 + (x1 - x0) * cw * pitch / w_px), (y1 - (y1 - y0) * ch * pitch / h_px, y1))
+        small = _cast(*args, (cw, ch), coarse_limits, *rest)
+        pre = np.concatenate([small[..., :3] * small[..., 3:4], small[..., 3:4]], axis=-1)
+        r = (np.arange(h_px) + 0.5) / pitch - 0.5  # a pixel's centre in the rays' picture, in rays
+        c = (np.arange(w_px) + 0.5) / pitch - 0.5
+        rr, cc = np.meshgrid(r, c, indexing="ij")
+        big = np.stack([map_coordinates(pre[..., i], [rr, cc], order=1, mode="nearest") for i in range(4)],
+                       axis=-1)
+        a = big[..., 3:4]
+        rgb = np.where(a > 0, big[..., :3] / np.where(a > 0, a, 1.0), 0.0)
+        tick(1.0)
+        return np.clip(np.concatenate([rgb, a], axis=-1), 0.0, 1.0)
+    finally:
+        close()
 
 
-def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step):
-    """`render_grid` with a ray through every pixel's centre."""
+def _box_entry(eye, dirs, lo_box, hi_box):
+    """``(t_in, t_out)`` (n,): where each ray ``eye + t dirs`` (dirs (n, 3), unit) enters and leaves
+    the box [lo_box, hi_box] (slabs; a zero component never crosses its pair), t_in >= 0 (never
+    behind the eye); t_out <= t_in when the ray misses the box."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / dirs
+        t1, t2 = (lo_box - eye) * inv, (hi_box - eye) * inv
+    flat_dir = dirs == 0.0
+    inside = (eye >= lo_box) & (eye <= hi_box)
+    t1 = np.where(flat_dir, np.where(inside, -np.inf, np.inf), t1)
+    t2 = np.where(flat_dir, np.where(inside, np.inf, -np.inf), t2)
+    return np.maximum(np.minimum(t1, t2).max(axis=1), 0.0), np.maximum(t1, t2).min(axis=1)
+
+
+def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
+          tick=lambda f: None):
+    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes."""
     vals = np.asarray(grid.values)
     spacing = float(grid.spacing)
     w_px, h_px = size
@@ -201,16 +249,7 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
     hi_box = lo_box + scale * spacing * (np.asarray(shape) - 1)
     eye, dirs = pixel_rays(size, limits, distance)
     dirs = dirs.reshape(-1, 3)
-    # where each ray enters and leaves the grid's box (slabs; a zero component never crosses its pair)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / dirs
-        t1, t2 = (lo_box - eye) * inv, (hi_box - eye) * inv
-    flat_dir = dirs == 0.0
-    inside = (eye >= lo_box) & (eye <= hi_box)
-    t1 = np.where(flat_dir, np.where(inside, -np.inf, np.inf), t1)
-    t2 = np.where(flat_dir, np.where(inside, np.inf, -np.inf), t2)
-    t_in = np.maximum(np.minimum(t1, t2).max(axis=1), 0.0)
-    t_out = np.maximum(t1, t2).min(axis=1)
+    t_in, t_out = _box_entry(eye, dirs, lo_box, hi_box)
     hit = np.flatnonzero(t_out > t_in)
     if not len(hit):
         return out
@@ -220,9 +259,17 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
     a0 = ((eye - shift) / scale - np.asarray(grid.origin, dtype=np.float64)) / spacing  # the eye, grid indices
     b = dirs[hit] / (scale * spacing)  # grid indices per scene unit along each ray
     upper = np.asarray(shape, dtype=np.float64) - 1
+    lo, hi = clim
+    if rendering == "sections":
+        best_t, best_v = _sections(flat, cells, shape, a0, b, t_in, t_out, upper * fractions, scale * spacing)
+        seen = np.isfinite(best_t)
+        rgba = np.zeros((len(hit), 4))
+        rgba[seen] = colormap(np.clip((best_v[seen] - lo) / (hi - lo), 0.0, 1.0))
+        rgba[seen, 3] = 1.0
+        out.reshape(-1, 4)[hit] = rgba
+        return out
     dt = step * spacing * scale  # scene units per sample
     n_steps = int(math.ceil(float((t_out - t_in).max()) / dt))
-    lo, hi = clim
     mip = rendering == "mip"
     best = np.full(len(hit), -np.inf)
     colour = np.zeros((len(hit), 3))
@@ -252,6 +299,7 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
             trans[live] *= before[-1] * (1.0 - alpha[-1])
             live = live[trans[live] > _OPAQUE]
         k += batch
+        tick(k / n_steps)
     rgba = np.zeros((len(hit), 4))
     if mip:
         seen = np.isfinite(best)
@@ -263,6 +311,33 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
         rgba[:, 3] = a
     out.reshape(-1, 4)[hit] = np.clip(rgba, 0.0, 1.0)
     return out
+
+
+def _sections(flat, cells, shape, a0, b, t_in, t_out, planes, unit):
+    """``(t, v)`` (n,): for each ray ``a0 + t b`` in grid indices (``b`` (n, 3) per scene unit,
+    inside the box for t_in <= t <= t_out), the nearest t at which it crosses one of the planes
+    index_a = ``planes[a]`` in a cell of eight finite nodes (``cells``), and the trilinear value
+    there; t = inf, v = NaN for a ray that crosses none.  ``unit``: scene units per spacing (the
+    slack of a millionth of a spacing at the box's faces)."""
+    n = len(t_in)
+    best_t = np.full(n, np.inf)
+    best_v = np.full(n, np.nan)
+    slack = 1e-6 * unit
+    upper = np.asarray(shape, dtype=np.float64) - 1
+    for a in range(3):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (planes[a] - a0[a]) / b[:, a]
+        rays = np.flatnonzero((b[:, a] != 0.0) & (t >= t_in - slack) & (t <= t_out + slack) & (t < best_t))
+        if not len(rays):
+            continue
+        tr = t[rays]
+        xyz = [np.full(len(rays), planes[a]) if c == a else np.clip(a0[c] + tr * b[rays, c], 0.0, upper[c])
+               for c in range(3)]
+        v, cell = _trilinear(flat, shape, *xyz)
+        ok = cells.take(cell)
+        rays, tr, v = rays[ok], tr[ok], v[ok]
+        best_t[rays], best_v[rays] = tr, v
+    return best_t, best_v
 
 
 def composite(images) -> np.ndarray:
@@ -278,46 +353,67 @@ def composite(images) -> np.ndarray:
     return acc
 
 
-def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis", clim=None,
-                density: float = DEFAULT_DENSITY):
-    """Paint the cut(s) of ``stack``'s field (a `StackSource` whose inner source has ``sample``,
-    like `Field4D.sample`) on ``ax`` as ``rendering`` ("mip" or "volume"): every slice of
-    ``data`` (the stack's slice at ``matrix``) sampled at its cut and placed as the live view
-    places it, ray-cast at ``size`` = (W, H) pixels over the axes' limits, slices composited back
-    to front by the depth of their centres, one image under the box's bars.  ``clim`` None: the
-    1st-99th percentile of the finite values of all the cuts (`default_clim`).  Returns the
-    ``AxesImage`` (None when no cut meets the data)."""
-    inner = getattr(stack, "source", stack)
+def cut_grids(stack, data, matrix):
+    """The grids (`FieldGrid`, one per slice of ``data``, the stack's slice at ``matrix``) of the
+    cuts of ``stack``'s field: its inner source's ``sample(matrix, w)`` at each cut w (the source
+    protocol's optional ``sample``; a TypeError naming it for a source without)."""
+    inner = getattr(stack, "wraps", None) or getattr(stack, "source", stack)
     sample = getattr(inner, "sample", None)
     if not callable(sample):
-        raise TypeError(f"rendering={rendering!r} needs a source sampled on a grid (a Field4D: `sample`), "
+        raise TypeError(f"A volume rendering needs a source sampled on a grid (a Field4D: `sample`), "
                         f"got {type(inner).__name__}")
+    return [sample(matrix, float(w)) for w in np.asarray(data.extra["cuts"], dtype=np.float64)]
+
+
+def grids_clim(grids) -> tuple:
+    """`default_clim` of the finite values of all ``grids`` ((0, 1) when every one is empty)."""
+    finite = [np.asarray(g.values)[np.isfinite(g.values)] for g in grids if not g.empty]
+    return default_clim(np.concatenate(finite)) if finite else (0.0, 1.0)
+
+
+def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis", clim=None,
+                density: float = DEFAULT_DENSITY, sections=DEFAULT_SECTIONS, grids=None, progress=True):
+    """Paint the cut(s) of ``stack``'s field (a `StackSource` whose inner source has ``sample``,
+    like `Field4D.sample`) on ``ax`` as ``rendering`` ("mip", "volume" or "sections"): every slice
+    of ``data`` (the stack's slice at ``matrix``) sampled at its cut (``grids``: sampled before,
+    `cut_grids`) and placed as the live view places it, ray-cast at ``size`` = (W, H) pixels over
+    the axes' limits, slices composited back to front by the depth of their centres, one image
+    under the box's bars.  ``clim`` None: the 1st-99th percentile of the finite values of all the
+    cuts (`grids_clim`).  ``progress``: as `render_grid`'s, one bar for the sampling and every
+    slice.  Returns the ``AxesImage``, whose ``get_clim()`` is the (lo, hi) coloured (None when
+    no cut meets the data)."""
     ex = data.extra
-    cuts = np.asarray(ex["cuts"], dtype=np.float64)
-    n = len(cuts)
-    scale = REFERENCE_RADIUS / stack.size  # source units -> displayed units (the live view's)
-    centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
-    scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
-    grids = [sample(matrix, float(w)) for w in cuts]
-    if clim is None:
-        finite = [np.asarray(g.values)[np.isfinite(g.values)] for g in grids if not g.empty]
-        clim = default_clim(np.concatenate(finite)) if finite else (0.0, 1.0)
-    limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
-    order = np.argsort(centres[:, 2], kind="stable") if n > 1 else np.arange(n)
-    images = []
-    for k in order:
-        if grids[k].empty:
-            continue
-        shift = scale * centres[k] if n > 1 else np.zeros(3)
-        sc = scale * scales[k] if n > 1 else scale
-        images.append(render_grid(grids[k], rendering, size=size, limits=limits, cmap=cmap, clim=clim, scale=sc,
-                                  shift=shift, density=density))
+    n = len(ex["cuts"])
+    tick, close = _progress_sink(progress, f"rendering the cut ({rendering})")
+    try:
+        if grids is None:
+            grids = cut_grids(stack, data, matrix)
+        tick(1.0 / (n + 1))
+        if clim is None:
+            clim = grids_clim(grids)
+        scale = REFERENCE_RADIUS / stack.size  # source units -> displayed units (the live view's)
+        centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
+        scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+        limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
+        order = np.argsort(centres[:, 2], kind="stable") if n > 1 else np.arange(n)
+        images = []
+        for rank, k in enumerate(order):
+            if grids[k].empty:
+                continue
+            shift = scale * centres[k] if n > 1 else np.zeros(3)
+            sc = scale * scales[k] if n > 1 else scale
+            images.append(render_grid(grids[k], rendering, size=size, limits=limits, cmap=cmap, clim=clim, scale=sc,
+                                      shift=shift, density=density, sections=sections,
+                                      progress=lambda f, r=rank: tick((1.0 + r + f) / (n + 1))))
+    finally:
+        close()
     if not images:
         return None
     (x0, x1), (y0, y1) = limits
     image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",
                       aspect="auto", zorder=_Z_BASE - 5.0)
     image.set_gid(rendering)
+    image.set_clim(*clim)  # what its colours stand for (an RGBA image draws without its norm)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     return image
