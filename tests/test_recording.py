@@ -202,7 +202,7 @@ def test_bad_input_is_named(tmp_path):
         Recording.load(tmp_path / "bad.json")
     d = rec.recording().to_dict()
     for change, match in (({"format": "x"}, "Not a rot4d_widget recording"), ({"version": 5}, "version 5"),
-                          ({"events": [{"t": 1.0}]}, "an 'action', a 'set' or a 'source'"),
+                          ({"events": [{"t": 1.0}]}, "an 'action', a 'set', a 'source' or a 'view'"),
                           ({"events": [{"t": -1, "action": "xw"}]}, "time stamp >= 0"),
                           ({"events": [{"t": 2.0, "action": "xw"}, {"t": 1.0, "action": "xw"}]}, "time order")):
         with pytest.raises(ValueError, match=match):

@@ -5,7 +5,9 @@ starts, it is told every action the widget applies (``recorder.record(key, shift
 inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
 (``recorder.record_set("c0", 0.3)``, a slider) and every setting of the source
 (``recorder.record_source("levels", (2.0, 3.0))``: ``levels``, ``slices``, ``spacing``,
-``arrangement``, or any of a source's own ``settings``: the source protocol's), with a time stamp.  It keeps at most
+``arrangement``, or any of a source's own ``settings``: the source protocol's) and every view
+setting (``recorder.record_view("rendering", "mip")``: how a field's cut is drawn, `VIEW_SETTINGS`),
+with a time stamp.  It keeps at most
 ``max_events``; older events are folded into the starting state, so a recording always replays
 to the live state.  ``recorder.recording()`` is an immutable `Recording`:
 
@@ -13,8 +15,10 @@ to the live state.  ``recorder.recording()`` is an immutable `Recording`:
   so a recorded ``r`` resets where the live one did);
 * ``initial_source``: the source settings the events start from (``{"levels": [...], ...}``, those
   the recorder was told with ``source_settings=``, and those folded in), possibly empty;
-* ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value) and
-  `SourceSetting` (t, name, value);
+* ``initial_view``: the view settings the events start from (``{"rendering": "surface", ...}``,
+  told with ``view_settings=``), possibly empty: a renderer then draws with its own;
+* ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value),
+  `SourceSetting` (t, name, value) and `ViewSetting` (t, name, value);
 * ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
 
 A recording is data: loading one imports nothing and runs nothing it names (a source's own
@@ -24,7 +28,8 @@ Replaying applies the same floating-point operations in the same order, so the f
 the recorded one bit for bit (tested).  A source's own actions (a field's level keys, a stack's
 slice keys) and the source's settings are replayed on a source when one is given
 (`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
-view into a stack replaces its source), else skipped.
+view into a stack replaces its source), else skipped; view settings change neither state nor
+source: they go to ``set_view=`` (the widget sets its traits), else are skipped.
 Part of `rot4d_widget.keep.recording`, which re-exports every public name; the animations are
 `rot4d_widget.keep.animation`'s.
 """
@@ -44,6 +49,7 @@ from typing import Mapping
 
 import numpy as np
 
+from ..core import look
 from ..core.keymap import Action
 from ..core.rotation import as_rotation_matrix
 from ..core.state import RotationState, action_from_data, action_to_data
@@ -52,9 +58,10 @@ from ..sources.tomography import ARRANGEMENTS, StackSource
 from .rebuild import _jsonable
 
 RECORDING_FORMAT = "rot4d_widget recording"
-#: Version 2 adds `SourceSetting` events; a recording without them is written as version 1
-#: (so that an older rot4d_widget still reads it).
-RECORDING_VERSION = 2
+#: Version 2 adds `SourceSetting` events, version 3 `ViewSetting` events and ``initial_view``; a
+#: recording is written in the lowest version that holds it (so that an older rot4d_widget still
+#: reads what it can).
+RECORDING_VERSION = 3
 #: Default bound of a `Recorder`: 100 000 events is about 55 minutes of a key held at 30 Hz
 #: (some 10 MB of JSON).
 MAX_EVENTS = 100_000
@@ -63,6 +70,12 @@ SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
 #: The built-in source settings (the widget's traits), whose values `Recorder.record_source` checks;
 #: it also takes a source's own settings (any name in its protocol ``settings``, a JSON value).
 SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement")
+#: The view settings `Recorder.record_view` takes (the widget's traits): how a field's cut is drawn,
+#: its colour scale and where its sections lie -- they change the picture, not the state or source.
+VIEW_SETTINGS = ("rendering", "cmap", "clim", "sections")
+#: Each view setting's default (the widget's and `rot4d_widget.keep.figures.render_state`'s), as JSON.
+VIEW_DEFAULTS = {"rendering": look.RENDERINGS[0], "cmap": look.LEVEL_COLORMAP, "clim": None,
+                 "sections": list(look.DEFAULT_SECTIONS)}
 #: The settings of a field (a stack's inner source).
 _FIELD_SETTINGS = ("levels", "inside", "caps")
 #: The settings that need parallel slices (a `StackSource`).
@@ -125,6 +138,39 @@ class SourceSetting(_NamedValue):
     state's): a sibling."""
 
     _KEY = "source"
+
+
+@dataclass(frozen=True)
+class ViewSetting(_NamedValue):
+    """A view setting (the widget's traits): ``name`` in `VIEW_SETTINGS` and its ``value`` as JSON
+    -- ``rendering`` one of `look.RENDERINGS`, ``cmap`` a matplotlib colour map name, ``clim``
+    [lo, hi] or None (the data's range), ``sections`` [fx, fy, fz] in [0, 1].  It changes how
+    the cut is drawn, not the state or the source."""
+
+    _KEY = "view"
+
+
+def check_view_setting(name, value):
+    """``value`` as a `ViewSetting` holds it (JSON: a tuple as a list), checked by `look`'s checks:
+    a ValueError (or a TypeError for a value of the wrong type) naming what is allowed."""
+    if name not in VIEW_SETTINGS:
+        raise ValueError(f"Expected a view setting among {', '.join(map(repr, VIEW_SETTINGS))}, got {name!r}")
+    check = {"rendering": look.check_rendering, "cmap": look.check_cmap, "clim": look.check_clim,
+             "sections": look.check_sections}[name]
+    value = check(value, name)
+    return list(value) if isinstance(value, tuple) else value
+
+
+def _check_view_settings(settings) -> dict:
+    """A ``{name: value}`` of view settings, checked, in `VIEW_SETTINGS` order."""
+    if settings is None:
+        return {}
+    if not isinstance(settings, Mapping):
+        raise ValueError(f"Expected the view settings as a dict {{name: value}}, got {settings!r}")
+    unknown = [n for n in settings if n not in VIEW_SETTINGS]
+    if unknown:
+        raise ValueError(f"Expected view settings among {', '.join(map(repr, VIEW_SETTINGS))}, got {unknown[0]!r}")
+    return {name: check_view_setting(name, settings[name]) for name in VIEW_SETTINGS if name in settings}
 
 
 def _time(t) -> float:
@@ -218,8 +264,14 @@ def _event_from_dict(d):
         return Setting(t, d["set"], _check_setting(d["set"], d.get("value")))
     if "source" in d:
         return SourceSetting(t, d["source"], _check_source_setting(d["source"], d.get("value")))
+    if "view" in d:
+        try:
+            return ViewSetting(t, d["view"], check_view_setting(d["view"], d.get("value")))
+        except TypeError as exc:  # a file's bad value: the file is wrong
+            raise ValueError(str(exc)) from None
     if "action" not in d:
-        raise ValueError(f"Expected a recorded event with an 'action', a 'set' or a 'source', got {dict(d)!r}")
+        raise ValueError("Expected a recorded event with an 'action', a 'set', a 'source' or a 'view', "
+                         f"got {dict(d)!r}")
     key = d.get("key")
     if key is not None and not isinstance(key, str):
         raise ValueError(f"Expected an event's 'key' to be a string or null, got {key!r}")
@@ -267,9 +319,15 @@ def _with_source_setting(source, name: str, value):
     return source
 
 
-def _apply(state: RotationState, event, source=None, set_source=None) -> bool:
+def _apply(state: RotationState, event, source=None, set_source=None, set_view=None) -> bool:
     """Apply one event to ``state`` (a source's own action and a source setting to ``source``, or
-    a source setting through ``set_source(name, value)``); True if applied."""
+    a source setting through ``set_source(name, value)``; a view setting through
+    ``set_view(name, value)``); True if applied."""
+    if isinstance(event, ViewSetting):
+        if set_view is None:
+            return False
+        set_view(event.name, event.value)
+        return True
     if isinstance(event, SourceSetting):
         if set_source is not None:
             set_source(event.name, event.value)
@@ -296,14 +354,16 @@ def _apply(state: RotationState, event, source=None, set_source=None) -> bool:
 class Recording:
     """A starting state and the events applied to it (immutable; see the module docstring)."""
 
-    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0, initial_source: Mapping | None = None):
+    def __init__(self, initial: Mapping, events=(), *, dropped: int = 0, initial_source: Mapping | None = None,
+                 initial_view: Mapping | None = None):
         RotationState.from_dict(initial)  # validates
         self._initial_source = _check_source_settings(initial_source)
+        self._initial_view = _check_view_settings(initial_view)
         self._initial = json.loads(json.dumps(dict(initial)))  # a private, JSON-clean copy
         self.events = tuple(events)
         for e in self.events:
-            if not isinstance(e, (Step, Setting, SourceSetting)):
-                raise TypeError(f"Expected Step, Setting or SourceSetting events, got {type(e).__name__}")
+            if not isinstance(e, (Step, Setting, SourceSetting, ViewSetting)):
+                raise TypeError(f"Expected Step, Setting, SourceSetting or ViewSetting events, got {type(e).__name__}")
         if isinstance(dropped, (bool, np.bool_)) or not isinstance(dropped, Integral) or dropped < 0:
             raise ValueError("Expected `dropped` (how many events were folded into the starting state) to be an "
                              f"int >= 0, got {dropped!r}")
@@ -313,6 +373,11 @@ class Recording:
     def initial_source(self) -> dict:
         """The source settings at the start (``{name: value}``: `SOURCE_SETTINGS` or a source's own; a copy)."""
         return json.loads(json.dumps(self._initial_source))
+
+    @property
+    def initial_view(self) -> dict:
+        """The view settings at the start (``{name: value}`` of `VIEW_SETTINGS`; a copy)."""
+        return json.loads(json.dumps(self._initial_view))
 
     @property
     def initial(self) -> dict:
@@ -345,7 +410,7 @@ class Recording:
             return e
 
         return Recording(initial, [converted(e) for e in self.events], dropped=self.dropped,
-                         initial_source=self._initial_source)
+                         initial_source=self._initial_source, initial_view=self._initial_view)
 
     @property
     def duration(self) -> float:
@@ -360,11 +425,18 @@ class Recording:
 
     # -- data ------------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        # version 1 unless a source setting needs 2: older readers keep reading what they can
-        version = 2 if self._initial_source or any(isinstance(e, SourceSetting) for e in self.events) else 1
+        # the lowest version that holds it: older readers keep reading what they can
+        if self._initial_view or any(isinstance(e, ViewSetting) for e in self.events):
+            version = 3
+        elif self._initial_source or any(isinstance(e, SourceSetting) for e in self.events):
+            version = 2
+        else:
+            version = 1
         d = {"format": RECORDING_FORMAT, "version": version, "initial": self.initial}
         if self._initial_source:
             d["initial_source"] = self.initial_source
+        if self._initial_view:
+            d["initial_view"] = self.initial_view
         d.update(dropped=self.dropped, events=[e.to_dict() for e in self.events])
         return d
 
@@ -381,7 +453,12 @@ class Recording:
         events = [_event_from_dict(e) for e in d["events"]]
         if any(b.t < a.t for a, b in zip(events, events[1:])):
             raise ValueError("Expected a recording's events in time order")
-        return cls(d["initial"], events, dropped=d.get("dropped", 0), initial_source=d.get("initial_source"))
+        try:
+            initial_view = _check_view_settings(d.get("initial_view"))
+        except TypeError as exc:  # a file's bad value: the file is wrong
+            raise ValueError(f"Bad 'initial_view': {exc}") from None
+        return cls(d["initial"], events, dropped=d.get("dropped", 0), initial_source=d.get("initial_source"),
+                   initial_view=initial_view)
 
     def save(self, path) -> None:
         """Write the recording as JSON to ``path``."""
@@ -401,7 +478,7 @@ class Recording:
 
     # -- replay ----------------------------------------------------------------------------
     def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True,
-               set_source=None) -> RotationState:
+               set_source=None, set_view=None) -> RotationState:
         """Apply the events to ``state`` (in place; default a fresh state) and return it.
 
         ``restart``: set ``state`` to the recording's starting state first (its orientation,
@@ -416,11 +493,17 @@ class Recording:
         widget can do), else set on ``source`` in place (``levels`` on a stack's inner source);
         a single-view ``source`` given a stack setting is refused (``ValueError``) before
         anything changes.  Without ``source`` or ``set_source`` they are skipped.
+
+        View settings (`ViewSetting`: ``rendering``, ``cmap``, ``clim``, ``sections``; with
+        ``restart`` the `initial_view` first) go to ``set_view(name, value)`` at their place among
+        the events (the widget sets its traits); without it they are skipped.
         """
-        if set_source is not None and not callable(set_source):
-            raise TypeError(f"Expected `set_source` to be a callable (name, value), got {type(set_source).__name__}")
+        for name, f in (("set_source", set_source), ("set_view", set_view)):
+            if f is not None and not callable(f):
+                raise TypeError(f"Expected `{name}` to be a callable (name, value), got {type(f).__name__}")
         if source is not None and self._initial.get("format", 2) < 2:
-            return self.for_source(source).replay(state, source, restart=restart, set_source=set_source)
+            return self.for_source(source).replay(state, source, restart=restart, set_source=set_source,
+                                                  set_view=set_view)
         if set_source is None and source is not None:
             self._check_source_settings(source, restart)
         if state is None:
@@ -432,15 +515,19 @@ class Recording:
             d.pop("keymap", None)
             state.restore(d)  # with the recorded reset point ("initial")
         if restart:
-            for e in self._start_settings():
-                _apply(state, e, source, set_source)
+            for e in self._start_settings() + self._start_view():
+                _apply(state, e, source, set_source, set_view)
         for e in self.events:
-            _apply(state, e, source, set_source)
+            _apply(state, e, source, set_source, set_view)
         return state
 
     def _start_settings(self) -> list:
         """`initial_source` as `SourceSetting` events at t = 0."""
         return [SourceSetting(0.0, name, value) for name, value in self.initial_source.items()]
+
+    def _start_view(self) -> list:
+        """`initial_view` as `ViewSetting` events at t = 0."""
+        return [ViewSetting(0.0, name, value) for name, value in self.initial_view.items()]
 
     def _check_source_settings(self, source, restart: bool = True) -> None:
         """ValueError now if ``source`` cannot take the recording's source settings in place."""
@@ -474,14 +561,15 @@ class Recorder:
     while the kernel's thread may read).  Past ``max_events`` the oldest event is folded into
     the starting state, so `recording` always replays to the live state (custom source actions
     that fall out are lost: count in ``dropped``; a source setting that falls out becomes the
-    recording's `Recording.initial_source`).  ``record_source(name, value)`` records a source
-    setting (``levels``, ``slices``, ``spacing``, ``arrangement``, or the source's own);
-    ``source_settings`` (here and
-    in `restart`) are the source's settings when recording starts, ``{name: value}``.
+    recording's `Recording.initial_source`, a view setting its ``initial_view``).
+    ``record_source(name, value)`` records a source setting (``levels``, ``slices``, ``spacing``,
+    ``arrangement``, or the source's own) and ``record_view(name, value)`` a view setting
+    (`VIEW_SETTINGS`); ``source_settings`` and ``view_settings`` (here and in `restart`) are
+    those settings when recording starts, ``{name: value}``.
     """
 
     def __init__(self, state: RotationState, *, max_events: int = MAX_EVENTS, clock=time.monotonic,
-                 source_settings: Mapping | None = None):
+                 source_settings: Mapping | None = None, view_settings: Mapping | None = None):
         if not isinstance(state, RotationState):
             raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
         if isinstance(max_events, bool) or not isinstance(max_events, int) or max_events < 1:
@@ -491,20 +579,24 @@ class Recorder:
         self.max_events = max_events
         self._clock = clock
         self._lock = threading.Lock()
-        self._start(state, source_settings)
+        self._start(state, source_settings, view_settings)
 
-    def _start(self, state, source_settings=None):
+    def _start(self, state, source_settings=None, view_settings=None):
         settings = _check_source_settings(source_settings)
+        view = _check_view_settings(view_settings)
         self._t0 = self._clock()
         self._shadow = state.copy()  # the state before the oldest kept event
         self._shadow_source = settings  # the source settings before the oldest kept event
+        self._shadow_view = view  # the view settings before the oldest kept event
         self._events = collections.deque()
         self.dropped = 0
 
-    def restart(self, state: RotationState, source_settings: Mapping | None = None) -> None:
-        """Forget everything; record from ``state`` (and the source's ``source_settings``) as they are now."""
+    def restart(self, state: RotationState, source_settings: Mapping | None = None,
+                view_settings: Mapping | None = None) -> None:
+        """Forget everything; record from ``state`` (and the source's ``source_settings``, the
+        ``view_settings``) as they are now."""
         with self._lock:
-            self._start(state, source_settings)
+            self._start(state, source_settings, view_settings)
 
     def _stamp(self, t):
         return max(0.0, self._clock() - self._t0) if t is None else _time(t)
@@ -518,6 +610,8 @@ class Recorder:
                 old = self._events.popleft()
                 if isinstance(old, SourceSetting):  # folded into the starting source settings
                     self._shadow_source[old.name] = old.value
+                elif isinstance(old, ViewSetting):  # folded into the starting view settings
+                    self._shadow_view[old.name] = old.value
                 else:
                     _apply(self._shadow, old)
                 self.dropped += 1
@@ -548,11 +642,18 @@ class Recorder:
         self._push(setting)
         return setting
 
+    def record_view(self, name: str, value, t=None) -> ViewSetting:
+        """A view setting (``"rendering"``, ``"cmap"``, ``"clim"``, ``"sections"``) set to ``value``
+        -- what the widget calls after a user changed it (a trait, a key)."""
+        setting = ViewSetting(self._stamp(t), name, check_view_setting(name, value))
+        self._push(setting)
+        return setting
+
     def recording(self) -> Recording:
         """The events so far as an immutable `Recording`."""
         with self._lock:
             return Recording(self._shadow.to_dict(initial=True), tuple(self._events), dropped=self.dropped,
-                             initial_source=self._shadow_source)
+                             initial_source=self._shadow_source, initial_view=self._shadow_view)
 
     def __len__(self) -> int:
         return len(self._events)
