@@ -10,6 +10,7 @@ Part of `rot4d_widget.keep.recording`, which re-exports every public name.
 from __future__ import annotations
 
 import copy
+import inspect
 import math
 import os
 import queue
@@ -24,7 +25,15 @@ from ..core.progress import progress as make_progress
 from ..core.state import RotationState
 from ..geometry.polytopes import pentachoron
 from ..sources.protocol import PolytopeSource, as_source
-from .recorder import SOURCE_SETTINGS, Recorder, Recording, SourceSetting, _apply, _with_source_setting
+from .recorder import (
+    SOURCE_SETTINGS,
+    VIEW_SETTINGS,
+    Recorder,
+    Recording,
+    SourceSetting,
+    _apply,
+    _with_source_setting,
+)
 
 ANIMATION_FORMATS = (".gif", ".mp4")
 
@@ -45,6 +54,14 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
     as the widget does): draw them before taking the next.  ``initial_state``: start there
     instead of the recording's starting state (its copy is used).  ``source`` is copied before
     its own actions and the recorded source settings change it."""
+    for t, state, src, _view in _steps(recording, initial_state, source, per=per, fps=fps):
+        yield t, state, src
+
+
+def _steps(recording: Recording, initial_state=None, source=None, *, per: str = "step", fps: float = 10.0):
+    """`animation_states`' frames with the view settings in effect at each: ``(t, state, source,
+    view)``, ``view`` a dict (`Recording.initial_view`, then each recorded `ViewSetting` up to
+    the frame; the same dict every time, changed in place)."""
     if per not in ("step", "time"):
         raise ValueError(f"Expected `per` to be 'step' or 'time', got {per!r}")
     fps = _positive("fps", fps)
@@ -66,21 +83,23 @@ def animation_states(recording: Recording, initial_state: RotationState | None =
     if src is not None:
         for e in recording._start_settings():
             set_source(e.name, e.value)
+    view = recording.initial_view
+    set_view = view.__setitem__
     events = recording.events
-    yield 0.0, state, src
+    yield 0.0, state, src, view
     if per == "step":
         for e in events:
-            _apply(state, e, src, setter)
-            yield e.t, state, src
+            _apply(state, e, src, setter, set_view)
+            yield e.t, state, src, view
         return
     n = _frame_count(recording, "time", fps)
     i = 0
     for k in range(1, n):
         t = k / fps
         while i < len(events) and events[i].t <= t + 1e-9:
-            _apply(state, events[i], src, setter)
+            _apply(state, events[i], src, setter, set_view)
             i += 1
-        yield t, state, src
+        yield t, state, src, view
 
 
 def _frame_count(recording, per: str, fps: float) -> int:
@@ -126,7 +145,10 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     When the recording has source settings (``levels``, ``slices``, ``spacing``,
     ``arrangement``: its `Recording.initial_source` or recorded ones), those keywords are the
     source's settings at the start unless ``initial_source`` has them, and each frame shows them
-    as recorded up to it.
+    as recorded up to it.  Likewise the view settings (``rendering``, ``cmap``, ``clim``,
+    ``sections``): the keywords are where the frames start unless `Recording.initial_view` has
+    them, and each frame is drawn with those recorded up to it (``sections`` only where
+    `render_state` takes it).
 
     ``frame="fit"`` (default): every frame is framed alike, by the union of the projected
     bounding boxes of all frames' slices (`figures.frame_extent`), which fills 90 % of the
@@ -159,19 +181,22 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         # the settings given are where the source starts; the recorded ones change it from there
         start = {k: settings.pop(k) for k in SOURCE_SETTINGS if k in settings}
         source = state_source(source, **start)
+    # the view settings given are where the frames start; the recorded ones change them from there
+    start_view = {k: settings.pop(k) for k in VIEW_SETTINGS if k in settings}
+    takes = inspect.signature(figures.render_state).parameters  # a recorded `sections` only where taken
     prep = {k: settings[k] for k in _PREPARE_KEYS if k in settings}
     cache: list = []
     canvas = figures._FrameCanvas()  # one figure for every frame
     if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
         boxes, kept = [], 0
-        for _t, state, src in animation_states(recording, initial_state, source, per=per, fps=fps):
+        for _t, state, src, _view in _steps(recording, initial_state, source, per=per, fps=fps):
             _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep)
             boxes.append(box)
             kept += _data_bytes(data)
             cache.append(data if kept <= _SLICE_CACHE_BYTES else None)
         box = figures.union_extent(boxes)
         frame = "camera" if box is None else box
-    for k, (t, state, src) in enumerate(animation_states(recording, initial_state, source, per=per, fps=fps)):
+    for k, (t, state, src, view) in enumerate(_steps(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
         note = f"t = {t:.2f} s, frame {k + 1}/{n}" if annotate else False
         drawn = src if src is not None else "5-cell"
@@ -179,8 +204,9 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         if k < len(cache) and cache[k] is not None:
             extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep)
             cache[k] = None  # drawn once: let it go
+        look_now = {**start_view, **{n: v for n, v in view.items() if n in takes}}
         fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,
-                                   **settings)
+                                   **look_now, **settings)
         yield canvas.rgba() if fig is canvas.fig else _figure_rgb(fig)
 
 
