@@ -14,7 +14,10 @@ absolute path, with the selection and dims it was opened with; its levels, ``ins
 the file: saving says so (`SourceNotRebuildable` warning) and loading then needs the source
 passed in (``load_state(path, source=field)``).  Files are written as version 1 unless a
 field needs what a version-1 reader would silently drop (a selection, ``inside="below"``,
-``caps=False``: version 2); both versions load.
+``caps=False``: version 2); both versions load.  The view settings (``rendering``, ``cmap``,
+``clim``, ``sections``: `rot4d_widget.keep.recorder.VIEW_SETTINGS`) are checked when a file is
+loaded (a ValueError naming what is allowed); a file without them (from before they existed)
+means their defaults (`rot4d_widget.keep.recorder.VIEW_DEFAULTS`).
 
 A state file is data, never code: loading one imports no module and calls nothing the file
 names.  A field made from a function is described by the function's name
@@ -49,11 +52,13 @@ from .rebuild import (
     describe_source,
     rebuild_source,
 )
+from .recorder import VIEW_SETTINGS, check_view_setting
 
 #: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
 #: `rot4d_widget.keep.figures.render_state` takes them as keywords).
 SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity",
-                 "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces", "cmap", "clim")
+                 "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces", "cmap", "clim",
+                 "rendering", "sections")
 
 #: ``"format"`` and ``"version"`` of a state file.
 STATE_FILE_FORMAT = "rot4d_widget state"
@@ -88,9 +93,11 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     ``settings`` is any dict of JSON-able values (tuples and numpy numbers are converted), for
     the widget: its traits (``levels``, ``slices``, ``spacing``, ``arrangement``,
     ``face_opacity``, ``ball_radius``, ``bar_radius``, ``background``, ``show_balls``,
-    ``show_bars``, ``show_faces``, ``color_by``) -- `rot4d_widget.keep.figures.render_state` takes the
-    same names.  A source that cannot be rebuilt (an in-memory array, a lambda) is described
-    anyway, with a `SourceNotRebuildable` warning saying so.  Returns the dict written.
+    ``show_bars``, ``show_faces``, ``color_by``, ``cmap``, ``clim``, ``rendering``, ``sections``)
+    -- `rot4d_widget.keep.figures.render_state` takes the same names; the view settings are
+    checked (as `load_state` will), so no file is written that cannot be loaded.  A source that
+    cannot be rebuilt (an in-memory array, a lambda) is described anyway, with a
+    `SourceNotRebuildable` warning saying so.  Returns the dict written.
     The file is replaced atomically (written beside it, then renamed).
     """
     if not isinstance(state, RotationState):
@@ -102,6 +109,10 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
             warnings.warn(f"The source is described in {os.fspath(path)!r} but cannot be rebuilt from it: "
                           f"{src['rebuild']}. Loading the file will need it passed in: "
                           "load_state(path, source=...)", SourceNotRebuildable, stacklevel=2)
+    settings = dict(settings or {})
+    for name in VIEW_SETTINGS:
+        if name in settings:
+            settings[name] = check_view_setting(name, settings[name])
     if src is not None:
         _add_relative_paths(src, os.path.dirname(os.path.abspath(os.fspath(path))))
     doc = {
@@ -109,7 +120,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         "version": _version_needed(src),
         "state": state.to_dict(),
         "source": src,
-        "settings": _jsonable(dict(settings or {}), "settings"),
+        "settings": _jsonable(settings, "settings"),
     }
 
     doc["rot4d_widget"] = __version__
@@ -224,6 +235,12 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     settings = doc["settings"]
     if not isinstance(settings, dict):
         raise ValueError(f"{path!r}: expected 'settings' to be a dict, got {type(settings).__name__}")
+    for name in VIEW_SETTINGS:  # checked here, so that nothing is set from a bad file
+        if name in settings:
+            try:
+                settings[name] = check_view_setting(name, settings[name])
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"{path!r}: bad setting {name!r}: {exc}") from None
     desc = doc["source"]
     if source is not None:
         source = as_source(source)
