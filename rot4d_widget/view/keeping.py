@@ -3,7 +3,8 @@ recordings).
 
 `Keeper` renders the view without a browser, exports its slice as a mesh, saves and loads the
 state, records every step and setting (also a user's source's own settings, read through the
-source protocol's ``settings``) and replays recordings onto the widget.
+source protocol's ``settings``, and the view settings: ``rendering``, ``cmap``, ``clim``,
+``sections``) and replays recordings onto the widget.
 """
 
 from __future__ import annotations
@@ -14,24 +15,29 @@ import os
 from ..core.state import without_source_keys
 from ..keep.export import SETTING_NAMES, load_state, save_state, slice_mesh
 from ..keep.export import settings_of as widget_settings
-from ..keep.recording import Recorder, Recording, render_animation
+from ..keep.recording import VIEW_DEFAULTS, VIEW_SETTINGS, Recorder, Recording, check_view_setting, render_animation
 from ..sources.protocol import apply_setting, inner_source, settings_of
-from .sync import COLOUR_TRAITS
 
 __all__ = ["Keeper", "view_settings"]
 
-#: The widget's settings `keep.export.SETTING_NAMES` does not name yet, saved and loaded here.
-EXTRA_SETTINGS = tuple(n for n in COLOUR_TRAITS if n not in SETTING_NAMES)
-
 
 def view_settings(widget) -> dict:
-    """What a state file keeps of the widget's settings: `keep.export.settings_of`'s and the
-    colour scale (``cmap``, ``clim``; a tuple as a list)."""
-    out = widget_settings(widget)
-    for name in EXTRA_SETTINGS:
-        value = getattr(widget, name)
-        out[name] = list(value) if isinstance(value, tuple) else value
-    return out
+    """What a state file keeps of the widget's settings (`keep.export.settings_of`: its
+    `SETTING_NAMES`, the view settings among them; a tuple as a list)."""
+    return widget_settings(widget)
+
+
+def _view_now(widget) -> dict:
+    """The widget's view settings (those of `VIEW_SETTINGS` it has as traits), as recorded."""
+    return {n: check_view_setting(n, getattr(widget, n)) for n in VIEW_SETTINGS if widget.has_trait(n)}
+
+
+def _taken_by_render_state(settings: dict) -> dict:
+    """``settings`` less the names `render_state` does not take (a trait newer than it)."""
+    from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
+
+    takes = inspect.signature(render_state).parameters
+    return {k: v for k, v in settings.items() if k in takes}
 
 
 class Keeper:
@@ -39,20 +45,43 @@ class Keeper:
 
     def __init__(self, widget, state, clock):
         self.w = widget
-        self.recorder = Recorder(state, clock=clock, source_settings=settings_of(widget.source))
+        view = _view_now(widget)  # the traits' defaults: the constructor's values are recorded at t = 0
+        self.recorder = Recorder(state, clock=clock, source_settings=settings_of(widget.source), view_settings=view)
         self.recorded_settings = settings_of(widget.source)  # the source's settings as last recorded
+        self.recorded_view = view  # the view settings as last recorded
+        # every change of a view trait is recorded (the constructor's too: watched from before it
+        # sets them); the widget's keys and observers may say so as well: recorded once
+        widget.observe(self._on_view_trait, names=list(view))
 
     # -- recording --------------------------------------------------------------------------
     def restart(self) -> None:
         """Forget what was recorded; record from the current state and source settings on."""
         w = self.w
-        self.recorder.restart(w.state, settings_of(w.source))
+        view = _view_now(w)
+        self.recorder.restart(w.state, settings_of(w.source), view)
         self.recorded_settings = settings_of(w.source)
+        self.recorded_view = view
 
     def record_source(self, name, value) -> None:
         """A source setting changed (a trait, a key): recorded, and remembered as recorded."""
         self.recorder.record_source(name, value)
         self.recorded_settings = settings_of(self.w.source)
+
+    def record_view(self, name, value) -> None:
+        """A view setting (``rendering``, ``cmap``, ``clim``, ``sections``) a user changed (a
+        trait, a key): recorded, and remembered as recorded; a value equal to the one last
+        recorded is not recorded again (a trait's observer and the key that set it both say so)."""
+        if self.recorded_view.get(name, _MISSING) == check_view_setting(name, value):
+            return
+        event = self.recorder.record_view(name, value)
+        self.recorded_view[name] = event.value
+
+    def _on_view_trait(self, change) -> None:
+        name, new = change["name"], change["new"]
+        samples = callable(getattr(inner_source(self.w.source), "sample", None))  # the protocol's optional grid
+        if name == "rendering" and new != "surface" and not samples:
+            return  # refused by the widget's own observer (only a field has more than the surface)
+        self.record_view(name, new)
 
     def note_settings(self) -> None:
         """The source changed through a recorded step (its own key): its settings are as recorded."""
@@ -60,7 +89,8 @@ class Keeper:
 
     def record_changed_settings(self) -> list:
         """The source's settings that changed since last recorded (a user's source changed in
-        code, then `refresh`), recorded as source settings; returns their names."""
+        code, then `refresh`), recorded as source settings; returns their names.  (The view
+        settings are traits, recorded as they change: `record_view`.)"""
         now = settings_of(self.w.source)
         changed = [k for k, v in now.items() if self.recorded_settings.get(k, _MISSING) != v]
         for name in changed:
@@ -76,7 +106,8 @@ class Keeper:
             recording = Recording.load(recording)
         with w._pump.lock:
             w._check_open()
-            recording.replay(w.state, _LiveSource(w), set_source=self.set_source_setting)
+            recording.replay(w.state, _LiveSource(w), set_source=self.set_source_setting,
+                             set_view=self.set_view_setting)
             w._source_version += 1
             w._sync.source_traits()
             self.restart()
@@ -98,18 +129,25 @@ class Keeper:
             apply_setting(w.source, name, value)
         w._source_version += 1
 
+    def set_view_setting(self, name, value) -> None:
+        """A recorded view setting, set on its trait (skipped if this widget has no such trait)."""
+        if isinstance(value, list):
+            value = tuple(value)
+        if self.w.has_trait(name) and getattr(self.w, name) != value:
+            setattr(self.w, name, value)
+
     # -- figures, meshes, animations ------------------------------------------------------------
     def render_animation(self, path, *, recording=None, fps: float = 10.0, per: str = "step", **options) -> int:
         w = self.w
         rec = w.recording if recording is None else recording
-        kwargs = {**widget_settings(w), **options}
+        kwargs = {**_taken_by_render_state(widget_settings(w)), **options}
         return render_animation(rec, None, inner_source(w.source), path, fps=fps, per=per, **kwargs)
 
     def render(self, path=None, *, size=None, dpi: float = 100, **options):
         w = self.w
         with w._pump.lock:
             state = w.state.copy()
-            kwargs = {**widget_settings(w), **options}
+            kwargs = {**_taken_by_render_state(widget_settings(w)), **options}
         size = (w.scene.width, w.scene.height) if size is None else size
         from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
 
@@ -151,20 +189,27 @@ class Keeper:
         allowed = set(inspect.signature(cls.__init__).parameters)
         init = {k: v for k, v in settings.items() if k in allowed and v is not None}
         w = cls(loaded.source, **{**init, **kwargs})
-        w._keeper.apply_loaded(loaded.state, {})
+        # view settings the constructor does not take (a trait only) are set once it is made
+        late = {k: settings[k] for k in VIEW_SETTINGS if k in settings and k not in init and k not in kwargs}
+        w._keeper.apply_loaded(loaded.state, late, defaults=False)
         return w
 
-    def apply_loaded(self, state, settings) -> None:
+    def apply_loaded(self, state, settings, *, defaults: bool = True) -> None:
+        """Set the loaded ``state`` and ``settings`` on the widget, which then records from there.
+        ``defaults``: a view setting the file lacks (one from before it existed) is set to its
+        default, as the file's view was drawn."""
         w = self.w
+        if defaults:
+            settings = {**{k: v for k, v in VIEW_DEFAULTS.items() if w.has_trait(k)}, **settings}
         d = state.to_dict()
         d.pop("keymap")
         with w._pump.lock:
             w._check_open()
             w.state.restore(d)  # the loaded state becomes what r resets to
             w._keys.use_keymap(without_source_keys(state.keymap), w.source)
-        for name in SETTING_NAMES + EXTRA_SETTINGS:  # slices before spacing and arrangement
+        for name in SETTING_NAMES:  # slices before spacing and arrangement
             value = settings.get(name)
-            if not w.has_trait(name) or (value is None and name not in COLOUR_TRAITS) or name not in settings:
+            if not w.has_trait(name) or (value is None and name not in VIEW_SETTINGS) or name not in settings:
                 continue  # a None clim is the data's range: loaded too
             if isinstance(value, list):
                 value = tuple(value)
