@@ -163,7 +163,7 @@ def _text_caching_canvas(fig):
 class _FrameCanvas:
     """One figure, axes and Agg canvas that an animation's frames are drawn into in turn
     (`render_state(..., _canvas=)`): building a figure and its axes was a third of a frame's time.
-    `begin` takes the figure (a new one when the size, dpi, title strip or background change)
+    `begin` takes the figure (a new one when the size, dpi, title or colour bar strip or background change)
     and removes what the frame before added; the annotation, its legend and the title are kept
     and given the new frame's text (`_draw_annotation`), and removed when a frame has none.
     A polytope's slice is drawn as one collection (`_slice_collection`) instead of a patch per
@@ -176,11 +176,13 @@ class _FrameCanvas:
         self.legend_key = None
         self.keep: set = set()
 
-    def begin(self, width, height, top, dpi, background):
-        key = (width, height, top, dpi, tuple(background))
+    def begin(self, width, height, top, dpi, background, right=0.0):
+        """The figure and axes for a frame ``width`` x ``height`` inches, a title strip ``top``
+        high above it and a strip ``right`` wide beside it (a field's colour bar)."""
+        key = (width, height, top, dpi, tuple(background), right)
         if self.fig is None or key != self.key:
-            self.fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
-            self.ax = self.fig.add_axes([0, 0, 1, height / (height + top)])
+            self.fig = Figure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
+            self.ax = self.fig.add_axes([0, 0, width / (width + right), height / (height + top)])
             self.ax.set_axis_off()
             self.ax.set_facecolor(background)
             self.ax.set_aspect("equal")
@@ -192,6 +194,9 @@ class _FrameCanvas:
             for a in (*ax.collections, *ax.patches, *ax.texts, *ax.lines, *ax.images, *self.fig.texts):
                 if a is not self.note and a is not self.title:
                     a.remove()
+            for other in self.fig.axes:  # a colour bar: drawn again for the frame
+                if other is not ax:
+                    other.remove()
         self.keep = set()
         return self.fig, self.ax
 

@@ -9,6 +9,7 @@ which re-exports every public name.
 from __future__ import annotations
 
 import copy
+from types import SimpleNamespace
 
 import numpy as np
 from matplotlib.colors import ListedColormap, to_rgba
@@ -19,7 +20,8 @@ from ..core import look
 from ..core.look import REFERENCE_RADIUS
 from ..core.state import RotationState
 from ..geometry.slicing import Slice
-from ..sources.protocol import apply_setting, as_source, settings_of
+from ..sources.field_labels import box_labels
+from ..sources.protocol import apply_setting, as_source, inner_source, settings_of
 from ..sources.tomography import StackSource
 from .drawing import (
     _REFERENCE_EDGE,
@@ -33,8 +35,20 @@ from .drawing import (
     draw_slice,
     perspective,
 )
-from .framing import _as_box, _draw_annotation, _frame_limits, _level_colors, annotation, frame_extent
-from .volume import check_rendering, draw_volume
+from .framing import (
+    _as_box,
+    _draw_annotation,
+    _draw_box_labels,
+    _draw_colorbar,
+    _frame_limits,
+    annotation,
+    colorbar_width,
+    frame_extent,
+    level_rgb,
+    small_font,
+    value_label,
+)
+from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume
 
 
 def render_tomography(
@@ -63,6 +77,13 @@ def render_tomography(
     background=look.BACKGROUND,
     frame="camera",
     annotate=False,
+    rendering: str = "surface",
+    cmap: str = look.LEVEL_COLORMAP,
+    clim=None,
+    sections=DEFAULT_SECTIONS,
+    colorbar: bool = True,
+    axis_labels: bool = True,
+    progress=True,
     _data=None,
     _theta0=None,
     _canvas=None,
@@ -95,6 +116,20 @@ def render_tomography(
     True (a corner text naming the source, c0, a field's level(s) and w span with their units,
     a stack's slices' w, and a legend of the levels' or slices' colours: `annotation`), or a
     string written as the first line of that text.
+
+    A field (a source with a ``data_range``) is drawn as ``rendering``: ``"surface"`` its
+    isosurfaces, coloured along ``cmap`` (by rank while ``clim`` is None, else by value over
+    ``clim``, as the live view colours them); ``"volume"``, ``"mip"`` or ``"sections"`` its cut
+    sampled on a grid and ray-cast (`rot4d_widget.keep.volume.render_grid`; ``clim`` None: the
+    1st-99th percentile of the cuts' values; ``sections`` the planes' places; ``progress``: a bar
+    when the casting takes more than a second, see `render_grid`), the box's edges drawn over it.
+    ``colorbar``: a colour bar in a strip right of the picture (`colorbar_width` inches: the
+    figure is that much wider, the picture itself unchanged): ``cmap`` over the limits the colours
+    stand for (``clim``, else the surfaces' data range or the rendering's percentiles), titled
+    with the variable's ``long_name`` (else ``name``) and ``units``, the iso levels marked in their
+    surfaces' colours (surface rendering).  ``axis_labels``: a single cut's box labelled with its
+    data coordinates (`rot4d_widget.sources.field_labels.box_labels`: the origin corner's, and
+    what changes along each edge leaving it), so the picture says which way time runs.
     """
     # a source that wraps another is parallel slices already (the protocol's ``wraps``)
     src = source if getattr(source, "wraps", None) is not None else None
@@ -118,7 +153,14 @@ def render_tomography(
         palette = np.asarray([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
                              dtype=np.float64).reshape(-1, 3)
     background = to_rgba(background)
+    rendering = check_rendering(rendering)
+    cmap, clim = look.check_cmap(cmap), look.check_clim(clim)
+    inner = inner_source(src)
+    field = getattr(inner, "data_range", None) is not None  # a field: values to colour
+    volume = rendering != "surface"
     data = src.slice(matrix, c0) if _data is None else _data
+    # a volume rendering's cuts, sampled once (drawn, and the box labelled); no `sample`: a TypeError here
+    grids = cut_grids(src, data, matrix) if volume else None
     ex = data.extra
     n = src.slices
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
@@ -129,13 +171,15 @@ def render_tomography(
     group_rgb = ex.get("group_rgb")
 
     top = TITLE_HEIGHT if title else 0.0
+    right = colorbar_width(height) if colorbar and (field or volume) else 0.0
     if _canvas is None:
-        fig = Figure(figsize=(width, height + top), dpi=dpi, facecolor=background)
-        ax = fig.add_axes([0, 0, 1, height / (height + top)])  # the camera's frame; the title above it
+        fig = Figure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
+        # the camera's frame; the title above it, the colour bar right of it
+        ax = fig.add_axes([0, 0, width / (width + right), height / (height + top)])
         ax.set_axis_off()
         ax.set_facecolor(background)
     else:  # an animation's next frame: the same figure, this frame's artists only
-        fig, ax = _canvas.begin(width, height, top, dpi, background)
+        fig, ax = _canvas.begin(width, height, top, dpi, background, right)
     aspect = width / height
     edge = getattr(src.source, "edge_length", None)
     base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
@@ -191,7 +235,8 @@ def render_tomography(
         else:
             bar_width = (0.35 * bar if bar_radius is None else bar) if show_bars else 0.0  # a field's box: thin
             _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb if palette is None else palette,
-                          src.source, face_alpha, z_shift, bar_width, show_faces=show_faces)
+                          src.source, face_alpha, z_shift, bar_width, show_faces=show_faces and not volume,
+                          cmap=cmap, clim=clim)
         if labels:
             jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, cuts[k], k == hi, z_shift))
     # labels that would overlap one already placed are left out: the highlighted slice's first,
@@ -202,8 +247,23 @@ def render_tomography(
         _label_slice(ax, *job, point=point, placed=placed)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
+    used = None
+    if volume:
+        image = draw_volume(ax, src, data, matrix, rendering, size=(round(width * dpi), round(height * dpi)),
+                            cmap=cmap, clim=clim, sections=sections, grids=grids, progress=progress)
+        used = image.get_clim() if image is not None else None
+    if right:
+        _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
+    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
+        grid = grids[0] if grids else _slice_box(data, offs, soff)
+        if grid is not None:
+            labels = box_labels(inner, matrix, c0, grid)
+            centre = np.asarray(grid.origin) + 0.5 * np.diff(np.asarray(grid.extent), axis=1).ravel()
+            _draw_box_labels(ax, labels, scale, centre, small_font(height) - 0.5, height)
     if annotate:
-        lines, legend = annotation(src, data, c0, theta0=_theta0)
+        lines, legend = annotation(src, data, c0, theta0=_theta0, cmap=cmap, clim=clim)
+        if volume:
+            legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
         if isinstance(annotate, str):
             lines = [annotate, *lines]
         _draw_annotation(ax, lines, legend, height, _canvas)
@@ -215,7 +275,8 @@ def render_tomography(
         if _canvas is not None and _canvas.title is not None:
             _canvas.title.set_text(text)
         else:
-            t = fig.text(0.5, 1.0 - 0.5 * top / (height + top), text, ha="center", va="center", fontsize=9)
+            t = fig.text(0.5 * width / (width + right), 1.0 - 0.5 * top / (height + top), text, ha="center",
+                         va="center", fontsize=9)
             if _canvas is not None:
                 _canvas.title = t
         if _canvas is not None:
@@ -225,6 +286,39 @@ def render_tomography(
     _save(fig, path)
     return fig
 
+
+def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top, right):
+    """A field's colour bar in the strip right of its picture: ``cmap`` over ``used`` (the limits a
+    volume rendering coloured by; None: ``given``, the caller's clim, else the field's data range),
+    its levels marked in their surfaces' colours (along ``cmap``, by value over ``given`` when set,
+    else by rank: `level_rgb`) for the surface rendering."""
+    clim = used if used is not None else given
+    if clim is None:
+        lo, hi = (float(v) for v in getattr(inner, "data_range", (0.0, 1.0)))
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            lo, hi = 0.0, 1.0
+        if not hi > lo:
+            lo, hi = lo - 0.5, lo + 0.5
+        clim = (lo, hi)
+    marks = ()
+    if rendering == "surface":
+        rgb = level_rgb(inner, cmap, given)
+        if rgb is not None:
+            marks = tuple(zip(tuple(getattr(inner, "levels", ())), rgb))
+    total_w, total_h = width + right, height + top
+    rect = ((width + 0.12) / total_w, 0.15 * height / total_h, 0.14 / total_w, 0.7 * height / total_h)
+    _draw_colorbar(fig, rect, cmap, clim, value_label(inner), marks, small_font(height))
+
+
+def _slice_box(data, offs, soff):
+    """The bounding box of a single cut's box edges (the slice's segments) as what `box_labels`
+    reads of a grid (``origin``, ``extent``); None when the cut is empty."""
+    seg = np.asarray(data.segments[soff[0]:soff[1]])
+    if not len(seg):
+        return None
+    pts = np.asarray(data.points[offs[0]:offs[1]], dtype=np.float64)[np.unique(seg) - offs[0]]
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)))
 
 
 def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
@@ -306,8 +400,9 @@ _TRIANGLES = None
 
 
 def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width,
-                  show_faces=True):
-    """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines."""
+                  show_faces=True, cmap=look.LEVEL_COLORMAP, clim=None):
+    """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines; a
+    field's levels coloured along ``cmap`` (by value over ``clim`` when given: `level_rgb`)."""
     # matplotlib collections: imported when a surface is drawn
     from matplotlib.collections import LineCollection
 
@@ -325,10 +420,9 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
             pal = np.asarray(group_rgb, dtype=np.float64)
             rgb = pal[np.minimum(groups, len(pal) - 1)] if len(pal) == 1 else pal[groups]
         else:
-            levels = getattr(inner, "levels", None)
-            if levels:
-                lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
-                rgb = _level_colors(levels, lo, hi)[groups]
+            level_colours = level_rgb(inner, cmap, clim)
+            if level_colours is not None:
+                rgb = level_colours[groups]
             else:
                 rgb = look.group_palette(int(groups.max()) + 1)[groups].astype(np.float64)
         # a triangle's mean normal and depth as (c0 + c1 + c2) / 3: the sums and the division of
@@ -418,6 +512,10 @@ def render_state(
     rendering: str = "surface",
     cmap="viridis",
     clim=None,
+    sections=DEFAULT_SECTIONS,
+    colorbar: bool = True,
+    axis_labels: bool = True,
+    progress=True,
     _prepared=None,
     _canvas=None,
 ) -> Figure:
@@ -446,19 +544,24 @@ def render_state(
     `render_tomography`).  ``annotate``: True writes θ0, c0 and what the source tells of itself
     (`annotation`: name, units, levels, w span, a stack's w) in the upper left corner and a
     legend of the levels' or slices' colours in the lower left; a string is written first.
-    ``rendering`` (a field's): ``"surface"`` (the default: the isosurfaces, as ever), ``"mip"``
-    (maximum intensity projection) or ``"volume"`` (emission-absorption with a transfer function:
-    colour ``cmap``, opacity rising linearly over ``clim``), ray-cast in numpy through the cut
-    sampled on a grid (`rot4d_widget.keep.volume`; the box's edges drawn over it).  ``cmap``: a
-    matplotlib colour map name; ``clim``: (lo, hi), default the 1st-99th percentile of the finite
-    values of the cut (of all the cuts of a stack): robust to a few outliers.
-    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels (plus the
-    title's strip when ``title`` is given).
+    ``rendering`` (a field's): ``"surface"`` (the default: the isosurfaces, coloured along ``cmap``,
+    by value over ``clim`` when given), ``"mip"`` (maximum intensity projection), ``"volume"``
+    (emission-absorption with a transfer function: colour ``cmap``, opacity rising linearly over
+    ``clim``) or ``"sections"`` (three orthogonal colour-mapped planes at ``sections`` = (fx, fy,
+    fz), fractions of the cut's extent), ray-cast in numpy through the cut sampled on a grid
+    (`rot4d_widget.keep.volume`; the box's edges drawn over it; ``progress``: a bar when that
+    takes more than a second).  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
+    default the 1st-99th percentile of the finite values of the cut (of all the cuts of a stack):
+    robust to a few outliers.  ``colorbar``: a field's colour bar right of the picture (the
+    variable's name and units, the levels marked); ``axis_labels``: a single cut's box labelled
+    with its data coordinates (`render_tomography`).
+    Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels, plus the
+    title's strip above when ``title`` is given and, for a field, the colour bar's strip right of
+    it (`colorbar_width`; the picture's own pixels are where they would be without it).
     Returns the Figure.
     """
     rendering = check_rendering(rendering)
-    if rendering != "surface":
-        cmap, clim = look.check_cmap(cmap), look.check_clim(clim)
+    cmap, clim, sections = look.check_cmap(cmap), look.check_clim(clim), look.check_sections(sections)
     if not isinstance(state, RotationState):
         raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
     try:
@@ -479,19 +582,14 @@ def render_state(
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
-    volume = rendering != "surface"
-    fig = render_tomography(
-        stack, state.matrix, state.c0, path=None if volume else path, width=w_px / dpi, height=h_px / dpi,
+    return render_tomography(
+        stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi,
         dpi=dpi, title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
-        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces and not volume,
+        bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
-        annotate=annotate, _data=data, _theta0=state.theta0, _canvas=_canvas,
+        annotate=annotate, rendering=rendering, cmap=cmap, clim=clim, sections=sections, colorbar=colorbar,
+        axis_labels=axis_labels, progress=progress, _data=data, _theta0=state.theta0, _canvas=_canvas,
     )
-    if volume:
-        draw_volume(fig.axes[0], stack, data, state.matrix, rendering, size=(round(w_px), round(h_px)), cmap=cmap,
-                    clim=clim)
-        _save(fig, path)
-    return fig
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
