@@ -7,13 +7,13 @@ The names live in the modules that do one job each, and are all importable from 
   `perspective`, the camera constants);
 * `rot4d_widget.keep.paper` -- grids of panels: `render_slice`, `render_key_sequence`, the paper's
   Figs. 3 and 4 (`paper_figure_3`, `paper_figure_4`, `panel_style`);
-* `rot4d_widget.keep.framing` -- the fitted frame (`frame_extent`, `union_extent`, `FIT_FILL`) and
-  the corner `annotation`;
+* `rot4d_widget.keep.framing` -- the fitted frame (`frame_extent`, `union_extent`, `FIT_FILL`),
+  the corner `annotation`, a field's colour bar strip (`colorbar_width`) and box labels;
 * `rot4d_widget.keep.picture` -- `render_state` (what a widget shows: a `RotationState` and any
   source, polytope, field, stack or a user's own, with the widget's display settings, at a size in
   pixels), `render_tomography` (parallel slices) and `state_source`;
-* `rot4d_widget.keep.volume` -- a field's cut ray-cast in numpy (`render_grid`: ``"mip"`` and
-  ``"volume"``, what ``render_state(..., rendering=...)`` draws; `default_clim`);
+* `rot4d_widget.keep.volume` -- a field's cut ray-cast in numpy (`render_grid`: ``"mip"``,
+  ``"volume"`` and ``"sections"``, what ``render_state(..., rendering=...)`` draws; `default_clim`);
 * `rot4d_widget.keep.canvas` -- the one reused figure an animation's frames are drawn into, with
   its glyph cache.
 
@@ -41,7 +41,7 @@ from .drawing import (
 )
 from .drawing import TITLE_HEIGHT as TITLE_HEIGHT
 from .drawing import _slice_collection as _slice_collection
-from .framing import FIT_FILL, annotation, frame_extent, union_extent
+from .framing import FIT_FILL, annotation, colorbar_width, frame_extent, union_extent
 from .framing import _level_colors as _level_colors
 from .paper import panel_style, paper_figure_3, paper_figure_4, render_key_sequence, render_slice
 from .picture import _prepare as _prepare
@@ -70,6 +70,7 @@ __all__ = [
     "frame_extent",
     "union_extent",
     "annotation",
+    "colorbar_width",
     "RENDERINGS",
     "render_grid",
     "default_clim",
