@@ -186,10 +186,10 @@ def test_reserved_labels_are_short_and_distinct():
 
 def test_repeating_kinds():
     REPEATING_KINDS = keymap_module.REPEATING_KINDS
-    assert REPEATING_KINDS == frozenset({"rotate", "alpha", "c0", "level", "spacing"})
+    assert REPEATING_KINDS == frozenset({"rotate", "alpha", "c0", "level", "spacing", "section"})
     kinds = {a.kind for a in DEFAULT_KEYMAP.values()}
     assert REPEATING_KINDS <= kinds
-    assert kinds - REPEATING_KINDS == {"theta0", "reset", "help", "slices", "screenshot"}
+    assert kinds - REPEATING_KINDS == {"theta0", "reset", "help", "slices", "screenshot", "rendering"}
 
 
 # -- custom actions a data source brings -----------------------------------------

@@ -9,13 +9,15 @@ A :class:`Keymap` maps *key names* to :class:`Action` s.  A key name is
   typed** (``key``), so "z" is the key labelled z on QWERTY, QWERTZ and AZERTY;
 * a longer name is a ``KeyboardEvent.code`` (``"NumpadAdd"``, ``"F1"``).
 
-Shift inverts rotations (the paper's Table 1) and does nothing to other
+Shift inverts rotations (the paper's Table 1), cycles a field's rendering
+backwards and moves a section plane back (`SHIFT_KINDS`); it does nothing to other
 actions.  From a browser event Shift means the ``shiftKey`` flag only, so Caps
 Lock does not invert.
 
 Besides the paper's keys the default table reserves keys for the next
 features (iso level ``o``/``i``, parallel slices ``n``/``b``, slice spacing
-``g``/``f``, screenshot ``p``); the core gives them no meaning.  A data source
+``g``/``f``, screenshot ``p``) and binds the view's field keys (rendering ``v``, section
+planes ``a``/``s``/``d``); the core gives them no meaning.  A data source
 brings its own keys as ``Action("custom", ...)`` through `Keymap.extended`.
 """
 
@@ -29,12 +31,13 @@ import numpy as np
 
 from .rotation import DOUBLE_PLANES, PLANES
 
-__all__ = ["Action", "Keymap", "DEFAULT_KEYMAP", "ACTION_NAMES", "RESERVED_KINDS", "REPEATING_KINDS"]
+__all__ = ["Action", "Keymap", "DEFAULT_KEYMAP", "ACTION_NAMES", "RESERVED_KINDS", "REPEATING_KINDS", "SHIFT_KINDS"]
 
 #: Parameter and control actions by name; rotations are named by their plane(s).
 ACTION_NAMES = (
     "alpha+", "alpha-", "c0+", "c0-", "theta0+", "theta0-", "reset", "help",
     "level+", "level-", "slices+", "slices-", "spacing+", "spacing-", "screenshot",
+    "rendering+", "section-x", "section-y", "section-z",
 )
 _ACTION_KINDS = {
     "alpha+": ("alpha", +1), "alpha-": ("alpha", -1),
@@ -45,6 +48,8 @@ _ACTION_KINDS = {
     "slices+": ("slices", +1), "slices-": ("slices", -1),
     "spacing+": ("spacing", +1), "spacing-": ("spacing", -1),
     "screenshot": ("screenshot", 0),
+    "rendering+": ("rendering", +1),
+    "section-x": ("section", +1, "x"), "section-y": ("section", +1, "y"), "section-z": ("section", +1, "z"),
 }
 
 #: Kinds bound in `DEFAULT_KEYMAP` for features still to come; `RotationState`
@@ -56,7 +61,12 @@ RESERVED_KINDS = frozenset({"level", "slices", "spacing", "screenshot"})
 #: spacing (g/f) -- continuous changes.  The others act once per press:
 #: theta0 (+/-) would run away, reset/help/screenshot are one-shot, and
 #: adding or removing a parallel slice (n/b) is counted by the user.
-REPEATING_KINDS = frozenset({"rotate", "alpha", "c0", "level", "spacing"})
+REPEATING_KINDS = frozenset({"rotate", "alpha", "c0", "level", "spacing", "section"})
+
+#: Kinds whose Shift goes the other way: rotations (the paper's Table 1), the field rendering
+#: cycle (v: surface, volume, mip, sections; Shift+v backwards) and the section planes (a, s, d
+#: move the x, y, z plane up; with Shift, down).  The view acts on the last two, the core ignores them.
+SHIFT_KINDS = frozenset({"rotate", "rendering", "section"})
 
 _SIGNED_LABELS = {
     "alpha": "\u03b1", "c0": "c0", "theta0": "\u03b80", "level": "level", "slices": "slices", "spacing": "spacing",
@@ -77,6 +87,7 @@ _DESCRIPTIONS = {
     ("spacing", +1): "widen the slice spacing (multi-slice view)",
     ("spacing", -1): "narrow the slice spacing (multi-slice view)",
     ("screenshot", 0): "save a picture of the view (PNG)",
+    ("rendering", 1): "next rendering of a field: surface, volume, mip, sections (Shift: the previous one)",
 }
 #: In help, a character typed on the same physical key as another one bound
 #: to the same action is not shown ("=" next to "+", "_" next to "-").
@@ -95,7 +106,9 @@ class Action:
     ``kind`` is ``"rotate"`` (``planes`` is one of ``"xy" ... "zw"`` or
     ``"xy,zw" "xz,yw" "xw,yz"``), ``"alpha"``, ``"c0"``, ``"theta0"`` (``sign``
     +1 or -1), ``"reset"`` or ``"help"``; the reserved ``"level"``,
-    ``"slices"``, ``"spacing"`` (``sign`` +1 or -1) and ``"screenshot"``; or
+    ``"slices"``, ``"spacing"`` (``sign`` +1 or -1) and ``"screenshot"``; the view's
+    ``"rendering"`` and ``"section"`` (``name`` the plane's axis, "x", "y" or "z"), which Shift
+    turns backwards like a rotation; or
     ``"custom"``, an action a data source brings, shown as ``name`` and
     described by ``text`` (``Action("custom", name="phase+", sign=1,
     text="advance the phase")``).
@@ -135,8 +148,8 @@ class Action:
             if spec in PLANES or spec in DOUBLE_PLANES:
                 return cls("rotate", planes=spec)
             if spec in _ACTION_KINDS:
-                kind, sign = _ACTION_KINDS[spec]
-                return cls(kind, sign=sign)
+                kind, sign, *name = _ACTION_KINDS[spec]
+                return cls(kind, sign=sign, name=name[0] if name else "")
         allowed = ", ".join(repr(s) for s in (*PLANES, *DOUBLE_PLANES, *ACTION_NAMES))
         raise ValueError(f"Unknown action {spec!r}; expected one of {allowed}")
 
@@ -154,6 +167,10 @@ class Action:
             return f"R_{self.planes}" + (_SUPERSCRIPT_MINUS_ONE if inverted else "")
         if self.kind == "custom":
             return self.name
+        if self.kind == "rendering":
+            return "rendering" + ("\u2212" if inverted else "+")
+        if self.kind == "section":
+            return f"section {self.name}" + ("\u2212" if inverted else "+")
         if self.kind in _SIGNED_LABELS:
             return _SIGNED_LABELS[self.kind] + ("+" if self.sign > 0 else "\u2212")
         return self.kind
@@ -167,6 +184,8 @@ class Action:
             return f"simple rotation R_{self.planes} by \u03b80"
         if self.kind == "custom":
             return self.text or self.name
+        if self.kind == "section":
+            return f"move the {self.name} section plane (sections rendering of a field; Shift: back)"
         sign = 0 if self.kind in ("reset", "help", "screenshot") else (1 if self.sign > 0 else -1)
         return _DESCRIPTIONS.get((self.kind, sign), self.kind)
 
@@ -296,7 +315,7 @@ class Keymap(Mapping):
             action = self._bindings.get(m.group(1) if m else key)
         if action is None:
             return None
-        return action, bool(shift) and action.is_rotation
+        return action, bool(shift) and action.kind in SHIFT_KINDS
 
     def lookup(self, event: Mapping):
         """Browser key event -> ``(action, inverted)`` or None.
@@ -325,7 +344,7 @@ class Keymap(Mapping):
             action = self._bindings.get(key.lower())
         if action is None:
             return None
-        return action, shift and action.is_rotation
+        return action, shift and action.kind in SHIFT_KINDS
 
     def help_rows(self):
         """``[(key, label, description), ...]`` in binding order, one row per binding."""
@@ -371,5 +390,7 @@ DEFAULT_KEYMAP = Keymap(
         "n": "slices+", "b": "slices-",  # parallel slices
         "g": "spacing+", "f": "spacing-",  # their spacing
         "p": "screenshot",  # a PNG of the view
+        "v": "rendering+",  # a field's rendering: surface, volume, mip, sections
+        "a": "section-x", "s": "section-y", "d": "section-z",  # the sections' planes
     }
 )

@@ -17,7 +17,7 @@ from ..core import tolerances as tol
 from ..core._arrays import sealed
 from ..core.rotation import as_rotation_matrix
 from .field_checks import _check_resolution
-from .field_slicing import _sample_raw
+from .field_slicing import _box_slice, _sample_raw
 
 __all__ = ["FieldGrid", "sample_field", "field_sample"]
 
@@ -40,6 +40,10 @@ class FieldGrid:
     data_range : (lo, hi)
         The field's data range (`Field4D.data_range`), for a colour scale shared by every cut.
 
+    outline : ((P, 3) float64, (S, 2) intp), read-only
+        The cut of the data's box: its corners and edges in slice coordinates (what the live
+        view draws as bars around a volume rendering); empty arrays when the cut misses it.
+
     A cut that misses the box is empty: ``values`` of shape (0, 0, 0), ``spacing`` 0.
     Node (i, j, k) is at ``origin + spacing * (i, j, k)``; the data point there is
     ``centre + (matrix.T @ (p, d)) * unit`` (`Field4D.to_data`).
@@ -52,6 +56,7 @@ class FieldGrid:
     name: str | None
     units: str | None
     data_range: tuple
+    outline: tuple = (sealed(np.zeros((0, 3))), sealed(np.zeros((0, 2), dtype=np.intp)))
 
     @property
     def empty(self) -> bool:
@@ -89,19 +94,22 @@ def sample_field(field, matrix, c0, resolution: int = 64, *, coarse: bool = Fals
     m = as_rotation_matrix(matrix)
     res = _check_resolution(resolution)
     src = field.coarse() if coarse else field
-    s = _sample_raw(src, m, d, res)
+    box = _box_slice(field, m, d)
+    outline = (sealed(np.asarray(box.vertices, dtype=np.float64).reshape(-1, 3).copy()),
+               sealed(np.asarray(box.edges, dtype=np.intp).reshape(-1, 2).copy()))
+    s = _sample_raw(src, m, d, res, box=box)
     name, units = getattr(field, "name", None), getattr(field, "units", None)
     rng = tuple(float(v) for v in field.data_range)
     if s is None:
         return FieldGrid(sealed(np.zeros((0, 0, 0), dtype=np.float32)), sealed(np.zeros(3)), 0.0,
-                         ((0.0, 0.0),) * 3, name, units, rng)
+                         ((0.0, 0.0),) * 3, name, units, rng, outline)
     spacing = float(s.spacing)
     with np.errstate(invalid="ignore"):
         v = np.where(np.asarray(s.g) >= -tol.ON_HYPERPLANE * spacing, np.asarray(s.f), np.nan)
     values = np.ascontiguousarray(v, dtype=np.float32)
     origin = np.asarray(s.origin, dtype=np.float64).copy()
     extent = tuple((float(origin[a]), float(origin[a] + spacing * (values.shape[a] - 1))) for a in range(3))
-    return FieldGrid(sealed(values), sealed(origin), spacing, extent, name, units, rng)
+    return FieldGrid(sealed(values), sealed(origin), spacing, extent, name, units, rng, outline)
 
 
 def field_sample(field, matrix, c0, resolution=None, *, coarse: bool = False) -> FieldGrid:

@@ -74,6 +74,21 @@ function defineLeaveGuard() {
 let surfaceVersion = 2 ** 30;
 const nextSurfaceVersion = () => ++surfaceVersion;
 
+// The unit cube's 12 triangles, counter-clockwise seen from outside (a volume box's template).
+const CUBE = [0,0,0,0,1,1,0,1,0,0,0,0,0,0,1,0,1,1,1,0,0,1,1,0,1,1,1,1,0,0,1,1,1,1,0,1,0,0,0,1,0,0,1,0,1,0,0,0,1,0,1,0,0,1,
+  0,1,0,1,1,1,1,1,0,0,1,0,0,1,1,1,1,1,0,0,0,1,1,0,1,0,0,0,0,0,0,1,0,1,1,0,0,0,1,1,0,1,1,1,1,0,0,1,1,1,1,0,1,1];
+
+// A texture of the same class and settings as ``t`` (a THREE.DataTexture), holding a 1 x 1 image.
+function likeTexture(t) {
+  const T = t.constructor;
+  const data = new Uint8Array(4);
+  const c = new T(data, 1, 1, t.format, t.type, t.mapping, t.wrapS, t.wrapT, t.magFilter, t.minFilter);
+  c.generateMipmaps = false;
+  c.flipY = false;
+  c.unpackAlignment = 1;
+  return c;
+}
+
 // 6. Plain geometries drawn in place of the instanced ones, shared by every companion view
 // of one scene (keyed by the layer's three.js instanced geometry).
 const expansions = new WeakMap();
@@ -241,11 +256,12 @@ async function render({ model, el }) {
     const manager = model.widget_manager;
     const isAlive = () => alive;
     const ids = (name) => (model.get(name) || []).map(modelId);
-    const [buffer, scene, geometries, meshes] = await Promise.all([
+    const [buffer, scene, geometries, meshes, textures] = await Promise.all([
       getModel(manager, modelId(model.get("buffer_model_id")), isAlive),
       getModel(manager, modelId(model.get("scene_model_id")), isAlive),
       Promise.all(ids("geometry_model_ids").map((id) => getModel(manager, id, isAlive))),
       Promise.all(ids("mesh_model_ids").map((id) => getModel(manager, id, isAlive))),
+      Promise.all(ids("texture_model_ids").map((id) => getModel(manager, id, isAlive))),
     ]);
     if (alive) {
       // The kernel owns the row buffer's state.  pythreejs would send the three.js buffer's
@@ -326,6 +342,101 @@ async function render({ model, el }) {
         // one opaque surface writes depth; nested translucent ones (sorted back to front) do not
         if (mesh.obj.material) mesh.obj.material.depthWrite = !(s.opacity < 1);
       };
+      // A field's cut ray-cast ("volume", "mip", "sections"; rot4d_widget/view/volume_layer.py):
+      // the atlas and colour table go into the mesh's textures, one box of 36 vertices per cut
+      // into its geometry, the mode and its numbers into uniforms; all from the same message.
+      let ownTextures = null; // [atlas, colour table]: see applyVolume
+      let volumeApplied = null; // {geometry, position, atlas, data}: what applyVolume put in last
+      // pythreejs may (re)build the geometry or a texture after the companion filled them, or the
+      // textures may not have been resolved yet when the message came: true if ours is not drawn
+      const volumeLost = () => {
+        const v = buffer.get("_rot4d_volume") || {};
+        if (!(v.n_boxes > 0)) return false;
+        const mesh = meshes.find((m) => m.obj && m.obj.name === "volume");
+        if (!mesh) return false;
+        const obj = mesh.obj;
+        const u = obj.material && obj.material.uniforms;
+        const atlas = u && u.u_atlas && u.u_atlas.value;
+        const a = volumeApplied;
+        return !a || !obj.visible || a.geometry !== obj.geometry || !obj.geometry.attributes.position ||
+          obj.geometry.attributes.position.array !== a.position || atlas !== a.atlas || !atlas || atlas.image !== a.image;
+      };
+      const applyVolume = () => {
+        const mesh = meshes.find((m) => m.obj && m.obj.name === "volume");
+        volumeApplied = null;
+        if (!mesh) return;
+        const obj = mesh.obj;
+        const v = buffer.get("_rot4d_volume") || {};
+        const n = Number.isInteger(v.n_boxes) ? v.n_boxes : 0;
+        const g = obj.geometry;
+        const u = obj.material && obj.material.uniforms;
+        const size = v.atlas_size || [0, 0];
+        // Textures of the companion's own, made once like the pythreejs placeholders (their
+        // class, format, type and filters): pythreejs writes its model's data back into its own
+        // texture whenever the model is synced (and refuses other dimensions), so ours are not
+        // its objects.  A texture set as a new uniform value needs the material set up again.
+        if (u && !ownTextures && textures.length === 2 && textures[0].obj && textures[1].obj) {
+          ownTextures = textures.map((m) => likeTexture(m.obj));
+          cleanups.push(() => ownTextures.forEach((t) => t.dispose && t.dispose()));
+        }
+        if (u && ownTextures && (!u.u_atlas || u.u_atlas.value !== ownTextures[0] || !u.u_lut || u.u_lut.value !== ownTextures[1])) {
+          u.u_atlas = { value: ownTextures[0] };
+          u.u_lut = { value: ownTextures[1] };
+          obj.material.needsUpdate = true;
+        }
+        if (!n || !g || !g.attributes || !g.attributes.position || !u || !u.u_atlas || !u.u_atlas.value || !u.u_lut ||
+            !u.u_lut.value || !(size[0] > 0 && size[1] > 0)) {
+          obj.visible = false;
+          return;
+        }
+        const boxes = copy(v.boxes, Float32Array);
+        if (boxes.length < n * 12) {
+          obj.visible = false;
+          return;
+        }
+        const V = CUBE.length / 3;
+        const arrays = { position: new Float32Array(n * V * 3) };
+        for (const name of ["a_lo", "a_span", "a_shape", "a_tile"]) arrays[name] = new Float32Array(n * V * 3);
+        for (let b = 0; b < n; b++) {
+          for (let k = 0; k < V; k++) {
+            const o = (b * V + k) * 3;
+            for (let j = 0; j < 3; j++) {
+              arrays.position[o + j] = CUBE[k * 3 + j];
+              arrays.a_lo[o + j] = boxes[b * 12 + j];
+              arrays.a_span[o + j] = boxes[b * 12 + 3 + j];
+              arrays.a_shape[o + j] = boxes[b * 12 + 6 + j];
+              arrays.a_tile[o + j] = boxes[b * 12 + 9 + j];
+            }
+          }
+        }
+        for (const [name, array] of Object.entries(arrays)) {
+          const attr = g.attributes[name];
+          if (!attr) continue;
+          attr.setArray(array);
+          attr.version = nextSurfaceVersion();
+        }
+        g.setDrawRange(0, n * V);
+        const atlas = u.u_atlas.value;
+        atlas.image = { data: copy(v.atlas, Uint8Array), width: size[0], height: size[1] };
+        atlas.needsUpdate = true;
+        const lut = u.u_lut.value;
+        lut.image = { data: copy(v.lut, Uint8Array), width: 256, height: 1 };
+        lut.needsUpdate = true;
+        const set = (name, value) => {
+          if (!u[name]) return;
+          const cur = u[name].value;
+          if (cur && typeof cur.fromArray === "function" && Array.isArray(value)) cur.fromArray(value);
+          else u[name].value = value;
+        };
+        set("u_atlas_size", [size[0], size[1]]);
+        set("u_mode", Number(v.mode) || 0);
+        set("u_sections", v.sections || [0.5, 0.5, 0.5]);
+        set("u_density", Number(v.density) || 0);
+        set("u_step", Number(v.step) || 0.5);
+        obj.material.uniformsNeedUpdate = true;
+        obj.visible = true;
+        volumeApplied = { geometry: g, position: arrays.position, atlas, image: atlas.image };
+      };
       // 6. rows drawn without instancing: geometries[i] is meshes[i]'s (balls, bars, faces)
       const layers = geometries.slice(0, 3).map((model, i) => ({ model, mesh: meshes[i], e: null }));
       const release = (layer) => {
@@ -380,6 +491,7 @@ async function render({ model, el }) {
       if (geometries.length) applyCounts();
       if (meshes.length) applyTurn();
       if (meshes.length) applySurface();
+      if (meshes.length) applyVolume();
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
@@ -393,6 +505,7 @@ async function render({ model, el }) {
         if (b === null) return;
         if (b.counts || b.array) applyCounts();
         if (b.surface) applySurface();
+        if (b.volume) applyVolume();
         if (b.turn) {
           applyTurn();
           scene.trigger("rerender", scene, {}); // a turn alone changes no three.js buffer
@@ -414,13 +527,17 @@ async function render({ model, el }) {
         batch[what] = true;
       };
       const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn"),
-                        _rot4d_surface: note("surface") };
+                        _rot4d_surface: note("surface"), _rot4d_volume: note("volume") };
       let guardsAt = -Infinity;
       const onRendered = () => {
         settle();
         if (surfaceLost()) {
           applySurface();
           scene.trigger("rerender", scene, {});
+        }
+        if (volumeLost()) {
+          applyVolume();
+          if (volumeApplied) scene.trigger("rerender", scene, {});
         }
         // A scan of the document for canvases (a live class collection walks the whole page
         // after any DOM change): at most twice a second, not on every frame.

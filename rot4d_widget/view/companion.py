@@ -72,8 +72,9 @@ class Companion(anywidget.AnyWidget):
     """Invisible front-end helper for one `Scene`.
 
     ``Companion(scene)`` reads ``scene.buffer_model_id``,
-    ``scene.scene_model_id``, ``scene.canvas_class``, ``scene.geometry_model_ids``
-    and ``scene.mesh_model_ids``; they can also be given as keyword arguments.
+    ``scene.scene_model_id``, ``scene.canvas_class``, ``scene.geometry_model_ids``,
+    ``scene.mesh_model_ids`` and ``scene.texture_model_ids``; they can also be given as keyword
+    arguments.
     """
 
     _esm = pathlib.Path(__file__).with_name("companion.js")
@@ -83,6 +84,7 @@ class Companion(anywidget.AnyWidget):
     canvas_class = Unicode("").tag(sync=True)
     geometry_model_ids = List(Unicode()).tag(sync=True)
     mesh_model_ids = List(Unicode()).tag(sync=True)
+    texture_model_ids = List(Unicode()).tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -92,6 +94,7 @@ class Companion(anywidget.AnyWidget):
                 kwargs.setdefault("canvas_class", scene.canvas_class)
                 kwargs.setdefault("geometry_model_ids", list(scene.geometry_model_ids))
                 kwargs.setdefault("mesh_model_ids", list(scene.mesh_model_ids))
+                kwargs.setdefault("texture_model_ids", list(getattr(scene, "texture_model_ids", ())))
             except AttributeError:
                 raise TypeError(f"Expected `scene` to be a rot4d_widget Scene, got {type(scene).__name__}") from None
         kwargs.setdefault("layout", Layout(display="none", width="0px", height="0px"))

@@ -13,7 +13,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 
-from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, Action, Keymap
+from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
 from .readout import help_html
 
 __all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
@@ -211,6 +211,8 @@ class KeyPath:
         if action.kind == "screenshot":
             w._shots.key_p()
             return False
+        if action.kind in ("rendering", "section"):  # the view's field keys (`renderings`)
+            return w._renderings.step(action, inverted)
         if action.kind == "slices" and not w._stacking.is_stack:
             # n on a single slice: the first added slice makes the view a stack of two (recorded
             # as the source setting it is; the stack's own keys are steps from here on)
@@ -235,7 +237,7 @@ class KeyPath:
 
 def _opposite(action: Action, inverted: bool):
     """``(action, inverted)`` of the step that undoes one step of ``action``."""
-    if action.is_rotation or action.kind == "custom":
+    if action.kind in SHIFT_KINDS or action.kind == "custom":
         return action, not inverted
     return dataclasses.replace(action, sign=-action.sign), inverted
 

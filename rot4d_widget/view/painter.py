@@ -14,8 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core import look
+from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source
 from . import readout as ro
+from .cuts import can_sample, grid_cut
+from .volume_layer import volume_message
 
 __all__ = ["ViewKey", "Painter", "READOUT_PERIOD", "checked_slice", "title"]
 
@@ -27,8 +30,8 @@ READOUT_PERIOD = 0.25
 @dataclass(frozen=True, eq=False)
 class ViewKey:
     """The state a picture shows: the rotation, the cut, the camera, the source's version, the
-    colouring, whether the slice was the coarse one (held keys) and the colour scale
-    ``(cmap, clim)`` of a field's levels."""
+    colouring, whether the slice was the coarse one (held keys) and how a field is drawn
+    ``(cmap, clim, rendering, sections)``."""
 
     matrix: np.ndarray
     c0: float
@@ -86,6 +89,10 @@ class Painter:
         #: coarse while keys repeat, full at rest; their rows are turned, not re-sliced, at rest
         self.coarse_ok = coarse_ok
         self.cache = None  # (matrix, c0, version, coarse, data)
+        self.grid_cache = None  # (matrix, c0, version, coarse, GridCut): the ray-cast renderings' cut
+        #: the colour limits of the ray-cast picture shown (the cut's 1st-99th percentile when
+        #: ``clim`` is None), for the colour bar
+        self.cast_clim = None
         self.shown = None
         self.rows_key = None
         self.rows_data = None
@@ -130,7 +137,9 @@ class Painter:
         held = bool(len(w._repeater))
         coarse = held and self.coarse_ok
         shown, rows = self.shown, self.rows_key
-        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse, (w.cmap, w.clim))
+        cast = w.rendering != "surface" and can_sample(w.source)  # ray-cast from the cut on grids
+        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse,
+                      (w.cmap, w.clim, w.rendering if cast else "surface", w.sections if cast else None))
         sent = None
         same_cut = rows is not None and key.same_cut(rows)
         # a stack turns each slice about its own centre: never turned as a whole
@@ -141,6 +150,28 @@ class Painter:
             if scene.turn(turn):
                 sent = scene.update_id
             self.shown = key
+        elif cast:
+            m, c0, version, coarse_ = key.matrix, key.c0, key.version, bool(coarse and self.coarse_ok)
+            cached = self.grid_cache
+            if cached is not None and cached[0] is m and cached[1:4] == (c0, version, coarse_):
+                cut = cached[4]
+            else:
+                source, lock, scale = w.source, w._source_lock, w._scale
+                cut = yield (lambda: grid_cut(source, m, c0, coarse_, lock, scale))  # the slow part, unlocked
+                if w._closed:
+                    return None
+                if w._source_version != version or w.source is not source:
+                    w._pump.mark_dirty()
+                    return None
+                self.grid_cache = (m, c0, version, coarse_, cut)
+            clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
+            volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections)
+            single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+            if scene.show(cut.data, single_rgb=single, volume=volume):
+                sent = scene.update_id
+            self.cast_clim = clim
+            self.rows_data = cut.data
+            self.shown = self.rows_key = key
         else:
             single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
             rows_turn = key.turn_from(rows) if same_cut else None

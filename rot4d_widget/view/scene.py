@@ -75,6 +75,7 @@ from . import buffers as bf
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
+from .volume_layer import VolumeLayer
 
 __all__ = ["Scene", "shader_source"]
 
@@ -99,7 +100,8 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     (balls, bars, faces: the companion sets the geometries' drawn count as it
     applies the message); ``_rot4d_turn`` a 3-D turn of the whole view as a
     column-major 4x4 (the companion sets it on the meshes); ``_rot4d_surface``
-    a smooth surface's quantised arrays (the companion uploads them).
+    a smooth surface's quantised arrays (the companion uploads them); ``_rot4d_volume`` a
+    field's cut(s) on grids for the ray-cast renderings (`rot4d_widget.view.volume_layer`).
     """
 
     _rot4d_seq = CInt(0).tag(sync=True)
@@ -108,6 +110,8 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     #: A smooth surface (`buffers.surface_arrays`, arrays as bytes): the companion uploads it
     #: into the surface mesh as it applies the same message as the rows.  {} = none.
     _rot4d_surface = Dict().tag(sync=True)
+    #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
+    _rot4d_volume = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
@@ -264,8 +268,13 @@ class Scene:
 
     @property
     def mesh_model_ids(self) -> list:
-        """Model ids of the ball, bar, face and surface meshes (the companion turns them)."""
-        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface")]
+        """Model ids of the ball, bar, face, surface and volume meshes (the companion turns them)."""
+        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume")]
+
+    @property
+    def texture_model_ids(self) -> list:
+        """Model ids of the volume layer's atlas and colour-table textures (the companion fills them)."""
+        return self._volume.texture_model_ids
 
     @property
     def scene_model_id(self) -> str:
@@ -365,7 +374,7 @@ class Scene:
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, group_rgb=None, force=False) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None) -> bool:
         """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
@@ -374,7 +383,9 @@ class Scene:
         not change and no "drawn" acknowledgement will come.  Never creates
         widgets.  A slice with ``normals`` is a smooth surface: its triangles
         travel quantised in the same message (``_rot4d_surface``, coloured by
-        ``group_rgb`` if given), the rows carry its points' bars.
+        ``group_rgb`` if given), the rows carry its points' bars.  ``volume``: a ray-cast
+        rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
+        of any surface (None: no volume; one shown before is hidden).
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
@@ -386,8 +397,10 @@ class Scene:
             n_levels = len(np.unique(np.asarray(data.groups))) if len(data.groups) else 0
             surface = _surface_message(arrays, 1.0 if n_levels <= 1 else look.SURFACE_OPACITY)
             data = bf.without_triangles(data)
-        elif self._surface_shown:
+        elif self._surface_shown or volume is not None:
             surface = {}
+        if volume is None and self._volume_shown:
+            volume = {}
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -395,13 +408,13 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
             capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
-        if (not force and not self._unsent and surface is None and np.array_equal(rows, self._rows)
+        if (not force and not self._unsent and surface is None and volume is None and np.array_equal(rows, self._rows)
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
         n_points = len(data.points) if getattr(data, "show_points", True) else 0
         counts = [n_points, len(data.segments), len(data.triangles)]
-        self._assign(rows, self.update_id, counts, surface=surface)
+        self._assign(rows, self.update_id, counts, surface=surface, volume=volume)
         return True
 
     @property
@@ -455,12 +468,15 @@ class Scene:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
         return self._buffer._rot4d_turn != _IDENTITY4
 
-    def _assign(self, rows, seq, counts=None, surface=None):
+    def _assign(self, rows, seq, counts=None, surface=None, volume=None):
         buf = self._buffer
         with self._sending():
             if surface is not None:
                 buf._rot4d_surface = surface
                 self._surface_shown = bool(surface)
+            if volume is not None:
+                buf._rot4d_volume = volume
+                self._volume_shown = bool(volume)
             buf.array = rows
             buf._rot4d_seq = seq
             if counts is not None:
@@ -591,6 +607,8 @@ def _build_three(scene, antialias, display):
         geometry=scene._surface_geometry, material=scene._materials["surface"], frustumCulled=False,
         name="surface", visible=display["show_faces"],
     )
+    scene._volume = VolumeLayer()  # a field's cut ray-cast: hidden until a volume arrives
+    scene._meshes["volume"] = scene._volume.build(shader_source)
     scene._camera = p3.PerspectiveCamera(
         position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=scene.width / scene.height,
         near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
@@ -617,8 +635,10 @@ def _build_three(scene, antialias, display):
         *scene._materials.values(), *scene._geometries.values(), *attrs.values(), scene._buffer,
         *(a for t in templates.values() for a in t.values()),
         scene._surface_geometry, *scene._surface_attrs.values(), scene._surface_index,
+        *(w for w in scene._volume.widgets if w is not scene._meshes["volume"]),
     ]  # fmt: skip
     scene._surface_shown = False
+    scene._volume_shown = False
     # ipywidgets' view count, kept by the front end on request (None: not requested)
     if scene._renderer._view_count is None:
         scene._renderer._view_count = 0

@@ -12,6 +12,8 @@ on unchanged.  The checks are plain functions too (`check_positive`, `check_frac
     arrangement = Choice(None, ("oval", "grid", "stack"), allow_none=True)
     cmap = Cmap("viridis")                            # a matplotlib colour map name
     clim = Clim(None, allow_none=True)                # (lo, hi) finite, lo < hi; None: the data's range
+    rendering = Rendering("surface")                  # "surface", "volume", "mip", "sections"
+    sections = Sections((0.5, 0.5, 0.5))              # three fractions in [0, 1]
 """
 
 from __future__ import annotations
@@ -28,7 +30,8 @@ from ..core.validate import real
 
 __all__ = [
     "Checked", "Angle", "Finite", "Positive", "Fraction", "Colour", "Flag", "ColorBy", "Count", "Spacing",
-    "Choice", "Levels", "Cmap", "Clim", "check_positive", "check_fraction", "check_flag", "check_color_by",
+    "Choice", "Levels", "Cmap", "Clim", "Rendering", "Sections", "check_positive", "check_fraction", "check_flag",
+    "check_color_by",
 ]
 
 
@@ -241,3 +244,22 @@ class Clim(Checked):
         if value is None:  # None is refused here only when the trait does not allow it
             raise TypeError(f"Expected `{name}` to be {self.info_text}, got None")
         return look.check_clim(value, name)
+
+
+class Rendering(Checked):
+    """How a field's cut is drawn: one of `rot4d_widget.core.look.RENDERINGS`."""
+
+    info_text = " or ".join(map(repr, look.RENDERINGS))
+
+    def check(self, name, value):
+        return look.check_rendering(value, name)
+
+
+class Sections(Checked):
+    """The section planes' positions (fx, fy, fz), each in [0, 1] of the cut's extent, as a tuple of
+    floats (`rot4d_widget.core.look.check_sections`)."""
+
+    info_text = "(fx, fy, fz), three numbers in [0, 1]"
+
+    def check(self, name, value):
+        return look.check_sections(value, name)

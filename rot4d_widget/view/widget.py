@@ -59,6 +59,7 @@ from . import readout as ro
 from . import traits as t
 from .buffers import estimate_capacity
 from .companion import Companion
+from .cuts import can_sample
 from .errors import MAX_ERRORS_SHOWN, ErrorArea  # noqa: F401 - MAX_ERRORS_SHOWN: part of the module's names
 from .keeping import Keeper
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
@@ -66,6 +67,7 @@ from .keypad import KeyPad, close_quietly
 from .keys import KeyPath, help_groups, source_actions
 from .painter import READOUT_PERIOD, Painter, checked_slice, title
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
+from .renderings import Renderings
 from .screenshots import Screenshots
 from .stacking import Stacking, make_stack
 from .sync import DISPLAY_TRAITS, TraitSync
@@ -186,6 +188,8 @@ class Rot4DWidget(widgets.HBox):
     arrangement = t.Choice(None, ARRANGEMENTS, allow_none=True, help="where the parallel slices are placed")
     cmap = t.Cmap(look.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
     clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
+    rendering = t.Rendering("surface", help="how a field's cut is drawn: surface, volume, mip or sections")
+    sections = t.Sections(look.DEFAULT_SECTIONS, help="the section planes, fractions (fx, fy, fz) of the cut")
 
     def __init__(
         self, source="5-cell", theta0: float = DEFAULT_THETA0, alpha: float | None = None, c0: float | None = None,
@@ -193,7 +197,7 @@ class Rot4DWidget(widgets.HBox):
         ball_radius: float | None = None, bar_radius: float | None = None, face_opacity: float = look.FACE_OPACITY,
         background=look.BACKGROUND, show_balls: bool = True, show_bars: bool = True, show_faces: bool = True,
         color_by="group", group_colors=None, levels=None, slices=None, spacing=None, arrangement="oval",
-        cmap: str = look.LEVEL_COLORMAP, clim=None,
+        cmap: str = look.LEVEL_COLORMAP, clim=None, rendering: str = "surface", sections=look.DEFAULT_SECTIONS,
         antialias: bool = False, keypad: bool = False, hold_delay: float = HOLD_DELAY, tick_rate: float = TICK_RATE,
         ack_timeout: float = ACK_TIMEOUT, _clock=None, _autotick: bool = True,
     ):
@@ -207,6 +211,7 @@ class Rot4DWidget(widgets.HBox):
         if _clock is not None and not callable(_clock):
             raise TypeError(f"Expected `_clock` to be a callable returning seconds, got {type(_clock).__name__}")
         color_by, cmap, clim = t.check_color_by(color_by), look.check_cmap(cmap), look.check_clim(clim)
+        rendering, sections = _check_rendering(src, rendering), look.check_sections(sections)
         scale = look.REFERENCE_RADIUS / float(src.size)
         coarse_ok = takes_coarse(src)
         if ball_radius is None:
@@ -233,6 +238,7 @@ class Rot4DWidget(widgets.HBox):
         self._stacking = Stacking(self)
         self._shots = Screenshots(self)
         self._keypad = KeyPad(self)
+        self._renderings = Renderings(self)
         self._pump = UpdatePump(
             self._painter.send, tick=self._keys.tick, deadline=repeater.next_deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
@@ -252,7 +258,7 @@ class Rot4DWidget(widgets.HBox):
             [self._canvas_box, self._side_box],
             layout=widgets.Layout(flex_flow="row wrap", align_items="flex-start"),
             **self.scene.display,
-            color_by=color_by, cmap=cmap, clim=clim,
+            color_by=color_by, cmap=cmap, clim=clim, rendering=rendering, sections=sections,
         )
         try:
             _wire(self, keypad)
@@ -500,6 +506,7 @@ def _wire(w, keypad) -> None:
     w.scene.on_view_count(w._keys.view_count)
     w.scene.on_eye_moved(w._painter.eye_moved)
     w._sync.observe()
+    w._renderings.observe()
     w.observe(w._on_keypad, names="keypad")
     w.keypad = keypad
 
@@ -576,6 +583,16 @@ def _build_children(w, options) -> None:
         for x in reversed(built):
             close_quietly(x)
         raise
+
+
+def _check_rendering(source, rendering) -> str:
+    """``rendering`` checked (`look.check_rendering`) and possible for ``source``: only a source that
+    gives its cut on a grid (``sample``) has more than the surface."""
+    rendering = look.check_rendering(rendering)
+    if rendering != "surface" and not can_sample(source):
+        raise ValueError(f"rendering={rendering!r} needs a field (a source with `sample`, the cut on a grid); "
+                         f"{title(source)} has only rendering='surface'")
+    return rendering
 
 
 def _source_and_state(source, theta0, alpha, c0, keymap, c0_step, levels, slices, spacing, arrangement):

@@ -1,0 +1,96 @@
+"""A field's cut for the ray-cast renderings: the grids the page casts rays through and the bars
+around them, read through the source protocol (``sample``, a stack's ``cuts``), never a class.
+
+`grid_cut` is the volume renderings' ``source.slice``: where a surface rendering asks the source
+for its isosurfaces, these ask for the values on a grid (`rot4d_widget.sources.field_grid`) --
+no isosurface is computed for a single field, so a held key costs a coarse sampling only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..sources.protocol import SliceData, inner_source
+
+__all__ = ["GridCut", "grid_cut", "can_sample", "STACK_NODES"]
+
+#: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
+STACK_NODES = 4 * 64 ** 3
+
+
+@dataclass(frozen=True)
+class GridCut:
+    """What a ray-cast picture shows: ``data`` (`SliceData`: the box's cut as bars, no faces, and the
+    readout rows) and ``parts``, one ``(values (nx, ny, nz), lo (3,), span (3,))`` per cut, the
+    grid's nodes spanning ``lo`` ... ``lo + span`` in scene units (``scale`` applied), and
+    ``grids`` the `FieldGrid` s themselves (their values' range for the colour limits)."""
+
+    data: SliceData
+    parts: tuple
+    grids: tuple
+
+    @property
+    def finite_values(self) -> np.ndarray:
+        """Every finite value of every cut, flattened (for default colour limits)."""
+        vals = [np.asarray(g.values)[np.isfinite(g.values)] for g in self.grids if not g.empty]
+        return np.concatenate(vals) if vals else np.zeros(0, dtype=np.float32)
+
+
+def can_sample(source) -> bool:
+    """True when the (inner) source gives its cut on a grid (the protocol's optional ``sample``)."""
+    return callable(getattr(inner_source(source), "sample", None))
+
+
+def _part(grid, lo_shift, scale):
+    values = np.asarray(grid.values)
+    lo = np.asarray(lo_shift, dtype=np.float64) + scale * np.asarray(grid.origin, dtype=np.float64)
+    span = scale * float(grid.spacing) * (np.asarray(values.shape, dtype=np.float64) - 1.0)
+    return values, lo, span
+
+
+def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
+    """The cut w = ``c0`` after ``matrix`` on grids, placed as the view places the slice: a single
+    field's grid scaled by ``scale`` (source units -> displayed units); a stack's slices each at
+    its centre and scale (``extra["cuts"]``, ``"centres"``, ``"scales"`` of the stack's slice, as
+    the static renders place them).  ``lock`` guards the source while it is read."""
+    inner = inner_source(source)
+    with lock:
+        if inner is source:
+            grid = _sample(inner, matrix, c0, None, coarse)
+            pts, segs = grid.outline
+            data = SliceData.build(pts, segs, show_points=False, readout=_readout(grid))
+            return GridCut(data, (_part(grid, np.zeros(3), scale),), (grid,))
+        sliced = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
+        ex = sliced.extra
+        cuts = np.asarray(ex["cuts"], dtype=np.float64)
+        centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
+        scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+        res = getattr(inner, "coarse_resolution" if coarse else "resolution", 64)
+        res = max(8, min(int(res), int(round((STACK_NODES / max(len(cuts), 1)) ** (1.0 / 3.0)))))
+        grids = tuple(_sample(inner, matrix, float(w), res, coarse) for w in cuts)
+    parts = tuple(_part(g, scale * centres[k], scale * scales[k]) for k, g in enumerate(grids))
+    data = SliceData.build(sliced.points, sliced.segments, show_points=False, readout=sliced.readout,
+                           extra=sliced.extra)
+    return GridCut(data, parts, grids)
+
+
+def _sample(inner, matrix, c0, resolution, coarse):
+    """``inner.sample``; a coarse one from the full data while the source's coarse copy is still
+    being built (``coarse_ready`` False: the copy is not waited for, as `Field4D.slice` does)."""
+    if coarse and not getattr(inner, "coarse_ready", True):
+        res = resolution if resolution is not None else getattr(inner, "coarse_resolution", None)
+        return inner.sample(matrix, c0, res)
+    return inner.sample(matrix, c0, resolution, coarse=coarse)
+
+
+def _readout(grid) -> tuple:
+    """Readout rows of one grid: its nodes and the range of the values it holds."""
+    rows = [("grid", " \u00d7 ".join(str(n) for n in grid.values.shape) + f" nodes, spacing {grid.spacing:.4g}")]
+    v = np.asarray(grid.values)
+    finite = v[np.isfinite(v)]
+    if len(finite):
+        units = f" {grid.units}" if grid.units else ""
+        rows.append(("cut range", f"{float(finite.min()):.4g} \u2026 {float(finite.max()):.4g}{units}"))
+    return tuple(rows)
