@@ -209,3 +209,34 @@ def test_a_cut_that_misses_the_data_shows_no_volume_and_no_error(make):
     assert w.scene._buffer._rot4d_volume == {} and len(w.errors.outputs) == 0
     w.c0 = 0.0
     assert w.scene._buffer._rot4d_volume["n_boxes"] == 1
+
+
+def test_the_colour_bar_spans_the_limits_the_ray_cast_colours_used(make):
+    w = make(blob(), rendering="mip")
+    lo, hi = w._painter.cast_clim
+    bar = w._painter.colourbar()
+    assert "rot4d-cbar-mark" not in bar  # no iso level drawn: none marked
+    assert f"{lo:.3g}"[:3] in bar and "blob" in bar and "kg/m3" in bar
+    w.clim = (0.25, 0.75)
+    bar = w._painter.colourbar()
+    assert "0.25" in bar and "0.75" in bar
+    w.rendering = "surface"
+    assert "rot4d-cbar-mark" in w._painter.colourbar()  # the level is marked again
+
+
+def test_a_single_field_labels_its_box_with_data_coordinates(make):
+    from rot4d_widget.sources.field_labels import box_labels
+
+    f = blob()
+    w = make(f, rendering="mip")
+    labels = w.scene._buffer._rot4d_labels
+    g = f.sample(w.state.matrix, w.c0)
+    want = box_labels(f, w.state.matrix, w.c0, g)
+    assert [lab["text"] for lab in labels] == [t for _, t in want] and len(labels) == 4
+    np.testing.assert_allclose([lab["p"] for lab in labels], [w.scene.scale * np.asarray(p) for p, _ in want])
+    w.press("4")  # x and w mix: the edge labels name both
+    assert any("w " in lab["text"] and "x " in lab["text"] for lab in w.scene._buffer._rot4d_labels[1:])
+    w.rendering = "surface"
+    assert len(w.scene._buffer._rot4d_labels) == 4  # the surface view is labelled too
+    p = make("24-cell")
+    assert p.scene._buffer._rot4d_labels == []

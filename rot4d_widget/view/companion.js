@@ -527,10 +527,71 @@ async function render({ model, el }) {
         batch[what] = true;
       };
       const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn"),
-                        _rot4d_surface: note("surface"), _rot4d_volume: note("volume") };
+                        _rot4d_surface: note("surface"), _rot4d_volume: note("volume"),
+                        _rot4d_labels: note("labels") };
       let guardsAt = -Infinity;
-      const onRendered = () => {
+      // Labels pinned to points of the view (`_rot4d_labels`: a field's box corners with their data
+      // coordinates): an overlay over each canvas of this scene, each text where its point projects
+      // through the camera of the frame just drawn, turned with the meshes.  Rewritten only when a
+      // position or a text changed.
+      const overlays = new Map(); // canvas host element -> {div, key}
+      cleanups.push(() => overlays.forEach((o) => o.div.remove()));
+      const placeLabels = (camera) => {
+        const labels = buffer.get("_rot4d_labels") || [];
+        const cls = model.get("canvas_class");
+        if (!cls || !camera || !camera.projectionMatrix) return;
+        const turn = meshes.length && meshes[0].obj ? meshes[0].obj.matrixWorld : null;
+        const V = camera.position.constructor;
+        for (const host of document.getElementsByClassName(cls)) {
+          const canvas = host.localName === "canvas" ? host : host.querySelector("canvas");
+          if (!canvas || !canvas.isConnected) continue;
+          const w = canvas.clientWidth, h = canvas.clientHeight;
+          const spots = labels.map((l) => {
+            const v = new V(l.p[0], l.p[1], l.p[2]);
+            if (turn) v.applyMatrix4(turn);
+            v.project(camera);
+            return { x: Math.round(((v.x + 1) / 2) * w), y: Math.round(((1 - v.y) / 2) * h), text: String(l.text || "") };
+          });
+          const key = JSON.stringify(spots);
+          let o = overlays.get(host);
+          if (o && o.key === key && o.div.isConnected) continue;
+          if (!o || !o.div.isConnected) {
+            const div = document.createElement("div");
+            div.className = "rot4d-labels";
+            div.style.cssText = "position:absolute;left:0;top:0;width:0;height:0;pointer-events:none;z-index:1";
+            if (getComputedStyle(host).position === "static") host.style.position = "relative";
+            host.appendChild(div);
+            o = { div, key: null };
+            overlays.set(host, o);
+          }
+          o.key = key;
+          // a dot at each point, its text beside it away from the labels' middle (the box's),
+          // kept inside the canvas
+          const mid = spots.reduce((a, s) => a + s.x, 0) / Math.max(spots.length, 1);
+          const shown = spots.filter((s) => s.text);
+          o.div.replaceChildren(...shown.map((s) => {
+            const span = document.createElement("span");
+            span.className = "rot4d-label";
+            span.textContent = s.x <= mid ? s.text + " \u25cf" : "\u25cf " + s.text;
+            span.style.cssText = `position:absolute;left:${s.x}px;top:${s.y}px;font:10px sans-serif;color:#333;` +
+              "background:rgba(255,255,255,0.72);padding:0 2px;white-space:nowrap;transform:translate(0,-50%)";
+            return span;
+          }));
+          Array.from(o.div.children).forEach((span, i) => {
+            const s = shown[i];
+            const width = span.offsetWidth;
+            const x0 = s.x <= mid ? s.x - width + 5 : s.x - 5;
+            span.style.left = `${Math.max(0, Math.min(w - width, x0))}px`;
+          });
+        }
+      };
+      const onRendered = (_scene, _renderer, camera) => {
         settle();
+        try {
+          placeLabels(camera);
+        } catch (e) {
+          console.warn("rot4d_widget companion: labels not placed", e);
+        }
         if (surfaceLost()) {
           applySurface();
           scene.trigger("rerender", scene, {});

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..sources.field_labels import box_labels
 from ..sources.protocol import SliceData, inner_source
 
-__all__ = ["GridCut", "grid_cut", "can_sample", "STACK_NODES"]
+__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "STACK_NODES"]
 
 #: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
 STACK_NODES = 4 * 64 ** 3
@@ -74,6 +75,31 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
     data = SliceData.build(sliced.points, sliced.segments, show_points=False, readout=sliced.readout,
                            extra=sliced.extra)
     return GridCut(data, parts, grids)
+
+
+class _Box:
+    """The bounding box of a slice's points in the shape `box_labels` reads (``origin``, ``extent``)."""
+
+    def __init__(self, points):
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        self.origin = p.min(axis=0)
+        self.extent = tuple(zip(self.origin, p.max(axis=0)))
+        self.values = None
+
+
+def cut_labels(source, matrix, c0, data, grid=None) -> tuple:
+    """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels`): its box's
+    origin corner and the far ends of the three edges leaving it, with the data coordinates there,
+    in slice coordinates; ``grid`` the cut's `FieldGrid` (ray-cast renderings) or None (the
+    bounding box of ``data``'s points, the box's cut).  () for a stack, a source that maps no
+    slice point to its data (no ``to_data``) or an empty cut."""
+    if inner_source(source) is not source or not callable(getattr(source, "to_data", None)):
+        return ()
+    if grid is None:
+        if not len(data.points):
+            return ()
+        grid = _Box(data.points)
+    return box_labels(source, matrix, c0, grid)
 
 
 def _sample(inner, matrix, c0, resolution, coarse):

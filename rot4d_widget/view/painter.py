@@ -17,7 +17,7 @@ from ..core import look
 from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source
 from . import readout as ro
-from .cuts import can_sample, grid_cut
+from .cuts import can_sample, cut_labels, grid_cut
 from .volume_layer import volume_message
 
 __all__ = ["ViewKey", "Painter", "READOUT_PERIOD", "checked_slice", "title"]
@@ -167,7 +167,8 @@ class Painter:
             clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections)
             single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
-            if scene.show(cut.data, single_rgb=single, volume=volume):
+            labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
+            if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels):
                 sent = scene.update_id
             self.cast_clim = clim
             self.rows_data = cut.data
@@ -195,7 +196,8 @@ class Painter:
                     self.cache = (m, c0, version, coarse_, data)
             colors = self.group_colors()
             extra = {} if colors is None else {"group_rgb": colors}
-            if scene.show(data, single_rgb=single, **extra):
+            labels = cut_labels(w.source, key.matrix, key.c0, data)
+            if scene.show(data, single_rgb=single, labels=labels, **extra):
                 sent = scene.update_id
             self.rows_data = data
             self.shown = self.rows_key = key
@@ -264,19 +266,25 @@ class Painter:
         """The colour bar of a field's values (`readout.colourbar_html`): ``cmap`` over ``clim`` (or
         the data's range), its name (xarray's ``long_name`` when the field keeps it) and units, a
         mark per iso level in its surface's colour (``level_rgb``; black when the surfaces are
-        coloured otherwise: a stack by w, one colour).  "" for a source without levels."""
+        coloured otherwise: a stack by w, one colour).  A ray-cast picture's bar spans the limits
+        its colours used (``clim``, or the cut's 1st-99th percentile) and marks no level.  "" for
+        a source without levels."""
         w = self.w
         inner = inner_source(w.source)
         levels = getattr(inner, "levels", None)
         if not levels:
             return ""
-        lo, hi = w.clim if w.clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
+        cast = self.shown is not None and self.shown.scale[2:3] not in ((), ("surface",))
+        if cast and self.cast_clim is not None:  # a ray-cast picture: the limits its colours used
+            lo, hi = self.cast_clim
+        else:
+            lo, hi = w.clim if w.clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
             return "no colour scale (the data's range is " + html.escape(f"{lo:.4g} \u2026 {hi:.4g})")
         if level_rgb is None or w.color_by != "group":
             level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
         label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
-        marks = [(float(v), look.hex_color(c)) for v, c in zip(levels, level_rgb)]
+        marks = [] if cast else [(float(v), look.hex_color(c)) for v, c in zip(levels, level_rgb)]
         return ro.colourbar_html(look.cmap_stops(w.cmap), lo, hi, str(label), getattr(inner, "units", None),
                                  marks, cmap=w.cmap)
 

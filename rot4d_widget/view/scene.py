@@ -112,6 +112,9 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     _rot4d_surface = Dict().tag(sync=True)
     #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
     _rot4d_volume = Dict().tag(sync=True)
+    #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str}): the
+    #: companion draws them over the canvas where the points project, turned with the view.
+    _rot4d_labels = List(Dict()).tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
@@ -374,7 +377,7 @@ class Scene:
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None, labels=()) -> bool:
         """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
@@ -385,7 +388,8 @@ class Scene:
         travel quantised in the same message (``_rot4d_surface``, coloured by
         ``group_rgb`` if given), the rows carry its points' bars.  ``volume``: a ray-cast
         rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
-        of any surface (None: no volume; one shown before is hidden).
+        of any surface (None: no volume; one shown before is hidden).  ``labels``: ``(point (3,)
+        in the source's units, text)`` pairs drawn over the canvas where the points project.
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
@@ -401,6 +405,9 @@ class Scene:
             surface = {}
         if volume is None and self._volume_shown:
             volume = {}
+        pinned = [{"p": [float(v) * self.scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t)}
+                  for p, t in labels]
+        pinned = None if pinned == self._buffer._rot4d_labels else pinned
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -408,13 +415,14 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
             capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
-        if (not force and not self._unsent and surface is None and volume is None and np.array_equal(rows, self._rows)
+        if (not force and not self._unsent and surface is None and volume is None and pinned is None
+                and np.array_equal(rows, self._rows)
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
         n_points = len(data.points) if getattr(data, "show_points", True) else 0
         counts = [n_points, len(data.segments), len(data.triangles)]
-        self._assign(rows, self.update_id, counts, surface=surface, volume=volume)
+        self._assign(rows, self.update_id, counts, surface=surface, volume=volume, labels=pinned)
         return True
 
     @property
@@ -468,9 +476,11 @@ class Scene:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
         return self._buffer._rot4d_turn != _IDENTITY4
 
-    def _assign(self, rows, seq, counts=None, surface=None, volume=None):
+    def _assign(self, rows, seq, counts=None, surface=None, volume=None, labels=None):
         buf = self._buffer
         with self._sending():
+            if labels is not None:
+                buf._rot4d_labels = labels
             if surface is not None:
                 buf._rot4d_surface = surface
                 self._surface_shown = bool(surface)

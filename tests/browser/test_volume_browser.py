@@ -95,6 +95,15 @@ def test_volume_mip_sections_in_the_page_agree_with_the_static_render(jupyter_se
         assert r["iou"] > 0.85, (rendering, r)
         assert r["shift"] < 3.0, (rendering, r)
         assert r["diff"] < 0.12, (rendering, r)
+    # the box's corner and edge ends carry the data coordinates there, over the canvas
+    host = page.locator(sel).locator("xpath=..")
+    labels = host.locator(".rot4d-label")
+    assert jp.wait_for(lambda: labels.count() == 4, timeout=10), labels.count()
+    texts = labels.all_inner_texts()
+    want = jp.kernel_json("[lab['text'] for lab in w.scene._buffer._rot4d_labels]")
+    assert [t.strip("\u25cf ") for t in texts] == want, (texts, want)
+    assert texts[0].strip("\u25cf ").startswith("x ") and " \u2192 " in texts[1], texts  # the corner; an edge
+    host.screenshot(path=str(artifacts / f"volume-labelled-{jupyter_server.kind}.png"))
     # the three renderings are different pictures of the same cut
     assert len({round(v["page_ink"], -2) for v in results.values()}) >= 2, results
 
