@@ -68,7 +68,8 @@ def _shot(jp, rendering):
     """The page's PNG of the view once it has drawn ``rendering`` (the kernel shows it and the page
     acknowledged every update sent), fresh each time."""
     shown = f"w._painter.shown is not None and w._painter.shown.scale[2] == {rendering!r}"
-    assert jp.wait_for(lambda: jp.kernel_json(f"{shown} and not w.in_flight"), timeout=30)
+    assert jp.wait_for(lambda: jp.kernel_json(f"{shown} and not w.in_flight"), timeout=90), jp.kernel_json(
+        "[str(w._painter.shown and w._painter.shown.scale), w.in_flight, w.stats.as_dict()]")
     jp.kernel("w.last_screenshot = None")
     jp.kernel_json("w.screenshot()")
     assert jp.wait_for(lambda: jp.kernel_json("w.last_screenshot is not None"), timeout=30), "no PNG from the page"
