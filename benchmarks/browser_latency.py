@@ -9,7 +9,13 @@ Renderer with the widget's settings (600 x 500, no multisampling) -- and
     python benchmarks/browser_latency.py [--presses 40] [--hold 2]
         [--tap 60-120] [--cases 5-cell,600-cell] [--seed 0] [--rev HEAD]
         [--nagle] [--runs 1] [--json out.json] [--ceiling] [--trace [--profile]]
-        [--targets own|slow|issue4] [--cpus 0 [--busy 1]] [--in-flight N]
+        [--targets own|slow|issue4] [--cpus 0 [--busy 1]] [--in-flight N] [--volume-step S]
+
+Issue 21's cases ``blob64-surface``, ``blob64-volume``, ``blob64-mip``: a 64^4 field (a Gaussian
+blob travelling along x as w grows, the array of benchmarks/volume_step.py) in each rendering,
+with a table of held fps, its ratio to the same run's baseline (target >= 0.6x for volume and
+mip) and bytes per update; ``--volume-step S`` sets the ray's sample spacing (a diagnosis).
+Figures and commands: docs/volume-speed.md.
 
 About 4 minutes for the default run (headless, runs as root).  The machine
 is shared and noisy: ``--runs 3`` repeats the whole measurement and ends
@@ -163,6 +169,25 @@ FIELD_CASES["allen-cahn"] = (
     "from rot4d_widget import Field4D\nfrom rot4d_widget.sources.datasets import phase_separation\n"
     "field = Field4D.from_xarray(phase_separation(), w='time', levels=[0.0])"
 )
+#: Issue 21: a Gaussian blob travelling along x as w grows, f[x, y, z, w] on a 64^4 float32 array
+#: (the array of benchmarks/volume_step.py), drawn in each rendering: ``--cases blob64-volume,...``.
+BLOB64 = (
+    "import numpy as np\nfrom rot4d_widget import Field4D\n"
+    "_g = np.linspace(-1.0, 1.0, 64, dtype=np.float32)\n"
+    "_yz = _g[None, :, None] ** 2 + _g[None, None, :] ** 2\n"
+    "_a = np.empty((64,) * 4, dtype=np.float32)\n"
+    "for _i, _w in enumerate(_g):\n"
+    "    _a[..., _i] = np.exp(-((_g[:, None, None] - 0.6 * _w) ** 2 + _yz) / 0.18)\n"
+    "field = Field4D(_a, axes='xyzw', extent=[(-1.0, 1.0)] * 4, levels=[0.5], name='blob')"
+)
+#: The widget's ``rendering`` per case (the fields above draw "surface").
+FIELD_RENDERING = {}
+for _r in ("surface", "volume", "mip"):
+    FIELD_CASES[f"blob64-{_r}"] = BLOB64
+    FIELD_RENDERING[f"blob64-{_r}"] = _r
+#: Issue 21's speed target: volume and mip held keys at >= 0.6x the baseline's held frame rate
+#: (same run), whatever ``--targets`` says for the rest.
+RATIO_FPS = {"blob64-volume": 0.6, "blob64-mip": 0.6}
 #: Parallel slices (issue 10): the widget's arguments.
 STACK_CASES = {
     "oval24": "'24-cell', slices=12, spacing=0.3, arrangement='oval'",
@@ -457,6 +482,8 @@ def targets_for(case: str, base_fps: float) -> tuple[float, float, str]:
     lat = t["frames"][k] * FRAME_MS
     if case in ABSOLUTE_FPS:
         return lat, ABSOLUTE_FPS[case], f"≥ {ABSOLUTE_FPS[case]:g} (its issue)"
+    if case in RATIO_FPS:
+        return lat, RATIO_FPS[case] * base_fps, f"≥ {RATIO_FPS[case]:g}× = {RATIO_FPS[case] * base_fps:.1f} (issue 21)"
     if t["ratio"]:
         return lat, t["fps"][k] * base_fps, f"≥ {t['fps'][k]:g}× = {t['fps'][k] * base_fps:.1f}"
     return lat, t["fps"][k], f"≥ {t['fps'][k]:g}"
@@ -464,6 +491,9 @@ def targets_for(case: str, base_fps: float) -> tuple[float, float, str]:
 
 #: ``--in-flight N``: set the widget's bound on updates in flight (None: the package's default).
 IN_FLIGHT = None
+#: ``--volume-step S``: the ray-cast renderings sample every S grid spacings (None: the package's
+#: ``volume_layer.STEP``, 0.5) -- to see how the page's time follows the samples per ray.
+VOLUME_STEP = None
 
 
 # -- helpers ------------------------------------------------------------------
@@ -540,8 +570,12 @@ def run_case(context, server, case: str, args, rng: random.Random, hold_baseline
     if case in UNIFORM_CASES:
         cells[1] = f"from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({UNIFORM_CASES[case]}))\nw"
     if case in FIELD_CASES:
-        cells[1] = (f"{FIELD_CASES[case]}\nfrom rot4d_widget import Rot4DWidget\n"
-                    "w = bench.probe(Rot4DWidget(field))\nw")
+        rendering = f", rendering={FIELD_RENDERING[case]!r}" if case in FIELD_RENDERING else ""
+        step = ""
+        if VOLUME_STEP is not None:  # --volume-step: the ray's sample spacing (volume_layer.STEP), a diagnosis
+            step = f"import rot4d_widget.view.volume_layer as _vl\n_vl.STEP = {VOLUME_STEP!r}\n"
+        cells[1] = (f"{FIELD_CASES[case]}\n{step}from rot4d_widget import Rot4DWidget\n"
+                    f"w = bench.probe(Rot4DWidget(field{rendering}))\nw")
     if IN_FLIGHT is not None:  # --in-flight: the widget's bound on updates in flight, for comparisons
         head, _, last = cells[1].rpartition("\n")  # ... w = bench.probe(...) / w
         cells[1] = f"{head}\nw._pump.max_in_flight = {IN_FLIGHT}\n{last}"
@@ -1166,6 +1200,7 @@ def report(results: dict, meta: dict) -> str:
                 sent = results[case]["widget"]["hold"].get("sent_kinds_per_update") or {}
                 prof.append(f"- {case}: " + ", ".join(f"{n} {v}" for n, v in k.items())
                             + "; sent by the page: " + ", ".join(f"{n} {v}" for n, v in sent.items()))
+    prof += renderings_table(results, bh.get("fps", math.nan))
     m = meta
     note = [
         "",
@@ -1183,6 +1218,56 @@ def report(results: dict, meta: dict) -> str:
     if errs:
         note.append("Page errors: " + "; ".join(errs[:5]))
     return "\n".join(lines + prof + note)
+
+
+def renderings_table(results: dict, base_fps: float) -> list:
+    """Issue 21's table, when a field is measured in several renderings (``FIELD_RENDERING``): held
+    fps, its ratio to the baseline's (same run), the kernel's held step and the bytes per update."""
+    cases = [c for c in results if c in FIELD_RENDERING]
+    if not cases:
+        return []
+    out = ["", f"Issue 21, a 64⁴ field in each rendering while '4' is held (baseline held fps {fmt(base_fps, 1)}, "
+               "30 Hz push): distinct frames/s, ratio to the baseline, updates per hold, median interval between "
+               "update arrivals and the page's part of it (arrival → \"drawn\" ack: deserialise, upload, draw), "
+               "every byte the page received per update (the update message alone, median)"
+               + (f"; rays sampled every {VOLUME_STEP:g} grid spacings (--volume-step)" if VOLUME_STEP else "")
+               + ".", "",
+           "| case | held fps | ÷ baseline | target | ok | updates / hold | update→update ms | arrival→ack (page) ms "
+           "| bytes/update | update msg bytes |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for case in cases:
+        h = results[case]["widget"]["hold"]
+        ratio = h["fps"] / base_fps if base_fps else math.nan
+        goal = RATIO_FPS.get(case)
+        out.append(f"| {case} | {fmt(h['fps'], 1)} | {fmt(ratio, 2)} | {f'≥ {goal:g}×' if goal else '—'} "
+                   f"| {('ok' if ratio >= goal else 'MISSED') if goal else '—'} "
+                   f"| {h['updates']} / {fmt(h['seconds'], 2)} s "
+                   f"| {fmt(h['interval_ms'], 1)} | {fmt(h['page_ms'], 1)} "
+                   f"| {fmt(h['bytes_per_update'])} | {fmt(h['update_msg_bytes'])} |")
+    return out
+
+
+def renderings_summary(runs: list[dict], base: list[float]) -> list:
+    """Issue 21's table over the runs: held fps, ratio and bytes per update per run, their medians."""
+    cases = [c for c in FIELD_RENDERING if any(c in r for r in runs)]
+    if not cases:
+        return []
+    out = ["", "Issue 21 over the runs (a 64⁴ field held on '4'; the same run's baseline):", "",
+           "| case | held fps, per run | median | ÷ baseline, per run | median | target | ok "
+           "| update msg bytes, median over runs | bytes/update (all WS), median over runs |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for case in cases:
+        hs = [(r[case]["widget"]["hold"], b) for r, b in zip(runs, base) if case in r]
+        fps = [h["fps"] for h, _ in hs]
+        ratios = [h["fps"] / b for h, b in hs]
+        goal = RATIO_FPS.get(case)
+        out.append(f"| {case} | {', '.join(fmt(x, 1) for x in fps)} | {fmt(median(fps), 1)} "
+                   f"| {', '.join(fmt(x, 2) for x in ratios)} | {fmt(median(ratios), 2)} "
+                   f"| {f'≥ {goal:g}×' if goal else '—'} "
+                   f"| {('ok' if median(ratios) >= goal else 'MISSED') if goal else '—'} "
+                   f"| {fmt(median([h['update_msg_bytes'] for h, _ in hs]))} "
+                   f"| {fmt(median([h['bytes_per_update'] for h, _ in hs]))} |")
+    return out
 
 
 # -- main ---------------------------------------------------------------------
@@ -1227,7 +1312,9 @@ def summary(runs: list[dict]) -> str:
         ratios = [v["fps"] / v["base_fps"] for v in vs]
         missed = sum(v["misses"] for v in vs)
         t = TARGETS[TARGET]
-        if case in ABSOLUTE_FPS or not t["ratio"]:
+        if case in RATIO_FPS:
+            fps_ok = median(ratios) >= RATIO_FPS[case]
+        elif case in ABSOLUTE_FPS or not t["ratio"]:
             fps_ok = median(fps) >= fps_target
         else:
             fps_ok = median(ratios) >= t["fps"][case in LARGE]
@@ -1238,7 +1325,8 @@ def summary(runs: list[dict]) -> str:
             f"| {', '.join(fmt(x, 2) for x in ratios)} | {fmt(median(ratios), 2)} "
             f"| {'yes' if all(v['release_ok'] for v in vs) else 'no'} |"
         )
-    return "\n".join(lines)
+    base_per_run = [next((v["base_fps"] for v in [verdicts(c, r[c]) for c in r]), math.nan) for r in runs]
+    return "\n".join(lines + renderings_summary(runs, base_per_run))
 
 
 def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
@@ -1320,7 +1408,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--presses", type=int, default=40, help="single presses per canvas per notebook (default 40)")
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
-    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six), fields (sphere64, waves128, allen-cahn) or "
+    ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six), "
+                         "fields (sphere64, waves128, allen-cahn, "
+                         "blob64-surface, blob64-volume, blob64-mip) or "
                          "parallel slices (oval24, oval600) or the largest uniform polychoron (omni120)")
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
@@ -1358,8 +1448,12 @@ def main(argv=None) -> int:
     ap.add_argument("--trace-dir", default=None, help="with --trace: also keep each raw trace here")
     ap.add_argument("--in-flight", type=int, default=None,
                     help="updates the widget may have in flight (default: the package's; 1 = the old protocol)")
+    ap.add_argument("--volume-step", type=float, default=None,
+                    help="ray-cast renderings (blob64-volume, -mip): sample every this many grid spacings "
+                         "(default: the package's volume_layer.STEP, 0.5); a diagnosis of the shader's cost")
     args = ap.parse_args(argv)
-    global IN_FLIGHT
+    global IN_FLIGHT, VOLUME_STEP
+    VOLUME_STEP = args.volume_step
     if args.in_flight is not None and args.in_flight < 1:
         ap.error("--in-flight must be >= 1")
     IN_FLIGHT = args.in_flight
