@@ -627,9 +627,30 @@ async function render({ model, el }) {
       scene.on("afterRender", onRendered);
       cleanups.push(() => scene.off("afterRender", onRendered));
       // the frame about to be drawn takes the update's counts and turn, and its rows unpacked
-      const beforeRender = () => {
+      // While keys are held a ray-cast picture is drawn at half the renderer's pixel ratio (a
+      // quarter of the rays; the browser scales the canvas up), at rest at its own again.
+      let baseRatio = null;
+      let ratioRenderer = null;
+      const applyRatio = (renderer) => {
+        if (!renderer || typeof renderer.setPixelRatio !== "function") return;
+        const v = buffer.get("_rot4d_volume") || {};
+        if (renderer !== ratioRenderer) {
+          if (ratioRenderer && baseRatio !== null) ratioRenderer.setPixelRatio(baseRatio);
+          ratioRenderer = renderer;
+          baseRatio = renderer.getPixelRatio();
+        }
+        const want = v.n_boxes > 0 && v.held ? baseRatio / 2 : baseRatio;
+        if (renderer.getPixelRatio() !== want) renderer.setPixelRatio(want);
+      };
+      cleanups.push(() => {
+        if (ratioRenderer && baseRatio !== null && ratioRenderer.getPixelRatio() !== baseRatio) {
+          ratioRenderer.setPixelRatio(baseRatio);
+        }
+      });
+      const beforeRender = (_scene, renderer) => {
         settle();
         expand();
+        applyRatio(renderer);
       };
       scene.on("beforeRender", beforeRender);
       cleanups.push(() => scene.off("beforeRender", beforeRender));

@@ -93,6 +93,7 @@ class Painter:
         #: the colour limits of the ray-cast picture shown (the cut's 1st-99th percentile when
         #: ``clim`` is None), for the colour bar
         self.cast_clim = None
+        self.labelled = False  # the scene shows labels (`cut_labels`)
         self.shown = None
         self.rows_key = None
         self.rows_data = None
@@ -165,10 +166,11 @@ class Painter:
                     return None
                 self.grid_cache = (m, c0, version, coarse_, cut)
             clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
-            volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections)
+            volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
             single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
             labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels):
+                self.labelled = bool(labels)
                 sent = scene.update_id
             self.cast_clim = clim
             self.rows_data = cut.data
@@ -197,8 +199,11 @@ class Painter:
             colors = self.group_colors()
             extra = {} if colors is None else {"group_rgb": colors}
             labels = cut_labels(w.source, key.matrix, key.c0, data)
-            if scene.show(data, single_rgb=single, labels=labels, **extra):
+            if labels or self.labelled:  # a source with labels (a field), or to take them away
+                extra["labels"] = labels
+            if scene.show(data, single_rgb=single, **extra):
                 sent = scene.update_id
+                self.labelled = bool(labels)
             self.rows_data = data
             self.shown = self.rows_key = key
         now = w._pump.clock()

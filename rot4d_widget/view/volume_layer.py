@@ -21,10 +21,12 @@ Message (``{}``: no volume shown)::
     atlas          (H, W, 2) uint8 bytes, atlas_size [W, H]
     lut            (256, 4) uint8 bytes: the colour map's table
     mode           0 volume, 1 mip, 2 sections;  sections [fx, fy, fz];  density;  step
+    held           keys are held: a quicker, coarser picture (`HELD_STEP`, half the pixel ratio)
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -41,8 +43,16 @@ MODES = {"volume": 0, "mip": 1, "sections": 2}
 ATLAS_MAX = 4096
 #: Samples every this many grid spacings along a ray (the static renders' default).
 STEP = 0.5
+#: While keys are held: samples this far apart, and the page draws at half its pixel ratio (a
+#: quarter of the rays), so a software renderer keeps up; at rest the picture is the exact one.
+HELD_STEP = 2.0
 #: The shader's most samples per ray (``MAX_STEPS`` in volume.frag): a longer ray takes longer steps.
 MAX_STEPS = 1024
+
+
+@functools.lru_cache(maxsize=16)
+def _table_bytes(cmap: str) -> bytes:
+    return colour_table(cmap).tobytes()
 
 
 def colour_table(cmap: str) -> np.ndarray:
@@ -103,13 +113,16 @@ def pack_atlas(grids, clim):
     return atlas, places
 
 
-def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = DEFAULT_DENSITY) -> dict:
+def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = DEFAULT_DENSITY, *,
+                   held: bool = False) -> dict:
     """The synced dict of one volume update.
 
     parts : sequence of ``(values (nx, ny, nz), lo (3,), span (3,))``: each cut's grid (at least 2
         nodes a side) and its box in scene units (the nodes span ``lo`` ... ``lo + span``).
     rendering : "volume", "mip" or "sections";  cmap : a matplotlib name;  clim : (lo, hi)
     sections : (fx, fy, fz) in [0, 1];  density : optical depth across the longest side.
+    held : keys are held: rays sampled every `HELD_STEP` spacings and the page draws at half its
+        pixel ratio (``"held"`` in the message); at rest every `STEP`, at full resolution.
     """
     parts = [(np.asarray(v), np.asarray(lo, dtype=np.float64), np.asarray(span, dtype=np.float64))
              for v, lo, span in parts if min(np.shape(v)) >= 2]
@@ -123,18 +136,19 @@ def volume_message(parts, rendering: str, cmap: str, clim, sections, density: fl
         boxes[i, 6:9] = values.shape
         boxes[i, 9:12] = (u0, v0, cols)
         longest = max(longest, float(np.linalg.norm(np.asarray(values.shape) - 1)))
-    step = max(STEP, longest / (MAX_STEPS - 8))
+    step = max(HELD_STEP if held else STEP, longest / (MAX_STEPS - 8))
     h, w = atlas.shape[:2]
     return {
         "n_boxes": len(parts),
         "boxes": memoryview(boxes.astype("<f4").tobytes()),
         "atlas": memoryview(np.ascontiguousarray(atlas).tobytes()),
         "atlas_size": [int(w), int(h)],
-        "lut": memoryview(colour_table(cmap).tobytes()),
+        "lut": memoryview(_table_bytes(look.check_cmap(cmap))),
         "mode": MODES[rendering],
         "sections": [float(s) for s in look.check_sections(sections)],
         "density": float(density),
         "step": float(step),
+        "held": bool(held),
     }
 
 
