@@ -98,9 +98,10 @@ class FakeScene:
 
         return look.group_palette(max(int(n_groups), 1))
 
-    def show(self, s, single_rgb=None, group_rgb=None):
+    def show(self, s, single_rgb=None, group_rgb=None, volume=None, labels=()):
         """Like Scene.show: True if sent, False (and no new update_id) if the picture is unchanged."""
-        if self.shown and np.array_equal(self.shown[-1].points, s.points) and self.single[-1] == single_rgb:
+        if (self.shown and np.array_equal(self.shown[-1].points, s.points) and self.single[-1] == single_rgb
+                and volume is None):
             return False
         self.shown.append(s)
         self.single.append(single_rgb)
