@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,8 +31,8 @@ from ._ragged import _gather, _owner, _ptr
 from .meshcheck import MeshError, duplicate_in_rows, index_lists, mesh_geometry
 from .offfile import read_off, write_off
 
-__all__ = ["Polytope", "Incidence", "MeshError", "MESH_TOLERANCE", "COORDINATE_RANGE", "check_scale",
-           "order_cycle"]
+__all__ = ["Polytope", "Incidence", "MeshError", "MESH_TOLERANCE", "MAX_TOLERANCE", "COORDINATE_RANGE",
+           "check_scale", "order_cycle"]
 
 #: Relative tolerance of a mesh's geometric checks: `rot4d_widget.core.tolerances.MESH`.
 MESH_TOLERANCE = tol_.MESH
@@ -53,6 +54,24 @@ def check_scale(scale: float, what: str) -> None:
                          f"(rot4d_widget.geometry.polytopes.COORDINATE_RANGE: "
                          f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
                          f"other units)")
+
+
+#: The loosest relative tolerance a mesh may be checked with.
+MAX_TOLERANCE = 1e-2
+
+
+def _check_tolerance(tolerance) -> float:
+    """The mesh checks' relative tolerance: None gives `MESH_TOLERANCE`; else a finite number in
+    (0, `MAX_TOLERANCE`], as a float (TypeError / ValueError naming what is allowed)."""
+    if tolerance is None:
+        return float(MESH_TOLERANCE)
+    allowed = f"None (the default {MESH_TOLERANCE:g}) or a number in (0, {MAX_TOLERANCE:g}]"
+    if isinstance(tolerance, (bool, np.bool_)) or not isinstance(tolerance, (int, float, np.integer, np.floating)):
+        raise TypeError(f"Expected `tolerance` to be {allowed}, relative to the vertices' extent; got {tolerance!r}")
+    t = float(tolerance)
+    if not (np.isfinite(t) and 0.0 < t <= MAX_TOLERANCE):
+        raise ValueError(f"Expected `tolerance` to be {allowed}, relative to the vertices' extent; got {tolerance!r}")
+    return t
 
 
 def _power_of_two_unit(amax: float) -> float:
@@ -108,7 +127,9 @@ class Polytope:
     cells : C sequences of face indices, the faces bounding each cell
 
     and checks it (ValueError / TypeError naming the first offence; the geometric
-    checks use `MESH_TOLERANCE` times the vertices' largest extent):
+    checks use ``tolerance`` -- default `MESH_TOLERANCE` -- times the vertices' largest extent; a
+    looser one, up to 1e-2, takes coordinates written with few digits, and a planarity error says
+    which would do):
 
     * every face has >= 3 distinct vertices, is planar and a strictly convex polygon
       in the order given (no three consecutive corners collinear, no star);
@@ -157,7 +178,8 @@ class Polytope:
     once), so an edit anywhere would corrupt every later slice.
     """
 
-    def __init__(self, vertices, faces=None, cells=None, name: str = "polytope", *, validate: bool = True):
+    def __init__(self, vertices, faces=None, cells=None, name: str = "polytope", *, validate: bool = True,
+                 tolerance: float | None = None):
         if isinstance(faces, str) and cells is None:
             raise TypeError("Expected `faces` to be a sequence of vertex cycles; pass the name as name=...")
         try:
@@ -170,6 +192,7 @@ class Polytope:
             raise ValueError("Expected `vertices` to be finite")
         if (faces is None) != (cells is None):
             raise TypeError("Expected both `faces` and `cells`, or neither (then the convex hull of the vertices)")
+        self.tolerance = _check_tolerance(tolerance)
         amax = float(np.abs(v).max())
         if amax == 0:
             raise ValueError("`vertices` are all the origin: they do not span a 4-D convex polytope" if faces is None
@@ -186,7 +209,7 @@ class Polytope:
         if faces is None:
             self._build_hull()
         else:
-            self._build_mesh(faces, cells, bool(validate))
+            self._build_mesh(faces, cells, bool(validate), self.tolerance)
 
     # -- construction ------------------------------------------------------
     def _build_hull(self) -> None:
@@ -256,7 +279,7 @@ class Polytope:
             cell_ecount=_sealed(ecount.astype(np.intp)))
         self._mask = None
 
-    def _build_mesh(self, faces, cells, validate: bool) -> None:
+    def _build_mesh(self, faces, cells, validate: bool, tolerance: float) -> None:
         v = self.vertices
         V = len(v)
         face_sizes, face_vidx = index_lists(faces, "faces", "vertex", V)
@@ -296,7 +319,7 @@ class Polytope:
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
         self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
-        normals, offsets, centres, ncomp, tol = mesh_geometry(self, validate)  # in the unit vertices' scale
+        normals, offsets, centres, ncomp, tol = mesh_geometry(self, validate, tolerance)  # unit vertices' scale
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets * self._unit)
         c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
@@ -305,13 +328,16 @@ class Polytope:
 
     # -- files -------------------------------------------------------------
     @classmethod
-    def from_off(cls, path_or_text, name: str | None = None, *, validate: bool = True) -> "Polytope":
+    def from_off(cls, path_or_text, name: str | None = None, *, validate: bool = True,
+                 tolerance: float | None = None) -> "Polytope":
         """A polytope from Stella4D's 4OFF format: a path, or the file's text (see `rot4d_widget.geometry.offfile`).
 
         The faces and cells are taken as written and checked as by ``Polytope(vertices, faces,
         cells)``; every error is a ValueError naming the file's line.  Colours are read and
         checked, then dropped.  A Geomview 4OFF (homogeneous 3-D coordinates) is refused.
-        ``name`` defaults to the file's stem (or "4OFF" for text).
+        ``name`` defaults to the file's stem (or "4OFF" for text).  ``tolerance``: the mesh checks'
+        relative tolerance (`Polytope`; None: `MESH_TOLERANCE`), looser for a file written with few
+        digits.  A counts line whose edge count E is wrong is read with a warning (E = 0: not counted).
         """
         data = read_off(path_or_text)
         if name is None:
@@ -320,16 +346,16 @@ class Polytope:
                 and not path_or_text.lstrip().startswith("4OFF"))
             name = os.path.splitext(os.path.basename(os.fspath(path_or_text)))[0] if is_path else "4OFF"
         try:
-            p = cls(data.vertices, data.faces, data.cells, name=name, validate=validate)
+            p = cls(data.vertices, data.faces, data.cells, name=name, validate=validate, tolerance=tolerance)
         except MeshError as exc:
             if exc.item is None:
                 raise ValueError(f"lines {data.cell_lines[0]}-{data.cell_lines[-1]} (the cells): {exc}") from None
             kind, i = exc.item
             line = {"face": data.face_lines, "cell": data.cell_lines, "vertex": data.vertex_lines}[kind][i]
             raise ValueError(f"line {line} ({kind} {i}): {exc}") from None
-        if data.edge_count and data.edge_count != len(p.edges):
-            raise ValueError(f"line {data.counts_line}: E = {data.edge_count} but the faces have {len(p.edges)} "
-                             f"edges (E may be 0 when not counted)")
+        if data.edge_count and data.edge_count != len(p.edges):  # other tools count E their own way
+            warnings.warn(f"line {data.counts_line}: E = {data.edge_count} but the faces have {len(p.edges)} edges; "
+                          f"read with the faces' edges", stacklevel=2)
         return p
 
     def to_off(self, path=None) -> str:

@@ -90,12 +90,26 @@ def duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
     return None
 
 
-def mesh_geometry(p, validate: bool) -> tuple:
+def loosen_hint(off, extent) -> str:
+    """How to accept a corner ``off`` from its plane on a mesh of ``extent`` (same units): the
+    relative ``tolerance`` that would take it (its first significant digit rounded up, then
+    doubled), e.g. for a file written with few digits."""
+    rel = 2.0 * float(off) / float(extent)
+    digits = 10.0 ** np.floor(np.log10(rel))
+    suggest = float(np.ceil(rel / digits) * digits)
+    return (f"; coordinates written with few digits (another program's file) load with a looser relative "
+            f"tolerance, e.g. tolerance={suggest:.1g} (Polytope(..., tolerance=...), Polytope.from_off(path, "
+            f"tolerance=...))")
+
+
+def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     """Check an explicit mesh's geometry: (outward cell normals, offsets, cell centres, number of
-    boundary components, the tolerance used); lengths in the scale of ``p.unit_vertices``."""
+    boundary components, the tolerance used); lengths in the scale of ``p.unit_vertices``.
+    ``tolerance``: relative to the vertices' largest extent (None: `rot4d_widget.core.tolerances.MESH`)."""
     v = p.unit_vertices
     V, F, C = len(v), len(p.incidence.face_ptr) - 1, len(p.incidence.cell_ptr) - 1
-    tol = tol_.MESH * float(np.ptp(v, axis=0).max())
+    extent = float(np.ptp(v, axis=0).max())
+    tol = (tol_.MESH if tolerance is None else float(tolerance)) * extent
     if tol == 0:
         raise ValueError("`vertices` are all the same point")
     # distinct vertices
@@ -122,7 +136,7 @@ def mesh_geometry(p, validate: bool) -> tuple:
         if len(bad):
             f = int(fs[bad[0]])
             raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]] * p.unit:.3g} from its plane "
-                            f"(tolerance {tol * p.unit:.3g})", item=("face", f))
+                            f"(tolerance {tol * p.unit:.3g}){loosen_hint(off.max(), extent)}", item=("face", f))
         e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
         e2 = np.roll(e, -1, axis=1)
         cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
@@ -163,7 +177,8 @@ def mesh_geometry(p, validate: bool) -> tuple:
         if len(bad):
             c = int(cs[bad[0]])
             raise MeshError(f"cell {c} does not lie in a hyperplane: a vertex is {off[bad[0]] * p.unit:.3g} "
-                            f"from it (tolerance {tol * p.unit:.3g})", item=("cell", c))
+                            f"from it (tolerance {tol * p.unit:.3g}){loosen_hint(off.max(), extent)}",
+                            item=("cell", c))
         bad = np.flatnonzero(s[:, 2] <= tol)
         if len(bad):
             raise MeshError(f"cell {int(cs[bad[0]])} is degenerate: its vertices span less than 3-D",
