@@ -74,6 +74,15 @@ def _check_tolerance(tolerance) -> float:
     return t
 
 
+def _all_inside(v, normals, offsets, tol, chunk: int = 256) -> bool:
+    """True when every point of ``v`` (V, 4) lies on the inner side (within ``tol``) of every
+    hyperplane ``normals[c] . x = offsets[c]``: the cells' hyperplanes support the polytope."""
+    for lo in range(0, len(normals), chunk):
+        if np.any(v @ normals[lo:lo + chunk].T > offsets[lo:lo + chunk] + tol):
+            return False
+    return True
+
+
 def _power_of_two_unit(amax: float) -> float:
     """The power of two 2**k with ``1 <= amax / 2**k < 2`` (dividing by it is exact)."""
     return math.ldexp(1.0, math.frexp(amax)[1] - 1)
@@ -168,8 +177,14 @@ class Polytope:
     face_cells : (F, 2) intp, the two cells of each face, ascending
     circumradius : float, max distance of a vertex from the origin
     convex : bool, the polytope is convex (always from the hull; for a mesh: one
-        boundary component and no reflex ridge, i.e. each cell's neighbours across
-        its faces on its inner side -- locally convex and connected is convex)
+        boundary component, no reflex ridge -- each cell's neighbours across its faces on
+        its inner side -- and every vertex on the inner side of every cell's hyperplane, so
+        a self-intersecting star polychoron, locally convex everywhere, is not convex)
+    self_intersecting : bool, found to wind round more than once: connected, closed and
+        locally convex but not convex (a star polychoron); False for a convex polytope and
+        where not detected (a polytope with reflex ridges is not checked for it).  A slice's
+        volume is then the volume weighted by the winding number (the divergence theorem over
+        its outward faces), each region counted as often as the boundary winds round it
     cell_normals : (C, 4) float64 outward unit normals; ``cell_offsets`` (C,)
         so that cell c lies in ``vertices @ cell_normals[c] == cell_offsets[c]``
 
@@ -245,6 +260,7 @@ class Polytope:
         self.cell_offsets = _sealed(np.ascontiguousarray(offsets) * self._unit)
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
         self.convex = True
+        self.self_intersecting = False
 
     def _set_combinatorics(self, face_ptr, face_vidx, cell_ptr, cell_fidx) -> None:
         """Edges, faces, cells and the flat incidence tables (`incidence`, also read by the slicer)."""
@@ -323,8 +339,14 @@ class Polytope:
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets * self._unit)
         c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
-        self.convex = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
-                           and np.all(np.einsum("fd,fd->f", normals[c2], centres[c1]) <= offsets[c2] + tol))
+        locally = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
+                       and np.all(np.einsum("fd,fd->f", normals[c2], centres[c1]) <= offsets[c2] + tol))
+        # locally convex and connected is convex only if the boundary does not wind round more than
+        # once (a star polychoron such as the grand 600-cell is locally convex everywhere): every
+        # vertex on the inner side of every cell's hyperplane, checked, never assumed
+        self.convex = locally and _all_inside(self._unit_vertices, normals, offsets, tol)
+        # connected, closed and locally convex but not convex: the boundary winds round more than once
+        self.self_intersecting = locally and not self.convex
 
     # -- files -------------------------------------------------------------
     @classmethod

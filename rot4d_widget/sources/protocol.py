@@ -321,6 +321,14 @@ _POLYGON_NAMES = {
 }
 
 
+def _winding_row(polytope) -> tuple:
+    """A readout row for a self-intersecting polytope (`Polytope.self_intersecting`): what its
+    volume means there."""
+    if not getattr(polytope, "self_intersecting", False):
+        return ()
+    return (("self-intersecting", "yes: the volume counts each region as often as the boundary winds round it"),)
+
+
 def _volume_or_none(s):
     """A polytope slice's volume, or None where it left float64's range (inf beyond coordinates of
     about 1e102, or a solid slice's volume underflowed below about 1e-102)."""
@@ -402,7 +410,7 @@ class PolytopeSource:
             groups=s.triangle_cells,
             normals=None,
             volume=_volume_or_none(s),
-            readout=(("slice", census_text(s)),),
+            readout=(("slice", census_text(s)),) + _winding_row(self.polytope),
             convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
             extra={"slice": s},
         )
