@@ -513,6 +513,7 @@ def render_state(
     cmap="viridis",
     clim=None,
     sections=DEFAULT_SECTIONS,
+    projection: bool = False,
     colorbar: bool = True,
     axis_labels: bool = True,
     progress=True,
@@ -554,7 +555,8 @@ def render_state(
     default the 1st-99th percentile of the finite values of the cut (of all the cuts of a stack):
     robust to a few outliers.  ``colorbar``: a field's colour bar right of the picture (the
     variable's name and units, the levels marked); ``axis_labels``: a single cut's box labelled
-    with its data coordinates (`render_tomography`).
+    with its data coordinates (`render_tomography`).  ``projection`` (the widget's trait, kept in
+    state files) is taken and ignored: the figure draws the slice view.
     Saved to ``path`` (.png, .svg or .pdf) if given, at ``dpi``: a PNG is ``size`` pixels, plus the
     title's strip above when ``title`` is given and, for a field, the colour bar's strip right of
     it (`colorbar_width`; the picture's own pixels are where they would be without it).

@@ -72,7 +72,7 @@ SETTABLE = ("theta0", "alpha", "c0", "c0_step", "matrix")
 SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement")
 #: The view settings `Recorder.record_view` takes (the widget's traits): how a field's cut is drawn,
 #: its colour scale and where its sections lie -- they change the picture, not the state or source.
-VIEW_SETTINGS = ("rendering", "cmap", "clim", "sections")
+VIEW_SETTINGS = ("rendering", "cmap", "clim", "sections", "projection")
 #: Each view setting's default (the widget's and `rot4d_widget.keep.figures.render_state`'s), as JSON.
 VIEW_DEFAULTS = {"rendering": look.RENDERINGS[0], "cmap": look.LEVEL_COLORMAP, "clim": None,
                  "sections": list(look.DEFAULT_SECTIONS)}
@@ -150,13 +150,20 @@ class ViewSetting(_NamedValue):
     _KEY = "view"
 
 
+def _check_flag(value, name):
+    """True or False (a numpy bool too), as a bool; else a TypeError naming what is allowed."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"Expected `{name}` to be True or False, got {value!r}")
+    return bool(value)
+
+
 def check_view_setting(name, value):
     """``value`` as a `ViewSetting` holds it (JSON: a tuple as a list), checked by `look`'s checks:
     a ValueError (or a TypeError for a value of the wrong type) naming what is allowed."""
     if name not in VIEW_SETTINGS:
         raise ValueError(f"Expected a view setting among {', '.join(map(repr, VIEW_SETTINGS))}, got {name!r}")
     check = {"rendering": look.check_rendering, "cmap": look.check_cmap, "clim": look.check_clim,
-             "sections": look.check_sections}[name]
+             "sections": look.check_sections, "projection": _check_flag}[name]
     value = check(value, name)
     return list(value) if isinstance(value, tuple) else value
 

@@ -58,7 +58,7 @@ from .recorder import VIEW_SETTINGS, check_view_setting
 #: `rot4d_widget.keep.figures.render_state` takes them as keywords).
 SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity",
                  "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces", "cmap", "clim",
-                 "rendering", "sections")
+                 "rendering", "sections", "projection")
 
 #: ``"format"`` and ``"version"`` of a state file.
 STATE_FILE_FORMAT = "rot4d_widget state"

@@ -4,7 +4,7 @@ recordings).
 `Keeper` renders the view without a browser, exports its slice as a mesh, saves and loads the
 state, records every step and setting (also a user's source's own settings, read through the
 source protocol's ``settings``, and the view settings: ``rendering``, ``cmap``, ``clim``,
-``sections``) and replays recordings onto the widget.
+``sections``, ``projection``) and replays recordings onto the widget.
 """
 
 from __future__ import annotations
@@ -27,9 +27,16 @@ def view_settings(widget) -> dict:
     return widget_settings(widget)
 
 
+#: View settings a recording's ``initial_view`` holds only when they differ from this default (a
+#: recording or file without them -- from before they existed -- means the default: off).
+_OPTIONAL_VIEW = {"projection": False}
+
+
 def _view_now(widget) -> dict:
-    """The widget's view settings (those of `VIEW_SETTINGS` it has as traits), as recorded."""
-    return {n: check_view_setting(n, getattr(widget, n)) for n in VIEW_SETTINGS if widget.has_trait(n)}
+    """The widget's view settings (those of `VIEW_SETTINGS` it has as traits), as recorded;
+    ``projection`` only when on (`_OPTIONAL_VIEW`)."""
+    view = {n: check_view_setting(n, getattr(widget, n)) for n in VIEW_SETTINGS if widget.has_trait(n)}
+    return {n: v for n, v in view.items() if _OPTIONAL_VIEW.get(n, _MISSING) != v}
 
 
 def _taken_by_render_state(settings: dict) -> dict:
@@ -51,7 +58,7 @@ class Keeper:
         self.recorded_view = view  # the view settings as last recorded
         # every change of a view trait is recorded (the constructor's too: watched from before it
         # sets them); the widget's keys and observers may say so as well: recorded once
-        widget.observe(self._on_view_trait, names=list(view))
+        widget.observe(self._on_view_trait, names=[n for n in VIEW_SETTINGS if widget.has_trait(n)])
 
     # -- recording --------------------------------------------------------------------------
     def restart(self) -> None:
@@ -71,7 +78,7 @@ class Keeper:
         """A view setting (``rendering``, ``cmap``, ``clim``, ``sections``) a user changed (a
         trait, a key): recorded, and remembered as recorded; a value equal to the one last
         recorded is not recorded again (a trait's observer and the key that set it both say so)."""
-        if self.recorded_view.get(name, _MISSING) == check_view_setting(name, value):
+        if self.recorded_view.get(name, _OPTIONAL_VIEW.get(name, _MISSING)) == check_view_setting(name, value):
             return
         event = self.recorder.record_view(name, value)
         self.recorded_view[name] = event.value
@@ -200,7 +207,8 @@ class Keeper:
         default, as the file's view was drawn."""
         w = self.w
         if defaults:
-            settings = {**{k: v for k, v in VIEW_DEFAULTS.items() if w.has_trait(k)}, **settings}
+            defaults = {**VIEW_DEFAULTS, **_OPTIONAL_VIEW}  # a file from before `projection`: off
+            settings = {**{k: v for k, v in defaults.items() if w.has_trait(k)}, **settings}
         d = state.to_dict()
         d.pop("keymap")
         with w._pump.lock:

@@ -206,6 +206,7 @@ class Painter:
                 self.labelled = bool(labels)
             self.rows_data = data
             self.shown = self.rows_key = key
+        w._projection.follow(key.matrix, key.c0, key.version)  # the projection, in the same update
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered
         if not len(w._repeater) or now - self.readout_at >= READOUT_PERIOD:
@@ -265,6 +266,9 @@ class Painter:
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
         if self.note:
             rows.append(("picture", html.escape(self.note)))
+        views = w._projection.readout_row()  # which view is which, with the projection shown
+        if views is not None:
+            rows.insert(0, views)
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
 
     def colourbar(self, level_rgb=None) -> str:

@@ -66,6 +66,7 @@ from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keypad import KeyPad, close_quietly
 from .keys import KeyPath, help_groups, source_actions
 from .painter import READOUT_PERIOD, Painter, checked_slice, title
+from .projection import ProjectionFlag, ProjectionView, check_projection
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .renderings import Renderings
 from .screenshots import Screenshots
@@ -130,8 +131,7 @@ class Rot4DWidget(widgets.HBox):
     color_by : "group" (each triangle the colour of its group: a polytope's
         4-D cell) or one colour for every face (e.g. ``"#9fb6cd"``)
     group_colors : sequence of colours, one per group, optional
-    antialias : bool
-        WebGL multisampling (default False).
+    antialias : bool -- WebGL multisampling (default False).
     slices, spacing, arrangement : int, float, str, optional
         Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
         `rot4d_widget.sources.tomography.StackSource`), placed "oval" (on a parabola, the slice at
@@ -149,6 +149,7 @@ class Rot4DWidget(widgets.HBox):
         button per action (simple and double rotations and their inverses, alpha, c0, the
         step, reset) for a mouse or a touch screen.  A click is one step; a button held
         down repeats exactly like a held key and stops on release or on leaving it.
+    projection : bool -- the whole object projected beside its slice (`rot4d_widget.view.projection`)
     hold_delay, tick_rate, ack_timeout : float
         Seconds before a held key repeats; repeats per second while held;
         seconds to wait for a "drawn" acknowledgement.
@@ -190,6 +191,7 @@ class Rot4DWidget(widgets.HBox):
     clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
     rendering = t.Rendering("surface", help="how a field's cut is drawn: surface, volume, mip or sections")
     sections = t.Sections(look.DEFAULT_SECTIONS, help="the section planes, fractions (fx, fy, fz) of the cut")
+    projection = ProjectionFlag(False, help="the whole object projected, beside the slice (`view.projection`)")
 
     def __init__(
         self, source="5-cell", theta0: float = DEFAULT_THETA0, alpha: float | None = None, c0: float | None = None,
@@ -198,8 +200,8 @@ class Rot4DWidget(widgets.HBox):
         background=look.BACKGROUND, show_balls: bool = True, show_bars: bool = True, show_faces: bool = True,
         color_by="group", group_colors=None, levels=None, slices=None, spacing=None, arrangement="oval",
         cmap: str = look.LEVEL_COLORMAP, clim=None, rendering: str = "surface", sections=look.DEFAULT_SECTIONS,
-        antialias: bool = False, keypad: bool = False, hold_delay: float = HOLD_DELAY, tick_rate: float = TICK_RATE,
-        ack_timeout: float = ACK_TIMEOUT, _clock=None, _autotick: bool = True,
+        antialias: bool = False, keypad: bool = False, projection: bool = False, hold_delay: float = HOLD_DELAY,
+        tick_rate: float = TICK_RATE, ack_timeout: float = ACK_TIMEOUT, _clock=None, _autotick: bool = True,
     ):
         # -- validate before any widget exists --------------------------------
         if not isinstance(keypad, bool):
@@ -211,7 +213,8 @@ class Rot4DWidget(widgets.HBox):
         if _clock is not None and not callable(_clock):
             raise TypeError(f"Expected `_clock` to be a callable returning seconds, got {type(_clock).__name__}")
         color_by, cmap, clim = t.check_color_by(color_by), look.check_cmap(cmap), look.check_clim(clim)
-        rendering, sections = _check_rendering(src, rendering), look.check_sections(sections)
+        rendering, sections, projection = (_check_rendering(src, rendering), look.check_sections(sections),
+                                           check_projection(projection))
         scale = look.REFERENCE_RADIUS / float(src.size)
         coarse_ok = takes_coarse(src)
         if ball_radius is None:
@@ -238,7 +241,7 @@ class Rot4DWidget(widgets.HBox):
         self._stacking = Stacking(self)
         self._shots = Screenshots(self)
         self._keypad = KeyPad(self)
-        self._renderings = Renderings(self)
+        self._renderings, self._projection = Renderings(self), ProjectionView(self)
         self._pump = UpdatePump(
             self._painter.send, tick=self._keys.tick, deadline=repeater.next_deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
@@ -258,7 +261,7 @@ class Rot4DWidget(widgets.HBox):
             [self._canvas_box, self._side_box],
             layout=widgets.Layout(flex_flow="row wrap", align_items="flex-start"),
             **self.scene.display,
-            color_by=color_by, cmap=cmap, clim=clim, rendering=rendering, sections=sections,
+            color_by=color_by, cmap=cmap, clim=clim, rendering=rendering, sections=sections, projection=projection,
         )
         try:
             _wire(self, keypad)
@@ -509,6 +512,8 @@ def _wire(w, keypad) -> None:
     w._renderings.observe()
     w.observe(w._on_keypad, names="keypad")
     w.keypad = keypad
+    w.observe(w._projection.changed, names="projection")
+    w._projection.changed()
 
     # The initial picture is part of the models' state: not "in flight".
     w._pump.send_now(expect_ack=False)
@@ -538,6 +543,7 @@ def _close_children(w) -> None:
     """Close every child widget; never raises.  The Events first, so their document listeners go
     before the canvas does."""
     w._keypad.close()
+    w._projection.close()
     for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
         x = getattr(w, name, None)
         if x is not None:

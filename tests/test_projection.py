@@ -1,0 +1,202 @@
+"""The whole object beside its slice (`rot4d_widget.view.projection`, ``projection=True``)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.keep.recording import ViewSetting
+from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.view import projection as pj
+from rot4d_widget.view.widget import Rot4DWidget
+
+
+def key_event(kind, key, code=None):
+    code = code or (f"Digit{key}" if key.isdigit() else f"Key{key.upper()}")
+    return {"type": kind, "event": kind, "key": key, "code": code, "shiftKey": False, "altKey": False,
+            "ctrlKey": False, "metaKey": False, "repeat": False, "location": 0, "target": {}}
+
+
+def press(w, key):
+    w._handle_event(key_event("keydown", key))
+    w._handle_event(key_event("keyup", key))
+
+
+@pytest.fixture
+def widgets():
+    made = []
+
+    def make(*args, **kwargs):
+        w = Rot4DWidget(*args, _autotick=False, **kwargs)
+        made.append(w)
+        return w
+
+    yield make
+    for w in made:
+        w.close()
+
+
+def small_field(n=9):
+    x = np.linspace(-1, 1, n)
+    q = np.stack(np.meshgrid(x, x, x, x, indexing="ij"), -1)
+    f = Field4D((0.6 - (q ** 2).sum(-1)).astype(np.float32), axes="xyzw", extent=((-1, 1),) * 4, name="ball")
+    f.levels = 0.0
+    return f
+
+
+def _match(a, b, atol=1e-6):
+    """Every row of ``a`` has a row of ``b`` within ``atol`` and back."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    d = np.linalg.norm(a[:, None] - b[None], axis=-1)
+    return bool(d.min(axis=1).max() <= atol and d.min(axis=0).max() <= atol)
+
+
+def test_projected_points_are_the_closed_form():
+    src = PolytopeSource("24-cell")
+    m = random_rotation(np.random.default_rng(1))
+    scale = 0.7
+    out = pj.projection_arrays(src, m, 0.2, scale)
+    v, e = np.asarray(src.polytope.vertices, float), np.asarray(src.polytope.edges)
+    d = 3.0 * src.size
+    r = v @ m.T
+    expect = np.concatenate([[r[a, :3] * d / (d - r[a, 3]), r[b, :3] * d / (d - r[b, 3])] for a, b in e])
+    assert out["distance"] == pytest.approx(d)
+    assert out["positions"].dtype == np.float32 and out["points"].dtype == np.float32
+    np.testing.assert_array_equal(out["index"], e.reshape(-1))
+    edges = out["positions"][out["index"]]  # what the line segments draw
+    np.testing.assert_allclose(edges, expect.reshape(-1, 3) * scale, rtol=1e-6, atol=1e-6)
+
+
+def test_edge_colours_follow_w():
+    src = PolytopeSource("120-cell")
+    m = random_rotation(np.random.default_rng(2))
+    c0 = 0.5
+    out = pj.projection_arrays(src, m, c0)
+    w = (np.asarray(src.polytope.vertices) @ m.T)[:, 3]
+    rgb = out["rgb"]
+    redder = rgb[:, 0] - rgb[:, 2]
+    far = np.abs(w - c0) > 1e-6
+    assert np.all(np.sign(redder[far]) == np.sign(w - c0)[far])  # red above c0, blue below
+    # the diverging map's closed form: coolwarm's blue end at c0 - size, grey at c0, red end at c0 + size
+    t = np.clip((w - c0) / src.size, -1, 1)[:, None]
+    blue, grey, red = np.array([0.230, 0.299, 0.754]), np.array([0.865] * 3), np.array([0.706, 0.016, 0.150])
+    expect = np.where(t > 0, grey + t * (red - grey), grey - t * (blue - grey))
+    np.testing.assert_allclose(rgb, expect, atol=1e-6)
+    top, bottom = np.argmax(w), np.argmin(w)
+    assert redder[top] == pytest.approx(redder.max()) and redder[bottom] == pytest.approx(redder.min())
+
+
+@pytest.mark.parametrize("name", ["5-cell", "24-cell", "120-cell"])
+def test_highlighted_points_are_the_slice_points_projected(name):
+    src = PolytopeSource(name)
+    rng = np.random.default_rng(3)
+    for _ in range(4):
+        m = random_rotation(rng)
+        w = np.asarray(src.polytope.vertices) @ m[3]
+        c0 = float(rng.uniform(w.min(), w.max()))
+        out = pj.projection_arrays(src, m, c0)
+        d = out["distance"]
+        sl = np.asarray(src.slice(m, c0).points)
+        assert len(sl) and _match(out["points"], sl * d / (d - c0), atol=1e-5)
+    # every crossing lies on an edge whose ends straddle c0
+    r = np.asarray(src.polytope.vertices) @ m.T
+    e = np.asarray(src.polytope.edges)
+    cross = pj.crossings(r, e, [c0])
+    a, b = r[e[:, 0]], r[e[:, 1]]
+    straddle = (np.minimum(a[:, 3], b[:, 3]) <= c0) & (np.maximum(a[:, 3], b[:, 3]) >= c0)
+    for p in cross:
+        ab, ap = b[straddle] - a[straddle], p - a[straddle]
+        t = np.einsum("ij,ij->i", ap, ab) / np.einsum("ij,ij->i", ab, ab)
+        off = np.linalg.norm(ap - t[:, None] * ab, axis=1)
+        assert np.any((off < 1e-9) & (t >= -1e-9) & (t <= 1 + 1e-9))
+
+
+def test_field_shows_its_box_and_cut(widgets):
+    f = small_field()
+    corners, edges = pj.skeleton(f)
+    assert corners.shape == (16, 4) and edges.shape == (32, 2)
+    assert len({tuple(sorted(x)) for x in edges.tolist()}) == 32
+    lengths = np.linalg.norm(corners[edges[:, 0]] - corners[edges[:, 1]], axis=1)
+    np.testing.assert_allclose(np.sort(lengths), np.sort(2 * np.repeat(np.asarray(f.half_widths), 8)))
+    w = widgets(f, projection=True)
+    out = w._projection.arrays
+    assert out["positions"].shape == (16, 3) and out["index"].shape == (64,)
+    assert len(out["points"]) == 8  # at rest w = c0 cuts the 8 edges along w at their middles
+
+
+def test_stack_marks_every_slice(widgets):
+    w = widgets("24-cell", slices=3, projection=True)
+    out = w._projection.arrays
+    assert len(out["offsets"]) == 3 and len(set(np.round(out["offsets"], 9))) == 3
+    src = PolytopeSource("24-cell")
+    r = np.asarray(src.polytope.vertices) @ np.asarray(w.state.matrix).T
+    d = out["distance"]
+    wanted = []
+    for o in out["offsets"]:
+        c = pj.crossings(r, src.polytope.edges, [o])
+        assert len(c), "every slice has crossings"
+        wanted.append(pj.perspective(c, d) * w._scale)
+    assert _match(out["points"], np.concatenate(wanted), atol=1e-5)
+
+
+def test_both_views_update_in_one_key_press(widgets):
+    w = widgets("24-cell", projection=True)
+    before_slice = w.scene.update_id
+    before = w._projection.arrays["positions"].copy()
+    press(w, "4")
+    assert w.scene.update_id != before_slice
+    assert w._projection.shown_key[0] is w.state.matrix
+    after = w._projection._edge_pos.array
+    assert not np.allclose(before, after)
+    now = pj.projection_arrays(w.source, w.state.matrix, w.state.c0, w._scale)
+    np.testing.assert_allclose(after, now["positions"])
+    np.testing.assert_array_equal(w._projection._edge_rgb.array, np.rint(now["rgb"] * 255).astype(np.uint8))
+    press(w, "l")  # c0 moves: the balls follow in the same update
+    assert w._projection.shown_key[1] == w.state.c0
+
+
+def test_projection_trait_recorded_saved_loaded(widgets, tmp_path):
+    w = widgets("5-cell")
+    w.projection = True
+    assert any(isinstance(e, ViewSetting) and e.name == "projection" and e.value is True
+               for e in w.recording.events)
+    path = tmp_path / "s.json"
+    w.save_state(path)
+    assert json.loads(path.read_text())["settings"]["projection"] is True
+    other = widgets("5-cell")
+    other.load_state(path)
+    assert other.projection is True and other._projection.box in other.children
+    # a file from before `projection` loads with it off
+    doc = json.loads(path.read_text())
+    del doc["settings"]["projection"]
+    path.write_text(json.dumps(doc))
+    other.load_state(path)
+    assert other.projection is False and other._projection.box not in other.children
+    loaded = Rot4DWidget.from_state(tmp_path / "s.json", _autotick=False)
+    try:
+        assert loaded.projection is False
+    finally:
+        loaded.close()
+
+
+def test_bad_projection_is_refused(widgets):
+    with pytest.raises(TypeError, match="Expected `projection` to be True or False, got 'yes'"):
+        widgets("5-cell", projection="yes")
+    w = widgets("5-cell")
+    with pytest.raises(TypeError, match="True or False"):
+        w.projection = "yes"
+
+
+def test_off_by_default_changes_nothing(widgets):
+    plain, shown = widgets("24-cell"), widgets("24-cell", projection=True)
+    assert plain.projection is False and plain._projection.box is None and len(plain.children) == 2
+    assert len(shown.children) == 3
+    for w in (plain, shown):
+        press(w, "4")
+        press(w, "c")
+    np.testing.assert_array_equal(plain.scene._buffer.array, shown.scene._buffer.array)
+    assert "views" not in plain.readout.value and "views" in shown.readout.value
