@@ -170,7 +170,7 @@ FIELD_CASES["allen-cahn"] = (
     "field = Field4D.from_xarray(phase_separation(), w='time', levels=[0.0])"
 )
 #: Issue 21: a Gaussian blob travelling along x as w grows, f[x, y, z, w] on a 64^4 float32 array
-#: (the array of benchmarks/volume_step.py), drawn in each rendering: ``--cases blob64-volume,...``.
+#: (benchmarks/volume_step.py's blob_array, as notebook-cell text), drawn in each rendering: ``--cases blob64-volume,...``.
 BLOB64 = (
     "import numpy as np\nfrom rot4d_widget import Field4D\n"
     "_g = np.linspace(-1.0, 1.0, 64, dtype=np.float32)\n"

@@ -62,6 +62,7 @@ from rot4d_widget.view.painter import checked_slice
 from rot4d_widget.view.volume_layer import volume_message
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+from field_step import best  # noqa: E402  (benchmarks/ is on the path when run as a script)
 from recording_comm import RecordingComm, install  # noqa: E402  (serialises like ipykernel)
 
 C0 = 0.1
@@ -77,30 +78,9 @@ def blob_array(n: int = 64) -> np.ndarray:
     return a
 
 
-#: The field, as a notebook cell builds it (browser_latency.py's blob64 cases run this text).
-FIELD_CODE = (
-    "import numpy as np\nfrom rot4d_widget import Field4D\n"
-    "_g = np.linspace(-1.0, 1.0, 64, dtype=np.float32)\n"
-    "_yz = _g[None, :, None] ** 2 + _g[None, None, :] ** 2\n"
-    "_a = np.empty((64,) * 4, dtype=np.float32)\n"
-    "for _i, _w in enumerate(_g):\n"
-    "    _a[..., _i] = np.exp(-((_g[:, None, None] - 0.6 * _w) ** 2 + _yz) / 0.18)\n"
-    "field = Field4D(_a, axes='xyzw', extent=[(-1.0, 1.0)] * 4, levels=[0.5], name='blob')"
-)
-
-
 def blob_field(n: int = 64, coarse_resolution=None) -> Field4D:
     kw = {} if coarse_resolution is None else {"coarse_resolution": coarse_resolution}
     return Field4D(blob_array(n), axes="xyzw", extent=[(-1.0, 1.0)] * 4, levels=[0.5], name="blob", **kw)
-
-
-def best(fn, repeats: int):
-    out, ts = None, []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t)
-    return out, min(ts)
 
 
 def comm_bytes(n0: int) -> tuple[int, int]:
