@@ -1,0 +1,338 @@
+"""Load and slice every 4OFF file of a library (issue 22): what a user loading another tool's
+collection file by file with `Polytope.from_off` gets, and whether the slices are right.
+
+For each ``*.off`` file in DIR (sorted by the number its name starts with, then by name):
+
+* **load**: ``Polytope.from_off(path)``; if that is refused with an error that names a tolerance
+  that would do (coordinates written with few digits), once more with that tolerance (the table
+  says which was used).  A wrong edge count E in the file is read with a warning (counted).
+* **slice**: one fixed random rotation (``--seed``), cut at c0 = 0 and at ``--levels`` more
+  levels spread over the rotated w range (``slice_polytope`` with a single c0 each; the time is
+  the median over the levels, the slicing tables built by a first, untimed cut).
+* **check**, independently of the slicer (numpy on the file's vertices and the edges of its
+  faces, read here from the file with its own few lines of parsing):
+  - the slice's points are the edges' crossings of the hyperplane: every crossing (and every
+    vertex lying in it) is within ``1e-7 * circumradius`` of a slice point and every slice point
+    is within that of a crossing;
+  - every slice point is finite (it lies in the hyperplane by construction: it is given in the
+    hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
+    failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
+    polytope with reflex ridges, not detected as self-intersecting, can wind round negatively);
+  - the slice's triangles make a closed surface (every directed edge as often as its reverse);
+  - for a polytope reported convex: the slice's volume equals the volume of
+    ``scipy.spatial.ConvexHull`` of its points (relative ``1e-6``).
+
+    python benchmarks/off_library.py DIR [--numbers 1-132] [--levels 3] [--seed 0]
+        [--max-bytes N] [--timeout S] [--json out.json] [--quiet]
+
+``--numbers A-B`` takes only files whose name starts with a number in A..B (the Bowers numbers of
+Pardesco/4d-polytope-viewer's ``public/data/polytopes``; docs/off-library.md).  Prints one row
+per file (file, V, E, F, C, convex, self-intersecting, tolerance, load ms, slice ms, result) and a
+summary: how many loaded (with the default or a looser tolerance), sliced and checked, and the
+refusals grouped by kind of error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import pathlib
+import re
+import signal
+import statistics
+import sys
+import time
+import warnings
+
+import numpy as np
+from scipy.spatial import ConvexHull, cKDTree
+
+from rot4d_widget.geometry.mesh import Polytope
+from rot4d_widget.geometry.slicing import slice_polytope
+
+#: distance (relative to the circumradius) within which a slice point and an edge crossing agree
+POINT_TOL = 1e-7
+#: relative agreement of a convex slice's volume with its points' hull volume
+VOLUME_RTOL = 1e-6
+#: the error that says which looser tolerance would load the file
+_HINT = re.compile(r"tolerance=([0-9.eE+-]+) \(Polytope")
+
+#: refusals grouped by what they say (first match wins); the rest by their text without numbers
+CATEGORIES = [
+    ("star face (not a convex polygon)", re.compile(r"not a convex polygon|not strictly convex")),
+    ("non-convex cell", re.compile(r"cell \d+ is not convex|is not convex: its vertex")),
+    ("face not planar", re.compile(r"not planar")),
+    ("cell not flat", re.compile(r"does not lie in a hyperplane|not flat")),
+    ("hemi cell (a face through the cell's centre: degenerate)", re.compile(r"centre lies in the plane of its face")),
+    ("not orientable", re.compile(r"not orientable")),
+    ("orientation", re.compile(r"orient")),
+    ("time limit", re.compile(r"time limit")),
+]
+
+
+# -- an independent reading of the file: vertices and the edges of its faces --------------------------
+def read_vertices_and_edges(path) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 4) vertices and (E, 2) sorted unique edges (consecutive corners of every face) of a 4OFF
+    file, parsed here with none of the package's code: the check's own reading."""
+    tokens = []
+    with open(path, encoding="utf-8") as fh:
+        for line in fh:
+            t = line.split("#", 1)[0].split()
+            if t:
+                tokens.append(t)
+    k = next(i for i, t in enumerate(tokens) if t[0] == "4OFF")
+    counts = tokens[k][1:] or tokens[k + 1]
+    start = k + 1 if tokens[k][1:] else k + 2
+    nv, nf = int(counts[0]), int(counts[1])
+    v = np.array([[float(x) for x in t] for t in tokens[start : start + nv]])
+    pairs = []
+    for t in tokens[start + nv : start + nv + nf]:
+        n = int(t[0])
+        f = np.array([int(x) for x in t[1 : n + 1]])
+        pairs.append(np.stack([f, np.roll(f, -1)], axis=1))
+    e = np.sort(np.concatenate(pairs), axis=1)
+    return v, np.unique(e, axis=0)
+
+
+def rotation(seed: int) -> np.ndarray:
+    """A fixed random rotation (det +1) of R^4."""
+    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(4, 4)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+def crossings(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: float) -> np.ndarray:
+    """(k, 3) points where the edges ``e`` of vertices ``v`` (rotated: ``v @ m.T``) meet w = c0: the
+    crossing of every edge with ends strictly on both sides, and every vertex within ``on_tol``."""
+    x = v @ m.T
+    h = x[:, 3] - c0
+    on = np.abs(h) <= on_tol
+    a, b = e[:, 0], e[:, 1]
+    cross = ~on[a] & ~on[b] & (np.sign(h[a]) != np.sign(h[b]))
+    a, b = a[cross], b[cross]
+    t = (h[a] / (h[a] - h[b]))[:, None]
+    return np.concatenate([x[a, :3] + t * (x[b, :3] - x[a, :3]), x[on, :3]])
+
+
+def closed(s) -> bool:
+    """The slice's triangles make a closed surface: every directed edge as often as its reverse."""
+    t = np.asarray(s.triangles)
+    if len(t) == 0:
+        return True
+    d = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    fwd = collections.Counter(map(tuple, d.tolist()))
+    return all(fwd[(j, i)] == n for (i, j), n in fwd.items())
+
+
+def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float) -> list[str]:
+    """What is wrong with slice ``s`` of ``p`` (rotated by ``m``, cut at ``c0``), checked against the
+    file's own vertices ``v`` and edges ``e``; an empty list when it is right."""
+    problems = []
+    scale = float(np.max(np.linalg.norm(v, axis=1)))
+    tol = POINT_TOL * scale
+    pts = np.asarray(s.vertices, dtype=float)
+    want = crossings(v, e, m, c0, 1e-9 * scale)
+    if not np.all(np.isfinite(pts)):
+        problems.append(f"c0={c0:.4g}: slice points not finite")
+        return problems
+    # compared as sets: crossing points may coincide (two edges meeting the hyperplane at one point)
+    if len(want) == 0 or len(pts) == 0:
+        if len(want) != len(pts):
+            problems.append(f"c0={c0:.4g}: {len(pts)} slice points but {len(want)} edge crossings")
+        return problems
+    d1 = cKDTree(pts).query(want)[0]
+    d2 = cKDTree(want).query(pts)[0]
+    if d1.max() > tol:
+        problems.append(f"c0={c0:.4g}: {int(np.sum(d1 > tol))} of {len(want)} edge crossings are no slice point "
+                        f"(worst {d1.max() / scale:.2g} x R)")
+    if d2.max() > tol:
+        problems.append(f"c0={c0:.4g}: {int(np.sum(d2 > tol))} of {len(pts)} slice points are no edge crossing "
+                        f"(worst {d2.max() / scale:.2g} x R)")
+    if not np.isfinite(s.volume):
+        problems.append(f"c0={c0:.4g}: volume {s.volume}")
+    if not closed(s):
+        problems.append(f"c0={c0:.4g}: the slice's surface is not closed")
+    if p.convex and s.dim == 3:
+        hull = ConvexHull(pts).volume
+        if abs(s.volume - hull) > VOLUME_RTOL * hull:
+            problems.append(f"c0={c0:.4g}: convex, volume {s.volume:.9g} but the points' hull has {hull:.9g}")
+    return problems
+
+
+def levels(p: Polytope, m: np.ndarray, n: int) -> list[float]:
+    """c0 = 0 and ``n`` levels spread over the rotated w range (never exactly at a vertex)."""
+    w = p.vertices @ m.T[:, 3]
+    lo, hi = float(w.min()), float(w.max())
+    fr = 0.1 + 0.8 * (np.arange(n) + 0.37) / n  # off the middle: a centrally symmetric one has 0 there
+    return [0.0] + [lo + f * (hi - lo) for f in fr]
+
+
+class _TimeUp(Exception):
+    pass
+
+
+def _alarm(signum, frame):
+    raise _TimeUp("time limit")
+
+
+def category(message: str) -> str:
+    for name, pattern in CATEGORIES:
+        if pattern.search(message):
+            return name
+    text = re.sub(r"^.*?line \d+ \([a-z]+ \d+\): ", "", message)
+    return re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "N", text)[:80]
+
+
+def load(path) -> tuple[Polytope, str, int]:
+    """(polytope, tolerance used: 'default' or the looser number, number of warnings)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            p = Polytope.from_off(path)
+            return p, "default", len(caught)
+        except ValueError as exc:
+            hint = _HINT.search(str(exc))
+            if not hint:
+                raise
+            t = float(hint.group(1))
+            p = Polytope.from_off(path, tolerance=t)
+            return p, f"{t:g}", len(caught)
+
+
+def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None) -> dict:
+    row = {"file": path.name, "bytes": path.stat().st_size}
+    if timeout:
+        signal.signal(signal.SIGALRM, _alarm)
+        signal.setitimer(signal.ITIMER_REAL, timeout)
+    try:
+        t0 = time.perf_counter()
+        try:
+            p, tol, nwarn = load(path)
+        except (ValueError, _TimeUp) as exc:
+            row.update(loaded=False, error=str(exc), category=category(str(exc)),
+                       load_ms=(time.perf_counter() - t0) * 1e3)
+            return row
+        row.update(loaded=True, load_ms=(time.perf_counter() - t0) * 1e3, tolerance=tol, warnings=nwarn)
+        row.update(zip("VEFC", p.counts))
+        row.update(convex=bool(p.convex), self_intersecting=bool(p.self_intersecting))
+        try:
+            v, e = read_vertices_and_edges(path)
+            problems = []
+            if len(v) != len(p.vertices) or len(e) != len(p.edges):
+                problems.append(f"counts: the file has {len(v)} vertices and {len(e)} face edges, the polytope "
+                                f"{len(p.vertices)} and {len(p.edges)}")
+            slice_polytope(p, m, 0.0)  # builds the slicing tables (not timed)
+            times, negative = [], []
+            for c0 in levels(p, m, nlevels):
+                t1 = time.perf_counter()
+                s = slice_polytope(p, m, c0)
+                times.append((time.perf_counter() - t1) * 1e3)
+                problems += check_slice(p, s, v, e, m, c0)
+                if s.volume < 0:
+                    negative.append(c0)
+            row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative)
+        except Exception as exc:  # noqa: BLE001 -- a slicer failure is a finding, reported per file
+            row.update(slice_ms=None, problems=[f"slice raised {type(exc).__name__}: {exc}"], ok=False, negative=[])
+        return row
+    finally:
+        if timeout:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+
+
+def number(path) -> int | None:
+    m = re.match(r"(\d+)-", path.name)  # "<Bowers number>-<acronym>.off"; "2gap.off" (a compound) has none
+    return int(m.group(1)) if m else None
+
+
+def select(directory, numbers: str | None, max_bytes: int | None) -> list[pathlib.Path]:
+    files = sorted(pathlib.Path(directory).glob("*.off"),
+                   key=lambda f: (number(f) is None, number(f) or 0, f.name))
+    if numbers:
+        a, _, b = numbers.partition("-")
+        lo, hi = int(a), int(b or a)
+        files = [f for f in files if number(f) is not None and lo <= number(f) <= hi]
+    if max_bytes:
+        files = [f for f in files if f.stat().st_size <= max_bytes]
+    return files
+
+
+def row_text(r: dict) -> str:
+    if not r["loaded"]:
+        return (f"{r['file'][:34]:34} {'':>6} {'':>6} {'':>6} {'':>5} {'':>6} {'':>6} {'':>8} "
+                f"{r['load_ms']:8.0f} {'':>8}  REFUSED: {r['error'][:150]}")
+    res = "ok" if r["ok"] else "CHECK FAILED: " + "; ".join(r["problems"])[:200]
+    if r["negative"]:
+        res += f" (negative volume at c0 = {', '.join(f'{c:.3g}' for c in r['negative'])})"
+    sl = f"{r['slice_ms']:8.2f}" if r["slice_ms"] is not None else f"{'-':>8}"
+    return (f"{r['file'][:34]:34} {r['V']:6d} {r['E']:6d} {r['F']:6d} {r['C']:5d} {str(r['convex']):>6} "
+            f"{str(r['self_intersecting']):>6} {r['tolerance']:>8} {r['load_ms']:8.0f} {sl}  {res}")
+
+
+HEADER = (f"{'file':34} {'V':>6} {'E':>6} {'F':>6} {'C':>5} {'convex':>6} {'selfx':>6} {'tol':>8} "
+          f"{'load ms':>8} {'slice ms':>8}  result")
+
+
+def summary(rows: list[dict]) -> str:
+    n = len(rows)
+    loaded = [r for r in rows if r["loaded"]]
+    loose = [r for r in loaded if r["tolerance"] != "default"]
+    ok = [r for r in loaded if r["ok"]]
+    refused = [r for r in rows if not r["loaded"]]
+    out = [f"{n} files: {len(loaded)} loaded ({len(loaded) - len(loose)} with the default tolerance, "
+           f"{len(loose)} with a looser one), {len(ok)} of them sliced with every check right, "
+           f"{len(loaded) - len(ok)} with a check failed; {len(refused)} refused",
+           f"  convex {sum(r['convex'] for r in loaded)}, self-intersecting "
+           f"{sum(r['self_intersecting'] for r in loaded)}, other non-convex "
+           f"{sum(not r['convex'] and not r['self_intersecting'] for r in loaded)}; "
+           f"{sum(r['warnings'] > 0 for r in loaded)} read with a warning (edge count); "
+           f"{sum(bool(r['negative']) for r in loaded)} with a negative (winding-weighted) slice volume somewhere"]
+    for cat, k in collections.Counter(r["category"] for r in refused).most_common():
+        names = [r["file"] for r in refused if r["category"] == cat]
+        out.append(f"  refused, {cat}: {k}  ({', '.join(names[:8])}{', ...' if k > 8 else ''})")
+    bad = [r for r in loaded if not r["ok"]]
+    for r in bad[:20]:
+        out.append(f"  check failed, {r['file']}: {'; '.join(r['problems'])[:300]}")
+    if loaded:
+        out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "
+                   f"max {max(r['load_ms'] for r in loaded):.0f}; slice ms median "
+                   f"{statistics.median(r['slice_ms'] for r in loaded if r['slice_ms'] is not None):.2f}")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("directory")
+    ap.add_argument("--numbers", help="only files whose name starts with a number in A-B")
+    ap.add_argument("--levels", type=int, default=3, help="levels besides c0 = 0 (default 3)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the fixed rotation")
+    ap.add_argument("--max-bytes", type=int, help="skip files larger than this")
+    ap.add_argument("--timeout", type=float, help="seconds per file (load and slices) before it counts as refused")
+    ap.add_argument("--json", help="write the rows here")
+    ap.add_argument("--quiet", action="store_true", help="the summary only")
+    args = ap.parse_args(argv)
+    files = select(args.directory, args.numbers, args.max_bytes)
+    if not files:
+        print("no .off files selected", file=sys.stderr)
+        return 2
+    m = rotation(args.seed)
+    rows = []
+    if not args.quiet:
+        print(HEADER, flush=True)
+    for f in files:
+        r = run_file(f, m, args.levels, args.timeout)
+        rows.append(r)
+        if not args.quiet:
+            print(row_text(r), flush=True)
+    print()
+    print(summary(rows))
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump(rows, fh, indent=1)
+    return 0 if all(r["loaded"] and r["ok"] for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
