@@ -60,13 +60,17 @@ _HINT = re.compile(r"tolerance=([0-9.eE+-]+) \(Polytope")
 
 #: refusals grouped by what they say (first match wins); the rest by their text without numbers
 CATEGORIES = [
-    ("star face (not a convex polygon)", re.compile(r"not a convex polygon|not strictly convex")),
-    ("non-convex cell", re.compile(r"cell \d+ is not convex|is not convex: its vertex")),
+    ("hemi cell (a face through the cell's centre, or coplanar faces)",
+     re.compile(r"centre lies in the plane of its face|lies in that face's plane|oriented areas cancel")),
+    ("star face (not a convex polygon)", re.compile(r"not a convex polygon")),
+    ("non-convex cell", re.compile(r"cell \d+ is not convex|is not convex: its vertex|not strictly convex")),
     ("face not planar", re.compile(r"not planar")),
     ("cell not flat", re.compile(r"does not lie in a hyperplane|not flat")),
-    ("hemi cell (a face through the cell's centre: degenerate)", re.compile(r"centre lies in the plane of its face")),
     ("not orientable", re.compile(r"not orientable")),
     ("orientation", re.compile(r"orient")),
+    ("a vertex in no face", re.compile(r"is in no face")),
+    ("coinciding vertices", re.compile(r"vertices \d+ and \d+ coincide")),
+    ("the suggested tolerance is refused", re.compile(r"Expected `tolerance`")),
     ("time limit", re.compile(r"time limit")),
 ]
 
