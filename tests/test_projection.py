@@ -150,11 +150,16 @@ def test_both_views_update_in_one_key_press(widgets):
     press(w, "4")
     assert w.scene.update_id != before_slice
     assert w._projection.shown_key[0] is w.state.matrix
-    after = w._projection._edge_pos.array
-    assert not np.allclose(before, after)
+    rows = w._projection._buffer.array  # what the page draws: vertices + colours, then the balls
+    n = len(before)
+    assert not np.allclose(before, rows[:n, :3])
     now = pj.projection_arrays(w.source, w.state.matrix, w.state.c0, w._scale)
-    np.testing.assert_allclose(after, now["positions"])
-    np.testing.assert_array_equal(w._projection._edge_rgb.array, np.rint(now["rgb"] * 255).astype(np.uint8))
+    np.testing.assert_allclose(rows[:n, :3], now["positions"])
+    np.testing.assert_allclose(rows[:n, 3:], now["rgb"])
+    balls = w._projection._point_index.array
+    shown = rows[balls][rows[balls][:, 2] < 1e5, :3]  # the slots in use; the rest hidden behind the camera
+    assert _match(shown, now["points"], atol=1e-6) and len(shown) == len(now["points"])
+    np.testing.assert_array_equal(w._projection._edge_index.array, now["index"])
     press(w, "l")  # c0 moves: the balls follow in the same update
     assert w._projection.shown_key[1] == w.state.c0
 

@@ -46,8 +46,8 @@ from .keypad import close_quietly
 from .traits import Checked
 
 __all__ = ["EYE_DISTANCE", "BELOW_RGB", "ON_RGB", "ABOVE_RGB", "skeleton", "tesseract", "hyperplane_offsets",
-           "perspective", "crossings", "w_colours", "projection_arrays", "ProjectionView", "ProjectionFlag",
-           "check_projection"]
+           "perspective", "crossings", "w_colours", "projection_arrays", "pack_rows", "crossing_capacity",
+           "ProjectionView", "ProjectionFlag", "check_projection"]
 
 #: The eye sits at w = EYE_DISTANCE x the source's size on the w axis.
 EYE_DISTANCE = 3.0
@@ -183,6 +183,35 @@ def projection_arrays(source, matrix, c0, scale: float = 1.0) -> dict | None:
     }
 
 
+#: Where an unused crossing slot is put: far behind the projection's camera (on the +z axis,
+#: looking down -z), so it is clipped and never drawn.
+HIDDEN = (0.0, 0.0, 1.0e6)
+
+
+def crossing_capacity(n_edges: int, n_offsets: int) -> int:
+    """Crossing slots kept in the buffer: every edge crossing every hyperplane once (an edge in a
+    hyperplane gives two ends, whose vertices other edges also cross: rarely more; more grows it)."""
+    return max(1, int(n_edges) * max(1, int(n_offsets)))
+
+
+def pack_rows(arrays, capacity: int) -> np.ndarray:
+    """(V + capacity, 6) float32 rows ``x, y, z, r, g, b``: the projected vertices with their colours
+    (`projection_arrays`), then the crossings (colour unused: the balls have one), then `HIDDEN`
+    rows up to ``capacity`` crossings.  None: one hidden row per slot."""
+    if arrays is None:
+        rows = np.zeros((capacity, 6), dtype=np.float32)
+        rows[:, :3] = HIDDEN
+        return rows
+    pos, rgb, pts = arrays["positions"], arrays["rgb"], arrays["points"]
+    n = len(pos)
+    rows = np.zeros((n + capacity, 6), dtype=np.float32)
+    rows[:n, :3] = pos
+    rows[:n, 3:] = rgb
+    rows[n:n + len(pts), :3] = pts
+    rows[n + len(pts):, :3] = HIDDEN
+    return rows
+
+
 class ProjectionView:
     """The projection's canvas, caption and pythreejs objects for one widget (``widget``): built
     the first time it is shown, updated by `follow` in the painter's update, closed with the widget."""
@@ -206,18 +235,23 @@ class ProjectionView:
         w = self.w
         scene = w.scene
         width, height = int(scene.width), int(scene.height)
-        zero = np.zeros((2, 3), dtype=np.float32)
-        self._edge_pos = p3.BufferAttribute(array=zero, normalized=False)
-        # colours as bytes (a quarter of float32's): a held key sends positions, colours and balls
-        self._edge_rgb = p3.BufferAttribute(array=np.zeros((2, 3), dtype=np.uint8), normalized=True)
-        self._edge_index = p3.BufferAttribute(array=np.array([0, 1], dtype=np.uint32), normalized=False)
-        self._edge_geometry = p3.BufferGeometry(attributes={"position": self._edge_pos, "color": self._edge_rgb,
-                                                            "index": self._edge_index})
+        # one interleaved float32 buffer (rows x, y, z, r, g, b): the V projected vertices, then
+        # `capacity` crossing slots; lines and balls index into it, so a held key's update of the
+        # projection is one message (positions, colours and balls together)
+        self._rows = pack_rows(None, 1)
+        self._buffer = p3.InterleavedBuffer(array=self._rows)
+        self._edge_index = p3.BufferAttribute(array=np.array([0, 0], dtype=np.uint32), normalized=False)
+        self._edge_geometry = p3.BufferGeometry(attributes={
+            "position": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=0),
+            "color": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=3),
+            "index": self._edge_index})
         self._edge_material = p3.LineBasicMaterial(vertexColors="VertexColors", linewidth=1)
         self._lines = p3.LineSegments(geometry=self._edge_geometry, material=self._edge_material,
                                       frustumCulled=False, name="projection edges")
-        self._point_pos = p3.BufferAttribute(array=np.zeros((1, 3), dtype=np.float32), normalized=False)
-        self._point_geometry = p3.BufferGeometry(attributes={"position": self._point_pos})
+        self._point_index = p3.BufferAttribute(array=np.array([0], dtype=np.uint32), normalized=False)
+        self._point_geometry = p3.BufferGeometry(attributes={
+            "position": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=0),
+            "index": self._point_index})
         ball = 4.0 * float(getattr(w, "ball_radius", 0.07))
         self._point_material = p3.PointsMaterial(color=CROSSING_RGB, size=ball, sizeAttenuation=True)
         self._points = p3.Points(geometry=self._point_geometry, material=self._point_material,
@@ -236,8 +270,10 @@ class ProjectionView:
         self.caption = widgets.HTML(self._caption_html())
         self.box = widgets.VBox([self.caption, self.renderer], layout=widgets.Layout(flex="0 0 auto"))
         self._widgets = [self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
-                         self._lines, self._points, self._edge_geometry, self._edge_material, self._edge_pos,
-                         self._edge_rgb, self._edge_index, self._point_geometry, self._point_material, self._point_pos]
+                         self._lines, self._points, self._edge_geometry, self._edge_material, self._buffer,
+                         self._edge_index, self._point_geometry, self._point_material, self._point_index]
+        self._widgets += [a for g in (self._edge_geometry, self._point_geometry) for a in g.attributes.values()
+                          if a not in self._widgets]
 
     def _caption_html(self) -> str:
         d = EYE_DISTANCE
@@ -283,14 +319,18 @@ class ProjectionView:
             self._lines.visible = self._points.visible = False
             return
         index, pts = arrays["index"], arrays["points"]
+        n_vertices = len(arrays["positions"])
+        capacity = len(self._rows) - n_vertices
+        if len(pts) > capacity or len(index) != len(self._edge_index.array) or capacity < 1:
+            capacity = max(len(pts), crossing_capacity(len(index) // 2, len(arrays["offsets"])))
+        rows = pack_rows(arrays, capacity)
         with self.renderer.hold_sync():
-            if len(index):
-                if not np.array_equal(index, self._edge_index.array):  # a new source: its edges, once
-                    self._edge_index.array = index
-                self._edge_pos.array = arrays["positions"]
-                self._edge_rgb.array = np.rint(arrays["rgb"] * 255.0).astype(np.uint8)
+            if len(rows) != len(self._rows) or not np.array_equal(index, self._edge_index.array):
+                # a new source (or more crossings than slots): its edges and the balls' slots, once
+                self._edge_index.array = index if len(index) else np.array([0, 0], dtype=np.uint32)
+                self._point_index.array = np.arange(n_vertices, len(rows), dtype=np.uint32)
+            self._buffer.array = self._rows = rows
             self._lines.visible = bool(len(index))
-            self._point_pos.array = pts if len(pts) else np.zeros((1, 3), dtype=np.float32)
             self._points.visible = bool(len(pts))
 
     def readout_row(self):

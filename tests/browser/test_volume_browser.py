@@ -64,12 +64,25 @@ def compare(png, rendering):
 w"""
 
 
+def _page_state(jp):
+    """What the page says when an update is not acknowledged: the view's canvas (drawn pixels,
+    WebGL context lost?) and the console's last messages."""
+    sel = jp.kernel("print(w.scene.canvas_class)").strip()
+    gl = jp.page.evaluate(
+        "(cls) => { const c = document.querySelector('.' + cls + ' canvas'); if (!c) return 'no canvas';"
+        " const gl = c.getContext('webgl'); return {w: c.width, h: c.height,"
+        " lost: gl ? gl.isContextLost() : null}; }", sel)
+    return {"canvas": gl, "stats": jp.canvas_stats(f".{sel} canvas"), "console": jp.page.console_messages[-12:],
+            "errors": jp.page.page_errors[-5:]}
+
+
 def _shot(jp, rendering):
     """The page's PNG of the view once it has drawn ``rendering`` (the kernel shows it and the page
     acknowledged every update sent), fresh each time."""
     shown = f"w._painter.shown is not None and w._painter.shown.scale[2] == {rendering!r}"
-    assert jp.wait_for(lambda: jp.kernel_json(f"{shown} and not w.in_flight"), timeout=90), jp.kernel_json(
-        "[str(w._painter.shown and w._painter.shown.scale), w.in_flight, w.stats.as_dict()]")
+    assert jp.wait_for(lambda: jp.kernel_json(f"{shown} and not w.in_flight"), timeout=90), (
+        jp.kernel_json("[str(w._painter.shown and w._painter.shown.scale), w.in_flight, w.stats.as_dict()]"),
+        _page_state(jp))
     jp.kernel("w.last_screenshot = None")
     jp.kernel_json("w.screenshot()")
     assert jp.wait_for(lambda: jp.kernel_json("w.last_screenshot is not None"), timeout=30), "no PNG from the page"
