@@ -42,7 +42,7 @@ _LAZY = {
     "slice_field": "sources.fields",
     "FieldSlice": "sources.fields",
     "FieldSliceData": "sources.fields",
-    "polytope_names": "geometry.uniform",
+    "polytope_names": "geometry.catalogue",
     "slice_mesh": "keep.export",
     "save_state": "keep.export",
     "load_state": "keep.export",
