@@ -18,7 +18,9 @@ For each ``*.off`` file in DIR (sorted by the number its name starts with, then 
     hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
     failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
     polytope with reflex ridges, not detected as self-intersecting, can wind round negatively);
-  - the slice's triangles make a closed surface (every directed edge as often as its reverse);
+  - the slice's polygons close up (every directed edge of their cycles as often as its reverse;
+    a non-convex section's fill corners, ``Slice.n_fill``, are not points: only checked to lie in
+    the points' bounding box);
   - for a polytope reported convex: the slice's volume equals the volume of
     ``scipy.spatial.ConvexHull`` of its points (relative ``1e-6``).
 
@@ -121,14 +123,27 @@ def crossings(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: fl
     return np.concatenate([x[a, :3] + t * (x[b, :3] - x[a, :3]), x[on, :3]])
 
 
-def closed(s) -> bool:
-    """The slice's triangles make a closed surface: every directed edge as often as its reverse."""
-    t = np.asarray(s.triangles)
-    if len(t) == 0:
-        return True
-    d = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+def unclosed(s) -> str | None:
+    """What keeps the slice's polygons from closing up, or None: every directed edge of their
+    cycles must come as often as its reverse (each segment of a face's chord bounds the sections
+    of the face's two cells, wound against each other, as the 4-D boundary's orientation induces).
+    The polygons, not the triangles: a non-convex section's fill has extra corners on the segments
+    (`Slice.n_fill`) that its neighbour's fill does not share."""
+    idx, off = np.asarray(s.polygon_indices), np.asarray(s.polygon_offsets)
+    if len(off) < 2:
+        return None
+    nxt = np.arange(1, len(idx) + 1)
+    nxt[off[1:] - 1] = off[:-1]  # each corner's successor in its own cycle
+    d = np.stack([idx, idx[nxt]], axis=1)
+    odd = sum(n % 2 for n in collections.Counter(map(tuple, np.sort(d, axis=1).tolist())).values())
+    if odd:
+        return f"{odd} polygon edges in an odd number of polygons (segments not shared)"
     fwd = collections.Counter(map(tuple, d.tolist()))
-    return all(fwd[(j, i)] == n for (i, j), n in fwd.items())
+    wrong = sum(fwd[(j, i)] != n for (i, j), n in fwd.items())
+    if wrong:
+        return (f"{wrong} polygon edges run the same way in both their polygons (the cycles' winding disagrees "
+                f"with the boundary's orientation)")
+    return None
 
 
 def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float) -> list[str]:
@@ -137,11 +152,15 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     problems = []
     scale = float(np.max(np.linalg.norm(v, axis=1)))
     tol = POINT_TOL * scale
-    pts = np.asarray(s.vertices, dtype=float)
+    allpts = np.asarray(s.vertices, dtype=float)
+    nfill = int(getattr(s, "n_fill", 0))  # extra corners of a non-convex section's fill, after the points
+    pts, fill = allpts[: len(allpts) - nfill], allpts[len(allpts) - nfill :]
     want = crossings(v, e, m, c0, 1e-9 * scale)
-    if not np.all(np.isfinite(pts)):
+    if not np.all(np.isfinite(allpts)):
         problems.append(f"c0={c0:.4g}: slice points not finite")
         return problems
+    if nfill and len(pts) and np.any((fill < pts.min(axis=0) - tol) | (fill > pts.max(axis=0) + tol)):
+        problems.append(f"c0={c0:.4g}: a fill corner outside the slice points' box")
     # compared as sets: crossing points may coincide (two edges meeting the hyperplane at one point)
     if len(want) == 0 or len(pts) == 0:
         if len(want) != len(pts):
@@ -157,8 +176,9 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
                         f"(worst {d2.max() / scale:.2g} x R)")
     if not np.isfinite(s.volume):
         problems.append(f"c0={c0:.4g}: volume {s.volume}")
-    if not closed(s):
-        problems.append(f"c0={c0:.4g}: the slice's surface is not closed")
+    why = unclosed(s)
+    if why:
+        problems.append(f"c0={c0:.4g}: the polygons do not close up: {why}")
     if p.convex and s.dim == 3:
         hull = ConvexHull(pts).volume
         if abs(s.volume - hull) > VOLUME_RTOL * hull:
