@@ -1,0 +1,118 @@
+"""Files of a public 4OFF library load and slice right (issue 22).
+
+Every file in tests/data/off_library (35 files of Pardesco/4d-polytope-viewer, MIT; README.md
+there: convex uniform, the ten regular star polychora, non-convex uniform ones with star faces,
+non-convex and hemi cells) is read with `Polytope.from_off` as a user would, and its slices are
+checked against what numpy computes from the file's own vertices and face edges
+(benchmarks/off_library.py, whose checks these are; that script runs a whole library):
+
+* the counts are the file's counts line (V F E C);
+* at c0 = 0 and three more levels after a fixed random rotation: the slice's points are the
+  edges' crossings of the hyperplane (and nothing else), finite; its triangles close up;
+* convex: the slice's volume is its points' convex hull volume;
+* Cavalieri, for four non-convex ones (firp, firt and frico have negative slice volumes at some
+  levels, their boundaries winding round some regions negatively; pinnip is self-intersecting):
+  the integral over c0 of the slices' volumes equals the
+  4-volume by the divergence theorem, (1/4) sum over the cells of (offset x 3-volume), each cell's
+  3-volume from scipy's hull of its vertices in its own hyperplane.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial import ConvexHull
+
+from rot4d_widget.geometry.mesh import Polytope
+from rot4d_widget.geometry.slicing import slice_polytope
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
+from off_library import check_slice, levels, read_vertices_and_edges, rotation  # noqa: E402
+
+DATA = pathlib.Path(__file__).resolve().parent / "data" / "off_library"
+FILES = sorted(DATA.glob("*.off"), key=lambda f: int(f.name.split("-")[0]))
+
+#: files not loadable yet, with why (a temporary state while issue 22's mesh work lands)
+_STAR = "refused: star faces {5/2} or {8/3} (issue 22: being made to load and slice)"
+_CELLS = "refused: non-convex cells (issue 22: being made to load and slice)"
+PENDING: dict[str, str] = {
+    **{f"{n}.off": _STAR for n in ("10-sishi", "12-gishi", "13-gashi", "16-gogishi", "34-quitit", "894-sissiddip",
+                                   "905-quithip")},
+    **{f"{n}.off": _CELLS for n in ("8-gohi", "11-gaghi", "14-gofix", "893-gaddip")},
+    "17-tho.off": "refused: not orientable (a hemi polychoron)",
+    "60-ihi.off": "refused: hemi cells (faces through a cell's centre, in the plane of other corners of the cell)",
+}
+
+
+def _params():
+    for f in FILES:
+        marks = [pytest.mark.xfail(strict=True, reason=PENDING[f.name])] if f.name in PENDING else []
+        yield pytest.param(f, id=f.stem, marks=marks)
+
+
+def counts_line(path) -> tuple[int, int, int, int]:
+    """(V, E, F, C) from the file's counts line (written V F E C)."""
+    with open(path, encoding="utf-8") as fh:
+        rows = [ln.split("#", 1)[0].split() for ln in fh]
+    rows = [r for r in rows if r]
+    k = next(i for i, r in enumerate(rows) if r[0] == "4OFF")
+    nv, nf, ne, nc = (int(x) for x in (rows[k][1:] or rows[k + 1]))
+    return nv, ne, nf, nc
+
+
+def test_the_library_is_here():
+    assert len(FILES) == 35
+    assert (DATA / "LICENSE").read_text().startswith("MIT License")
+    assert all(name in {f.name for f in FILES} for name in PENDING)
+
+
+@pytest.mark.parametrize("path", list(_params()))
+def test_loads_and_slices_right(path):
+    p = Polytope.from_off(path)  # Miratope-style files carry 15 digits: the default tolerance
+    assert p.counts == counts_line(path)
+    v, e = read_vertices_and_edges(path)
+    assert len(e) == len(p.edges)
+    m = rotation(0)
+    problems = []
+    for c0 in levels(p, m, 3):
+        s = slice_polytope(p, m, c0)
+        assert s.dim == 3, f"c0={c0}: the hyperplane crosses the polytope"
+        problems += check_slice(p, s, v, e, m, c0)
+    assert not problems, "\n".join(problems)
+
+
+CONVEX = {"1-pen", "2-tes", "3-hex", "4-ico", "5-hi", "6-ex", "18-tip", "19-tat", "20-thex", "21-tico", "39-rap",
+          "42-rit", "45-rico"}
+
+
+@pytest.mark.parametrize("path", [pytest.param(f, id=f.stem) for f in FILES if f.stem in CONVEX])
+def test_convex_ones_are_convex(path):
+    p = Polytope.from_off(path)
+    assert p.convex and not p.self_intersecting
+
+
+def four_volume(p: Polytope) -> float:
+    """(1/4) sum_c offset_c vol3(c): the divergence theorem over the outward cells (each convex
+    here), vol3 from scipy's hull of the cell's vertices in its hyperplane's coordinates."""
+    total = 0.0
+    for c in range(len(p.cells)):
+        x = p.vertices[p.cell_vertices(c)]
+        n = p.cell_normals[c]
+        basis = np.linalg.svd(np.eye(4) - np.outer(n, n))[0][:, :3]  # an orthonormal basis of n's complement
+        total += p.cell_offsets[c] * ConvexHull(x @ basis).volume
+    return total / 4
+
+
+@pytest.mark.parametrize("name", ["40-firp", "41-pinnip", "43-firt", "46-frico"])
+def test_cavalieri_for_non_convex_ones(name):
+    p = Polytope.from_off(DATA / f"{name}.off")
+    assert not p.convex
+    m = rotation(1)
+    w = p.vertices @ m.T[:, 3]
+    c0 = np.linspace(w.min(), w.max(), 801)
+    vols = np.array([s.volume for s in slice_polytope(p, m, c0)])
+    integral = float(np.sum((vols[1:] + vols[:-1]) / 2 * np.diff(c0)))
+    assert integral == pytest.approx(four_volume(p), rel=1e-6)  # agrees to ~1e-11 with 801 levels
