@@ -205,3 +205,19 @@ def test_off_by_default_changes_nothing(widgets):
         press(w, "c")
     np.testing.assert_array_equal(plain.scene._buffer.array, shown.scene._buffer.array)
     assert "views" not in plain.readout.value and "views" in shown.readout.value
+
+
+def test_keys_over_the_projection_turn_the_object(widgets):
+    """A key pressed with the mouse over the projection's canvas goes the same way as over the slice:
+    its ipyevents listener hands the event to the widget's key handler."""
+    w = widgets("24-cell", projection=True)
+    ev = w._projection.events
+    assert ev is not None and ev.source is w._projection.renderer
+    assert set(ev.watched_events) == {"keydown", "keyup", "mouseleave"}
+    m0 = np.array(w.state.matrix)
+    for kind in ("keydown", "keyup"):
+        ev._handle_mouse_msg(None, key_event(kind, "4"), None)
+    assert not np.allclose(w.state.matrix, m0)
+    assert w._projection.shown_key[0] is w.state.matrix  # both views show the turn
+    w._projection.close()
+    assert w._projection.events is None

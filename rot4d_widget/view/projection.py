@@ -58,6 +58,8 @@ ABOVE_RGB = np.array([0.706, 0.016, 0.150])
 #: The projection's camera is this much farther than the slice view's: a vertex at w = size is
 #: drawn up to d / (d - size) = 1.5 times farther out (such vertices are rare: a little is cut at worst).
 CAMERA_FARTHER = 1.2
+#: What the projection's canvas listens to: the slice canvas's events, handled alike.
+KEY_EVENTS = ("keydown", "keyup", "mouseleave")
 #: The crossing balls' colour.
 CROSSING_RGB = "#e07b00"
 
@@ -222,6 +224,7 @@ class ProjectionView:
         self.shown_key = None  # (matrix, c0, version) last drawn
         self.arrays = None  # what was last sent (`projection_arrays`), for tests and the readout
         self._widgets = []
+        self.events = None  # the ipyevents listener on the projection's canvas, once built
 
     @property
     def on(self) -> bool:
@@ -267,9 +270,14 @@ class ProjectionView:
                                     width=width, height=height, background=background, background_opacity=1.0,
                                     clearColor=background)
         self.renderer.add_class("rot4d-projection")
+        from ipyevents import Event  # keys over the projection turn the object as over the slice
+
+        self.events = Event(source=self.renderer, watched_events=list(KEY_EVENTS), prevent_default_action=True,
+                            ignore_modifier_key_events=True)
+        self.events.on_dom_event(w._handle_event)
         self.caption = widgets.HTML(self._caption_html())
         self.box = widgets.VBox([self.caption, self.renderer], layout=widgets.Layout(flex="0 0 auto"))
-        self._widgets = [self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
+        self._widgets = [self.events, self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
                          self._lines, self._points, self._edge_geometry, self._edge_material, self._buffer,
                          self._edge_index, self._point_geometry, self._point_material, self._point_index]
         self._widgets += [a for g in (self._edge_geometry, self._point_geometry) for a in g.attributes.values()
@@ -340,6 +348,9 @@ class ProjectionView:
         return ("views", "left: the slice w = c0 &middot; right: the whole object projected (balls: the slice)")
 
     def close(self) -> None:
+        if self.events is not None:
+            self.events.on_dom_event(self.w._handle_event, remove=True)
+            self.events = None
         for x in self._widgets:
             close_quietly(x)
         self._widgets = []

@@ -1,5 +1,6 @@
 """The whole object beside its slice (issue 22, ``projection=True``) in JupyterLab and Notebook 7:
 the projection's canvas is drawn (non-background pixels), one key press changes both canvases,
+a key pressed over the projection turns the object too,
 and a screenshot of the two views is kept in test-artifacts/projection-<front end>.png."""
 
 from __future__ import annotations
@@ -40,6 +41,13 @@ def test_projection_drawn_and_turned_with_the_slice(jupyter_server, page, artifa
     assert jp.wait_for(lambda: jp.canvas_stats(sel)["hash"] != before[0]
                        and jp.canvas_stats(PROJECTION)["hash"] != before[1], timeout=15), \
         "a key press must change both canvases"
+    # a key with the mouse over the projection turns the object too
+    page.locator(PROJECTION).scroll_into_view_if_needed()
+    _hover(jp, PROJECTION)
+    m1 = jp.kernel_json("w.state.matrix.tolist()")
+    page.keyboard.press("c")
+    assert jp.wait_for(lambda: jp.kernel_json("w.state.matrix.tolist()") != m1, timeout=10), \
+        "a key over the projection's canvas must turn the object"
     host = page.locator(PROJECTION).locator("xpath=ancestor::div[contains(@class, 'widget-hbox')][1]")
     host.screenshot(path=str(artifacts / f"projection-{jupyter_server.kind}.png"))
     assert "right: the whole object projected" in jp.kernel_json("w.readout.value")
