@@ -220,17 +220,50 @@ def test_a_vertex_in_no_face_and_coinciding_vertices():
         Polytope(v, faces, cells)
 
 
-def test_a_star_pentagon_face_is_refused():
+def test_a_star_pentagon_face_is_accepted_and_sliced():
+    """The {5/2}-{5} duoprism (issue 22: star faces load): its slice at w = c0 is a prism over a
+    pentagram, checked against an independent computation (the edges' crossings interpolated
+    here, the volume winding-weighted: the pentagram's shoelace area times the chord of the
+    pentagon; the drawn area even-odd: the pentagram's five points, twice, and five rectangles)."""
     v, f, c = duoprism_mesh(5, 5)
-    f[0] = [f[0][i] for i in (0, 2, 4, 1, 3)]  # the same corners as a pentagram
-    with pytest.raises(MeshError, match="face 0 .* not a convex polygon .* or a star"):
-        Polytope(v, f, c)
+    rp = float(np.linalg.norm(v[0, :2]))
+    ang = 4 * np.pi * (np.arange(25) // 5) / 5  # corner i of the first factor at 4 pi i / 5: a pentagram
+    v[:, 0], v[:, 1] = rp * np.cos(ang), rp * np.sin(ang)
+    p = Polytope(v, f, c)
+    assert p.counts == (25, 50, 35, 10) and not p.convex and p.self_intersecting
+    c0 = 0.3
+    s = slice_polytope(p, np.eye(4), c0)
+    a, b = p.edges.T
+    cross = (v[a, 3] - c0) * (v[b, 3] - c0) < 0
+    a, b = a[cross], b[cross]
+    t = ((c0 - v[a, 3]) / (v[b, 3] - v[a, 3]))[:, None]
+    expected = v[a, :3] + t * (v[b, :3] - v[a, :3])
+    got = np.asarray(s.vertices)[: len(s.vertices) - s.n_fill]
+    assert len(got) == len(expected) == 10
+    assert np.abs(np.sort(got, axis=0) - np.sort(expected, axis=0)).max() < 1e-12
+    star = v[f[0], :2]
+    wind = 0.5 * np.sum(star[:, 0] * np.roll(star[:, 1], -1) - np.roll(star[:, 0], -1) * star[:, 1])
+    q = v[:5, 2:]  # the pentagon (z, w) of corner i = 0
+    zs = [qa[0] + (c0 - qa[1]) / (qb[1] - qa[1]) * (qb[0] - qa[0])
+          for qa, qb in zip(q, np.roll(q, -1, axis=0)) if (qa[1] - c0) * (qb[1] - c0) < 0]
+    chord = abs(zs[0] - zs[1])
+    assert s.volume == pytest.approx(abs(wind) * chord, rel=1e-12)
+    inner = 2.5 * np.sin(2 * np.pi / 5) * (rp * np.cos(2 * np.pi / 5) / np.cos(np.pi / 5)) ** 2
+    tri = np.asarray(s.vertices)[s.triangles]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+    side = 2 * rp * np.sin(2 * np.pi / 5)
+    assert area == pytest.approx(2 * (abs(wind) - 2 * inner) + 5 * side * chord, rel=1e-12)
 
 
-def test_a_non_convex_cell_is_refused_and_its_convex_prism_accepted():
+def test_a_non_convex_cell_is_accepted_and_sliced_and_its_convex_prism_too():
     v, f, c = prism_mesh(*dented_octahedron())
-    with pytest.raises(MeshError, match=r"cell [01] is not convex: its vertex \d+ is outside the plane of its face"):
-        Polytope(v, f, c)
+    p = Polytope(v, f, c)  # issue 22: non-convex cells load
+    assert p.counts == (12, 30, 28, 10) and not p.convex and not p.self_intersecting
+    for c0 in (0.0, 0.5, 1.0):  # the dented octahedron: a pyramid of height 1.5 less one of 0.5, base 2
+        s = slice_polytope(p, np.eye(4), c0)
+        assert s.volume == pytest.approx(2 * 1.5 / 3 - 2 * 0.5 / 3, rel=1e-12)
+        assert s.n_fill == 0 and np.abs(np.sort(np.asarray(s.vertices), axis=0)
+                                        - np.sort(dented_octahedron()[0], axis=0)).max() < 1e-12
     ov = np.array([[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0, 0, 1.0], [0, 0, -1.0]])
     octa = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [1, 0, 5], [2, 1, 5], [3, 2, 5], [0, 3, 5]]
     p = Polytope(*prism_mesh(ov, octa))

@@ -261,6 +261,7 @@ class Polytope:
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
         self.convex = True
         self.self_intersecting = False
+        self._star = None
 
     def _set_combinatorics(self, face_ptr, face_vidx, cell_ptr, cell_fidx) -> None:
         """Edges, faces, cells and the flat incidence tables (`incidence`, also read by the slicer)."""
@@ -335,9 +336,16 @@ class Polytope:
         order = np.argsort(cell_fidx, kind="stable")
         cell_of = _owner(cell_ptr)
         self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
-        normals, offsets, centres, ncomp, tol = mesh_geometry(self, validate, tolerance)  # unit vertices' scale
+        normals, offsets, centres, ncomp, tol, star = mesh_geometry(self, validate, tolerance)  # unit scale
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets * self._unit)
+        self._star = star
+        if star is not None:  # a star face or a non-convex cell: not convex, self-intersecting if found so
+            for name in ("face_convex", "cell_convex", "face_star", "cell_star", "face_basis", "pair_rho"):
+                _sealed(getattr(star, name))
+            self.convex = False
+            self.self_intersecting = bool(star.face_star.any() or star.cell_star.any())
+            return
         c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
         locally = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
                        and np.all(np.einsum("fd,fd->f", normals[c2], centres[c1]) <= offsets[c2] + tol))
@@ -393,6 +401,13 @@ class Polytope:
     def incidence(self) -> Incidence:
         """The flat incidence tables (`Incidence`: faces, cells, their vertices and edges, read-only)."""
         return self._incidence
+
+    @property
+    def star(self):
+        """`rot4d_widget.geometry.meshcheck.StarData` (read-only arrays) when some face is not a convex
+        polygon or some cell not a convex polyhedron (the slicer then takes its general path:
+        `rot4d_widget.geometry.starslice`), else None."""
+        return self._star
 
     @property
     def unit(self) -> float:

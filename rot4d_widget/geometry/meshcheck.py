@@ -12,15 +12,16 @@ Lengths are in the scale of the polytope's `Polytope.unit_vertices`; the toleran
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ..core import tolerances as tol_
-from ._ragged import _owner, _ptr
+from ._ragged import _gather, _owner, _ptr
 
-__all__ = ["MeshError", "index_lists", "duplicate_in_rows", "mesh_geometry"]
+__all__ = ["MeshError", "StarData", "index_lists", "duplicate_in_rows", "mesh_geometry"]
 
 
 class MeshError(ValueError):
@@ -123,6 +124,8 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     face_c = np.empty((F, 4))
     face_e = np.empty((F, 2, 4))
     face_area = np.empty(F)
+    face_convex = np.empty(F, dtype=bool)
+    face_star = np.empty(F, dtype=bool)
     for k in np.unique(fsize).tolist():
         fs = np.flatnonzero(fsize == k)
         P = v[fv[fptr[fs][:, None] + np.arange(k)]]  # (n, k, 4)
@@ -137,6 +140,12 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
             f = int(fs[bad[0]])
             raise MeshError(f"face {f} is not planar: a corner is {off[bad[0]] * p.unit:.3g} from its plane "
                             f"(tolerance {tol * p.unit:.3g}){loosen_hint(off.max(), extent)}", item=("face", f))
+        spread = np.abs(xy[..., 1]).max(axis=1)  # the second principal axis: 0 when collinear
+        bad = np.flatnonzero(spread <= tol)
+        if len(bad):
+            f = int(fs[bad[0]])
+            raise MeshError(f"face {f} {p.faces[f].tolist()} is degenerate: its corners are collinear",
+                            item=("face", f))
         e = np.roll(xy, -1, axis=1) - xy  # side k: corner k -> k + 1
         e2 = np.roll(e, -1, axis=1)
         cross = e[..., 0] * e2[..., 1] - e[..., 1] * e2[..., 0]
@@ -145,17 +154,23 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
         dist = np.abs(cross) / np.maximum(chord, tol_.TINY)  # corner k + 1 from the line of its neighbours
         turning = np.arctan2(cross, dot).sum(axis=1)
         sign = np.sign(cross)
-        ok = (dist > tol).all(axis=1) & (sign == sign[:, :1]).all(axis=1) & (np.abs(np.abs(turning) - 2 * np.pi) < 1)
-        bad = np.flatnonzero(~ok)
+        convex = ((dist > tol).all(axis=1) & (sign == sign[:, :1]).all(axis=1)
+                  & (np.abs(np.abs(turning) - 2 * np.pi) < 1))
+        wind = np.rint(turning / (2 * np.pi)).astype(np.intp)  # the turning number: +-1 convex, +-2 a {5/2}
+        bad = np.flatnonzero(~convex & (wind == 0))
         if len(bad):
             f = int(fs[bad[0]])
-            raise MeshError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given "
-                            f"(collinear or repeated corners, a reflex corner, or a star); faces must be "
-                            f"strictly convex polygons with their vertices in cyclic order", item=("face", f))
+            raise MeshError(f"face {f} {p.faces[f].tolist()} is not a convex polygon in the order given, nor a "
+                            f"star polygon: its sides turn through no net angle (a figure eight: two corners "
+                            f"swapped?); faces must be polygons with their vertices in cyclic order",
+                            item=("face", f))
+        area2 = (xy[..., 0] * np.roll(xy[..., 1], -1, axis=1) - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1]).sum(1)
+        B[area2 < 0, 1] *= -1.0  # the plane's axes oriented so that the cycle winds positively
         face_c[fs] = c
         face_e[fs] = B
-        face_area[fs] = 0.5 * np.abs((xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
-                                      - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1]).sum(axis=1))
+        face_area[fs] = 0.5 * np.abs(area2)  # a star's inner parts counted as often as the cycle winds round
+        face_convex[fs] = convex
+        face_star[fs] = np.abs(wind) >= 2
     if validate:  # before the cells' geometry: an open cell is a mistake in the lists, named as such
         _check_closed(p)
     # cells: flat, 3-D, normal
@@ -191,13 +206,18 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     for basis in (n[pc], face_e[pf, 0], face_e[pf, 1]):
         m -= np.einsum("id,id->i", m, basis)[:, None] * basis
     height = np.linalg.norm(m, axis=1)  # the cell's centroid from each face's plane, in the cell
-    bad = np.flatnonzero(height <= tol)
+    # a cell is convex when its faces are and every vertex lies on the inner side of every face
+    cell_convex = ~np.logical_or.reduceat(~face_convex[pf], cptr[:-1])
+    if validate:
+        cell_convex &= _convex_cells(p, v, tol, pc, pf, m / np.maximum(height, tol_.TINY)[:, None], face_c)
+    bad = np.flatnonzero((height <= tol) & cell_convex[pc])
     if len(bad):
         raise MeshError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
                         f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
-    m /= height[:, None]  # each face's outward normal within each of its cells
-    if validate:
-        _check_cells(p, v, tol, pc, pf, m, face_c)
+    m /= np.maximum(height, tol_.TINY)[:, None]  # each face's outward normal within each of its cells
+    cell_star = np.zeros(C, dtype=bool)
+    if not cell_convex.all():  # outward normals from the faces' orientation, not from the centre
+        cell_star = _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_convex)
     # orientation: the sign of det[n_c, m_cf, plane of f] relates the two cells of each face
     sigma = np.sign(np.linalg.det(np.stack([n[pc], m, face_e[pf, 0], face_e[pf, 1]], axis=1)))
     order = np.argsort(pf, kind="stable")
@@ -212,7 +232,8 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
                         f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
     s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
     ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
-    vol3 = np.bincount(pc, weights=face_area[pf] * height, minlength=C) / 3.0
+    # each cell's 3-volume (winding-weighted for a star cell): the divergence theorem over its faces
+    vol3 = np.bincount(pc, weights=face_area[pf] * np.einsum("id,id->i", face_c[pf] - g[pc], m), minlength=C) / 3.0
     offsets = np.einsum("cd,cd->c", n, g)
     vol4 = np.bincount(comp, weights=s * offsets * vol3, minlength=ncomp) / 4.0
     small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
@@ -224,7 +245,36 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
         flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
     s = np.where(flip[comp], -s, s)
     normals = np.ascontiguousarray(n * s[:, None])
-    return normals, np.ascontiguousarray(offsets * s), g, ncomp, tol
+    star = None
+    if not cell_convex.all():
+        # the direction of each face's chord along w = c0 in each of its cells (slicer): -sign det[n, m, e0, e1]
+        rho = -(s[pc] * sigma).astype(np.intp)
+        star = StarData(face_convex=face_convex, cell_convex=cell_convex, face_star=face_star, cell_star=cell_star,
+                        face_basis=face_e, pair_rho=rho)
+    return normals, np.ascontiguousarray(offsets * s), g, ncomp, tol, star
+
+
+@dataclass(frozen=True)
+class StarData:
+    """What the slicer of a polytope with a non-convex face or cell needs (`Polytope.star`).
+
+    face_convex (F,), cell_convex (C,) : strictly convex (a cell: its faces too, and every vertex
+        on the inner side of each face's plane)
+    face_star (F,) : the face winds round some point more than once (a {5/2}, {8/3})
+    cell_star (C,) : the cell's faces wind round its vertex centre more than once (a star polyhedron)
+    face_basis (F, 2, 4) : orthonormal axes of each face's plane (unit vertices' scale), oriented so
+        that the face's cycle winds positively
+    pair_rho (P,) : for each (cell, face) entry of ``incidence.cell_fidx``, +-1: the face's chord
+        along a hyperplane runs along ``e1 * (e0 . w) - e0 * (e1 . w)`` (rho = +1) or against it,
+        as the boundary of the cell's section seen from its outward normal
+    """
+
+    face_convex: np.ndarray
+    cell_convex: np.ndarray
+    face_star: np.ndarray
+    cell_star: np.ndarray
+    face_basis: np.ndarray
+    pair_rho: np.ndarray
 
 
 def _check_closed(p) -> None:
@@ -238,11 +288,15 @@ def _check_closed(p) -> None:
                         f"each edge of a cell must be in exactly two of its faces", item=("cell", c))
 
 
-def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
-    """Every cell strictly convex (MeshError naming the cell)."""
+def _convex_cells(p, v, tol, pc, pf, m, face_c) -> np.ndarray:
+    """(C,) bool: the cell is convex (every vertex on the inner side of each face's plane).
+
+    A convex cell must also be strictly convex: only a face's own corners on its plane (else a
+    MeshError naming the cell: two coplanar faces).  A non-convex cell may have coplanar faces."""
     cptr, vptr, cvx = p.incidence.cell_ptr, p.incidence.cell_vptr, p.incidence.cell_vidx
     nf, nv = np.diff(cptr), np.diff(vptr)
     fsize = np.diff(p.incidence.face_ptr)
+    out_c = np.ones(len(nf), dtype=bool)
     kinds, kind = np.unique(nf * (nv.max() + 1) + nv, return_inverse=True)
     for j in range(len(kinds)):
         cells_j = np.flatnonzero(kind.reshape(-1) == j)
@@ -254,18 +308,88 @@ def _check_cells(p, v, tol, pc, pf, m, face_c) -> None:
             pairs = cptr[cs][:, None] + np.arange(q)  # (n, q)
             M = m[pairs]
             D = M @ P.transpose(0, 2, 1) - np.einsum("nqd,nqd->nq", M, face_c[pf[pairs]])[..., None]
-            out = D > tol
-            if out.any():
-                i, j2, k2 = np.argwhere(out)[0]
-                raise MeshError(f"cell {int(cs[i])} is not convex: its vertex {int(cvx[vptr[cs[i]] + k2])} is "
-                                f"outside the plane of its face {int(pf[pairs[i, j2]])}", item=("cell", int(cs[i])))
+            convex = ~(D > tol).any(axis=(1, 2))
+            out_c[cs] = convex
             on = (D >= -tol).sum(axis=2)
-            wrong = on != fsize[pf[pairs]]
+            wrong = (on != fsize[pf[pairs]]) & convex[:, None]
             if wrong.any():
                 i, j2 = np.argwhere(wrong)[0]
                 raise MeshError(f"cell {int(cs[i])} is not strictly convex: a vertex that is not a corner of its "
                                 f"face {int(pf[pairs[i, j2]])} lies in that face's plane (two coplanar faces?)",
-                                 item=("cell", int(cs[i])))
+                                item=("cell", int(cs[i])))
+    return out_c
+
+
+def _cross4(a, b, c):
+    """(n, 4) x3 -> (n, 4): the vector x with ``x . y = det[y, a, b, c]`` for every y."""
+    M = np.stack([a, b, c], axis=1)  # (n, 3, 4)
+    cols = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]
+    return np.stack([(-1) ** k * np.linalg.det(M[:, :, cols[k]]) for k in range(4)], axis=1)
+
+
+def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_convex) -> np.ndarray:
+    """Outward face normals ``m`` (written in place) of the non-convex cells, from their faces' orientation.
+
+    Within each such cell the faces are oriented alike (every edge run through in opposite directions
+    by its two faces, propagated as connected components), and each connected set of faces is turned
+    so that it encloses positive (winding-weighted) volume; ``m`` of a face is then its plane's normal
+    within the cell, signed by that orientation (for a convex cell it is the centroid's rule).
+    Returns (C,) bool: the cell winds round its vertex centre more than once (a star polyhedron).
+    MeshError for a one-sided cell (a hemi-polyhedron) or one enclosing no volume."""
+    inc = p.incidence
+    C, E = len(cell_convex), len(p.edges)
+    sel = np.flatnonzero(~cell_convex[pc])  # the (cell, face) entries of non-convex cells
+    P = len(sel)
+    idx, row = _gather(inc.face_ptr, pf[sel])
+    nxt = idx + 1
+    ends = np.isin(nxt, inc.face_ptr[1:])
+    nxt[ends] = inc.face_ptr[:-1][np.searchsorted(inc.face_ptr, idx[ends], side="right") - 1]
+    direction = np.where(inc.face_vidx[idx] < inc.face_vidx[nxt], 1, -1)
+    key = pc[sel][row] * E + inc.face_eidx[idx]
+    order = np.argsort(key, kind="stable")
+    k1, k2 = order[0::2], order[1::2]
+    if len(order) % 2 or (key[k1] != key[k2]).any():
+        c = int(pc[sel][row][order[0]])
+        raise MeshError(f"cell {c} is not closed: an edge is not in exactly two of its faces", item=("cell", c))
+    i, j = row[k1], row[k2]
+    same = direction[k1] != direction[k2]  # then the two faces keep the same sign
+    a = np.concatenate([i, i + P])
+    b = np.concatenate([np.where(same, j, j + P), np.where(same, j + P, j)])
+    _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * P, 2 * P)), directed=False)
+    bad = np.flatnonzero(lab[:P] == lab[P:])
+    if len(bad):
+        c = int(pc[sel[bad[0]]])
+        raise MeshError(f"cell {c} is not orientable: its faces cannot be given normals that agree across "
+                        f"their shared edges (a one-sided polyhedron such as a hemi-polyhedron)", item=("cell", c))
+    s0 = np.where(lab[:P] < lab[P:], 1.0, -1.0)
+    comp = np.unique(np.minimum(lab[:P], lab[P:]), return_inverse=True)[1].reshape(-1)
+    cs, fs = pc[sel], pf[sel]
+    nu = _cross4(n[cs], face_e[fs, 0], face_e[fs, 1])
+    nu /= -np.linalg.norm(nu, axis=1)[:, None]  # det[n, nu, e0, e1] > 0
+    part = s0 * face_area[fs] * np.einsum("id,id->i", face_c[fs] - g[cs], nu) / 3.0
+    vol = np.bincount(comp, weights=part)
+    small = np.flatnonzero(np.abs(vol) <= tol * tol * tol)
+    if len(small):
+        c = int(cs[np.flatnonzero(comp == small[0])[0]])
+        raise MeshError(f"cell {c} encloses no volume: its faces' oriented areas cancel", item=("cell", c))
+    s = s0 * np.sign(vol)[comp]
+    m[sel] = s[:, None] * nu
+    # the winding number of each cell's faces about its vertex centre: solid angles of their fans
+    fptr = inc.face_ptr
+    size = fptr[fs + 1] - fptr[fs]
+    tri_row = np.repeat(np.arange(P), size - 2)
+    first = _ptr(size - 2)
+    kk = np.arange(first[-1]) - first[tri_row] + 1
+    base = fptr[fs][tri_row]
+    q0, q1, q2 = (v[inc.face_vidx[base + o]] - g[cs][tri_row] for o in (0 * kk, kk, kk + 1))
+    triple = np.linalg.det(np.stack([n[cs][tri_row], q0, q1, q2], axis=1))
+    l0, l1, l2 = (np.linalg.norm(q, axis=1) for q in (q0, q1, q2))
+    den = (l0 * l1 * l2 + np.einsum("id,id->i", q0, q1) * l2 + np.einsum("id,id->i", q0, q2) * l1
+           + np.einsum("id,id->i", q1, q2) * l0)
+    omega = 2 * np.arctan2(triple, den) * s[tri_row]
+    # det[n, nu, e0, e1] > 0 and the fans wind as the cycle (positively in e0, e1): signs agree
+    wind = np.bincount(cs[tri_row], weights=omega, minlength=C) / (4 * np.pi)
+    return np.abs(np.rint(wind)) >= 2
 
 
 def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:
@@ -292,3 +416,6 @@ def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray
         crossings = np.bincount(comp[ok], minlength=ncomp)
         depth[k] = int((crossings % 2).sum())
     return depth % 2 == 1
+
+
+_check_cells = _convex_cells  # its name before non-convex cells were accepted (re-exported by polytopes)

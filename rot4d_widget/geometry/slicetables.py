@@ -110,6 +110,9 @@ class Slice:
     volume : float -- the 3-volume (0 unless the slice is solid; inf, or 0, when it is
         beyond float64's range: coordinates above ~5e102 or below ~2e-103)
     dim : int -- 3 solid, 2/1/0 when H only touches a face/edge/vertex, -1 empty
+    n_fill : int -- the last ``n_fill`` vertices are not points of the slice but extra corners of
+        the triangles that fill a non-convex or self-intersecting section even-odd (0 unless
+        the polytope has star faces or non-convex cells: `rot4d_widget.geometry.starslice`)
 
     Every array is read-only (a missed slice shares its empty arrays with
     every other missed slice of the polytope); copy one to edit it.
@@ -124,6 +127,7 @@ class Slice:
     triangle_cells: np.ndarray
     volume: float
     dim: int
+    n_fill: int = 0
 
     def __post_init__(self):
         for name in ("vertices", "edges", "polygon_indices", "polygon_offsets", "cell_ids", "triangles",

@@ -98,6 +98,7 @@ from .section import _TWO_PI_PLUS, _boundary_only, _faces_in_h, _slice, _touchin
 from .section import slice_level as _slice_level
 from .slicetables import _TABLES, Slice, _fan, _Inconsistent, _inplane_axes, _padded, _scaled, _scaled_volume, _Tables
 from .slicetables import tables as _tables
+from .starslice import slice_star
 
 __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
 
@@ -134,6 +135,9 @@ def slice_polytope(polytope, matrix, c0=0.0):
     if t.unit != 1.0:
         with np.errstate(over="ignore"):  # a level beyond float64 in the unit scale is inf: H misses
             levels = levels / t.unit
+    if p.star is not None:  # star faces or non-convex cells: the general slicer, level by level
+        out = tuple(slice_star(p, t, x, m, float(c)) for c in levels)
+        return out if many else out[0]
     if not many:
         return _slice_level(t, x, m, float(levels[0]), t.radius)
     return _slice_many(t, x, m, levels, t.radius)

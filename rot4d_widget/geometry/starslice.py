@@ -1,0 +1,332 @@
+"""The general slicer: a polytope with star faces or non-convex (star) cells cut by w = c0.
+
+`Polytope.star` is not None (some face is not a convex polygon or some cell not a convex
+polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the slice is:
+
+* **points**: where the edges cross H (as for a convex polytope);
+* **segments** (the slice's edges): a face meets H in a line; its crossing points, sorted along
+  that line, are paired by the **even-odd rule** -- 1st with 2nd, 3rd with 4th, ... -- so a
+  segment covers the stretches of the line inside the face by parity (a line through a
+  pentagram {5/2} gives two segments, skipping its inner pentagon, whose points the boundary
+  winds round twice);
+* **polygons**: a cell's cross-section is the set of cycles its faces' segments chain into (each
+  crossing point of a cell ends exactly two of them, one from each of the cell's two faces at that
+  edge), each wound counter-clockwise about the cell's outward normal (its signed area positive);
+* **triangles**: a convex cell's one cycle is fanned as before; any other cell's cycles are filled
+  by the even-odd rule with a slab decomposition (the plane cut into slabs at the corners'
+  heights, the segments crossing each slab paired left to right into trapezoids), vectorised over
+  every slab of every cell.  A trapezoid's corners off the segments' ends are extra vertices,
+  appended after the slice's points (`Slice.n_fill` says how many); a non-convex polygon is never
+  fanned;
+* **volume**: winding-weighted, ``(1/6) sum over cells, faces, stretches k of rho * W_k *
+  det(a_c, p_k, p_k+1)``, where W_k is the number of times the face winds round the stretch
+  p_k -> p_k+1 of its line (the running sum of the +-1 its sides add where they cross H), rho the
+  direction of the chord in the cell's section (`StarData.pair_rho`), a_c a point of the cell's
+  section plane.  Each region counts as often as the boundary winds round it: the true volume
+  for an embedded polytope, and for a star polytope the slice of its density-weighted content,
+  so the slices' volumes integrate over c0 to the 4-volume the divergence theorem gives
+  (Cavalieri).
+
+Vertices on H are resolved by simulation of simplicity: they count as above H (the slice just
+below c0, as a limit) unless some cell lies in H, when the side whose slice has the larger volume
+is kept (so the cap of a prism at its end level is there).  The crossing points of the edges at
+such a vertex are that vertex, kept once; stretches of no length are dropped from the segments
+and polygons.  Per level: no Python loop over geometry (per-polytope tables built once).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from ._ragged import _ptr
+from .section import _touching
+from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+
+__all__: list = []
+
+
+class _StarTables:
+    """What the general slicer adds to `slicetables._Tables`, once per polytope."""
+
+    def __init__(self, p, t: _Tables):
+        st = p.star
+        inc = p.incidence
+        n = len(inc.face_vidx)
+        nxt = np.arange(1, n + 1, dtype=np.intp)
+        nxt[inc.face_ptr[1:] - 1] = inc.face_ptr[:-1]
+        self.fv_next = nxt  # the next corner of each face corner's cycle
+        order = np.argsort(inc.cell_fidx, kind="stable")  # each face's two (cell, face) entries, cells ascending
+        self.face_rho = st.pair_rho[order].reshape(-1, 2).astype(np.float64)  # aligned with p.face_cells
+        self.face_basis = st.face_basis
+        self.cell_convex = st.cell_convex
+
+
+_STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def star_tables(p, t: _Tables) -> _StarTables:
+    s = _STAR.get(p)
+    if s is None:
+        s = _STAR[p] = _StarTables(p, t)
+    return s
+
+
+def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
+    """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
+    st = star_tables(p, t)
+    h = x[:, 3] - c0
+    on = np.abs(h) <= t.tol
+    for nudge in (0.0, 1e-7 * t.radius):
+        try:
+            if nudge:
+                h = x[:, 3] - (c0 + nudge)
+                on = np.abs(h) <= t.tol
+            out = _cut(st, t, x, m, h, on, 1)
+            if on.any() and np.logical_and.reduceat(on[t.cv_vert], t.c_starts).any():
+                other = _cut(st, t, x, m, h, on, -1)
+                if other is not None and (out is None or abs(other.volume) > abs(out.volume)):
+                    out = other
+            break
+        except _Inconsistent:
+            continue
+    if out is not None:
+        return out
+    on_idx = on.nonzero()[0]
+    vert = np.full(len(h), -1, dtype=np.intp)
+    vert[on_idx] = np.arange(len(on_idx))
+    e_on = on[t.ea] & on[t.eb]
+    edges = np.stack([vert[t.ea[e_on]], vert[t.eb[e_on]]], axis=1) if e_on.any() else t.empty_i2
+    f_on = np.logical_and.reduceat(on[t.fv_vert], t.f_starts)
+    return _touching(t, x[on_idx, :3], edges, on_idx, f_on)
+
+
+def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
+    """The slice with the vertices on H counted above (``side`` 1) or below (-1); None if no edge crosses."""
+    above = (h > 0) & ~on if side < 0 else (h > 0) | on
+    cross = above[t.ea] != above[t.eb]
+    ce = np.flatnonzero(cross)
+    if not len(ce):
+        return None
+    a, b = t.ea[ce], t.eb[ce]
+    ha, hb = h[a], h[b]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(on[a], 0.0, np.where(on[b], 1.0, ha / (ha - hb)))
+    xa = x[a, :3]
+    dx = x[b, :3] - xa
+    pts = xa + s[:, None] * dx
+    dpdc = dx / (x[b, 3] - x[a, 3])[:, None]  # how a crossing moves with the level (ties on H)
+    cid = np.full(len(t.ea), -1, dtype=np.intp)
+    cid[ce] = np.arange(len(ce))
+    # one slice vertex per crossing point, the crossings at a vertex on H merged into it
+    rep = np.where(on[a], a, np.where(on[b], b, len(h) + np.arange(len(ce))))
+    urep, first, vid = np.unique(rep, return_index=True, return_inverse=True)
+    vid = vid.reshape(-1)
+    vertices = pts[first]
+
+    # each crossing face's points along its line w = c0, sorted; paired even-odd
+    k = np.flatnonzero(cross[t.fe_edge])
+    fk = t.fe_face[k]
+    pk = cid[t.fe_edge[k]]
+    delta = np.where(above[t.fv_vert[st.fv_next[k]]], 1, -1)  # +1 where the side rises through H
+    uf, cnt = np.unique(fk, return_counts=True)
+    if (cnt % 2).any():
+        raise _Inconsistent
+    rb = st.face_basis[uf] @ m.T  # (nf, 2, 4) each face's plane, rotated
+    d = rb[:, 1, :3] * rb[:, 0, 3:4] - rb[:, 0, :3] * rb[:, 1, 3:4]  # the line's direction (J grad w)
+    fr = np.repeat(np.arange(len(uf)), cnt)
+    dfr = d[fr]
+    tpos = np.einsum("ij,ij->i", pts[pk], dfr)
+    tie = -side * np.einsum("ij,ij->i", dpdc[pk], dfr)
+    order = np.lexsort((tie, tpos, fr))
+    pk, delta = pk[order], delta[order]
+    seg = pk.reshape(-1, 2)  # even-odd: 1st-2nd, 3rd-4th, ... of each face (counts are even)
+    seg_face = uf[fr[0::2]]
+    fcells = t.face_cells[seg_face]  # (ns, 2)
+
+    # volume: winding-weighted stretches of every crossing face, in both its cells
+    W = np.cumsum(delta)
+    ptr = _ptr(cnt)
+    base = np.zeros(len(uf), dtype=W.dtype)
+    base[1:] = W[ptr[1:-1] - 1]
+    W = W - base[fr]
+    last = np.zeros(len(pk), dtype=bool)
+    last[ptr[1:] - 1] = True
+    i = np.flatnonzero(~last & (W != 0))
+    centre = vertices.mean(axis=0)
+    anchor = np.zeros((t.C, 3))
+    anchor[fcells.ravel()] = np.repeat(pts[seg[:, 0]], 2, axis=0) - centre
+    P, Q = pts[pk[i]] - centre, pts[pk[i + 1]] - centre
+    PxQ = np.cross(P, Q)
+    fi = uf[fr[i]]
+    vol = 0.0
+    for j in (0, 1):
+        c = t.face_cells[fi, j]
+        vol += float((W[i] * st.face_rho[fi, j] * np.einsum("ij,ij->i", anchor[c], PxQ)).sum())
+    volume = vol / 6.0
+
+    # cycles of each cell: chain the segments' ends at the crossing points (pointer jumping)
+    ns = len(seg)
+    rec_cell = fcells.ravel()
+    rec_seg = np.repeat(np.arange(ns), 2)
+    end_cell = np.repeat(rec_cell, 2)
+    end_pt = seg[rec_seg].ravel()
+    n_end = len(end_pt)
+    o = np.lexsort((end_pt, end_cell))
+    if (end_pt[o[0::2]] != end_pt[o[1::2]]).any() or (end_cell[o[0::2]] != end_cell[o[1::2]]).any():
+        raise _Inconsistent
+    partner = np.empty(n_end, dtype=np.intp)
+    partner[o[0::2]] = o[1::2]
+    partner[o[1::2]] = o[0::2]
+    nxt = partner ^ 1  # along the other segment at this point, to its far end
+    lab = np.arange(n_end)
+    J = nxt.copy()
+    rounds = max(1, int(np.ceil(np.log2(n_end))) + 1)
+    for _ in range(rounds):
+        lab = np.minimum(lab, lab[J])
+        J = J[J]
+    normals = t.cell_normals @ m[:3].T  # (C, 3) each cell's outward normal, restricted to H
+    pe = pts[end_pt] - centre
+    area = np.einsum("ij,ij->i", normals[end_cell], np.cross(pe - anchor[end_cell], pe[nxt] - anchor[end_cell]))
+    orbit_area = np.bincount(lab, weights=area, minlength=n_end)
+    fwd, rev = orbit_area[lab], orbit_area[lab[np.arange(n_end) ^ 1]]
+    keep = (fwd > rev) | ((fwd == rev) & (lab < lab[np.arange(n_end) ^ 1]))
+    term = nxt == lab  # the end before its orbit's first
+    J = np.where(term, np.arange(n_end), nxt)
+    dist = (~term).astype(np.intp)
+    for _ in range(rounds):
+        dist = dist + dist[J]
+        J = J[J]
+    kept = np.flatnonzero(keep)
+    kept = kept[np.lexsort((-dist[kept], lab[kept], end_cell[kept]))]
+    flat = vid[end_pt[kept]]
+    plab = lab[kept]
+    # drop repeats (crossings merged at a vertex on H), then polygons of fewer than 3 corners
+    newp = np.ones(len(kept), dtype=bool)
+    newp[1:] = plab[1:] != plab[:-1]
+    startp = np.flatnonzero(newp)
+    pid = np.cumsum(newp) - 1
+    prev = np.arange(len(kept)) - 1
+    prev[startp] = np.append(startp[1:], len(kept)) - 1
+    good = flat != flat[prev]
+    flat, pid, kcell = flat[good], pid[good], end_cell[kept][good]
+    counts = np.bincount(pid, minlength=len(startp))
+    big = counts >= 3
+    sel = big[pid]
+    flat, pid, kcell = flat[sel], pid[sel], kcell[sel]
+    counts = counts[big]
+    prank = np.cumsum(big) - 1
+    pid = prank[pid]
+    offsets = _ptr(counts)
+    cell_ids = kcell[offsets[:-1]] if len(counts) else t.empty_i
+
+    # triangles: a convex cell's cycle fanned, every other cell's section filled even-odd by slabs
+    conv = st.cell_convex[cell_ids]
+    pconv = conv[pid]
+    fo = _ptr(counts[conv])
+    ftri, fpoly = _fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
+    tri = [ftri]
+    tcell = [cell_ids[conv][fpoly]]
+    extra = np.zeros((0, 3))
+    gen = ~st.cell_convex[rec_cell]
+    if gen.any():
+        ttri, tc, extra = _slabs(rec_cell[gen], seg[rec_seg[gen]], pts, vid, normals, anchor + centre,
+                                 len(vertices))
+        tri.append(ttri)
+        tcell.append(tc)
+    triangles = np.concatenate(tri)
+    triangle_cells = np.concatenate(tcell)
+    all_v = np.concatenate([vertices, extra]) if len(extra) else vertices
+    ev = vid[seg]
+    ev = ev[ev[:, 0] != ev[:, 1]]
+    edges = np.unique(np.sort(ev, axis=1), axis=0) if len(ev) else t.empty_i2
+    return Slice(_scaled(t, all_v), edges, flat, offsets, cell_ids, triangles, triangle_cells,
+                 _scaled_volume(t, volume), 3, len(extra))
+
+
+def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
+    """Even-odd fill of each cell's section from its segments: ((k, 3) triangles, (k,) cells,
+    (n, 3) extra vertices numbered from ``n_vertices``).
+
+    In each cell's plane (axes u, v of `_inplane_axes`, right-handed about the outward normal),
+    the segments are cut at every corner's height v; within each slab the segments crossing it,
+    sorted by u, pair 1st-2nd, 3rd-4th, ... into trapezoids (even-odd), each two triangles wound
+    counter-clockwise about the normal."""
+    uv = _inplane_axes(normals)[rcell]  # (r, 6)
+    rel0 = pts[rseg[:, 0]] - anchor[rcell]
+    rel1 = pts[rseg[:, 1]] - anchor[rcell]
+    X0 = rel0[:, 0] * uv[:, 0] + rel0[:, 1] * uv[:, 1] + rel0[:, 2] * uv[:, 2]
+    Y0 = rel0[:, 0] * uv[:, 3] + rel0[:, 1] * uv[:, 4] + rel0[:, 2] * uv[:, 5]
+    X1 = rel1[:, 0] * uv[:, 0] + rel1[:, 1] * uv[:, 1] + rel1[:, 2] * uv[:, 2]
+    Y1 = rel1[:, 0] * uv[:, 3] + rel1[:, 1] * uv[:, 4] + rel1[:, 2] * uv[:, 5]
+    up = Y1 > Y0
+    lo_p = np.where(up, rseg[:, 0], rseg[:, 1])
+    hi_p = np.where(up, rseg[:, 1], rseg[:, 0])
+    Xl, Yl, Xh, Yh = np.where(up, X0, X1), np.where(up, Y0, Y1), np.where(up, X1, X0), np.where(up, Y1, Y0)
+    keep = Yh > Yl  # level segments bound no slab
+    rcell, lo_p, hi_p, Xl, Yl, Xh, Yh = (a[keep] for a in (rcell, lo_p, hi_p, Xl, Yl, Xh, Yh))
+    nr = len(rcell)
+    ic, iy = _crossings(rcell, Xl, Yl, Xh, Yh)  # slab lines also where two segments cross
+    ev_cell = np.concatenate([rcell, rcell, ic])
+    ev_y = np.concatenate([Yl, Yh, iy])
+    o = np.lexsort((ev_y, ev_cell))
+    new = np.ones(len(o), dtype=bool)
+    new[1:] = (ev_y[o][1:] != ev_y[o][:-1]) | (ev_cell[o][1:] != ev_cell[o][:-1])
+    uidx = np.empty(len(o), dtype=np.intp)
+    uidx[o] = np.cumsum(new) - 1
+    uy = ev_y[o][new]
+    ylo, yhi = uidx[:nr], uidx[nr:2 * nr]
+    span = yhi - ylo
+    r = np.repeat(np.arange(nr), span)
+    slab = ylo[r] + np.arange(len(r)) - _ptr(span)[:-1][r]
+    slope = (Xh - Xl) / (Yh - Yl)
+    xa = Xl[r] + (uy[slab] - Yl[r]) * slope[r]
+    xb = Xl[r] + (uy[slab + 1] - Yl[r]) * slope[r]
+    o = np.lexsort((xa + xb, slab))
+    r, slab = r[o], slab[o]
+    if (np.bincount(slab) % 2).any():
+        raise _Inconsistent
+    # corners: a segment's end where the slab line passes through it, else a new point on it
+    ck = np.concatenate([r * len(uy) + slab, r * len(uy) + slab + 1])
+    cr, cy = np.concatenate([r, r]), np.concatenate([slab, slab + 1])
+    at_lo, at_hi = cy == ylo[cr], cy == yhi[cr]
+    mid = ~(at_lo | at_hi)
+    ukey, inv = np.unique(ck[mid], return_inverse=True)
+    corner = np.where(at_lo, vid[lo_p[cr]], vid[hi_p[cr]])
+    corner[mid] = n_vertices + inv.reshape(-1)
+    mr, my = ukey // len(uy), ukey % len(uy)
+    lam = ((uy[my] - Yl[mr]) / (Yh[mr] - Yl[mr]))[:, None]
+    extra = pts[lo_p[mr]] + lam * (pts[hi_p[mr]] - pts[lo_p[mr]])
+    n = len(r)
+    bottom, top = corner[:n], corner[n:]
+    a, b = bottom[0::2], bottom[1::2]  # left and right on the slab's lower line
+    d, c = top[0::2], top[1::2]
+    tri = np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
+    cells = np.tile(rcell[r[0::2]], 2)
+    ok = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
+    return tri[ok], cells[ok], extra
+
+
+
+def _crossings(rcell, Xl, Yl, Xh, Yh):
+    """Where two segments of one cell cross inside both: ((k,) cells, (k,) heights Y).
+
+    Every pair of segments of a cell is tested (a cell's section has a few dozen at most)."""
+    o = np.argsort(rcell, kind="stable")
+    cnt = np.bincount(rcell)
+    start = _ptr(cnt)[:-1]
+    pos = np.arange(len(o)) - start[rcell[o]]
+    npair = cnt[rcell[o]] - 1 - pos
+    i = np.repeat(o, npair)
+    j = o[np.repeat(np.arange(len(o)), npair) + 1 + np.arange(npair.sum()) - np.repeat(_ptr(npair)[:-1], npair)]
+    d1x, d1y = Xh[i] - Xl[i], Yh[i] - Yl[i]
+    d2x, d2y = Xh[j] - Xl[j], Yh[j] - Yl[j]
+    ex, ey = Xl[j] - Xl[i], Yl[j] - Yl[i]
+    den = d1x * d2y - d1y * d2x
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (ex * d2y - ey * d2x) / den
+        u = (ex * d1y - ey * d1x) / den
+    eps = 1e-12
+    hit = (den != 0) & (s > eps) & (s < 1 - eps) & (u > eps) & (u < 1 - eps)
+    return rcell[i[hit]], Yl[i[hit]] + s[hit] * d1y[hit]
