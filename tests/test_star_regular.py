@@ -13,6 +13,10 @@ orientations from its two cells, every cell edge is run once each way).  Then th
 of the boundary round the centre is the sum, over the cells a ray from the centre crosses, of the
 cell's own 3-D winding number at the crossing (its faces fan-triangulated from their centres,
 solid angles summed), for several random rays.
+
+As `Polytope` objects (validated, with star faces and non-convex cells): one cached object per
+name, not convex, self-intersecting, and a slice through the centre whose points are exactly the
+edges' crossings, computed here from the vertices and edges.
 """
 
 from __future__ import annotations
@@ -22,10 +26,12 @@ from collections import defaultdict
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 import rot4d_widget
 from rot4d_widget import polytope
 from rot4d_widget.geometry import star_regular
+from rot4d_widget.geometry.slicing import slice_polytope
 from rot4d_widget.geometry.star_regular import STAR_FAMILY, star_arrays
 
 PHI = (1 + math.sqrt(5)) / 2
@@ -284,3 +290,45 @@ def test_a_bad_name_still_says_what_is_allowed():
         polytope("{5/2,5/2,5/2}")
     with pytest.raises(ValueError, match="Unknown polytope '7-cell'; expected one of '5-cell'"):
         polytope("7-cell")
+
+
+# -- as Polytope objects (star faces and non-convex cells accepted by the mesh checks) ---------------
+
+
+def _rotation(seed: int) -> np.ndarray:
+    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(4, 4)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_validated_polytope_by_every_name(name):
+    sym, counts, _, _ = PUBLISHED[name]
+    p = polytope(name)
+    assert p is polytope(sym) is polytope(name.title()) is polytope(sym.replace(",", ", "))  # one cached object
+    assert p.name == name and p.counts == counts
+    assert p.convex is False and p.self_intersecting is True  # density > 1: winds round its centre
+    v = star_arrays(name)[0]
+    assert np.array_equal(p.vertices, v)
+    assert np.allclose(np.linalg.norm(v[p.edges[:, 0]] - v[p.edges[:, 1]], axis=1), 2.0)  # edge 2
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_slice_through_the_centre_is_at_the_edges_crossings(name):
+    p = polytope(name)
+    for seed in (1, 2):
+        m = _rotation(seed)
+        s = slice_polytope(p, m, 0.0)
+        x = p.vertices @ m.T  # computed here from the vertices and edges alone
+        w = x[:, 3]
+        assert np.abs(w).min() > 1e-6  # a generic cut: no vertex on it
+        a, b = p.edges[(w[p.edges[:, 0]] < 0) != (w[p.edges[:, 1]] < 0)].T
+        t = w[a] / (w[a] - w[b])
+        want = x[a, :3] + t[:, None] * (x[b, :3] - x[a, :3])
+        got = s.vertices[: len(s.vertices) - s.n_fill]  # the extra corners of fill triangles are not points
+        assert s.dim == 3 and len(got) == len(want) > 0
+        d1, _ = cKDTree(want).query(got)
+        d2, _ = cKDTree(got).query(want)
+        assert max(d1.max(), d2.max()) < 1e-9 * p.circumradius
