@@ -413,3 +413,20 @@ def test_segments_are_the_faces_even_odd_chords(star_duoprism, which, seed, c0):
         mid = np.append(0.5 * (v[a] + v[b]), c0)
         assert any(np.linalg.norm((mid - c) - ((mid - c) @ ax.T) @ ax) < 1e-9
                    and in_polygon((mid - c) @ ax.T, (poly - c) @ ax.T) for (c, ax), poly in frames)
+
+
+@pytest.mark.parametrize("seed, c0", [(13, 0.3), (14, -0.5), (22, 0.45)])
+@pytest.mark.parametrize("name", ["great dodecahedron", "great icosahedron"])
+def test_cycles_run_each_segment_both_ways(name, seed, c0):
+    """Each segment bounds the sections of its face's two cells, wound against each other (the
+    cycles follow the boundary's orientation) where the faces wind round at most once, however the
+    cells pass through each other.  (Not so with star faces: a pentagram's even-odd points border
+    both its outside and its doubly wound centre, and no one way round a cycle agrees with both.)"""
+    m = random_rotation(seed)
+    p = Polytope(*prism_mesh(*STARS[name]()))
+    s = slice_polytope(p, m, c0)
+    idx, off = np.asarray(s.polygon_indices), np.asarray(s.polygon_offsets)
+    nxt = np.arange(1, len(idx) + 1)
+    nxt[off[1:] - 1] = off[:-1]
+    directed = sorted(zip(idx.tolist(), idx[nxt].tolist()))
+    assert len(directed) > 0 and directed == sorted((b, a) for a, b in directed)

@@ -11,7 +11,9 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
   winds round twice);
 * **polygons**: a cell's cross-section is the set of cycles its faces' segments chain into (each
   crossing point of a cell ends exactly two of them, one from each of the cell's two faces at that
-  edge), each wound counter-clockwise about the cell's outward normal (its signed area positive);
+  edge), each run the way the boundary's orientation runs its segments (so a segment runs opposite
+  ways in its two cells' cycles, as on a convex polytope's slice); where a star face's segments
+  disagree about it, the way that winds counter-clockwise about the cell's outward normal;
 * **triangles**: a convex cell's one cycle is fanned as before; any other cell's cycles are filled
   by the even-odd rule with a slab decomposition (the plane cut into slabs at the corners'
   heights, the segments crossing each slab paired left to right into trapezoids), vectorised over
@@ -189,9 +191,16 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     normals = t.cell_normals @ m[:3].T  # (C, 3) each cell's outward normal, restricted to H
     pe = pts[end_pt] - centre
     area = np.einsum("ij,ij->i", normals[end_cell], np.cross(pe - anchor[end_cell], pe[nxt] - anchor[end_cell]))
+    # each cycle run the way its segments bound the cell's section (rho times the sign of the face's
+    # winding along the segment: for faces winding at most once every segment then runs opposite
+    # ways in its two cells' cycles); by signed area where they disagree (a star face), then by label
+    nat = (st.face_rho[seg_face] * np.sign(W[0::2])[:, None]).ravel()  # per (segment, cell) record
+    agree = np.where(((np.arange(n_end) & 1) == 1) == (nat[np.arange(n_end) >> 1] > 0), 1.0, -1.0)
+    rev_lab = lab[np.arange(n_end) ^ 1]
+    score = np.bincount(lab, weights=agree, minlength=n_end)
     orbit_area = np.bincount(lab, weights=area, minlength=n_end)
-    fwd, rev = orbit_area[lab], orbit_area[lab[np.arange(n_end) ^ 1]]
-    keep = (fwd > rev) | ((fwd == rev) & (lab < lab[np.arange(n_end) ^ 1]))
+    fs, rs, fwd, rev = score[lab], score[rev_lab], orbit_area[lab], orbit_area[rev_lab]
+    keep = (fs > rs) | ((fs == rs) & ((fwd > rev) | ((fwd == rev) & (lab < rev_lab))))
     term = nxt == lab  # the end before its orbit's first
     J = np.where(term, np.arange(n_end), nxt)
     dist = (~term).astype(np.intp)
