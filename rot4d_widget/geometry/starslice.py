@@ -296,26 +296,32 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
     r, slab = r[o], slab[o]
     if (np.bincount(slab) % 2).any():
         raise _Inconsistent
-    # corners: a segment's end where the slab line passes through it, else a new point on it
-    ck = np.concatenate([r * len(uy) + slab, r * len(uy) + slab + 1])
-    cr, cy = np.concatenate([r, r]), np.concatenate([slab, slab + 1])
+    # a trapezoid goes on up while the same two segments bound it in the next slab (nothing
+    # happens between them there): merged, it needs corners only where it starts and ends
+    L, R, k = r[0::2], r[1::2], slab[0::2]
+    o = np.lexsort((k, R, L))
+    L, R, k = L[o], R[o], k[o]
+    brk = np.ones(len(k), dtype=bool)
+    brk[1:] = (L[1:] != L[:-1]) | (R[1:] != R[:-1]) | (k[1:] != k[:-1] + 1)
+    first = np.flatnonzero(brk)
+    lastk = k[np.append(first[1:], len(k)) - 1]
+    L, R, y0, y1 = L[first], R[first], k[first], lastk + 1
+    # corners: a segment's end where the trapezoid's line passes through it, else a new point on it
+    cr = np.concatenate([L, R, R, L])
+    cy = np.concatenate([y0, y0, y1, y1])
     at_lo, at_hi = cy == ylo[cr], cy == yhi[cr]
     mid = ~(at_lo | at_hi)
-    ukey, inv = np.unique(ck[mid], return_inverse=True)
+    ukey, inv = np.unique((cr * len(uy) + cy)[mid], return_inverse=True)
     corner = np.where(at_lo, vid[lo_p[cr]], vid[hi_p[cr]])
     corner[mid] = n_vertices + inv.reshape(-1)
     mr, my = ukey // len(uy), ukey % len(uy)
     lam = ((uy[my] - Yl[mr]) / (Yh[mr] - Yl[mr]))[:, None]
     extra = pts[lo_p[mr]] + lam * (pts[hi_p[mr]] - pts[lo_p[mr]])
-    n = len(r)
-    bottom, top = corner[:n], corner[n:]
-    a, b = bottom[0::2], bottom[1::2]  # left and right on the slab's lower line
-    d, c = top[0::2], top[1::2]
+    a, b, c, d = corner.reshape(4, -1)  # lower left, lower right, upper right, upper left
     tri = np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
-    cells = np.tile(rcell[r[0::2]], 2)
+    cells = np.tile(rcell[L], 2)
     ok = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
     return tri[ok], cells[ok], extra
-
 
 
 def _crossings(rcell, Xl, Yl, Xh, Yh):
