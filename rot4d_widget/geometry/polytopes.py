@@ -10,8 +10,9 @@ This module gathers names that live in smaller modules (it defines nothing itsel
                                     closed convex cells, orientation)
 `rot4d_widget.geometry.regular`     the six regular polychora (`pentachoron`, `POLYTOPE_NAMES`,
                                     their aliases and Schläfli symbols, `PHI`)
-`rot4d_widget.geometry.catalogue`   `polytope(name)`: the regular six and every uniform
-                                    polychoron (`rot4d_widget.geometry.uniform`) by name
+`rot4d_widget.geometry.catalogue`   `polytope(name)`: the regular six, the ten regular star
+                                    ones (`rot4d_widget.geometry.star_regular`) and every
+                                    uniform polychoron (`rot4d_widget.geometry.uniform`) by name
 ==================================  ============================================================
 
 `polytope(name)` gives the six regular polychora, all with edge length 2 and centred on the
