@@ -123,12 +123,14 @@ def crossings(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: fl
     return np.concatenate([x[a, :3] + t * (x[b, :3] - x[a, :3]), x[on, :3]])
 
 
-def unclosed(s) -> str | None:
-    """What keeps the slice's polygons from closing up, or None: every directed edge of their
+def unclosed(s) -> tuple[str, str] | None:
+    """What keeps the slice's polygons from closing up, as (kind, text), or None: every directed edge of their
     cycles must come as often as its reverse (each segment of a face's chord bounds the sections
     of the face's two cells, wound against each other, as the 4-D boundary's orientation induces).
     The polygons, not the triangles: a non-convex section's fill has extra corners on the segments
-    (`Slice.n_fill`) that its neighbour's fill does not share."""
+    (`Slice.n_fill`) that its neighbour's fill does not share.  kind "segments": an edge is in an
+    odd number of polygons (a segment not shared); kind "winding": the segments are shared but
+    some run the same way in both their polygons."""
     idx, off = np.asarray(s.polygon_indices), np.asarray(s.polygon_offsets)
     if len(off) < 2:
         return None
@@ -137,18 +139,20 @@ def unclosed(s) -> str | None:
     d = np.stack([idx, idx[nxt]], axis=1)
     odd = sum(n % 2 for n in collections.Counter(map(tuple, np.sort(d, axis=1).tolist())).values())
     if odd:
-        return f"{odd} polygon edges in an odd number of polygons (segments not shared)"
+        return "segments", f"{odd} polygon edges in an odd number of polygons (segments not shared)"
     fwd = collections.Counter(map(tuple, d.tolist()))
     wrong = sum(fwd[(j, i)] != n for (i, j), n in fwd.items())
     if wrong:
-        return (f"{wrong} polygon edges run the same way in both their polygons (the cycles' winding disagrees "
-                f"with the boundary's orientation)")
+        return "winding", (f"{wrong} polygon edges run the same way in both their polygons (the sections' "
+                           f"cycles are not wound as the boundary's orientation induces)")
     return None
 
 
-def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float) -> list[str]:
+def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float,
+                winding: bool = True) -> list[str]:
     """What is wrong with slice ``s`` of ``p`` (rotated by ``m``, cut at ``c0``), checked against the
-    file's own vertices ``v`` and edges ``e``; an empty list when it is right."""
+    file's own vertices ``v`` and edges ``e``; an empty list when it is right.  ``winding=False``:
+    the polygons' edges need only be shared, not wound against each other (see `unclosed`)."""
     problems = []
     scale = float(np.max(np.linalg.norm(v, axis=1)))
     tol = POINT_TOL * scale
@@ -177,8 +181,8 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     if not np.isfinite(s.volume):
         problems.append(f"c0={c0:.4g}: volume {s.volume}")
     why = unclosed(s)
-    if why:
-        problems.append(f"c0={c0:.4g}: the polygons do not close up: {why}")
+    if why and (winding or why[0] != "winding"):
+        problems.append(f"c0={c0:.4g}: the polygons do not close up: {why[1]}")
     if p.convex and s.dim == 3:
         hull = ConvexHull(pts).volume
         if abs(s.volume - hull) > VOLUME_RTOL * hull:
@@ -249,17 +253,21 @@ def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None) -> dict:
                 problems.append(f"counts: the file has {len(v)} vertices and {len(e)} face edges, the polytope "
                                 f"{len(p.vertices)} and {len(p.edges)}")
             slice_polytope(p, m, 0.0)  # builds the slicing tables (not timed)
-            times, negative = [], []
+            times, negative, wound = [], [], []
             for c0 in levels(p, m, nlevels):
                 t1 = time.perf_counter()
                 s = slice_polytope(p, m, c0)
                 times.append((time.perf_counter() - t1) * 1e3)
-                problems += check_slice(p, s, v, e, m, c0)
+                found = check_slice(p, s, v, e, m, c0)
+                problems += [x for x in found if "not wound" not in x]
+                wound += [x for x in found if "not wound" in x]
                 if s.volume < 0:
                     negative.append(c0)
-            row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative)
+            row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative,
+                       wound=wound)
         except Exception as exc:  # noqa: BLE001 -- a slicer failure is a finding, reported per file
-            row.update(slice_ms=None, problems=[f"slice raised {type(exc).__name__}: {exc}"], ok=False, negative=[])
+            row.update(slice_ms=None, problems=[f"slice raised {type(exc).__name__}: {exc}"], ok=False, negative=[],
+                       wound=[])
         return row
     finally:
         if timeout:
@@ -288,6 +296,8 @@ def row_text(r: dict) -> str:
         return (f"{r['file'][:34]:34} {'':>6} {'':>6} {'':>6} {'':>5} {'':>6} {'':>6} {'':>8} "
                 f"{r['load_ms']:8.0f} {'':>8}  REFUSED: {r['error'][:150]}")
     res = "ok" if r["ok"] else "CHECK FAILED: " + "; ".join(r["problems"])[:200]
+    if r["wound"]:
+        res += f" (sections not wound as the boundary at {len(r['wound'])} of the levels)"
     if r["negative"]:
         res += f" (negative volume at c0 = {', '.join(f'{c:.3g}' for c in r['negative'])})"
     sl = f"{r['slice_ms']:8.2f}" if r["slice_ms"] is not None else f"{'-':>8}"
@@ -317,8 +327,18 @@ def summary(rows: list[dict]) -> str:
         names = [r["file"] for r in refused if r["category"] == cat]
         out.append(f"  refused, {cat}: {k}  ({', '.join(names[:8])}{', ...' if k > 8 else ''})")
     bad = [r for r in loaded if not r["ok"]]
-    for r in bad[:20]:
-        out.append(f"  check failed, {r['file']}: {'; '.join(r['problems'])[:300]}")
+    kinds = collections.Counter()
+    for r in bad:
+        kinds.update({re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "N", x.split(": ", 1)[-1])[:90] for x in r["problems"]})
+    for kind, k in kinds.most_common():
+        names = [r["file"] for r in bad if any(re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "N", x.split(": ", 1)[-1])[:90]
+                                               == kind for x in r["problems"])]
+        out.append(f"  check failed, {kind}: {k}  ({', '.join(names[:8])}{', ...' if k > 8 else ''})")
+    wound = [r["file"] for r in loaded if r["wound"]]
+    if wound:
+        out.append(f"  sections not wound as the boundary's orientation induces (polygons' edges shared but running "
+                   f"the same way; not counted as failed): {len(wound)}  ({', '.join(wound[:8])}"
+                   f"{', ...' if len(wound) > 8 else ''})")
     if loaded:
         out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "
                    f"max {max(r['load_ms'] for r in loaded):.0f}; slice ms median "
