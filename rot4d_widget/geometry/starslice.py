@@ -63,6 +63,8 @@ class _StarTables:
         self.face_rho = st.pair_rho[order].reshape(-1, 2).astype(np.float64)  # aligned with p.face_cells
         self.face_basis = st.face_basis
         self.cell_convex = st.cell_convex
+        E = len(p.edges)
+        self.cell_ekey = np.repeat(np.arange(len(p.cells)), np.diff(inc.cell_eptr)) * E + inc.cell_eidx  # ascending
 
 
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -122,9 +124,19 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     cid = np.full(len(t.ea), -1, dtype=np.intp)
     cid[ce] = np.arange(len(ce))
     # one slice vertex per crossing point, the crossings at a vertex on H merged into it
-    rep = np.where(on[a], a, np.where(on[b], b, len(h) + np.arange(len(ce))))
-    urep, first, vid = np.unique(rep, return_index=True, return_inverse=True)
-    vid = vid.reshape(-1)
+    at_v = np.where(on[a], a, np.where(on[b], b, -1))
+    vid = np.arange(len(ce))
+    if on.any():  # no sort: vertices on H numbered in vertex order after the other crossings
+        own = at_v < 0
+        vid = np.cumsum(own) - 1
+        mark = np.zeros(len(h), dtype=bool)
+        mark[at_v[~own]] = True
+        vnum = np.cumsum(mark) - 1 + int(own.sum())
+        vid[~own] = vnum[at_v[~own]]
+        first = np.empty(int(vid.max()) + 1, dtype=np.intp)
+        first[vid] = np.arange(len(ce))
+    else:
+        first = vid
     vertices = pts[first]
 
     # each crossing face's points along its line w = c0, sorted; paired even-odd
@@ -132,7 +144,10 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     fk = t.fe_face[k]
     pk = cid[t.fe_edge[k]]
     delta = np.where(above[t.fv_vert[st.fv_next[k]]], 1, -1)  # +1 where the side rises through H
-    uf, cnt = np.unique(fk, return_counts=True)
+    newf = np.ones(len(fk), dtype=bool)
+    newf[1:] = fk[1:] != fk[:-1]  # fk ascending (face sides in face order)
+    uf = fk[newf]
+    cnt = np.diff(np.append(np.flatnonzero(newf), len(fk)))
     if (cnt % 2).any():
         raise _Inconsistent
     rb = st.face_basis[uf] @ m.T  # (nf, 2, 4) each face's plane, rotated
@@ -160,7 +175,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     anchor = np.zeros((t.C, 3))
     anchor[fcells.ravel()] = np.repeat(pts[seg[:, 0]], 2, axis=0) - centre
     P, Q = pts[pk[i]] - centre, pts[pk[i + 1]] - centre
-    PxQ = np.cross(P, Q)
+    PxQ = _cross(P, Q)
     fi = uf[fr[i]]
     vol = 0.0
     for j in (0, 1):
@@ -175,12 +190,19 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     end_cell = np.repeat(rec_cell, 2)
     end_pt = seg[rec_seg].ravel()
     n_end = len(end_pt)
-    o = np.lexsort((end_pt, end_cell))
-    if (end_pt[o[0::2]] != end_pt[o[1::2]]).any() or (end_cell[o[0::2]] != end_cell[o[1::2]]).any():
+    # the two ends at each (cell, crossing edge): found by its slot in the cell-edge table, no sort
+    slot = np.searchsorted(st.cell_ekey, end_cell * len(t.ea) + ce[end_pt])
+    slot = np.minimum(slot, len(st.cell_ekey) - 1)
+    if (st.cell_ekey[slot] != end_cell * len(t.ea) + ce[end_pt]).any():
         raise _Inconsistent
-    partner = np.empty(n_end, dtype=np.intp)
-    partner[o[0::2]] = o[1::2]
-    partner[o[1::2]] = o[0::2]
+    last_in = np.full(len(st.cell_ekey), -1, dtype=np.intp)
+    last_in[slot] = np.arange(n_end)
+    second = last_in[slot] == np.arange(n_end)
+    first_in = np.full(len(st.cell_ekey), -1, dtype=np.intp)
+    first_in[slot[~second]] = np.flatnonzero(~second)
+    partner = np.where(second, first_in[slot], last_in[slot])
+    if (partner < 0).any() or (partner == np.arange(n_end)).any() or (partner[partner] != np.arange(n_end)).any():
+        raise _Inconsistent
     nxt = partner ^ 1  # along the other segment at this point, to its far end
     lab = np.arange(n_end)
     J = nxt.copy()
@@ -190,7 +212,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
         J = J[J]
     normals = t.cell_normals @ m[:3].T  # (C, 3) each cell's outward normal, restricted to H
     pe = pts[end_pt] - centre
-    area = np.einsum("ij,ij->i", normals[end_cell], np.cross(pe - anchor[end_cell], pe[nxt] - anchor[end_cell]))
+    area = np.einsum("ij,ij->i", normals[end_cell], _cross(pe - anchor[end_cell], pe[nxt] - anchor[end_cell]))
     # each cycle run the way its segments bound the cell's section (rho times the sign of the face's
     # winding along the segment: for faces winding at most once every segment then runs opposite
     # ways in its two cells' cycles); by signed area where they disagree (a star face), then by label
@@ -207,8 +229,13 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     for _ in range(rounds):
         dist = dist + dist[J]
         J = J[J]
+    # each kept orbit's ends in cycle order, orbits by their first end: placed, not sorted
     kept = np.flatnonzero(keep)
-    kept = kept[np.lexsort((-dist[kept], lab[kept], end_cell[kept]))]
+    size = np.bincount(lab[kept], minlength=n_end)
+    start = _ptr(size)[:-1]
+    place = np.empty(len(kept), dtype=np.intp)
+    place[start[lab[kept]] + size[lab[kept]] - 1 - dist[kept]] = np.arange(len(kept))
+    kept = kept[place]
     flat = vid[end_pt[kept]]
     plab = lab[kept]
     # drop repeats (crossings merged at a vertex on H), then polygons of fewer than 3 corners
@@ -249,7 +276,10 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     all_v = np.concatenate([vertices, extra]) if len(extra) else vertices
     ev = vid[seg]
     ev = ev[ev[:, 0] != ev[:, 1]]
-    edges = np.unique(np.sort(ev, axis=1), axis=0) if len(ev) else t.empty_i2
+    if on.any() and len(ev):  # chords along an edge lying in H come from each of its faces: once
+        lo_hi = np.sort(ev, axis=1)
+        ev = lo_hi[np.unique(lo_hi[:, 0] * len(vertices) + lo_hi[:, 1], return_index=True)[1]]
+    edges = ev if len(ev) else t.empty_i2
     return Slice(_scaled(t, all_v), edges, flat, offsets, cell_ids, triangles, triangle_cells,
                  _scaled_volume(t, volume), 3, len(extra))
 
@@ -345,3 +375,12 @@ def _crossings(rcell, Xl, Yl, Xh, Yh):
     eps = 1e-12
     hit = (den != 0) & (s > eps) & (s < 1 - eps) & (u > eps) & (u < 1 - eps)
     return rcell[i[hit]], Yl[i[hit]] + s[hit] * d1y[hit]
+
+
+def _cross(a, b):
+    """Row-wise 3-D cross product (np.cross's checks cost more than the work at these sizes)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
