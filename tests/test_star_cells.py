@@ -430,3 +430,13 @@ def test_cycles_run_each_segment_both_ways(name, seed, c0):
     nxt[off[1:] - 1] = off[:-1]
     directed = sorted(zip(idx.tolist(), idx[nxt].tolist()))
     assert len(directed) > 0 and directed == sorted((b, a) for a, b in directed)
+
+
+def test_touching_and_missing_levels(star_duoprism):
+    """At the top vertex's level H only touches (dim 0, no polygons, volume 0); above, it misses."""
+    p, _ = star_duoprism
+    m = random_rotation(3)
+    w = np.asarray(p.unit_vertices) @ m[3] * p.unit
+    top = slice_polytope(p, m, float(w.max()))
+    assert top.dim == 0 and len(top.polygon_offsets) == 1 and top.volume == 0 and len(top.triangles) == 0
+    assert slice_polytope(p, m, float(w.max()) + 0.5).dim == -1

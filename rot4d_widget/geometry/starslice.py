@@ -254,8 +254,10 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     counts = counts[big]
     prank = np.cumsum(big) - 1
     pid = prank[pid]
+    if not len(counts):  # every cycle shrank to a vertex or an edge on H: H only touches
+        return None
     offsets = _ptr(counts)
-    cell_ids = kcell[offsets[:-1]] if len(counts) else t.empty_i
+    cell_ids = kcell[offsets[:-1]]
 
     # triangles: a convex cell's cycle fanned, every other cell's section filled even-odd by slabs
     conv = st.cell_convex[cell_ids]
