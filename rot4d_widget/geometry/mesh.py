@@ -140,13 +140,13 @@ class Polytope:
     looser one, up to 1e-2, takes coordinates written with few digits, and a planarity error says
     which would do):
 
-    * every face has >= 3 distinct vertices, is planar and a strictly convex polygon
-      in the order given (no three consecutive corners collinear, no star);
+    * every face has >= 3 distinct vertices, is planar, its corners not all collinear, and its
+      sides turn through some net angle in the order given (convex, or a star such as {5/2},
+      {8/3}; a figure eight is refused);
     * every face is in exactly two cells (the boundary is closed), every vertex in a face;
     * every cell has >= 4 distinct faces, lies in a hyperplane, spans 3-D, is closed
-      (each of its edges in exactly two of its faces) and strictly convex (every
-      vertex of the cell on the inner side of each face's plane, and only the face's
-      own corners on it);
+      (each of its edges in exactly two of its faces) and two-sided; convex or not (a star
+      polyhedron too), but a convex cell strictly so (only a face's own corners on its plane);
     * the boundary is consistently orientable.  The outward normals then come from that
       orientation, not from the origin: each boundary component is oriented so that it
       encloses positive 4-volume, and a component inside another (a cavity, found by
@@ -185,6 +185,10 @@ class Polytope:
         where not detected (a polytope with reflex ridges is not checked for it).  A slice's
         volume is then the volume weighted by the winding number (the divergence theorem over
         its outward faces), each region counted as often as the boundary winds round it
+    star : None, or `rot4d_widget.geometry.meshcheck.StarData` when some face or cell is not
+        convex (its slices then come from `rot4d_widget.geometry.starslice`: even-odd chords and
+        fill, winding-weighted volume); such a polytope is not convex, and self-intersecting when
+        a face is a star or a cell's faces wind round its centre more than once
     cell_normals : (C, 4) float64 outward unit normals; ``cell_offsets`` (C,)
         so that cell c lies in ``vertices @ cell_normals[c] == cell_offsets[c]``
 
