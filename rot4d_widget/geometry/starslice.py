@@ -42,6 +42,7 @@ import weakref
 
 import numpy as np
 
+from ..core import tolerances as tol_
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
@@ -82,7 +83,8 @@ def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     st = star_tables(p, t)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol
-    for nudge in (0.0, 1e-7 * t.radius):
+    out = None
+    for nudge in (0.0, tol_.NUDGE * t.radius, -tol_.NUDGE * t.radius):  # a hair off, if rounding disagrees
         try:
             if nudge:
                 h = x[:, 3] - (c0 + nudge)
