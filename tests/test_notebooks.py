@@ -37,6 +37,7 @@ PROJECT_NOTEBOOKS = [
     "06_uniform_polychora.ipynb",
     "07_your_data.ipynb",
     "08_real_fmri.ipynb",
+    "09_star_polychora.ipynb",
 ]
 NOTEBOOKS = [NB_DIR / name for name in PROJECT_NOTEBOOKS]
 MARKER = "NBVAL_CHECK_OUTPUT"
