@@ -136,16 +136,21 @@ def crossings(rotated, edges, offsets) -> np.ndarray:
     e = np.asarray(edges, dtype=np.intp).reshape(-1, 2)
     o = np.asarray(offsets, dtype=np.float64).reshape(-1, 1)  # (K, 1)
     w = v[:, 3]
-    wa, wb = w[e[:, 0]][None, :], w[e[:, 1]][None, :]  # (1, E): only w first, whole rows where cut
+    wa, wb = w.take(e[:, 0]), w.take(e[:, 1])  # (E,): only w first, whole rows where cut
     lo, hi = np.minimum(wa, wb), np.maximum(wa, wb)
     tol = 1e-12 * max(1.0, float(np.abs(w).max(initial=0.0)))
     flat = (hi - lo) <= tol
-    cut = (lo <= o + tol) & (hi >= o - tol) & ~flat  # (K, E)
+    any_flat = bool(flat.any())
+    cut = (lo <= o + tol) & (hi >= o - tol)  # (K, E)
+    if any_flat:
+        cut &= ~flat
     k, j = np.nonzero(cut)
     a, b = v[e[j, 0]], v[e[j, 1]]
-    t = np.clip((o[k, 0] - wa[0, j]) / (wb[0, j] - wa[0, j]), 0.0, 1.0)
+    t = np.clip((o[k, 0] - wa[j]) / (wb[j] - wa[j]), 0.0, 1.0)
     pts = a + t[:, None] * (b - a)
     pts[:, 3] = o[k, 0]
+    if not any_flat:
+        return pts
     k2, j2 = np.nonzero(flat & (np.abs(lo - o) <= tol))  # edges in the plane: both ends
     return np.concatenate([pts, v[e[j2, 0]], v[e[j2, 1]]])
 
@@ -154,7 +159,7 @@ def w_colours(w, offset, size) -> np.ndarray:
     """(n, 3) float64 in [0, 1]: a diverging map of ``w`` about the hyperplane ``offset`` -- `BELOW_RGB`
     at offset - size or lower, `ON_RGB` on it, `ABOVE_RGB` at offset + size or higher, linear between."""
     t = np.clip((np.asarray(w, dtype=np.float64).reshape(-1) - float(offset)) / float(size), -1.0, 1.0)[:, None]
-    return np.where(t < 0, ON_RGB + (-t) * (BELOW_RGB - ON_RGB), ON_RGB + t * (ABOVE_RGB - ON_RGB))
+    return ON_RGB + np.maximum(t, 0.0) * (ABOVE_RGB - ON_RGB) + np.minimum(t, 0.0) * (ON_RGB - BELOW_RGB)
 
 
 def projection_arrays(source, matrix, c0, scale: float = 1.0) -> dict | None:
