@@ -75,6 +75,7 @@ CATEGORIES = [
     ("a vertex in no face", re.compile(r"is in no face")),
     ("coinciding vertices", re.compile(r"vertices \d+ and \d+ coincide")),
     ("the suggested tolerance is refused", re.compile(r"Expected `tolerance`")),
+    ("a line with the wrong count of numbers (the file is cut or damaged)", re.compile(r"has \d+ numbers; expected")),
     ("time limit", re.compile(r"time limit")),
 ]
 
@@ -244,7 +245,7 @@ def category(message: str) -> str:
     for name, pattern in CATEGORIES:
         if pattern.search(message):
             return name
-    text = re.sub(r"^.*?line \d+ \([a-z]+ \d+\): ", "", message)
+    text = re.sub(r"^('.*?', )?line \d+( \([a-z]+ \d+\))?: ", "", message)
     return re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "N", text)[:80]
 
 
@@ -375,8 +376,8 @@ def summary(rows: list[dict]) -> str:
     wound = [r["file"] for r in loaded if r["wound"]]
     if wound:
         out.append(f"  sections not wound as the boundary's orientation induces (polygons' edges shared but running "
-                   f"the same way; not counted as failed): {len(wound)}  ({', '.join(wound[:8])}"
-                   f"{', ...' if len(wound) > 8 else ''})")
+                   f"the same way; not counted as failed: even-odd sections of star faces close up only as a set): "
+                   f"{len(wound)}  ({', '.join(wound[:8])}{', ...' if len(wound) > 8 else ''})")
     if loaded:
         out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "
                    f"max {max(r['load_ms'] for r in loaded):.0f}; slice ms median "
