@@ -5,13 +5,14 @@ For each ``*.off`` file in DIR or its sub-folders (sorted by the number its name
 by path):
 
 * **load**: ``Polytope.from_off(path)``; if that is refused with an error that names a tolerance
-  that would do (coordinates written with few digits), once more with that tolerance (the table
-  says which was used).  A wrong edge count E in the file is read with a warning (counted).
+  that would do (coordinates written with few digits), again with that tolerance, up to three
+  times (`load`; the table says which were used).  A wrong edge count E is read with a warning
+  (counted).
 * **slice**: one fixed random rotation (``--seed``), cut at c0 = 0 and at ``--levels`` more
   levels spread over the rotated w range (``slice_polytope`` with a single c0 each; the time is
   the median over the levels, the slicing tables built by a first, untimed cut).
-* **check**, independently of the slicer (numpy on the file's vertices and the edges of its
-  faces, read here from the file with its own few lines of parsing):
+* **check**, independently of the slicer (numpy on the file's vertices, faces and cells, read
+  here from the file with its own few lines of parsing):
   - the slice's points are the edges' crossings of the hyperplane: every crossing (and every
     vertex lying in it) is within ``1e-7 * circumradius`` of a slice point and every slice point
     is within that of a crossing;
@@ -19,9 +20,11 @@ by path):
     hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
     failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
     polytope with reflex ridges, not detected as self-intersecting, can wind round negatively);
-  - the slice's polygons close up (every directed edge of their cycles as often as its reverse;
-    a non-convex section's fill corners, ``Slice.n_fill``, are not points: only checked to lie in
-    the points' bounding box);
+  - the slice's polygons close up: every edge of their cycles is in an even number of them (a
+    non-convex section's fill corners, ``Slice.n_fill``, are not points: only checked to lie in
+    the points' bounding box); whether each edge also runs one way in one polygon and the other
+    way in the other, as the boundary's orientation induces, is reported apart (`unclosed`: with
+    star faces the even-odd rule does not promise it);
   - for a polytope reported convex: the slice's volume equals the volume of
     ``scipy.spatial.ConvexHull`` of its points (relative ``1e-6``, plus 4 x the slice's area x the
     file's `flatness`: a file written with few digits leaves its faces and cells that far from flat).
