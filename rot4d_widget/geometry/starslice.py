@@ -321,34 +321,45 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
     uy = ev_y[o][new]
     ylo, yhi = uidx[:nr], uidx[nr:2 * nr]
     span = yhi - ylo
+    # pieces: each segment cut at the slab lines it spans, numbered segment by segment, slab by slab
+    n = int(span.sum())
     r = np.repeat(np.arange(nr), span)
-    slab = ylo[r] + np.arange(len(r)) - _ptr(span)[:-1][r]
+    pstart = _ptr(span)[:-1]
+    slab = ylo[r] + np.arange(n) - pstart[r]
     slope = (Xh - Xl) / (Yh - Yl)
     xa = Xl[r] + (uy[slab] - Yl[r]) * slope[r]
     xb = Xl[r] + (uy[slab + 1] - Yl[r]) * slope[r]
-    o = np.lexsort((xa + xb, slab))
-    r, slab = r[o], slab[o]
+    o = np.argsort(xa + xb)  # by slab, then left to right: a float sort, then a stable (radix) one by slab
+    o = o[np.argsort(slab[o].astype(np.uint16) if len(uy) < 65536 else slab[o], kind="stable")]
     if (np.bincount(slab) % 2).any():
         raise _Inconsistent
     # a trapezoid goes on up while the same two segments bound it in the next slab (nothing
-    # happens between them there): merged, it needs corners only where it starts and ends
-    L, R, k = r[0::2], r[1::2], slab[0::2]
-    o = np.lexsort((k, R, L))
-    L, R, k = L[o], R[o], k[o]
-    brk = np.ones(len(k), dtype=bool)
-    brk[1:] = (L[1:] != L[:-1]) | (R[1:] != R[:-1]) | (k[1:] != k[:-1] + 1)
-    first = np.flatnonzero(brk)
-    lastk = k[np.append(first[1:], len(k)) - 1]
-    L, R, y0, y1 = L[first], R[first], k[first], lastk + 1
-    # corners: a segment's end where the trapezoid's line passes through it, else a new point on it
+    # happens between them there): merged, it needs corners only where it starts and ends.  It
+    # goes on from left piece q to q + 1 (the same segment's next slab) when that is a left piece
+    # with the same right segment: no sort, runs of pieces
+    Lq, R = o[0::2], r[o[1::2]]
+    rr = np.append(r, -1)
+    rpart = np.full(n + 1, -1, dtype=np.intp)
+    rpart[Lq] = R
+    cont = np.zeros(n + 1, dtype=bool)
+    cont[Lq] = (rr[Lq + 1] == rr[Lq]) & (rpart[Lq + 1] == R)
+    isleft = rpart[:n] >= 0
+    sq = np.flatnonzero(isleft & ~cont[np.arange(-1, n - 1)])  # cont[-1] is the pad: False
+    eq = np.flatnonzero(isleft & ~cont[:n])
+    L, R, y0, y1 = r[sq], rpart[sq], slab[sq], slab[eq] + 1
+    # corners: a segment's end where the trapezoid's line passes through it, else a new point on
+    # it, one per (segment, slab line): numbered by the piece starting there, no sort
     cr = np.concatenate([L, R, R, L])
     cy = np.concatenate([y0, y0, y1, y1])
     at_lo, at_hi = cy == ylo[cr], cy == yhi[cr]
     mid = ~(at_lo | at_hi)
-    ukey, inv = np.unique((cr * len(uy) + cy)[mid], return_inverse=True)
+    piece = (pstart[cr] + cy - ylo[cr])[mid]
+    mark = np.zeros(n, dtype=bool)
+    mark[piece] = True
     corner = np.where(at_lo, vid[lo_p[cr]], vid[hi_p[cr]])
-    corner[mid] = n_vertices + inv.reshape(-1)
-    mr, my = ukey // len(uy), ukey % len(uy)
+    corner[mid] = n_vertices + (np.cumsum(mark) - 1)[piece]
+    mq = np.flatnonzero(mark)
+    mr, my = r[mq], slab[mq]
     lam = ((uy[my] - Yl[mr]) / (Yh[mr] - Yl[mr]))[:, None]
     extra = pts[lo_p[mr]] + lam * (pts[hi_p[mr]] - pts[lo_p[mr]])
     a, b, c, d = corner.reshape(4, -1)  # lower left, lower right, upper right, upper left
