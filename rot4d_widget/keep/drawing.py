@@ -273,20 +273,12 @@ def draw_slice(
     z = pts[:, 2]
     drawing = SliceDrawing(centers=xy, factors=fac)
 
-    # faces: convex polygons (a cell meets a hyperplane in a convex polygon); order the corners
-    # around the projected centroid so the drawing does not depend on the slicer's corner order.
-    polygons = list(slice.polygons)
-    colors = _cell_colors(np.asarray(slice.cell_ids), colormap) if polygons else []
-    for poly, rgba in zip(polygons, colors):
-        idx = np.asarray(poly, dtype=np.int64)
-        if len(idx) < 3:
-            continue
-        p2 = xy[idx]
-        c2 = p2.mean(axis=0)
-        order = np.argsort(np.arctan2(p2[:, 1] - c2[1], p2[:, 0] - c2[0]))
-        depth = z[idx].mean()
+    # faces: a convex cell's section is a convex polygon: order its corners around the projected
+    # centroid so the drawing does not depend on the slicer's corner order.  A slice with fill
+    # corners (non-convex sections, `Slice.n_fill`) draws its triangles instead (the even-odd fill).
+    for corners, rgba, depth in _face_patches(slice, xy, z, colormap):
         patch = Polygon(
-            p2[order], closed=True, facecolor=(*rgba[:3], face_alpha), edgecolor="none",
+            corners, closed=True, facecolor=(*rgba[:3], face_alpha), edgecolor="none",
             zorder=_Z_BASE + depth + _Z_KIND["face"], gid="face",
         )
         _add_patch(ax, patch)
@@ -314,7 +306,7 @@ def draw_slice(
     # balls: circles of radius ball_radius * factor, with a highlight towards the upper left
     if ball_radius > 0:
         dark = tuple(0.55 * np.asarray(ball_rgba[:3])) + (ball_rgba[3],)
-        for i in range(len(pts)):
+        for i in range(_n_balls(slice, len(pts))):
             r = ball_radius * fac[i]
             zo = _Z_BASE + z[i] + _Z_KIND["ball"]
             ball = Circle(xy[i], r, facecolor=ball_rgba, edgecolor=dark, linewidth=0.4, zorder=zo, gid="ball")
@@ -349,6 +341,37 @@ def draw_slice(
         ax.text(0.03, 0.97, label, transform=ax.transAxes, ha="left", va="top", fontsize=10,
                 zorder=_Z_LABEL)
     return drawing
+
+
+
+def _n_balls(slice, n_points: int) -> int:
+    """Balls drawn: every vertex but the last ``n_fill`` (fill corners of non-convex sections)."""
+    return n_points - int(getattr(slice, "n_fill", 0))
+
+
+def _face_patches(slice, xy, z, colormap):
+    """``(corners (k, 2), rgba, depth)`` per face patch: a convex slice's polygons with corners
+    ordered by angle about their projected centroid; a slice with fill corners (``n_fill`` > 0:
+    its non-convex sections are even-odd filled) its triangles, coloured by ``triangle_cells``."""
+    if int(getattr(slice, "n_fill", 0)):
+        tri = np.asarray(slice.triangles, dtype=np.int64).reshape(-1, 3)
+        if not len(tri):
+            return []
+        colors = _cell_colors(np.asarray(slice.triangle_cells), colormap)
+        depth = z[tri].mean(axis=1)
+        return [(xy[t], rgba, float(d)) for t, rgba, d in zip(tri, colors, depth)]
+    out = []
+    polygons = list(slice.polygons)
+    colors = _cell_colors(np.asarray(slice.cell_ids), colormap) if polygons else []
+    for poly, rgba in zip(polygons, colors):
+        idx = np.asarray(poly, dtype=np.int64)
+        if len(idx) < 3:
+            continue
+        p2 = xy[idx]
+        c2 = p2.mean(axis=0)
+        order = np.argsort(np.arctan2(p2[:, 1] - c2[1], p2[:, 0] - c2[0]))
+        out.append((p2[order], rgba, float(z[idx].mean())))
+    return out
 
 
 # --------------------------------------------------------------------------- one panel, fast (animations)
@@ -393,9 +416,18 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
     paths, face, edge, width, zo = [], [], [], [], []
     none = (0.0, 0.0, 0.0, 0.0)
 
-    # faces: corners ordered around the projected centroid (draw_slice's order), one loop-free pass
+    # faces: corners ordered around the projected centroid (draw_slice's order), one loop-free pass;
+    # a slice with fill corners: its triangles (as draw_slice)
     off = np.asarray(slice.polygon_offsets, dtype=np.int64)
     lens = np.diff(off)
+    if int(getattr(slice, "n_fill", 0)):
+        for corners, rgba, depth in _face_patches(slice, xy, z, cmap):
+            paths.append(Path(np.concatenate([corners, corners[:1]]), _closed_codes(len(corners))))
+            face.append((*rgba[:3], face_alpha))
+            edge.append(none)
+            width.append(0.0)
+            zo.append(_Z_BASE + depth + _Z_KIND["face"])
+        lens = lens[:0]
     if len(lens):
         rgba = _cell_colors(np.asarray(slice.cell_ids), cmap)
         flat = np.asarray(slice.polygon_indices, dtype=np.int64)
@@ -449,7 +481,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
         r = ball_radius * fac
         zb = _Z_BASE + z + _Z_KIND["ball"]
         shine = xy + np.array([-0.35, 0.35]) * r[:, None]
-        for i in range(len(pts)):
+        for i in range(_n_balls(slice, len(pts))):
             paths.append(Path(circ_v * r[i] + xy[i], circ_c))
             paths.append(Path(circ_v * (0.3 * r[i]) + shine[i], circ_c))
             face += [ball_rgba, (1.0, 1.0, 1.0, 0.55)]

@@ -211,7 +211,7 @@ def render_tomography(
             s = ex["slices"][k]
             placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
-                           s.volume, s.dim)
+                           s.volume, s.dim, n_fill=int(getattr(s, "n_fill", 0)))
             if palette is not None:
                 cmap = ListedColormap(palette)
             else:
@@ -219,7 +219,7 @@ def render_tomography(
             if not show_faces:
                 placed = Slice(placed.vertices, placed.edges, placed.polygon_indices[:0], placed.polygon_offsets[:1],
                                placed.cell_ids[:0], placed.triangles[:0], placed.triangle_cells[:0], placed.volume,
-                               placed.dim)
+                               placed.dim, n_fill=placed.n_fill)
             if _canvas is not None:  # one collection per slice, in draw_slice's painter's order
                 coll = _slice_collection(placed, scale=scale, ball_radius=ball if show_balls else 0.0,
                                          bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap,

@@ -158,6 +158,8 @@ class SliceData:
     convex : bool -- the triangles bound one convex solid: back-facing then
         front-facing order blends exactly; otherwise triangles are sorted by depth
     show_points : bool -- draw balls at ``points`` (False: points only carry corners)
+    corner_only : (n,) bool or None -- True where a point only carries a corner of a filled face
+        (the extra corners of a non-convex section's even-odd fill, `Slice.n_fill`): no ball there
     """
 
     points: np.ndarray
@@ -170,6 +172,7 @@ class SliceData:
     convex: bool = False
     show_points: bool = True
     extra: Mapping = field(default_factory=dict)
+    corner_only: np.ndarray | None = None
 
     def turned(self, rotation) -> "SliceData":
         """The same slice turned by the 3-D ``rotation`` (3, 3): points and normals turned, rest shared.
@@ -183,7 +186,7 @@ class SliceData:
         normals = None if self.normals is None else self.normals @ r.T
         return SliceData.build(self.points @ r.T, self.segments, self.triangles, self.groups, normals=normals,
                                volume=self.volume, readout=self.readout, convex=self.convex,
-                               show_points=self.show_points, extra=self.extra)
+                               show_points=self.show_points, extra=self.extra, corner_only=self.corner_only)
 
     @classmethod
     def build(cls, points, segments=None, triangles=None, groups=None, **kwargs) -> "SliceData":
@@ -200,6 +203,13 @@ class SliceData:
             normals = _readonly(normals, np.float64, (3,), "normals")
             if len(normals) != len(p):
                 raise ValueError(f"Expected `normals` to have one row per point ({len(p)}), got {len(normals)}")
+        corner = kwargs.pop("corner_only", None)
+        if corner is not None:
+            corner = np.array(corner, dtype=bool, copy=True).reshape(-1)
+            if corner.shape != (len(p),):
+                raise ValueError(f"Expected `corner_only` to have one flag per point ({len(p)}), got {corner.shape}")
+            corner.flags.writeable = False
+            kwargs["corner_only"] = corner if corner.any() else None
         data = cls(p, s, t, g, normals, **kwargs)
         check_slice(data)
         return data
@@ -373,6 +383,17 @@ class PolytopeSlice(SliceData):
         return f"PolytopeSlice({self.slice!r})"
 
 
+def _fill_flags(s):
+    """(n,) bool, read-only, True at a `Slice`'s last ``n_fill`` vertices (fill corners), or None."""
+    n_fill = int(getattr(s, "n_fill", 0))
+    if not n_fill:
+        return None
+    flags = np.zeros(len(s.vertices), dtype=bool)
+    flags[len(flags) - n_fill:] = True
+    flags.flags.writeable = False
+    return flags
+
+
 class PolytopeSource:
     """A 4-polytope (convex or not) as a source: groups are its cells, the slice is exact."""
 
@@ -413,6 +434,7 @@ class PolytopeSource:
             readout=(("slice", census_text(s)),) + _winding_row(self.polytope),
             convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
             extra={"slice": s},
+            corner_only=_fill_flags(s),
         )
 
     def describe(self) -> dict:

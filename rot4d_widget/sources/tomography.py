@@ -286,7 +286,7 @@ class StackSliceData(SliceData):
         normals = None if self.normals is None else self.normals @ r.T
         return type(self).build(points, self.segments, self.triangles, self.groups, normals=normals,
                                 volume=self.volume, readout=self.readout, convex=self.convex,
-                                show_points=self.show_points, extra=self.extra)
+                                show_points=self.show_points, extra=self.extra, corner_only=self.corner_only)
 
 
 _SHORT = {3: "tri", 4: "quad", 5: "pent", 6: "hex", 7: "hept", 8: "oct", 9: "non", 10: "dec"}
@@ -523,13 +523,18 @@ class StackSource:
         pieces = self._inner_slices(m, cuts, coarse)
         centres, scales = self.layout()
         by_w = self._color_by == "w" and n > 1
-        pts, segs, tris, groups, nrms = [], [], [], [], []
+        pts, segs, tris, groups, nrms, corners = [], [], [], [], [], []
         p_off, s_off, t_off = [0], [0], [0]
         volumes = []
         has_normals = all(getattr(p, "normals", None) is not None for p in pieces)
         for k, piece in enumerate(pieces):
             p = np.asarray(piece.points, dtype=np.float64).reshape(-1, 3)
             pts.append(p * scales[k] + centres[k] if n > 1 else p)
+            flags = getattr(piece, "corner_only", None)  # fill corners: no ball (a `Slice`: its last n_fill)
+            if flags is None:
+                n_fill = int(getattr(piece, "n_fill", 0) or 0)
+                flags = np.arange(len(p)) >= len(p) - n_fill if n_fill else np.zeros(len(p), dtype=bool)
+            corners.append(np.asarray(flags, dtype=bool))
             segs.append(np.asarray(piece.segments, dtype=np.intp).reshape(-1, 2) + p_off[-1])
             t = np.asarray(piece.triangles, dtype=np.intp).reshape(-1, 3)
             tris.append(t + p_off[-1])
@@ -554,12 +559,13 @@ class StackSource:
                 pts[0], segs[0], tris[0], groups[0], normals=nrms[0] if has_normals else None,
                 volume=volumes[0], readout=tuple(getattr(pieces[0], "readout", ())),
                 convex=bool(getattr(pieces[0], "convex", False)),
-                show_points=bool(getattr(pieces[0], "show_points", True)), extra=extra)
+                show_points=bool(getattr(pieces[0], "show_points", True)), extra=extra, corner_only=corners[0])
         return StackSliceData.build(
             np.concatenate(pts), np.concatenate(segs), np.concatenate(tris), np.concatenate(groups),
             normals=np.concatenate(nrms) if has_normals else None, volume=None,
             readout=self._readout(cuts, pieces, volumes, hi, m), convex=False,
-            show_points=any(bool(getattr(p, "show_points", True)) for p in pieces), extra=extra)
+            show_points=any(bool(getattr(p, "show_points", True)) for p in pieces), extra=extra,
+            corner_only=np.concatenate(corners) if corners else None)
 
     def _readout(self, cuts, pieces, volumes, hi, m) -> tuple:
         """Rows for the readout: each slice labelled by its w in the data's own units (a field's
@@ -612,6 +618,7 @@ class _PolytopePiece:
     volume = property(lambda self: float(self.slice.volume))
     readout = property(lambda self: (("slice", census_text(self.slice)),))
     show_points = True
+    n_fill = property(lambda self: int(getattr(self.slice, "n_fill", 0)))  # fill corners: the last n_fill points
     data = property(lambda self: self.slice)
 
 

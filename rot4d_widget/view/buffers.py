@@ -200,6 +200,9 @@ def slice_rows(
     out = np.zeros((capacity, ROW_FLOATS), dtype=np.float32)
     out[:nv, 0:3] = p[:nv]
     out[:nv, 3] = 1.0
+    corner = getattr(data, "corner_only", None)
+    if nv and corner is not None:
+        out[:nv, 3][np.asarray(corner, dtype=bool)] = 0.0  # a fill corner: no ball
     out[:ne, 4:7] = p[e[:, 0]]
     out[:ne, 7:10] = p[e[:, 1]]
     out[:nt, 10:19] = p[t].reshape(nt, 9)
