@@ -261,20 +261,40 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     offsets = _ptr(counts)
     cell_ids = kcell[offsets[:-1]]
 
-    # triangles: a convex cell's cycle fanned, every other cell's section filled even-odd by slabs
+    # triangles: a convex cell's cycle fanned; a non-convex cell's section that is one cycle
+    # winding once, always the same way, round its corners' centroid (a star-shaped polygon: its
+    # even-odd fill) fanned from that centroid, an extra corner, wound counter-clockwise about
+    # the normal as the slabs are; every other section filled even-odd by slabs
     conv = st.cell_convex[cell_ids]
     pconv = conv[pid]
     fo = _ptr(counts[conv])
     ftri, fpoly = _fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
     tri = [ftri]
     tcell = [cell_ids[conv][fpoly]]
-    extra = np.zeros((0, 3))
-    gen = ~st.cell_convex[rec_cell]
+    turn, centroid = _star_alone(vertices, flat, pid, offsets, counts, cell_ids, normals, rec_cell, t.C)
+    turn[conv] = 0
+    sp = np.flatnonzero(turn)
+    done = np.zeros(t.C, dtype=bool)
+    extra = [centroid[sp]]
+    if len(sp):
+        done[cell_ids[sp]] = True
+        rank = np.full(len(counts), -1, dtype=np.intp)
+        rank[sp] = len(vertices) + np.arange(len(sp))
+        nxt = np.arange(1, len(flat) + 1)
+        nxt[offsets[1:] - 1] = offsets[:-1]
+        j = np.flatnonzero(turn[pid])
+        ccw = turn[pid[j]] > 0
+        tri.append(np.stack([rank[pid[j]], np.where(ccw, flat[j], flat[nxt[j]]),
+                             np.where(ccw, flat[nxt[j]], flat[j])], axis=1))
+        tcell.append(cell_ids[pid[j]])
+    gen = ~(st.cell_convex[rec_cell] | done[rec_cell])
     if gen.any():
-        ttri, tc, extra = _slabs(rec_cell[gen], seg[rec_seg[gen]], pts, vid, normals, anchor + centre,
-                                 len(vertices))
+        ttri, tc, sx = _slabs(rec_cell[gen], seg[rec_seg[gen]], pts, vid, normals, anchor + centre,
+                              len(vertices) + len(sp))
         tri.append(ttri)
         tcell.append(tc)
+        extra.append(sx)
+    extra = np.concatenate(extra)
     triangles = np.concatenate(tri)
     triangle_cells = np.concatenate(tcell)
     all_v = np.concatenate([vertices, extra]) if len(extra) else vertices
@@ -286,6 +306,29 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     edges = ev if len(ev) else t.empty_i2
     return Slice(_scaled(t, all_v), edges, flat, offsets, cell_ids, triangles, triangle_cells,
                  _scaled_volume(t, volume), 3, len(extra))
+
+
+def _star_alone(vertices, flat, pid, offsets, counts, cell_ids, normals, rec_cell, C):
+    """Per polygon: 1 (-1) where it is its cell's whole section (one cycle, every segment of the
+    cell in it) and winds once counter-clockwise (clockwise) about the cell's normal round its
+    corners' centroid, every corner strictly that way from the last (a star-shaped polygon with
+    the centroid in its kernel), else 0; and the (p, 3) centroids."""
+    alone = ((np.bincount(cell_ids, minlength=C) == 1)[cell_ids]
+             & (np.bincount(rec_cell, minlength=C)[cell_ids] == counts))
+    P = vertices[flat]
+    centroid = np.stack([np.bincount(pid, weights=P[:, i], minlength=len(counts)) for i in range(3)],
+                        axis=1) / counts[:, None]
+    nxt = np.arange(1, len(flat) + 1)
+    nxt[offsets[1:] - 1] = offsets[:-1]
+    rel = P - centroid[pid]
+    n = normals[cell_ids][pid]
+    y = np.einsum("ij,ij->i", _cross(rel, rel[nxt]), n)
+    ang = np.arctan2(y * (1 / np.sqrt(np.einsum("ij,ij->i", n, n))), np.einsum("ij,ij->i", rel, rel[nxt]))
+    total = np.bincount(pid, weights=ang, minlength=len(counts))
+    once = alone & (np.abs(np.abs(total) - 2 * np.pi) < 1e-6)
+    left = np.bincount(pid, weights=y > 0, minlength=len(counts)) == counts
+    right = np.bincount(pid, weights=y < 0, minlength=len(counts)) == counts
+    return np.where(once & left, 1, np.where(once & right, -1, 0)), centroid
 
 
 def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
