@@ -158,7 +158,10 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     dfr = d[fr]
     tpos = np.einsum("ij,ij->i", pts[pk], dfr)
     tie = -side * np.einsum("ij,ij->i", dpdc[pk], dfr)
-    order = np.lexsort((tie, tpos, fr))
+    order = np.argsort(tpos)  # by face, then along its line: a float sort, then a stable (radix) one by face
+    order = order[np.argsort(fr[order].astype(np.uint16) if len(uf) < 65536 else fr[order], kind="stable")]
+    if (tpos[order[1:]] == tpos[order[:-1]]).any():  # equal positions (a vertex on H): ordered as it moves
+        order = np.lexsort((tie, tpos, fr))
     pk, delta = pk[order], delta[order]
     seg = pk.reshape(-1, 2)  # even-odd: 1st-2nd, 3rd-4th, ... of each face (counts are even)
     seg_face = uf[fr[0::2]]
@@ -208,13 +211,12 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     nxt = partner ^ 1  # along the other segment at this point, to its far end
     lab = np.arange(n_end)
     J = nxt.copy()
-    rounds = max(1, int(np.ceil(np.log2(n_end))) + 1)
+    # an orbit stays in its cell: no longer than the cell's records (one end of each)
+    rounds = max(1, int(np.ceil(np.log2(max(2, int(np.bincount(rec_cell).max()))))) + 1)
     for _ in range(rounds):
         lab = np.minimum(lab, lab[J])
         J = J[J]
     normals = t.cell_normals @ m[:3].T  # (C, 3) each cell's outward normal, restricted to H
-    pe = pts[end_pt] - centre
-    area = np.einsum("ij,ij->i", normals[end_cell], _cross(pe - anchor[end_cell], pe[nxt] - anchor[end_cell]))
     # each cycle run the way its segments bound the cell's section (rho times the sign of the face's
     # winding along the segment: for faces winding at most once every segment then runs opposite
     # ways in its two cells' cycles); by signed area where they disagree (a star face), then by label
@@ -222,9 +224,16 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     agree = np.where(((np.arange(n_end) & 1) == 1) == (nat[np.arange(n_end) >> 1] > 0), 1.0, -1.0)
     rev_lab = lab[np.arange(n_end) ^ 1]
     score = np.bincount(lab, weights=agree, minlength=n_end)
-    orbit_area = np.bincount(lab, weights=area, minlength=n_end)
-    fs, rs, fwd, rev = score[lab], score[rev_lab], orbit_area[lab], orbit_area[rev_lab]
-    keep = (fs > rs) | ((fs == rs) & ((fwd > rev) | ((fwd == rev) & (lab < rev_lab))))
+    fs, rs = score[lab], score[rev_lab]
+    keep = fs > rs
+    e = np.flatnonzero(fs == rs)  # whole orbits, each with its reverse: their signed areas
+    if len(e):
+        ec = end_cell[e]
+        pe, pn = pts[end_pt[e]] - centre - anchor[ec], pts[end_pt[nxt[e]]] - centre - anchor[ec]
+        orbit_area = np.bincount(lab[e], weights=np.einsum("ij,ij->i", normals[ec], _cross(pe, pn)),
+                                 minlength=n_end)
+        fwd, rev = orbit_area[lab[e]], orbit_area[rev_lab[e]]
+        keep[e] = (fwd > rev) | ((fwd == rev) & (lab[e] < rev_lab[e]))
     term = nxt == lab  # the end before its orbit's first
     J = np.where(term, np.arange(n_end), nxt)
     dist = (~term).astype(np.intp)
@@ -271,8 +280,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     ftri, fpoly = _fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
     tri = [ftri]
     tcell = [cell_ids[conv][fpoly]]
-    turn, centroid = _star_alone(vertices, flat, pid, offsets, counts, cell_ids, normals, rec_cell, t.C)
-    turn[conv] = 0
+    turn, centroid = _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, t.C, conv)
     sp = np.flatnonzero(turn)
     done = np.zeros(t.C, dtype=bool)
     extra = [centroid[sp]]
@@ -308,27 +316,37 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
                  _scaled_volume(t, volume), 3, len(extra))
 
 
-def _star_alone(vertices, flat, pid, offsets, counts, cell_ids, normals, rec_cell, C):
-    """Per polygon: 1 (-1) where it is its cell's whole section (one cycle, every segment of the
-    cell in it) and winds once counter-clockwise (clockwise) about the cell's normal round its
-    corners' centroid, every corner strictly that way from the last (a star-shaped polygon with
-    the centroid in its kernel), else 0; and the (p, 3) centroids."""
-    alone = ((np.bincount(cell_ids, minlength=C) == 1)[cell_ids]
-             & (np.bincount(rec_cell, minlength=C)[cell_ids] == counts))
-    P = vertices[flat]
-    centroid = np.stack([np.bincount(pid, weights=P[:, i], minlength=len(counts)) for i in range(3)],
-                        axis=1) / counts[:, None]
-    nxt = np.arange(1, len(flat) + 1)
-    nxt[offsets[1:] - 1] = offsets[:-1]
-    rel = P - centroid[pid]
-    n = normals[cell_ids][pid]
+def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, conv):
+    """Per polygon: 1 (-1) where it is its non-convex cell's whole section (one cycle, every
+    segment of the cell in it) and winds once counter-clockwise (clockwise) about the cell's
+    normal round its corners' centroid, every corner strictly that way from the last (a
+    star-shaped polygon with the centroid in its kernel), else 0; and the (p, 3) centroids (of
+    those that could be: one polygon in a non-convex cell)."""
+    cand = (~conv & (np.bincount(cell_ids, minlength=C) == 1)[cell_ids]
+            & (np.bincount(rec_cell, minlength=C)[cell_ids] == counts))
+    turn = np.zeros(len(counts), dtype=np.intp)
+    centroid = np.zeros((len(counts), 3))
+    if not cand.any():
+        return turn, centroid
+    sel = cand[pid]
+    q = (np.cumsum(cand) - 1)[pid[sel]]
+    cnt = counts[cand]
+    off = _ptr(cnt)
+    P = vertices[flat[sel]]
+    cen = np.stack([np.bincount(q, weights=P[:, i], minlength=len(cnt)) for i in range(3)], axis=1) / cnt[:, None]
+    nxt = np.arange(1, len(q) + 1)
+    nxt[off[1:] - 1] = off[:-1]
+    rel = P - cen[q]
+    n = normals[cell_ids[cand]]
+    n = (n * (1 / np.sqrt(np.einsum("ij,ij->i", n, n)))[:, None])[q]
     y = np.einsum("ij,ij->i", _cross(rel, rel[nxt]), n)
-    ang = np.arctan2(y * (1 / np.sqrt(np.einsum("ij,ij->i", n, n))), np.einsum("ij,ij->i", rel, rel[nxt]))
-    total = np.bincount(pid, weights=ang, minlength=len(counts))
-    once = alone & (np.abs(np.abs(total) - 2 * np.pi) < 1e-6)
-    left = np.bincount(pid, weights=y > 0, minlength=len(counts)) == counts
-    right = np.bincount(pid, weights=y < 0, minlength=len(counts)) == counts
-    return np.where(once & left, 1, np.where(once & right, -1, 0)), centroid
+    ang = np.arctan2(y, np.einsum("ij,ij->i", rel, rel[nxt]))
+    once = np.abs(np.abs(np.bincount(q, weights=ang, minlength=len(cnt))) - 2 * np.pi) < 1e-6
+    left = np.bincount(q, weights=y > 0, minlength=len(cnt)) == cnt
+    right = np.bincount(q, weights=y < 0, minlength=len(cnt)) == cnt
+    turn[cand] = np.where(once & left, 1, np.where(once & right, -1, 0))
+    centroid[cand] = cen
+    return turn, centroid
 
 
 def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
@@ -356,7 +374,8 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
     ic, iy = _crossings(rcell, Xl, Yl, Xh, Yh)  # slab lines also where two segments cross
     ev_cell = np.concatenate([rcell, rcell, ic])
     ev_y = np.concatenate([Yl, Yh, iy])
-    o = np.lexsort((ev_y, ev_cell))
+    o = np.argsort(ev_y)  # by cell, then height: a float sort, then a stable (radix) one by cell
+    o = o[np.argsort(ev_cell[o].astype(np.uint16) if len(normals) < 65536 else ev_cell[o], kind="stable")]
     new = np.ones(len(o), dtype=bool)
     new[1:] = (ev_y[o][1:] != ev_y[o][:-1]) | (ev_cell[o][1:] != ev_cell[o][:-1])
     uidx = np.empty(len(o), dtype=np.intp)
@@ -415,14 +434,17 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
 def _crossings(rcell, Xl, Yl, Xh, Yh):
     """Where two segments of one cell cross inside both: ((k,) cells, (k,) heights Y).
 
-    Every pair of segments of a cell is tested (a cell's section has a few dozen at most)."""
-    o = np.argsort(rcell, kind="stable")
+    Every pair of segments of a cell is tested (a cell's section has a few dozen at most): the
+    cells' segments in the rows of a padded table, its pairs of columns taken at once."""
+    o = np.argsort(rcell.astype(np.uint16) if rcell.max(initial=0) < 65536 else rcell, kind="stable")
     cnt = np.bincount(rcell)
     start = _ptr(cnt)[:-1]
-    pos = np.arange(len(o)) - start[rcell[o]]
-    npair = cnt[rcell[o]] - 1 - pos
-    i = np.repeat(o, npair)
-    j = o[np.repeat(np.arange(len(o)), npair) + 1 + np.arange(npair.sum()) - np.repeat(_ptr(npair)[:-1], npair)]
+    table = np.full((len(cnt), int(cnt.max(initial=0))), -1, dtype=np.intp)
+    table[rcell[o], np.arange(len(o)) - start[rcell[o]]] = o
+    iu, ju = np.triu_indices(table.shape[1], 1)
+    i, j = table[:, iu].ravel(), table[:, ju].ravel()
+    ok = j >= 0  # (a row's entries are packed to the left)
+    i, j = i[ok], j[ok]
     d1x, d1y = Xh[i] - Xl[i], Yh[i] - Yl[i]
     d2x, d2y = Xh[j] - Xl[j], Yh[j] - Yl[j]
     ex, ey = Xl[j] - Xl[i], Yl[j] - Yl[i]
