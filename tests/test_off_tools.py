@@ -92,3 +92,16 @@ def test_a_file_without_the_keyword_says_what_is_missing():
     body = [ln for ln in polytope("5-cell").to_off().splitlines() if ln and not ln.startswith("#")]
     with pytest.raises(ValueError, match=r"line 1: expected the header 4OFF"):
         Polytope.from_off("\n".join(body[1:]))
+
+
+def test_a_deviation_beyond_rounding_is_not_offered_a_tolerance():
+    """A corner 5 % of the extent off its plane is a wrong number, not rounding: the error says so
+    and suggests no tolerance (one above MAX_TOLERANCE would itself be refused)."""
+    lines = polytope("8-cell").to_off().splitlines()
+    i = next(i for i, ln in enumerate(lines) if len(ln.split("#")[0].split()) == 4 and "." in ln)
+    x = [float(t) for t in lines[i].split()]
+    x[0] += 0.2  # the tesseract's extent is 2: 10 %
+    lines[i] = " ".join(repr(v) for v in x)
+    with pytest.raises(ValueError, match=r"more than rounding \(the loosest tolerance allowed is 0\.01\)") as err:
+        Polytope.from_off("\n".join(lines) + "\n")
+    assert "tolerance=" not in str(err.value)

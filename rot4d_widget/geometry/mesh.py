@@ -28,7 +28,7 @@ from scipy.spatial import ConvexHull
 from ..core import tolerances as tol_
 from ..core._arrays import sealed as _sealed
 from ._ragged import _gather, _owner, _ptr
-from .meshcheck import MeshError, duplicate_in_rows, index_lists, mesh_geometry
+from .meshcheck import MAX_TOLERANCE, MeshError, duplicate_in_rows, index_lists, mesh_geometry
 from .offfile import read_off, write_off
 
 __all__ = ["Polytope", "Incidence", "MeshError", "MESH_TOLERANCE", "MAX_TOLERANCE", "COORDINATE_RANGE",
@@ -55,9 +55,6 @@ def check_scale(scale: float, what: str) -> None:
                          f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
                          f"other units)")
 
-
-#: The loosest relative tolerance a mesh may be checked with.
-MAX_TOLERANCE = 1e-2
 
 
 def _check_tolerance(tolerance) -> float:

@@ -91,13 +91,21 @@ def duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
     return None
 
 
+#: The loosest relative tolerance a mesh may be checked with (`Polytope(..., tolerance=)`).
+MAX_TOLERANCE = 1e-2
+
+
 def loosen_hint(off, extent) -> str:
     """How to accept a corner ``off`` from its plane on a mesh of ``extent`` (same units): the
     relative ``tolerance`` that would take it (its first significant digit rounded up, then
-    doubled), e.g. for a file written with few digits."""
+    doubled), e.g. for a file written with few digits; beyond `MAX_TOLERANCE` it is no rounding,
+    and the hint says so instead of suggesting a tolerance that would be refused."""
     rel = 2.0 * float(off) / float(extent)
     digits = 10.0 ** np.floor(np.log10(rel))
     suggest = float(np.ceil(rel / digits) * digits)
+    if suggest > MAX_TOLERANCE:
+        return (f"; {float(off) / float(extent):.2g} of the mesh's extent is more than rounding (the loosest "
+                f"tolerance allowed is {MAX_TOLERANCE:g}): a number in the file or the face's corners are wrong")
     return (f"; coordinates written with few digits (another program's file) load with a looser relative "
             f"tolerance, e.g. tolerance={suggest:.1g} (Polytope(..., tolerance=...), Polytope.from_off(path, "
             f"tolerance=...))")
