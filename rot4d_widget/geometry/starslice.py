@@ -317,13 +317,14 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
 
 
 def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, conv):
-    """Per polygon: 1 (-1) where it is its non-convex cell's whole section (one cycle, every
-    segment of the cell in it) and winds once counter-clockwise (clockwise) about the cell's
-    normal round its corners' centroid, every corner strictly that way from the last (a
-    star-shaped polygon with the centroid in its kernel), else 0; and the (p, 3) centroids (of
-    those that could be: one polygon in a non-convex cell)."""
-    cand = (~conv & (np.bincount(cell_ids, minlength=C) == 1)[cell_ids]
-            & (np.bincount(rec_cell, minlength=C)[cell_ids] == counts))
+    """Per polygon: 1 (-1) where it winds once counter-clockwise (clockwise) about its
+    non-convex cell's normal round its corners' centroid, every corner strictly that way from the
+    last (a star-shaped polygon with the centroid in its kernel), and so do the cell's other
+    polygons, whose bounding boxes it meets none of, all the cell's segments in them (the cell's
+    section is then their fills, side by side), else 0; and the (p, 3) centroids (of those that
+    could be)."""
+    npoly = np.bincount(cell_ids, minlength=C)
+    cand = ~conv & (np.bincount(rec_cell, minlength=C) == np.bincount(cell_ids, weights=counts, minlength=C))[cell_ids]
     turn = np.zeros(len(counts), dtype=np.intp)
     centroid = np.zeros((len(counts), 3))
     if not cand.any():
@@ -344,7 +345,23 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
     once = np.abs(np.abs(np.bincount(q, weights=ang, minlength=len(cnt))) - 2 * np.pi) < 1e-6
     left = np.bincount(q, weights=y > 0, minlength=len(cnt)) == cnt
     right = np.bincount(q, weights=y < 0, minlength=len(cnt)) == cnt
-    turn[cand] = np.where(once & left, 1, np.where(once & right, -1, 0))
+    tc = np.where(once & left, 1, np.where(once & right, -1, 0))
+    cc = cell_ids[cand]
+    ok = np.bincount(cc[tc != 0], minlength=C) == npoly  # every polygon of the cell star-shaped
+    many = np.flatnonzero(ok[cc] & (npoly[cc] > 1))
+    if len(many):  # several: each pair's bounding boxes apart
+        lo, hi = np.minimum.reduceat(P, off[:-1])[many], np.maximum.reduceat(P, off[:-1])[many]
+        mc = cc[many]
+        o = np.argsort(mc, kind="stable")
+        k = np.bincount(mc, minlength=C)
+        table = np.full((C, int(k.max())), -1, dtype=np.intp)
+        table[mc[o], np.arange(len(o)) - _ptr(k)[:-1][mc[o]]] = o
+        iu, ju = np.triu_indices(table.shape[1], 1)
+        i, j = table[:, iu].ravel(), table[:, ju].ravel()
+        i, j = i[j >= 0], j[j >= 0]
+        meet = ((lo[i] <= hi[j]) & (lo[j] <= hi[i])).all(axis=1)
+        ok[mc[i[meet]]] = False
+    turn[cand] = np.where(ok[cc], tc, 0)
     centroid[cand] = cen
     return turn, centroid
 
