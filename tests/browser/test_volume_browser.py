@@ -93,6 +93,8 @@ def test_volume_mip_sections_in_the_page_agree_with_the_static_render(jupyter_se
     jp = JupyterPage(page, jupyter_server, "volume.ipynb").open()
     jp.run_all(timeout=300)
     sel = _canvas(jp)
+    page.locator(sel).scroll_into_view_if_needed()  # in view before the first ray-cast picture
+    assert jp.wait_for(lambda: (st := jp.canvas_stats(sel)) and st["count"] > 50, timeout=60), _page_state(jp)
     page.mouse.move(5, 300)  # off the canvas: nothing moves the camera
     results = {}
     for rendering in ("mip", "volume", "sections"):
