@@ -33,19 +33,10 @@ from rot4d_widget.view.widget import Rot4DWidget
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from recording_comm import RecordingComm, install  # noqa: E402  (serialises like ipykernel)
+from widget_update import drawn_msg, key_msg  # noqa: E402  (the same event and ack dicts)
 
 KEYS = [("4", "Digit4"), ("8", "Digit8"), ("c", "KeyC"), ("z", "KeyZ")]
 WARMUP = 10
-
-
-def key_msg(kind, key, code, t):
-    event = {"type": kind, "event": kind, "key": key, "code": code, "shiftKey": False, "altKey": False,
-             "ctrlKey": False, "metaKey": False, "repeat": False, "timeStamp": t, "location": 0, "target": {}}
-    return {"content": {"data": {"method": "custom", "content": event}}, "buffers": []}
-
-
-def drawn_msg(seq):
-    return {"content": {"data": {"method": "custom", "content": {"event": "drawn", "seq": seq}}}, "buffers": []}
 
 
 def ball_field(n: int = 64) -> Field4D:

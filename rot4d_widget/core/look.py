@@ -225,6 +225,14 @@ RENDERINGS = ("surface", "volume", "mip", "sections")
 DEFAULT_SECTIONS = (0.5, 0.5, 0.5)
 
 
+def check_projection(value, name: str = "projection") -> bool:
+    """``value`` as a bool when it is True or False (a numpy bool too), else a TypeError naming
+    what is allowed: the ``projection`` view setting (the widget's trait and recordings alike)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"Expected `{name}` to be True or False, got {value!r}")
+    return bool(value)
+
+
 def check_rendering(rendering, name: str = "rendering") -> str:
     """``rendering`` when it is one of `RENDERINGS`, else a ValueError (TypeError for a
     non-string) naming them.

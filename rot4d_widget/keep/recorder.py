@@ -150,20 +150,13 @@ class ViewSetting(_NamedValue):
     _KEY = "view"
 
 
-def _check_flag(value, name):
-    """True or False (a numpy bool too), as a bool; else a TypeError naming what is allowed."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"Expected `{name}` to be True or False, got {value!r}")
-    return bool(value)
-
-
 def check_view_setting(name, value):
     """``value`` as a `ViewSetting` holds it (JSON: a tuple as a list), checked by `look`'s checks:
     a ValueError (or a TypeError for a value of the wrong type) naming what is allowed."""
     if name not in VIEW_SETTINGS:
         raise ValueError(f"Expected a view setting among {', '.join(map(repr, VIEW_SETTINGS))}, got {name!r}")
     check = {"rendering": look.check_rendering, "cmap": look.check_cmap, "clim": look.check_clim,
-             "sections": look.check_sections, "projection": _check_flag}[name]
+             "sections": look.check_sections, "projection": look.check_projection}[name]
     value = check(value, name)
     return list(value) if isinstance(value, tuple) else value
 

@@ -71,6 +71,7 @@ from .protocol import (
     PolytopeSource,
     SliceData,
     SourceAction,
+    _fill_flags,
     apply_setting,
     as_source,
     census_text,
@@ -530,11 +531,8 @@ class StackSource:
         for k, piece in enumerate(pieces):
             p = np.asarray(piece.points, dtype=np.float64).reshape(-1, 3)
             pts.append(p * scales[k] + centres[k] if n > 1 else p)
-            flags = getattr(piece, "corner_only", None)  # fill corners: no ball (a `Slice`: its last n_fill)
-            if flags is None:
-                n_fill = int(getattr(piece, "n_fill", 0) or 0)
-                flags = np.arange(len(p)) >= len(p) - n_fill if n_fill else np.zeros(len(p), dtype=bool)
-            corners.append(np.asarray(flags, dtype=bool))
+            flags = getattr(piece, "corner_only", None)  # fill corners: no ball
+            corners.append(np.zeros(len(p), dtype=bool) if flags is None else np.asarray(flags, dtype=bool))
             segs.append(np.asarray(piece.segments, dtype=np.intp).reshape(-1, 2) + p_off[-1])
             t = np.asarray(piece.triangles, dtype=np.intp).reshape(-1, 3)
             tris.append(t + p_off[-1])
@@ -618,7 +616,7 @@ class _PolytopePiece:
     volume = property(lambda self: float(self.slice.volume))
     readout = property(lambda self: (("slice", census_text(self.slice)),))
     show_points = True
-    n_fill = property(lambda self: int(getattr(self.slice, "n_fill", 0)))  # fill corners: the last n_fill points
+    corner_only = property(lambda self: _fill_flags(self.slice))  # as `PolytopeSource.slice` flags them
     data = property(lambda self: self.slice)
 
 

@@ -47,7 +47,7 @@ from .traits import Checked
 
 __all__ = ["EYE_DISTANCE", "BELOW_RGB", "ON_RGB", "ABOVE_RGB", "skeleton", "tesseract", "hyperplane_offsets",
            "perspective", "crossings", "w_colours", "projection_arrays", "pack_rows", "crossing_capacity",
-           "ProjectionView", "ProjectionFlag", "check_projection"]
+           "ProjectionView", "ProjectionFlag"]
 
 #: The eye sits at w = EYE_DISTANCE x the source's size on the w axis.
 EYE_DISTANCE = 3.0
@@ -64,20 +64,13 @@ KEY_EVENTS = ("keydown", "keyup", "mouseleave")
 CROSSING_RGB = "#e07b00"
 
 
-def check_projection(value) -> bool:
-    """``value`` as a bool: True or False (a numpy bool too), else a TypeError naming what is allowed."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"Expected `projection` to be True or False, got {value!r}")
-    return bool(value)
-
-
 class ProjectionFlag(Checked):
-    """The ``projection`` trait: True or False (`check_projection`)."""
+    """The ``projection`` trait: True or False (`rot4d_widget.core.look.check_projection`)."""
 
     info_text = "True or False"
 
     def check(self, name, value):
-        return check_projection(value)
+        return look.check_projection(value)
 
 
 def tesseract(half_widths) -> tuple:

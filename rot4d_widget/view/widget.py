@@ -66,7 +66,7 @@ from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keypad import KeyPad, close_quietly
 from .keys import KeyPath, help_groups, source_actions
 from .painter import READOUT_PERIOD, Painter, checked_slice, title
-from .projection import ProjectionFlag, ProjectionView, check_projection
+from .projection import ProjectionFlag, ProjectionView
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .renderings import Renderings
 from .screenshots import Screenshots
@@ -214,7 +214,7 @@ class Rot4DWidget(widgets.HBox):
             raise TypeError(f"Expected `_clock` to be a callable returning seconds, got {type(_clock).__name__}")
         color_by, cmap, clim = t.check_color_by(color_by), look.check_cmap(cmap), look.check_clim(clim)
         rendering, sections, projection = (_check_rendering(src, rendering), look.check_sections(sections),
-                                           check_projection(projection))
+                                           look.check_projection(projection))
         scale = look.REFERENCE_RADIUS / float(src.size)
         coarse_ok = takes_coarse(src)
         if ball_radius is None:
