@@ -55,6 +55,7 @@ import warnings
 import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
+from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.mesh import Polytope
 from rot4d_widget.geometry.slicing import slice_polytope
 
@@ -130,15 +131,6 @@ def flatness(v: np.ndarray, faces: list, cells: list) -> float:
         n = np.linalg.svd(c)[2][3]
         worst = max(worst, float(np.abs(c @ n).max()))
     return worst
-
-
-def rotation(seed: int) -> np.ndarray:
-    """A fixed random rotation (det +1) of R^4."""
-    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
 
 
 def crossings(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: float) -> np.ndarray:
@@ -403,7 +395,7 @@ def main(argv=None) -> int:
     if not files:
         print("no .off files selected", file=sys.stderr)
         return 2
-    m = rotation(args.seed)
+    m = random_rotation(args.seed)
     rows = []
     if not args.quiet:
         print(HEADER, flush=True)

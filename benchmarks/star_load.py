@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from rot4d_widget import Polytope, polytope
+from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.slicing import slice_polytope
 from rot4d_widget.geometry.star_regular import SPECS, star_arrays
 
@@ -37,14 +38,7 @@ THREE = ["great 120-cell", "icosahedral 120-cell", "small stellated 120-cell"]
 
 def rotations(steps: int, seed: int = 0) -> list:
     rng = np.random.default_rng(seed)
-    out = []
-    for _ in range(steps):
-        q, r = np.linalg.qr(rng.normal(size=(4, 4)))
-        q = q * np.sign(np.diag(r))
-        if np.linalg.det(q) < 0:
-            q[:, 0] = -q[:, 0]
-        out.append(q)
-    return out
+    return [random_rotation(rng) for _ in range(steps)]
 
 
 def arrays(name: str):

@@ -31,11 +31,12 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
+from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.mesh import Polytope
 from rot4d_widget.geometry.slicing import slice_polytope
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
-from off_library import check_slice, edges_of, flatness, levels, load, read_file, rotation  # noqa: E402
+from off_library import check_slice, edges_of, flatness, levels, load, read_file  # noqa: E402
 
 DATA = pathlib.Path(__file__).resolve().parent / "data" / "off_library"
 
@@ -96,7 +97,7 @@ def test_loads_and_slices_right(path):
     e = edges_of(faces)
     assert len(e) == len(p.edges)
     flat = flatness(v, faces, cells) if p.convex else 0.0
-    m = rotation(0)
+    m = random_rotation(0)
     problems = []
     for c0 in levels(p, m, 3):
         s = slice_polytope(p, m, c0)
@@ -122,7 +123,7 @@ def test_sections_are_wound_as_the_boundary_induces(path):
         pytest.skip("star faces: the even-odd sections close up as a set, not as an oriented cycle")
     v, faces, _ = read_file(path)
     e = edges_of(faces)
-    m = rotation(0)
+    m = random_rotation(0)
     problems = []
     for c0 in levels(p, m, 3):
         problems += [x for x in check_slice(p, slice_polytope(p, m, c0), v, e, m, c0) if "not wound" in x]
@@ -157,7 +158,7 @@ def four_volume(p: Polytope) -> float:
 def test_cavalieri_for_non_convex_ones(stem):
     p = Polytope.from_off(DATA / "pardesco" / f"{stem}.off")
     assert not p.convex
-    m = rotation(1)
+    m = random_rotation(1)
     w = p.vertices @ m.T[:, 3]
     c0 = np.linspace(w.min(), w.max(), 801)
     vols = np.array([s.volume for s in slice_polytope(p, m, c0)])

@@ -30,6 +30,7 @@ from scipy.spatial import cKDTree
 
 import rot4d_widget
 from rot4d_widget import polytope
+from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry import star_regular
 from rot4d_widget.geometry.slicing import slice_polytope
 from rot4d_widget.geometry.star_regular import STAR_FAMILY, star_arrays
@@ -295,14 +296,6 @@ def test_a_bad_name_still_says_what_is_allowed():
 # -- as Polytope objects (star faces and non-convex cells accepted by the mesh checks) ---------------
 
 
-def _rotation(seed: int) -> np.ndarray:
-    q, r = np.linalg.qr(np.random.default_rng(seed).normal(size=(4, 4)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    return q
-
-
 @pytest.mark.parametrize("name", NAMES)
 def test_a_validated_polytope_by_every_name(name):
     sym, counts, _, _ = PUBLISHED[name]
@@ -319,7 +312,7 @@ def test_a_validated_polytope_by_every_name(name):
 def test_the_slice_through_the_centre_is_at_the_edges_crossings(name):
     p = polytope(name)
     for seed in (1, 2):
-        m = _rotation(seed)
+        m = random_rotation(seed)
         s = slice_polytope(p, m, 0.0)
         x = p.vertices @ m.T  # computed here from the vertices and edges alone
         w = x[:, 3]
