@@ -22,7 +22,7 @@ from rot4d_widget import PolytopeSource, SourceAction
 from rot4d_widget.sources.protocol import as_source, census_text
 from rot4d_widget.view.widget import Rot4DWidget
 
-from widget_time import service
+from widget_time import sent, service
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
@@ -117,7 +117,7 @@ def test_the_readme_source_runs_in_the_widget_and_keys_change_the_buffers():
         assert np.allclose(shown, torus.points[near, :3] * scale, atol=1e-6)  # float32
         assert f"{near.sum()}" in w.readout.value
         w.press("4")
-        service(w, w._pump.clock() + 1.0)  # no view: the timeout sends the latest
+        sent(w)  # no view: the timeout sends the latest (the ticker thread may be sending it)
         m = w.state.matrix
         q = torus.points @ m.T
         near = np.abs(q[:, 3]) < torus.thickness
