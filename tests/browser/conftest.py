@@ -82,7 +82,8 @@ def page(browser_context):
     pg.console_messages = []
     pg.page_errors = []
     pg.on("console", lambda m: pg.console_messages.append((m.type, m.text)))
-    pg.on("pageerror", lambda e: pg.page_errors.append(str(e)))
+    # with the first lines of its stack: which plugin or widget threw is what a failure needs to say
+    pg.on("pageerror", lambda e: pg.page_errors.append(f"{e}\n{(getattr(e, 'stack', None) or '')[:600]}"))
     yield pg
 
 
