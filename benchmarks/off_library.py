@@ -19,7 +19,9 @@ by path):
   - every slice point is finite (it lies in the hyperplane by construction: it is given in the
     hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
     failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
-    polytope with reflex ridges, not detected as self-intersecting, can wind round negatively);
+    polytope with reflex ridges, not detected as self-intersecting, can wind round negatively), or,
+    for a polytope with no inside (``Polytope.volume_defined`` False: hemi cells or a boundary that
+    is not orientable), None and nothing else (the table's ``novol`` column says why);
   - the slice's polygons close up: every edge of their cycles is in an even number of them (a
     non-convex section's fill corners, ``Slice.n_fill``, are not points: only checked to lie in
     the points' bounding box); whether each edge also runs one way in one polygon and the other
@@ -203,8 +205,11 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     if d2.max() > tol:
         problems.append(f"c0={c0:.4g}: {int(np.sum(d2 > tol))} of {len(pts)} slice points are no edge crossing "
                         f"(worst {d2.max() / scale:.2g} x R)")
-    if not np.isfinite(s.volume):
-        problems.append(f"c0={c0:.4g}: volume {s.volume}")
+    if p.volume_defined:
+        if s.volume is None or not np.isfinite(s.volume):
+            problems.append(f"c0={c0:.4g}: volume {s.volume}")
+    elif s.volume is not None:  # a hemi or non-orientable polytope has no inside: no volume, never a number
+        problems.append(f"c0={c0:.4g}: volume {s.volume!r} where the polytope has none ({p.why_no_volume})")
     why = unclosed(s)
     if why and (winding or why[0] != "winding"):
         problems.append(f"c0={c0:.4g}: the polygons do not close up: {why[1]}")
@@ -277,7 +282,7 @@ def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str
             return row
         row.update(loaded=True, load_ms=(time.perf_counter() - t0) * 1e3, tolerance=tol, warnings=nwarn)
         row.update(zip("VEFC", p.counts))
-        row.update(convex=bool(p.convex), self_intersecting=bool(p.self_intersecting))
+        row.update(convex=bool(p.convex), self_intersecting=bool(p.self_intersecting), no_volume=p.why_no_volume)
         try:
             v, faces, cells = read_file(path)
             e = edges_of(faces)
@@ -295,7 +300,7 @@ def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str
                 found = check_slice(p, s, v, e, m, c0, flat=flat)
                 problems += [x for x in found if "not wound" not in x]
                 wound += [x for x in found if "not wound" in x]
-                if s.volume < 0:
+                if s.volume is not None and s.volume < 0:
                     negative.append(c0)
             row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative,
                        wound=wound)
@@ -334,6 +339,8 @@ def row_text(r: dict) -> str:
         res += f" (sections not wound as the boundary at {len(r['wound'])} of the levels)"
     if r["negative"]:
         res += f" (negative volume at c0 = {', '.join(f'{c:.3g}' for c in r['negative'])})"
+    if r.get("no_volume"):
+        res += f" (no volume: {r['no_volume']})"
     sl = f"{r['slice_ms']:8.2f}" if r["slice_ms"] is not None else f"{'-':>8}"
     return (f"{r['file'][-40:]:40} {r['V']:6d} {r['E']:6d} {r['F']:6d} {r['C']:5d} {str(r['convex']):>6} "
             f"{str(r['self_intersecting']):>6} {r['tolerance']:>12} {r['load_ms']:8.0f} {sl}  {res}")
@@ -357,6 +364,11 @@ def summary(rows: list[dict]) -> str:
            f"{sum(not r['convex'] and not r['self_intersecting'] for r in loaded)}; "
            f"{sum(r['warnings'] > 0 for r in loaded)} read with a warning (edge count); "
            f"{sum(bool(r['negative']) for r in loaded)} with a negative (winding-weighted) slice volume somewhere"]
+    novol = collections.Counter(r["no_volume"] for r in loaded if r.get("no_volume"))
+    for why, k in sorted(novol.items()):
+        names = [r["file"] for r in loaded if r.get("no_volume") == why]
+        out.append(f"  loaded with no volume ({why}; slice volume None): {k}  ({', '.join(names[:8])}"
+                   f"{', ...' if k > 8 else ''})")
     for cat, k in collections.Counter(r["category"] for r in refused).most_common():
         names = [r["file"] for r in refused if r["category"] == cat]
         out.append(f"  refused, {cat}: {k}  ({', '.join(names[:8])}{', ...' if k > 8 else ''})")
@@ -371,7 +383,8 @@ def summary(rows: list[dict]) -> str:
     wound = [r["file"] for r in loaded if r["wound"]]
     if wound:
         out.append(f"  sections not wound as the boundary's orientation induces (polygons' edges shared but running "
-                   f"the same way; not counted as failed: even-odd sections of star faces close up only as a set): "
+                   f"the same way; not counted as failed: even-odd sections of star faces close up only as a set, "
+                   f"and a boundary with no orientation, hemi or not orientable, induces none): "
                    f"{len(wound)}  ({', '.join(wound[:8])}{', ...' if len(wound) > 8 else ''})")
     if loaded:
         out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "

@@ -13,6 +13,7 @@ whose checks these are; that script runs a whole library):
   edges' crossings of the hyperplane (and nothing else), finite; its polygons' edges are shared
   (each in two polygons), and, where the faces are convex, wound against each other as the
   boundary's orientation induces;
+* hemi and non-orientable (17-tho, 60-ihi): the volume is None, the readout says why;
 * convex: the slice's volume is its points' convex hull volume (to 1e-6, and to what the file's
   rounded coordinates allow: 4 x the slice's area x how far its faces and cells are from flat);
 * Cavalieri, for four non-convex ones (firp, firt and frico have negative slice volumes at some
@@ -34,6 +35,7 @@ from scipy.spatial import ConvexHull
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.mesh import Polytope
 from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.sources.protocol import PolytopeSource
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
 from off_library import check_slice, edges_of, flatness, levels, load, read_file  # noqa: E402
@@ -53,12 +55,13 @@ def name(f) -> str:
     return f"{f.parent.name}/{f.name}"
 
 
-#: files not loadable (a temporary state while issue 22's mesh work lands), with why
-PENDING: dict[str, str] = {
-    "pardesco/17-tho.off": "refused: not orientable (a hemi polychoron)",
-    "pardesco/60-ihi.off": "refused: hemi cells (faces through a cell's centre, in the plane of other corners of "
-                           "the cell)",
-}
+#: files not loadable (a temporary state while mesh work lands), with why: none now
+PENDING: dict[str, str] = {}
+
+#: the files with no inside (hemi cells, or a boundary that is not orientable): they load and
+#: slice, their slices' volume is None, and the readout says why
+NO_VOLUME = {"pardesco/17-tho.off": "not orientable",  # convex cells (8 tetrahedra, 4 octahedra), one-sided
+             "pardesco/60-ihi.off": "not orientable"}  # 24 hemi cells: tetrahemihexahedra, one-sided
 
 
 def _params(pending, files=FILES):
@@ -82,7 +85,7 @@ def test_the_libraries_are_here():
         "pardesco": 35, "polytopeviewer": 11}
     for d in ("pardesco", "polytopeviewer"):
         assert (DATA / d / "LICENSE").read_text().startswith("MIT License")
-    assert set(PENDING) <= {name(f) for f in FILES}
+    assert set(PENDING) | set(NO_VOLUME) <= {name(f) for f in FILES}
 
 
 @pytest.mark.parametrize("path", list(_params(PENDING)))
@@ -121,6 +124,8 @@ def test_sections_are_wound_as_the_boundary_induces(path):
     p, _, _ = load(path)
     if star_faced(p):
         pytest.skip("star faces: the even-odd sections close up as a set, not as an oriented cycle")
+    if not p.volume_defined:
+        pytest.skip(f"{p.why_no_volume}: no orientation of the boundary to induce")
     v, faces, _ = read_file(path)
     e = edges_of(faces)
     m = random_rotation(0)
@@ -128,6 +133,24 @@ def test_sections_are_wound_as_the_boundary_induces(path):
     for c0 in levels(p, m, 3):
         problems += [x for x in check_slice(p, slice_polytope(p, m, c0), v, e, m, c0) if "not wound" in x]
     assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("path", [pytest.param(DATA / f, id=f[:-4]) for f in NO_VOLUME])
+def test_hemi_and_non_orientable_ones_have_no_volume_and_say_why(path):
+    """17-tho (tetrahedra and octahedra, a one-sided boundary) and 60-ihi (one-sided hemi cells) load, are not
+    convex, and every slice's volume is None -- never a number, never a hull's -- with the readout
+    saying why; the checks of `test_loads_and_slices_right` (points, closed sections) hold too."""
+    p, tolerance, _ = load(path)
+    why = NO_VOLUME[name(path)]
+    assert tolerance == "default"
+    assert p.volume_defined is False and p.why_no_volume == why
+    assert p.convex is False and p.self_intersecting is True
+    m = random_rotation(0)
+    for c0 in levels(p, m, 3):
+        s = slice_polytope(p, m, c0)
+        assert s.volume is None and s.dim == 3
+        data = PolytopeSource(p).slice(m, c0)
+        assert data.volume is None and ("volume", f"none ({why})") in data.readout
 
 
 CONVEX = {"1-pen", "2-tes", "3-hex", "4-ico", "5-hi", "6-ex", "18-tip", "19-tat", "20-thex", "21-tico", "39-rap",

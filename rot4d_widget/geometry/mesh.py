@@ -142,12 +142,14 @@ class Polytope:
       {8/3}; a figure eight is refused);
     * every face is in exactly two cells (the boundary is closed), every vertex in a face;
     * every cell has >= 4 distinct faces, lies in a hyperplane, spans 3-D, is closed
-      (each of its edges in exactly two of its faces) and two-sided; convex or not (a star
-      polyhedron too), but a convex cell strictly so (only a face's own corners on its plane);
-    * the boundary is consistently orientable.  The outward normals then come from that
-      orientation, not from the origin: each boundary component is oriented so that it
-      encloses positive 4-volume, and a component inside another (a cavity, found by
-      casting a ray) the other way.
+      (each of its edges in exactly two of its faces); convex or not (a star polyhedron, a
+      hemi-polyhedron too), but a convex cell strictly so (only a face's own corners on its plane);
+    * where the boundary is orientable and no cell is a hemi-polyhedron, the outward normals
+      come from that orientation, not from the origin: each boundary component is oriented so
+      that it encloses positive 4-volume, and a component inside another (a cavity, found by
+      casting a ray) the other way.  Otherwise (a hemi or non-orientable polychoron, issue 22) the
+      polytope loads with `volume_defined` False, its normals a documented choice
+      (`rot4d_widget.geometry.meshcheck.mesh_geometry`), and its slices have no volume.
 
     Scale: the largest absolute coordinate must lie in `COORDINATE_RANGE` (1e-150 to 1e150; else
     a ValueError naming the range).  Within it any scale works alike: the vertices are divided by
@@ -183,9 +185,12 @@ class Polytope:
         volume is then the volume weighted by the winding number (the divergence theorem over
         its outward faces), each region counted as often as the boundary winds round it
     star : None, or `rot4d_widget.geometry.meshcheck.StarData` when some face or cell is not
-        convex (its slices then come from `rot4d_widget.geometry.starslice`: even-odd chords and
-        fill, winding-weighted volume); such a polytope is not convex, and self-intersecting when
-        a face is a star or a cell's faces wind round its centre more than once
+        convex, or the volume is not defined (its slices then come from
+        `rot4d_widget.geometry.starslice`: even-odd chords and fill, winding-weighted volume or
+        None); such a polytope is not convex, and self-intersecting when a face is a star, a
+        cell's faces wind round its centre more than once, or it has no inside
+    volume_defined, why_no_volume : see the properties (False / the reason for a hemi or
+        non-orientable polychoron, whose slices' volume is None)
     cell_normals : (C, 4) float64 outward unit normals; ``cell_offsets`` (C,)
         so that cell c lies in ``vertices @ cell_normals[c] == cell_offsets[c]``
 
@@ -341,11 +346,14 @@ class Polytope:
         self.cell_normals = _sealed(normals)
         self.cell_offsets = _sealed(offsets * self._unit)
         self._star = star
-        if star is not None:  # a star face or a non-convex cell: not convex, self-intersecting if found so
-            for name in ("face_convex", "cell_convex", "face_star", "cell_star", "face_basis", "pair_rho"):
+        if star is not None:  # a star face, a non-convex cell or no inside: not convex, self-intersecting
+            for name in ("face_convex", "cell_convex", "face_star", "cell_star", "face_basis", "pair_rho",
+                         "hemi_cells"):
                 _sealed(getattr(star, name))
             self.convex = False
-            self.self_intersecting = bool(star.face_star.any() or star.cell_star.any())
+            # a hemi cell's faces pass through each other, and a non-orientable closed hypersurface
+            # cannot be embedded in R^4: both intersect themselves
+            self.self_intersecting = bool(star.face_star.any() or star.cell_star.any() or not star.volume_defined)
             return
         c1, c2 = self.face_cells[:, 0], self.face_cells[:, 1]
         locally = bool(ncomp == 1 and np.all(np.einsum("fd,fd->f", normals[c1], centres[c2]) <= offsets[c1] + tol)
@@ -409,6 +417,21 @@ class Polytope:
         polygon or some cell not a convex polyhedron (the slicer then takes its general path:
         `rot4d_widget.geometry.starslice`), else None."""
         return self._star
+
+    @property
+    def volume_defined(self) -> bool:
+        """False for a polytope with no inside to measure: its boundary is not orientable, or a cell is
+        a hemi-polyhedron (`why_no_volume`).  It still loads and slices (points, even-odd segments,
+        each cell's section drawn and filled even-odd, as for a star polychoron), but every `Slice`
+        of it has ``volume`` None."""
+        return self._star is None or self._star.volume_defined
+
+    @property
+    def why_no_volume(self) -> str | None:
+        """Why `volume_defined` is False: ``"not orientable"`` (the boundary is one-sided, or a cell
+        is: a tetrahemihexahedron), ``"hemi cells"`` (orientable, but a cell's faces enclose no
+        volume: an octahemioctahedron, faces through its centre); None when it is defined."""
+        return None if self._star is None else self._star.why_no_volume
 
     @property
     def unit(self) -> float:

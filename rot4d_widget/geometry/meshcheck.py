@@ -4,7 +4,8 @@
 `duplicate_in_rows` finds a repeated index; `mesh_geometry` checks the faces' and cells' geometry
 (planar strictly convex faces, flat 3-D cells, closed and convex cells when asked) and derives
 the outward cell normals from the boundary's orientation (a cavity, found by casting a ray, the
-other way).  Every failure is a `MeshError` naming the first offending face, cell or vertex.
+other way); a hemi or non-orientable polychoron has none, and loads flagged so (`StarData`).
+Every failure is a `MeshError` naming the first offending face, cell or vertex.
 Lengths are in the scale of the polytope's `Polytope.unit_vertices`; the tolerance is
 `rot4d_widget.core.tolerances.MESH` times their largest extent.  Everything is vectorised.
 """
@@ -113,8 +114,18 @@ def loosen_hint(off, extent) -> str:
 
 def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     """Check an explicit mesh's geometry: (outward cell normals, offsets, cell centres, number of
-    boundary components, the tolerance used); lengths in the scale of ``p.unit_vertices``.
-    ``tolerance``: relative to the vertices' largest extent (None: `rot4d_widget.core.tolerances.MESH`)."""
+    boundary components, the tolerance used, `StarData` or None); lengths in the scale of
+    ``p.unit_vertices``.  ``tolerance``: relative to the vertices' largest extent (None:
+    `rot4d_widget.core.tolerances.MESH`).
+
+    A polytope with no inside -- a hemi cell (one-sided, or its faces' oriented areas cancel) or a
+    boundary that cannot be oriented (`StarData.volume_defined` False) -- is not refused: its cut is
+    still defined.  Its normals are then a choice: an orientable component keeps its orientation
+    (turned to positive divergence-theorem 4-volume where that is not 0), a cell of a component
+    that cannot be oriented points away from the vertices' centroid (the SVD's sign where its
+    hyperplane holds it), and a hemi cell's face normals are `_orient_cells`'; no cavity is looked
+    for.  The slicer's even-odd cut does not depend on them; only which way round a section's
+    cycles run does (and the volume, which is then None)."""
     v = p.unit_vertices
     V, F, C = len(v), len(p.incidence.face_ptr) - 1, len(p.incidence.cell_ptr) - 1
     extent = float(np.ptp(v, axis=0).max())
@@ -214,18 +225,17 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     for basis in (n[pc], face_e[pf, 0], face_e[pf, 1]):
         m -= np.einsum("id,id->i", m, basis)[:, None] * basis
     height = np.linalg.norm(m, axis=1)  # the cell's centroid from each face's plane, in the cell
-    # a cell is convex when its faces are and every vertex lies on the inner side of every face
-    cell_convex = ~np.logical_or.reduceat(~face_convex[pf], cptr[:-1])
-    if validate:
-        cell_convex &= _convex_cells(p, v, tol, pc, pf, m / np.maximum(height, tol_.TINY)[:, None], face_c)
-    bad = np.flatnonzero((height <= tol) & cell_convex[pc])
-    if len(bad):
-        raise MeshError(f"cell {int(pc[bad[0]])} is degenerate: its centre lies in the plane of its face "
-                        f"{int(pf[bad[0]])}", item=("cell", int(pc[bad[0]])))
+    # a cell is convex when its faces are and every vertex lies on the inner side of every face; a
+    # face whose plane holds the cell's vertex centre (a hemi-polyhedron's) makes it non-convex: a
+    # strictly convex 3-D cell has its centre strictly inside
+    cell_convex = ~np.logical_or.reduceat(~face_convex[pf] | (height <= tol), cptr[:-1])
     m /= np.maximum(height, tol_.TINY)[:, None]  # each face's outward normal within each of its cells
-    cell_star = np.zeros(C, dtype=bool)
+    if validate:
+        cell_convex &= _convex_cells(p, v, tol, pc, pf, m, face_c, cell_convex)
+    cell_star = hemi = one_sided = np.zeros(C, dtype=bool)
     if not cell_convex.all():  # outward normals from the faces' orientation, not from the centre
-        cell_star = _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_convex)
+        cell_star, hemi, one_sided = _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area,
+                                                   cell_convex)
     # orientation: the sign of det[n_c, m_cf, plane of f] relates the two cells of each face
     sigma = np.sign(np.linalg.det(np.stack([n[pc], m, face_e[pf, 0], face_e[pf, 1]], axis=1)))
     order = np.argsort(pf, kind="stable")
@@ -234,31 +244,35 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
     a = np.concatenate([c1, c1 + C])
     b = np.concatenate([np.where(same, c2, c2 + C), np.where(same, c2 + C, c2)])
     _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * C, 2 * C)), directed=False)
-    bad = np.flatnonzero(lab[:C] == lab[C:])
-    if len(bad):
-        raise MeshError(f"the boundary is not orientable: the cells around cell {int(bad[0])} cannot all be "
-                        f"given outward normals that agree across their shared faces", item=("cell", int(bad[0])))
+    twisted = lab[:C] == lab[C:]  # cells of a boundary component that cannot be oriented
+    orientable = not (twisted.any() or one_sided.any())
+    defined = orientable and not hemi.any()  # else no inside: no outward side, no volume (StarData)
     s = np.where(lab[:C] < lab[C:], 1.0, -1.0)
+    # where it cannot be oriented, each cell's normal points away from the vertices' centroid (the
+    # SVD's sign where its hyperplane holds the centroid): a choice, consistent only cell by cell
+    away = np.einsum("cd,cd->c", n, g - v.mean(axis=0))
+    s[twisted] = np.where(away[twisted] < -tol, -1.0, 1.0)
     ncomp, comp = connected_components(coo_matrix((np.ones(F), (c1, c2)), shape=(C, C)), directed=False)
     # each cell's 3-volume (winding-weighted for a star cell): the divergence theorem over its faces
     vol3 = np.bincount(pc, weights=face_area[pf] * np.einsum("id,id->i", face_c[pf] - g[pc], m), minlength=C) / 3.0
     offsets = np.einsum("cd,cd->c", n, g)
     vol4 = np.bincount(comp, weights=s * offsets * vol3, minlength=ncomp) / 4.0
-    small = np.flatnonzero(np.abs(vol4) <= tol * tol * tol * tol)
-    if len(small):
-        raise MeshError(f"the boundary component of cell {int(np.flatnonzero(comp == small[0])[0])} encloses "
-                        f"no 4-volume")
-    flip = vol4 < 0
-    if ncomp > 1:
+    small = np.abs(vol4) <= tol * tol * tol * tol
+    if defined and small.any():
+        raise MeshError(f"the boundary component of cell {int(np.flatnonzero(comp == np.argmax(small))[0])} "
+                        f"encloses no 4-volume")
+    flip = (vol4 < 0) & ~small
+    if defined and ncomp > 1:
         flip ^= _cavities(n * s[:, None], offsets * s, g, comp, ncomp, pc, pf, m, face_c)
+    flip &= ~np.bincount(comp, weights=twisted, minlength=ncomp).astype(bool)  # "away" is kept there
     s = np.where(flip[comp], -s, s)
     normals = np.ascontiguousarray(n * s[:, None])
     star = None
-    if not cell_convex.all():
+    if not (cell_convex.all() and defined):
         # the direction of each face's chord along w = c0 in each of its cells (slicer): -sign det[n, m, e0, e1]
         rho = -(s[pc] * sigma).astype(np.intp)
         star = StarData(face_convex=face_convex, cell_convex=cell_convex, face_star=face_star, cell_star=cell_star,
-                        face_basis=face_e, pair_rho=rho)
+                        face_basis=face_e, pair_rho=rho, hemi_cells=hemi, orientable=orientable)
     return normals, np.ascontiguousarray(offsets * s), g, ncomp, tol, star
 
 
@@ -275,6 +289,14 @@ class StarData:
     pair_rho (P,) : for each (cell, face) entry of ``incidence.cell_fidx``, +-1: the face's chord
         along a hyperplane runs along ``e1 * (e0 . w) - e0 * (e1 . w)`` (rho = +1) or against it,
         as the boundary of the cell's section seen from its outward normal
+    hemi_cells (C,) : the cell is a hemi-polyhedron: its faces are one-sided (no orientation of
+        them agrees across every edge) or enclose no volume (their oriented areas cancel, as some
+        pass through its centre): it has no inside, so neither has the polytope
+    orientable : the boundary can be oriented (no one-sided cell, and the cells' orientations agree
+        across every face).  When it cannot, or some cell is hemi, there is no volume to measure
+        (`volume_defined` False, `Polytope.volume_defined`): the normals and ``pair_rho`` are then
+        a choice (`mesh_geometry`), and the slices' volume is None; their cut is the same even-odd
+        one as a star's
     """
 
     face_convex: np.ndarray
@@ -283,6 +305,20 @@ class StarData:
     cell_star: np.ndarray
     face_basis: np.ndarray
     pair_rho: np.ndarray
+    hemi_cells: np.ndarray
+    orientable: bool = True
+
+    @property
+    def volume_defined(self) -> bool:
+        """The polytope has an inside to measure: its boundary is orientable and no cell is hemi."""
+        return self.orientable and not bool(self.hemi_cells.any())
+
+    @property
+    def why_no_volume(self) -> str | None:
+        """``"not orientable"``, ``"hemi cells"`` or None (the volume is defined)."""
+        if not self.orientable:
+            return "not orientable"
+        return "hemi cells" if self.hemi_cells.any() else None
 
 
 def _check_closed(p) -> None:
@@ -296,18 +332,21 @@ def _check_closed(p) -> None:
                         f"each edge of a cell must be in exactly two of its faces", item=("cell", c))
 
 
-def _convex_cells(p, v, tol, pc, pf, m, face_c) -> np.ndarray:
-    """(C,) bool: the cell is convex (every vertex on the inner side of each face's plane).
+def _convex_cells(p, v, tol, pc, pf, m, face_c, candidate=None) -> np.ndarray:
+    """(C,) bool: the cell is one of the ``candidate`` (C,) cells (None: all) and convex (every vertex on the
+    inner side of each face's plane).
 
     A convex cell must also be strictly convex: only a face's own corners on its plane (else a
     MeshError naming the cell: two coplanar faces).  A non-convex cell may have coplanar faces."""
     cptr, vptr, cvx = p.incidence.cell_ptr, p.incidence.cell_vptr, p.incidence.cell_vidx
     nf, nv = np.diff(cptr), np.diff(vptr)
     fsize = np.diff(p.incidence.face_ptr)
-    out_c = np.ones(len(nf), dtype=bool)
+    out_c = np.zeros(len(nf), dtype=bool)
     kinds, kind = np.unique(nf * (nv.max() + 1) + nv, return_inverse=True)
     for j in range(len(kinds)):
-        cells_j = np.flatnonzero(kind.reshape(-1) == j)
+        cells_j = np.flatnonzero((kind.reshape(-1) == j) & (True if candidate is None else candidate))
+        if not len(cells_j):
+            continue
         q, k = int(nf[cells_j[0]]), int(nv[cells_j[0]])
         step = max(1, 2_000_000 // (q * k))
         for lo in range(0, len(cells_j), step):
@@ -342,8 +381,13 @@ def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_co
     by its two faces, propagated as connected components), and each connected set of faces is turned
     so that it encloses positive (winding-weighted) volume; ``m`` of a face is then its plane's normal
     within the cell, signed by that orientation (for a convex cell it is the centroid's rule).
-    Returns (C,) bool: the cell winds round its vertex centre more than once (a star polyhedron).
-    MeshError for a one-sided cell (a hemi-polyhedron) or one enclosing no volume."""
+    A hemi-polyhedron has no such orientation: its faces are one-sided (no signs agree across every
+    edge: the tetrahemihexahedron) or two-sided but enclosing no volume (their oriented areas cancel:
+    the octahemioctahedron).  Its ``m`` are then signed as far as the faces' orientation goes, the
+    rest (and the sign of a cancelling set) +1 times ``nu`` (det[n, nu, e0, e1] > 0: from the face's
+    cycle): a choice, documented, that the slicer's even-odd cut does not depend on.
+    Returns three (C,) bool: the cell winds round its vertex centre more than once (a star
+    polyhedron); the cell is hemi (one-sided or enclosing no volume); the cell is one-sided."""
     inc = p.incidence
     C, E = len(cell_convex), len(p.edges)
     sel = np.flatnonzero(~cell_convex[pc])  # the (cell, face) entries of non-convex cells
@@ -364,23 +408,21 @@ def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_co
     a = np.concatenate([i, i + P])
     b = np.concatenate([np.where(same, j, j + P), np.where(same, j + P, j)])
     _, lab = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(2 * P, 2 * P)), directed=False)
-    bad = np.flatnonzero(lab[:P] == lab[P:])
-    if len(bad):
-        c = int(pc[sel[bad[0]]])
-        raise MeshError(f"cell {c} is not orientable: its faces cannot be given normals that agree across "
-                        f"their shared edges (a one-sided polyhedron such as a hemi-polyhedron)", item=("cell", c))
-    s0 = np.where(lab[:P] < lab[P:], 1.0, -1.0)
+    twisted = lab[:P] == lab[P:]  # the faces of a one-sided set (a hemi-polyhedron's)
+    one_sided = np.zeros(C, dtype=bool)
+    one_sided[pc[sel[twisted]]] = True
+    s0 = np.where(twisted | (lab[:P] < lab[P:]), 1.0, -1.0)
     comp = np.unique(np.minimum(lab[:P], lab[P:]), return_inverse=True)[1].reshape(-1)
     cs, fs = pc[sel], pf[sel]
     nu = _cross4(n[cs], face_e[fs, 0], face_e[fs, 1])
     nu /= -np.linalg.norm(nu, axis=1)[:, None]  # det[n, nu, e0, e1] > 0
     part = s0 * face_area[fs] * np.einsum("id,id->i", face_c[fs] - g[cs], nu) / 3.0
     vol = np.bincount(comp, weights=part)
-    small = np.flatnonzero(np.abs(vol) <= tol * tol * tol)
-    if len(small):
-        c = int(cs[np.flatnonzero(comp == small[0])[0]])
-        raise MeshError(f"cell {c} encloses no volume: its faces' oriented areas cancel", item=("cell", c))
-    s = s0 * np.sign(vol)[comp]
+    cancel = np.abs(vol) <= tol * tol * tol  # (a one-sided set's "volume" has no meaning: counted here too)
+    cancel[np.unique(comp[twisted])] = True
+    hemi = np.zeros(C, dtype=bool)
+    hemi[cs[cancel[comp]]] = True
+    s = s0 * np.where(cancel, 1.0, np.sign(vol))[comp]
     m[sel] = s[:, None] * nu
     # the winding number of each cell's faces about its vertex centre: solid angles of their fans
     fptr = inc.face_ptr
@@ -397,7 +439,7 @@ def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_co
     omega = 2 * np.arctan2(triple, den) * s[tri_row]
     # det[n, nu, e0, e1] > 0 and the fans wind as the cycle (positively in e0, e1): signs agree
     wind = np.bincount(cs[tri_row], weights=omega, minlength=C) / (4 * np.pi)
-    return np.abs(np.rint(wind)) >= 2
+    return np.abs(np.rint(wind)) >= 2, hemi, one_sided
 
 
 def _cavities(normals, offsets, g, comp, ncomp, pc, pf, m, face_c) -> np.ndarray:

@@ -107,8 +107,9 @@ class Slice:
     triangles : (k, 3) intp -- the polygons fanned into a closed surface, CCW
         seen from outside
     triangle_cells : (k,) intp -- the 4-D cell of each triangle
-    volume : float -- the 3-volume (0 unless the slice is solid; inf, or 0, when it is
-        beyond float64's range: coordinates above ~5e102 or below ~2e-103)
+    volume : float or None -- the 3-volume (0 unless the slice is solid; inf, or 0, when it is
+        beyond float64's range: coordinates above ~5e102 or below ~2e-103); None for every slice
+        of a polytope with no inside (`Polytope.volume_defined` False: hemi or non-orientable)
     dim : int -- 3 solid, 2/1/0 when H only touches a face/edge/vertex, -1 empty
     n_fill : int -- the last ``n_fill`` vertices are not points of the slice but extra corners of
         the triangles that fill a non-convex or self-intersecting section even-odd (0 unless
@@ -125,7 +126,7 @@ class Slice:
     cell_ids: np.ndarray
     triangles: np.ndarray
     triangle_cells: np.ndarray
-    volume: float
+    volume: float | None
     dim: int
     n_fill: int = 0
 
@@ -152,7 +153,8 @@ class Slice:
     def __repr__(self) -> str:
         return (
             f"Slice(dim={self.dim}, V={len(self.vertices)}, E={len(self.edges)}, "
-            f"F={len(self.cell_ids)}, census={self.face_census()}, volume={self.volume:.6g})"
+            f"F={len(self.cell_ids)}, census={self.face_census()}, "
+            f"volume={'none' if self.volume is None else format(self.volume, '.6g')})"
         )
 
 

@@ -42,6 +42,10 @@ replaced it:
 * H touching P: the dimension is 2 if a face lies in H, else 1 if an edge
   does, else 0 (a convex polytope touches in one face, edge or vertex).
 
+A polytope with no inside (`Polytope.volume_defined` False: a hemi or non-orientable
+polychoron) is cut like a star one (`rot4d_widget.geometry.starslice`: the edges' crossings, even-odd
+segments, each cell's section filled even-odd), and every slice's ``volume`` is None.
+
 The volume (divergence theorem over the outward triangles, about any point)
 and the per-cell polygons never relied on convexity: S may have several
 pieces and holes and tunnels.  Where H passes through a reflex vertex of P, or
@@ -84,6 +88,8 @@ but no crossing edge (a polytope in pieces), take the single-slice path.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -137,6 +143,8 @@ def slice_polytope(polytope, matrix, c0=0.0):
             levels = levels / t.unit
     if p.star is not None:  # star faces or non-convex cells: the general slicer, level by level
         out = tuple(slice_star(p, t, x, m, float(c)) for c in levels)
+        if not p.volume_defined:  # a hemi or non-orientable polychoron: no inside, no volume
+            out = tuple(dataclasses.replace(s, volume=None) for s in out)
         return out if many else out[0]
     if not many:
         return _slice_level(t, x, m, float(levels[0]), t.radius)

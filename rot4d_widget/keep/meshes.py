@@ -88,8 +88,8 @@ def _as_slice_data(obj):
     # The two class tests left in keep/: they name the slicers' bare results (geometry's `Slice`,
     # `slice_field`'s `FieldSlice`), not source kinds -- any source's own slice is used as it is.
     if isinstance(obj, Slice):
-        return SliceData.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells, volume=float(obj.volume),
-                               extra={"slice": obj})
+        return SliceData.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells,
+                               volume=None if obj.volume is None else float(obj.volume), extra={"slice": obj})
     if isinstance(obj, FieldSlice):
         return SliceData.build(obj.vertices, None, obj.triangles, None, volume=float(obj.volume))
     return obj

@@ -332,16 +332,30 @@ _POLYGON_NAMES = {
 
 
 def _winding_row(polytope) -> tuple:
-    """A readout row for a self-intersecting polytope (`Polytope.self_intersecting`): what its
-    volume means there."""
+    """Readout rows for a self-intersecting polytope (`Polytope.self_intersecting`): what its
+    volume means there; for one with no inside (`Polytope.volume_defined` False: hemi cells, or
+    not orientable) that it has none, and why (`no_volume_row`)."""
     if not getattr(polytope, "self_intersecting", False):
         return ()
+    if not getattr(polytope, "volume_defined", True):
+        return (("self-intersecting", "yes"),) + no_volume_row(polytope)
     return (("self-intersecting", "yes: the volume counts each region as often as the boundary winds round it"),)
 
 
+def no_volume_row(polytope) -> tuple:
+    """``(("volume", "none (not orientable)"),)`` or ``"none (hemi cells)"`` for a polytope whose
+    slices have no volume (`Polytope.volume_defined` False: `Slice.volume` is None), else ``()``."""
+    if getattr(polytope, "volume_defined", True):
+        return ()
+    return (("volume", f"none ({getattr(polytope, 'why_no_volume', None) or 'not defined'})"),)
+
+
 def _volume_or_none(s):
-    """A polytope slice's volume, or None where it left float64's range (inf beyond coordinates of
-    about 1e102, or a solid slice's volume underflowed below about 1e-102)."""
+    """A polytope slice's volume, or None where it has none (a hemi or non-orientable polytope's:
+    `Slice.volume` None) or left float64's range (inf beyond coordinates of about 1e102, or a solid
+    slice's volume underflowed below about 1e-102)."""
+    if s.volume is None:
+        return None
     v = float(s.volume)
     if not math.isfinite(v) or (s.dim == 3 and abs(v) < sys.float_info.min):
         return None

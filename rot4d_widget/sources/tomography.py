@@ -72,10 +72,12 @@ from .protocol import (
     SliceData,
     SourceAction,
     _fill_flags,
+    _winding_row,
     apply_setting,
     as_source,
     census_text,
     data_w_text,
+    no_volume_row,
     settings_of,
     takes_coarse,
     w_frame,
@@ -509,8 +511,8 @@ class StackSource:
     def _inner_slices(self, matrix, cuts, coarse):
         if self._polytope is not None:
             if len(cuts) == 1:  # today's single slice, bit for bit
-                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(cuts[0])), self._polytope.convex)]
-            return [_PolytopePiece(s, self._polytope.convex) for s in slice_polytope(self._polytope, matrix, cuts)]
+                return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(cuts[0])), self._polytope)]
+            return [_PolytopePiece(s, self._polytope) for s in slice_polytope(self._polytope, matrix, cuts)]
         if coarse:
             return [self.source.slice(matrix, float(w), coarse=True) for w in cuts]
         return [self.source.slice(matrix, float(w)) for w in cuts]
@@ -592,6 +594,8 @@ class StackSource:
                               f"(\u25b8 {data_w_text(self.source, cuts[hi], m)[2:]})"))
             if any(v is not None for v in volumes):
                 rows.append(("volumes", " ".join("\u2014" if v is None else f"{v:.3g}" for v in volumes)))
+        if polytope:  # a hemi or non-orientable polytope: its slices have no volume, and why
+            rows += no_volume_row(self._polytope)
         return tuple(rows)
 
     def __repr__(self) -> str:
@@ -602,19 +606,20 @@ class StackSource:
 class _PolytopePiece:
     """A polytope `Slice` seen as slice data (what `PolytopeSource.slice` would give)."""
 
-    __slots__ = ("slice", "convex")
+    __slots__ = ("slice", "convex", "rows")
 
-    def __init__(self, s, convex: bool = True):
+    def __init__(self, s, polytope):
         self.slice = s
-        self.convex = bool(convex)  # a convex polytope's slice is convex; a non-convex one's may not be
+        self.convex = bool(polytope.convex)  # a convex polytope's slice is convex; a non-convex one's may not be
+        self.rows = _winding_row(polytope)  # self-intersecting; no volume, and why (hemi, not orientable)
 
     points = property(lambda self: self.slice.vertices)
     segments = property(lambda self: self.slice.edges)
     triangles = property(lambda self: self.slice.triangles)
     groups = property(lambda self: self.slice.triangle_cells)
     normals = None
-    volume = property(lambda self: float(self.slice.volume))
-    readout = property(lambda self: (("slice", census_text(self.slice)),))
+    volume = property(lambda self: None if self.slice.volume is None else float(self.slice.volume))
+    readout = property(lambda self: (("slice", census_text(self.slice)),) + self.rows)
     show_points = True
     corner_only = property(lambda self: _fill_flags(self.slice))  # as `PolytopeSource.slice` flags them
     data = property(lambda self: self.slice)
