@@ -11,6 +11,7 @@ from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.keep.recording import ViewSetting
 from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.tomography import StackSource
 from rot4d_widget.view import projection as pj
 from rot4d_widget.view.widget import Rot4DWidget
 
@@ -143,25 +144,132 @@ def test_stack_marks_every_slice(widgets):
     assert _match(out["points"], np.concatenate(wanted), atol=1e-5)
 
 
-def test_both_views_update_in_one_key_press(widgets):
+def test_both_views_update_from_one_message(widgets, recording_comms):
+    """A key press sends ONE message for both views: the slice's rows and the projection's state
+    (the 4x4 matrix and the hyperplane's offset, `state_message` of the new state) in the
+    scene buffer's update; nothing goes to the projection's own widgets (the page projects).
+    The skeleton went once, with the first picture."""
+    log = recording_comms
     w = widgets("24-cell", projection=True)
-    before_slice = w.scene.update_id
-    before = w._projection.arrays["positions"].copy()
-    press(w, "4")
-    assert w.scene.update_id != before_slice
-    assert w._projection.shown_key[0] is w.state.matrix
-    rows = w._projection._buffer.array  # what the page draws: vertices + colours, then the balls
-    n = len(before)
-    assert not np.allclose(before, rows[:n, :3])
+    buf = w.scene._buffer
+    sk = buf._rot4d_skeleton
+    vertices, edges = pj.skeleton(w.source)
+    np.testing.assert_array_equal(np.frombuffer(sk["vertices"], "<f8").reshape(-1, 4), vertices)
+    np.testing.assert_array_equal(np.frombuffer(sk["edges"], "<u4").reshape(-1, 2), edges)
+    assert sk["distance"] == pytest.approx(3.0 * w.source.size) and sk["scale"] == w._scale
+    own = {x.model_id for x in w._projection._widgets}
+    for key in ("4", "l", "c"):  # a rotation in w, c0 up, a rotation in xy
+        log.clear()
+        seq = w.scene.update_id
+        press(w, key)
+        sent = [(cid, data) for cid, data, n, bufs in log if data.get("method") == "update"]
+        assert not [cid for cid, _ in sent if cid in own], "the projection's widgets get no message"
+        ((data,),) = [[d for cid, d in sent if cid == w.scene.buffer_model_id and "array" in d["state"]]]
+        assert data["state"]["_rot4d_seq"] == w.scene.update_id == seq + 1
+        assert data["state"]["_rot4d_project"] == pj.state_message(w.source, w.state.matrix, w.state.c0)
+        assert "_rot4d_skeleton" not in data["state"]
+        assert w._projection.shown_key[0] is w.state.matrix and w._projection.shown_key[1] == w.state.c0
     now = pj.projection_arrays(w.source, w.state.matrix, w.state.c0, w._scale)
-    np.testing.assert_allclose(rows[:n, :3], now["positions"])
-    np.testing.assert_allclose(rows[:n, 3:], now["rgb"])
-    balls = w._projection._point_index.array
-    shown = rows[balls][rows[balls][:, 2] < 1e5, :3]  # the slots in use; the rest hidden behind the camera
-    assert _match(shown, now["points"], atol=1e-6) and len(shown) == len(now["points"])
-    np.testing.assert_array_equal(w._projection._edge_index.array, now["index"])
-    press(w, "l")  # c0 moves: the balls follow in the same update
-    assert w._projection.shown_key[1] == w.state.c0
+    np.testing.assert_array_equal(w._projection.arrays["positions"], now["positions"])
+
+
+def test_turned_on_later_sends_skeleton_and_state_once(widgets, recording_comms):
+    w = widgets("5-cell")
+    press(w, "4")
+    assert w.scene._buffer._rot4d_project == {}  # off: the slice's messages carry nothing for it
+    recording_comms.clear()
+    w.projection = True
+    sent = [d for cid, d, n, b in recording_comms if cid == w.scene.buffer_model_id]
+    assert len(sent) == 1 and set(sent[0]["state"]) == {"_rot4d_project", "_rot4d_skeleton"}
+    assert sent[0]["state"]["_rot4d_project"] == pj.state_message(w.source, w.state.matrix, w.state.c0)
+    assert w.companion.projection_model_ids == [w._projection._lines.model_id, w._projection._points.model_id,
+                                                w._projection._scene.model_id]
+    assert w.companion.projection_class == w._projection.canvas_class
+
+
+# -- the page's projection (companion.js) under Node against projection_arrays ------------
+NODE_DRIVER = r"""
+import { pathToFileURL } from "node:url";
+import { readFileSync } from "node:fs";
+const m = await import(pathToFileURL(process.argv[2]).href);
+const cases = JSON.parse(readFileSync(0, "utf8"));
+const out = cases.map(({ skeleton, state }) => {
+  const sk = { ...skeleton, vertices: Buffer.from(skeleton.vertices, "base64"), edges: Buffer.from(skeleton.edges, "base64") };
+  const r = m.projectSkeleton(m.decodeSkeleton(sk), state);
+  return r && { positions: Array.from(r.positions), rgb: Array.from(r.rgb), index: Array.from(r.index),
+                points: Array.from(r.points) };
+});
+console.log(JSON.stringify(out));
+"""
+
+
+def _page_projection(tmp_path, cases):
+    """companion.js's ``projectSkeleton`` for ``(source, matrix, c0, scale)`` cases, run by Node."""
+    import base64
+    import shutil
+    import subprocess
+
+    from test_companion import JS, _apt_install_node
+
+    node = shutil.which("node") or shutil.which("nodejs") or _apt_install_node()
+    if node is None:
+        pytest.skip("Node.js is not installed: companion.js's projection not run (apt-get install nodejs)")
+    msgs = []
+    for src, m, c0, scale in cases:
+        sk = pj.skeleton_message(src, scale)
+        sk.update({k: base64.b64encode(bytes(sk[k])).decode() for k in ("vertices", "edges")})
+        msgs.append({"skeleton": sk, "state": json.loads(json.dumps(pj.state_message(src, m, c0)))})
+    driver = tmp_path / "projection.mjs"
+    driver.write_text(NODE_DRIVER)
+    proc = subprocess.run([node, str(driver), str(JS)], input=json.dumps(msgs), capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_page_projects_as_python_does(tmp_path):
+    """What the page draws (companion.js ``projectSkeleton`` on the messages the kernel sends)
+    equals `projection_arrays`: positions and colours to float32 rounding, the same edges, the
+    same crossings in the same order -- random rotations and levels, a level at a vertex (edges
+    touching it), a field's box with edges lying in the hyperplane, a stack's three hyperplanes."""
+    rng = np.random.default_rng(11)
+    cases = []
+    for name in ("5-cell", "24-cell", "120-cell"):
+        src = PolytopeSource(name)
+        for k in range(3):
+            m = random_rotation(rng)
+            w = np.asarray(src.polytope.vertices) @ m[3]
+            c0 = float(w[rng.integers(len(w))]) if k == 2 else float(rng.uniform(w.min(), w.max()))
+            cases.append((src, m, c0, float(rng.uniform(0.2, 2.0))))
+    f = small_field()
+    hw = float(np.asarray(f.half_widths)[3])
+    cases += [(f, np.eye(4), hw, 1.0), (f, np.eye(4), 0.0, 0.5), (f, random_rotation(rng), 0.1, 1.0)]
+    stack = StackSource(PolytopeSource("24-cell"), slices=3)
+    cases.append((stack, random_rotation(rng), 0.05, 0.8))
+    page = _page_projection(tmp_path, cases)
+    touched = flat = 0
+    for (src, m, c0, scale), got in zip(cases, page):
+        want = pj.projection_arrays(src, m, c0, scale)
+        np.testing.assert_allclose(np.reshape(got["positions"], (-1, 3)), want["positions"], rtol=2e-7, atol=1e-7)
+        np.testing.assert_allclose(np.reshape(got["rgb"], (-1, 3)), want["rgb"], rtol=2e-7, atol=1e-7)
+        np.testing.assert_array_equal(got["index"], want["index"])
+        pts = np.reshape(got["points"], (-1, 3))
+        assert pts.shape == want["points"].shape
+        np.testing.assert_allclose(pts, want["points"], rtol=1e-6, atol=1e-6)
+        touched += len(want["points"]) > len(np.unique(np.round(want["points"], 5), axis=0))
+        flat += src is f and c0 == hw
+    assert touched >= 1 and flat == 1  # the cases meant to hit a vertex and a flat edge did
+
+
+def test_page_projection_shows_nothing_without_a_skeleton(tmp_path):
+    class Bare:
+        size, n_groups = 1.0, 1
+
+        def slice(self, m, c0):  # pragma: no cover - never sliced here
+            raise AssertionError
+
+    assert pj.skeleton_message(Bare()) == {"n_vertices": 0, "n_edges": 0}
+    assert pj.projection_arrays(Bare(), np.eye(4), 0.0) is None
 
 
 def test_projection_trait_recorded_saved_loaded(widgets, tmp_path):

@@ -563,3 +563,44 @@ def test_single_rgb_paints_every_face_and_is_an_update(scenes, log):
     assert len(buffer_messages(sc, log)) == 1
     assert sc.show(s) is True  # back to group colours
     assert len(np.unique(sc.rows[:nt, 19])) > 1
+
+
+# ----------------------------------------------------------------- the projection's fields
+def test_projection_travels_in_the_slice_message_and_only_when_it_changed(scenes, log):
+    """`show(projection=...)` puts the projection's state (and, when new, its skeleton) into the
+    buffer's own update message; an unchanged state is not re-sent, a changed one alone is an
+    update (with its id), `project` sends it without one, `turn` carries it too."""
+    from rot4d_widget.view import projection as pj
+
+    sc, src = scenes("24-cell")
+    rng = np.random.default_rng(8)
+    m = random_rotation(rng)
+    first = {"state": pj.state_message(src, m, 0.1), "skeleton": pj.skeleton_message(src, sc.scale)}
+    log.clear()
+    assert sc.show(src.slice(m, 0.1), projection=first)
+    ((data, n, bufs),) = buffer_messages(sc, log)
+    assert len(log) == 1 and {"array", "_rot4d_seq", "_rot4d_project", "_rot4d_skeleton"} <= set(data["state"])
+    assert data["state"]["_rot4d_project"] == first["state"]
+    log.clear()  # the same state again: nothing
+    assert sc.show(src.slice(m, 0.1), projection={"state": pj.state_message(src, m, 0.1)}) is False and log == []
+    # the slice unchanged (c0 beyond the object: empty) but the projection's colours move with c0
+    far = 2 * src.size
+    assert sc.show(src.slice(m, far), projection={"state": pj.state_message(src, m, far)})
+    log.clear()
+    seq = sc.update_id
+    assert sc.show(src.slice(m, far + 1), projection={"state": pj.state_message(src, m, far + 1)}) is True
+    ((data, n, bufs),) = buffer_messages(sc, log)
+    assert data["state"]["_rot4d_project"]["offsets"] == [far + 1] and "_rot4d_skeleton" not in data["state"]
+    assert sc.update_id == seq + 1
+    log.clear()
+    assert sc.project({"state": pj.state_message(src, m, 0.3)}) is True and sc.update_id == seq + 1
+    ((data, n, bufs),) = buffer_messages(sc, log)
+    assert set(data["state"]) == {"_rot4d_project"}
+    log.clear()
+    c, s_ = math.cos(0.3), math.sin(0.3)
+    r = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])  # a turn about z: w unchanged
+    m2 = np.eye(4)
+    m2[:3, :3] = r
+    assert sc.turn(r, projection={"state": pj.state_message(src, m2 @ m, 0.3)})
+    ((data, n, bufs),) = buffer_messages(sc, log)
+    assert {"_rot4d_turn", "_rot4d_seq", "_rot4d_project"} <= set(data["state"]) and "array" not in data["state"]

@@ -59,6 +59,7 @@ __all__ = [
     "quad_template",
     "triangle_template",
     "surface_arrays",
+    "surface_message",
     "without_triangles",
 ]
 
@@ -284,6 +285,21 @@ def surface_arrays(data, *, scale: float = 1.0, group_rgb=None, eye=None, single
     rgb = np.rint(np.clip(palette[vertex_group[keep]], 0.0, 1.0) * 255.0).astype(np.uint8)
     return {"position": position, "normal": normal, "rgb": rgb, "index": new[t].astype(np.uint32).ravel(),
             "lo": [float(x) for x in lo], "span": [float(x) for x in span]}
+
+
+def surface_message(arrays: dict, opacity) -> dict:
+    """`surface_arrays` as the synced dict (the scene's ``_rot4d_surface``): arrays as little-endian
+    bytes (binary buffers)."""
+    n, k = len(arrays["position"]), len(arrays["index"])
+    return {
+        "n_vertices": int(n),
+        "n_indices": int(k),
+        "lo": list(arrays["lo"]),
+        "span": list(arrays["span"]),
+        "opacity": 1.0 if opacity is None else float(opacity),
+        **{name: memoryview(np.ascontiguousarray(arrays[name]).astype(arrays[name].dtype.newbyteorder("<")).tobytes())
+           for name in ("position", "normal", "rgb", "index")},
+    }
 
 
 # -- colours (the palette itself lives in rot4d_widget.core.look) --------------------

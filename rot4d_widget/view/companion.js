@@ -41,6 +41,11 @@
 //     reads the same columns, per vertex instead of per instance.  Filled in the scene's
 //     `beforeRender` from the array three.js holds at that moment, so a frame draws one
 //     whole update, and the drawn acknowledgement (job 1) stays exact.
+//  7. the projection view (rot4d_widget/view/projection.py): from the skeleton (once per source)
+//     and the state (the 4x4 matrix and hyperplane offsets) that travel in the row buffer's own
+//     update message, the page rotates, projects, colours and finds the crossings
+//     (projectSkeleton, exported for tests) and draws them with geometries of its own: no array
+//     is sent to the projection, and both canvases change from the same message.
 // All listeners are removed when the view is removed (and each layer gets its instanced
 // geometry back).
 
@@ -92,6 +97,9 @@ function likeTexture(t) {
 // 6. Plain geometries drawn in place of the instanced ones, shared by every companion view
 // of one scene (keyed by the layer's three.js instanced geometry).
 const expansions = new WeakMap();
+// 7. The projection's geometries, shared by every companion view of one widget (keyed by the
+// projection's edges mesh, a three.js object).
+const projections = new WeakMap();
 
 // THREE.BufferGeometry without importing three.js: the instanced geometry's parent class.
 function plainGeometryClass(inst) {
@@ -158,6 +166,82 @@ function fillExpansion(e, rows, stride, count) {
   return n;
 }
 
+// 7. The projection (rot4d_widget/view/projection.py): the skeleton as the kernel sends it once
+// per source (`skeleton_message`), decoded; null if there is none or it is malformed.
+const bytesAs = (dv, T) =>
+  dv && dv.byteLength !== undefined ? new T(dv.buffer.slice(dv.byteOffset, dv.byteOffset + dv.byteLength)) : new T(0);
+
+export function decodeSkeleton(sk) {
+  const V = sk && Number.isInteger(sk.n_vertices) ? sk.n_vertices : 0;
+  const E = sk && Number.isInteger(sk.n_edges) ? sk.n_edges : 0;
+  if (!V) return null;
+  const vertices = bytesAs(sk.vertices, Float64Array);
+  const edges = bytesAs(sk.edges, Uint32Array);
+  if (vertices.length !== 4 * V || edges.length !== 2 * E || edges.some((i) => i >= V)) return null;
+  const rgb = (x) => (Array.isArray(x) && x.length === 3 ? x.map(Number) : [0.5, 0.5, 0.5]);
+  return { V, E, vertices, edges, d: Number(sk.distance), size: Number(sk.size), scale: Number(sk.scale),
+           below: rgb(sk.below), on: rgb(sk.on), above: rgb(sk.above) };
+}
+
+// What the projection draws for the state `st` (`state_message`: matrix row by row, offsets,
+// middle), exactly as projection.projection_arrays computes it: the vertices rotated
+// (v @ matrix.T) and seen from (0, 0, 0, d), xyz * d / (d - w) * scale; their colours on the
+// diverging map of w about the middle hyperplane; the edges' crossings of every hyperplane,
+// offset by offset then edge by edge (an edge whose ends straddle or touch it: a + t (b - a);
+// edges lying in a hyperplane: their first ends, then their second ends), projected alike.
+// Float32 arrays: positions (3V), rgb (3V), points (3m); index (2E) is the skeleton's own.
+export function projectSkeleton(s, st) {
+  const m = st && st.matrix;
+  const offsets = st && Array.isArray(st.offsets) ? st.offsets.map(Number) : [];
+  if (!s || !Array.isArray(m) || m.length !== 16) return null;
+  const { V, vertices: v, edges: e, d, size, scale } = s;
+  const r = new Float64Array(4 * V);
+  let wmax = 0;
+  for (let i = 0; i < V; i++) {
+    const x = v[4 * i], y = v[4 * i + 1], z = v[4 * i + 2], w = v[4 * i + 3];
+    for (let a = 0; a < 4; a++) r[4 * i + a] = m[4 * a] * x + m[4 * a + 1] * y + m[4 * a + 2] * z + m[4 * a + 3] * w;
+    wmax = Math.max(wmax, Math.abs(r[4 * i + 3]));
+  }
+  const positions = new Float32Array(3 * V);
+  const rgb = new Float32Array(3 * V);
+  const middle = Number(st.middle);
+  for (let i = 0; i < V; i++) {
+    const w = r[4 * i + 3];
+    const f = d / (d - w);
+    const t = Math.min(1, Math.max(-1, (w - middle) / size));
+    for (let j = 0; j < 3; j++) {
+      positions[3 * i + j] = r[4 * i + j] * f * scale;
+      rgb[3 * i + j] = s.on[j] + Math.max(t, 0) * (s.above[j] - s.on[j]) + Math.min(t, 0) * (s.on[j] - s.below[j]);
+    }
+  }
+  const tol = 1e-12 * Math.max(1, wmax);
+  const pts = [];
+  const put = (x, y, z, w) => {
+    const f = d / (d - w);
+    pts.push(x * f * scale, y * f * scale, z * f * scale);
+  };
+  const flat = [];
+  for (const o of offsets) {
+    for (let j = 0; j < e.length; j += 2) {
+      const a = 4 * e[j], b = 4 * e[j + 1];
+      const wa = r[a + 3], wb = r[b + 3];
+      const lo = Math.min(wa, wb), hi = Math.max(wa, wb);
+      if (hi - lo <= tol) {
+        if (Math.abs(lo - o) <= tol) flat.push(a, b);
+        continue;
+      }
+      if (lo <= o + tol && hi >= o - tol) {
+        const t = Math.min(1, Math.max(0, (o - wa) / (wb - wa)));
+        put(r[a] + t * (r[b] - r[a]), r[a + 1] + t * (r[b + 1] - r[a + 1]), r[a + 2] + t * (r[b + 2] - r[a + 2]), o);
+      }
+    }
+  }
+  for (let k = 0; k < 2; k++) {
+    for (let i = k; i < flat.length; i += 2) put(r[flat[i]], r[flat[i] + 1], r[flat[i] + 2], r[flat[i] + 3]);
+  }
+  return { positions, rgb, index: e, points: new Float32Array(pts) };
+}
+
 function modelId(ref) {
   return typeof ref === "string" && ref.startsWith("IPY_MODEL_") ? ref.slice(10) : ref;
 }
@@ -205,7 +289,7 @@ async function render({ model, el }) {
   // 3. shortcut guard
   const guard = (event) => {
     if (event.ctrlKey || event.metaKey || event.altKey) return;
-    if (canvasHovered(model.get("canvas_class"))) event.preventDefault();
+    if (canvasHovered(model.get("canvas_class")) || canvasHovered(model.get("projection_class"))) event.preventDefault();
   };
   for (const type of ["keydown", "keypress", "keyup"]) listen(window, type, guard, true);
 
@@ -219,12 +303,14 @@ async function render({ model, el }) {
     console.warn("rot4d_widget companion: leave guard unavailable", e);
   }
   const ensureGuards = () => {
-    const cls = model.get("canvas_class");
-    if (!alive || !cls || typeof customElements === "undefined" || !customElements.get(GUARD_TAG)) return;
-    // a live collection, cheap; a canvas element has only a few children
-    for (const host of document.getElementsByClassName(cls)) {
-      if (!Array.from(host.children).some((c) => c.localName === GUARD_TAG)) {
-        host.appendChild(document.createElement(GUARD_TAG));
+    if (!alive || typeof customElements === "undefined" || !customElements.get(GUARD_TAG)) return;
+    for (const cls of [model.get("canvas_class"), model.get("projection_class")]) {
+      if (!cls) continue;
+      // a live collection, cheap; a canvas element has only a few children
+      for (const host of document.getElementsByClassName(cls)) {
+        if (!Array.from(host.children).some((c) => c.localName === GUARD_TAG)) {
+          host.appendChild(document.createElement(GUARD_TAG));
+        }
       }
     }
   };
@@ -492,6 +578,109 @@ async function render({ model, el }) {
       if (meshes.length) applyTurn();
       if (meshes.length) applySurface();
       if (meshes.length) applyVolume();
+      // 7. the projection: the kernel names its meshes and scene (`projection_model_ids`) when it
+      // is first shown; each update's skeleton and state are projected here (projectSkeleton)
+      // into geometries of the companion's own, shared by every view of this companion (keyed by
+      // the edges mesh's three.js object), which the two meshes draw in place of their
+      // placeholders.  Computed in the projection scene's `beforeRender` from the buffer's values
+      // at that moment; an arriving state asks that scene to render.
+      let proj = null; // {lines, points, scene} models
+      let projCleanup = null;
+      const projectionShared = (lo) => {
+        let g = projections.get(lo);
+        if (g) return g;
+        const G = lo.geometry && lo.geometry.constructor;
+        const A = lo.geometry && lo.geometry.attributes && lo.geometry.attributes.position &&
+          lo.geometry.attributes.position.constructor;
+        if (typeof G !== "function" || typeof A !== "function" || !A.prototype.setArray) return null;
+        const attr = (n) => new A(new Float32Array(3 * n), 3);
+        const lines = new G();
+        const points = new G();
+        const add = (geometry, name, a) => (geometry.addAttribute ? geometry.addAttribute(name, a) : geometry.setAttribute(name, a));
+        add(lines, "position", attr(1));
+        add(lines, "color", attr(1));
+        lines.setIndex(new A(new Uint32Array(0), 1));
+        add(points, "position", attr(1));
+        g = { lines, points, sk: undefined, decoded: null, st: undefined, result: null };
+        projections.set(lo, g);
+        return g;
+      };
+      const projectionBefore = () => {
+        const lo = proj && proj.lines.obj, po = proj && proj.points.obj;
+        if (!lo || !po) return;
+        const g = projectionShared(lo);
+        if (!g) return;
+        const sk = buffer.get("_rot4d_skeleton"), st = buffer.get("_rot4d_project");
+        if (g.sk !== sk) {
+          g.sk = sk;
+          g.decoded = decodeSkeleton(sk);
+          g.st = undefined;
+        }
+        if (g.st !== st) {
+          g.st = st;
+          const out = g.decoded ? projectSkeleton(g.decoded, st) : null;
+          g.result = out;
+          const set = (a, array) => {
+            if (a.array === array) return;
+            a.setArray(array);
+            a.needsUpdate = true;
+          };
+          if (out) {
+            set(g.lines.attributes.position, out.positions);
+            set(g.lines.attributes.color, out.rgb);
+            set(g.lines.index, out.index);
+            set(g.points.attributes.position, out.points);
+          }
+          lo.visible = !!out && out.index.length > 0;
+          po.visible = !!out && out.points.length > 0;
+        }
+        if (lo.geometry !== g.lines) lo.geometry = g.lines;
+        if (po.geometry !== g.points) po.geometry = g.points;
+      };
+      // the test hook: the arrays last computed, on the projection canvas's element
+      let hookAt = -Infinity;
+      const projectionAfter = () => {
+        const now = performance.now();
+        const cls = model.get("projection_class");
+        if (now - hookAt < 500 || !cls || !proj) return;
+        hookAt = now;
+        const lo = proj.lines.obj;
+        const hook = () => {
+          const g = lo && projections.get(lo);
+          const o = g && g.result;
+          return o ? { positions: Array.from(o.positions), rgb: Array.from(o.rgb), index: Array.from(o.index),
+                       points: Array.from(o.points), state: g.st } : null;
+        };
+        for (const host of document.getElementsByClassName(cls)) host.rot4dProjection = hook;
+      };
+      const projectionRerender = () => {
+        if (proj && proj.scene) proj.scene.trigger("rerender", proj.scene, {});
+      };
+      const attachProjection = async () => {
+        const pids = ids("projection_model_ids");
+        if (projCleanup) projCleanup();
+        projCleanup = null;
+        proj = null;
+        if (pids.length !== 3) return;
+        const [lines, points, pscene] = await Promise.all(pids.map((id) => getModel(manager, id, isAlive)));
+        if (!alive || ids("projection_model_ids").join() !== pids.join()) return;
+        proj = { lines, points, scene: pscene };
+        pscene.on("beforeRender", projectionBefore);
+        pscene.on("afterRender", projectionAfter);
+        projCleanup = () => {
+          pscene.off("beforeRender", projectionBefore);
+          pscene.off("afterRender", projectionAfter);
+        };
+        hookAt = -Infinity;
+        projectionRerender();
+      };
+      const onProjectionIds = () => attachProjection().catch((e) => console.warn("rot4d_widget companion: projection not found", e));
+      if (typeof model.on === "function") model.on("change:projection_model_ids", onProjectionIds);
+      cleanups.push(() => {
+        if (typeof model.off === "function") model.off("change:projection_model_ids", onProjectionIds);
+        if (projCleanup) projCleanup();
+      });
+      onProjectionIds();
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
@@ -506,6 +695,7 @@ async function render({ model, el }) {
         if (b.counts || b.array) applyCounts();
         if (b.surface) applySurface();
         if (b.volume) applyVolume();
+        if (b.project) projectionRerender();
         if (b.turn) {
           applyTurn();
           scene.trigger("rerender", scene, {}); // a turn alone changes no three.js buffer
@@ -528,7 +718,8 @@ async function render({ model, el }) {
       };
       const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn"),
                         _rot4d_surface: note("surface"), _rot4d_volume: note("volume"),
-                        _rot4d_labels: note("labels") };
+                        _rot4d_labels: note("labels"), _rot4d_project: note("project"),
+                        _rot4d_skeleton: note("project") };
       let guardsAt = -Infinity;
       // Labels pinned to points of the view (`_rot4d_labels`: a field's box corners with their data
       // coordinates): an overlay over each canvas of this scene, each text where its point projects

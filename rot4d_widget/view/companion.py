@@ -52,6 +52,17 @@ step) and does four things in JupyterLab 4 and Notebook 7 alike:
    view is in the page).  `on_screenshot` callbacks get ``(n, png_bytes,
    error)``.  Every displayed view answers; the widget keeps the first.
 
+6. **projection** -- with the projection view shown (`rot4d_widget.view.projection`), the
+   kernel sets ``projection_model_ids`` (its edges' and crossings' meshes and its Scene) and
+   ``projection_class`` (its canvas's CSS class).  As each update of the scene's buffer
+   arrives, the companion reads its ``_rot4d_skeleton`` (once per source) and ``_rot4d_project``
+   (the 4x4 matrix and the hyperplanes' offsets), rotates, projects and colours the vertices and
+   finds the crossings (``projectSkeleton``, as `projection.projection_arrays` does), writes them
+   into geometries of its own that the two meshes draw, and asks the projection's scene to
+   render: both canvases change from the same message.  The keys' guards (3, 4) cover the
+   projection's canvas too.  For tests, the canvas element gets ``rot4dProjection()``: the
+   arrays last computed (plain lists) and the state they were computed from.
+
 Listeners are removed when the view is removed.
 """
 
@@ -85,6 +96,10 @@ class Companion(anywidget.AnyWidget):
     geometry_model_ids = List(Unicode()).tag(sync=True)
     mesh_model_ids = List(Unicode()).tag(sync=True)
     texture_model_ids = List(Unicode()).tag(sync=True)
+    #: the projection's edges mesh, crossings mesh and Scene (empty: no projection shown)
+    projection_model_ids = List(Unicode()).tag(sync=True)
+    #: the projection canvas's CSS class (its key guards and its test hook)
+    projection_class = Unicode("").tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:

@@ -148,7 +148,7 @@ class Painter:
         if shown is not None and key.same(shown) and (shown is rows or held):
             pass  # the view shows this state (turned rows only while keys are held)
         elif held and turn is not None and (key.coarse or not rows.coarse):
-            if scene.turn(turn):
+            if scene.turn(turn, **self.projection(key)):
                 sent = scene.update_id
             self.shown = key
         elif cast:
@@ -169,7 +169,7 @@ class Painter:
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
             single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
             labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
-            if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels):
+            if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
                 self.labelled = bool(labels)
                 sent = scene.update_id
             self.cast_clim = clim
@@ -201,12 +201,11 @@ class Painter:
             labels = cut_labels(w.source, key.matrix, key.c0, data)
             if labels or self.labelled:  # a source with labels (a field), or to take them away
                 extra["labels"] = labels
-            if scene.show(data, single_rgb=single, **extra):
+            if scene.show(data, single_rgb=single, **extra, **self.projection(key)):
                 sent = scene.update_id
                 self.labelled = bool(labels)
             self.rows_data = data
             self.shown = self.rows_key = key
-        w._projection.follow(key.matrix, key.c0, key.version)  # the projection, in the same update
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered
         if not len(w._repeater) or now - self.readout_at >= READOUT_PERIOD:
@@ -215,6 +214,12 @@ class Painter:
         else:
             self.readout_stale = True
         return sent
+
+    def projection(self, key: ViewKey) -> dict:
+        """The projection view's part of the update showing ``key`` (`ProjectionView.message`), as the
+        scene's ``projection`` keyword ({} while the projection is off): both views from one message."""
+        message = self.w._projection.message(key.matrix, key.c0, key.version)
+        return {} if message is None else {"projection": message}
 
     def eye_moved(self, eye) -> None:
         """Scene: the camera moved (a mouse orbit ended): send the faces in the order for the new eye."""

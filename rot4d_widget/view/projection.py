@@ -20,11 +20,19 @@ so the slice's points lie in the projection exactly where the slice is (scaled),
 above the hyperplane (nearer the eye) are drawn larger -- the depth cue is w itself.  With
 d = 3 x size every vertex has d - w >= 2 x size > 0: nothing crosses the eye.
 
-The arrays are computed vectorised (no Python loop over vertices or edges) and sent as float32,
-in the same update as the slice (`rot4d_widget.view.painter.Painter.send` calls `follow`), so
-the two views never show different states.  The geometry functions (`skeleton`,
-`hyperplane_offsets`, `perspective`, `crossings`, `w_colours`, `projection_arrays`) need no
-browser; `ProjectionView` builds the pythreejs objects, only when the projection is first shown:
+**The page projects; the kernel sends the state.**  Once per source the kernel sends the
+skeleton (`skeleton_message`: vertices (V, 4) float64, edges (E, 2) uint32, d, size, scale,
+colours); per update only the state (`state_message`: the 4x4 matrix, the hyperplanes' offsets and
+the middle one) -- as fields of the slice view's own update message (the scene's row buffer,
+`rot4d_widget.view.scene.Scene.show` / ``turn`` with ``projection=``), so a held key costs no
+second widget message and both canvases change from the same message: they never show
+different states.  The companion (``companion.js``: ``decodeSkeleton``, ``projectSkeleton``)
+rotates, projects, colours and finds the crossings in the page, as `projection_arrays` does here,
+and writes them into the projection's own three.js geometries.  The geometry functions
+(`skeleton`, `hyperplane_offsets`, `perspective`, `crossings`, `w_colours`, `projection_arrays`)
+need no browser: they serve static pictures and exports, and are the reference the page's
+arrays are tested against (tests/test_projection.py under Node, the browser suite in the page).
+`ProjectionView` builds the pythreejs objects only when the projection is first shown:
 ``projection=False`` (the default) makes no widget and changes nothing of the picture.
 
 What the view knows of the source comes from the source protocol's members, never from its
@@ -37,6 +45,7 @@ nothing in the projection (the caption says so).
 from __future__ import annotations
 
 import html
+import uuid
 
 import numpy as np
 
@@ -46,8 +55,8 @@ from .keypad import close_quietly
 from .traits import Checked
 
 __all__ = ["EYE_DISTANCE", "BELOW_RGB", "ON_RGB", "ABOVE_RGB", "skeleton", "tesseract", "hyperplane_offsets",
-           "perspective", "crossings", "w_colours", "projection_arrays", "pack_rows", "crossing_capacity",
-           "ProjectionView", "ProjectionFlag"]
+           "middle_offset", "perspective", "crossings", "w_colours", "projection_arrays", "skeleton_message",
+           "state_message", "ProjectionView", "ProjectionFlag"]
 
 #: The eye sits at w = EYE_DISTANCE x the source's size on the w axis.
 EYE_DISTANCE = 3.0
@@ -155,13 +164,19 @@ def w_colours(w, offset, size) -> np.ndarray:
     return ON_RGB + np.maximum(t, 0.0) * (ABOVE_RGB - ON_RGB) + np.minimum(t, 0.0) * (ON_RGB - BELOW_RGB)
 
 
+def middle_offset(offsets) -> float:
+    """The hyperplane the colours are centred on: the middle one of ``offsets`` (K,) (K odd), else their mean."""
+    o = np.asarray(offsets, dtype=np.float64).reshape(-1)
+    return float(o[len(o) // 2]) if len(o) % 2 else float(o.mean())
+
+
 def projection_arrays(source, matrix, c0, scale: float = 1.0) -> dict | None:
     """What the projection draws, in displayed units (``scale`` x slice units), float32, or None for
     a source without a skeleton: ``positions`` (V, 3) the vertices projected, ``rgb`` (V, 3) their
-    colours by w (`w_colours` about the middle hyperplane; an edge blends its ends' colours),
+    colours by w (`w_colours` about `middle_offset`; an edge blends its ends' colours),
     ``index`` (2E,) uint32 the edges as pairs of rows, ``points`` (m, 3) the hyperplanes'
-    crossings (`crossings`) projected, ``distance`` d and ``offsets`` (K,).  Only positions,
-    colours and points change with the state: the index is sent once per source."""
+    crossings (`crossings`) projected, ``distance`` d and ``offsets`` (K,).  The reference for
+    what the page computes from `skeleton_message` and `state_message` (``companion.js``)."""
     sk = skeleton(source)
     if sk is None:
         return None
@@ -171,11 +186,10 @@ def projection_arrays(source, matrix, c0, scale: float = 1.0) -> dict | None:
     d = EYE_DISTANCE * size
     rotated = vertices @ m.T
     offsets = hyperplane_offsets(source, c0)
-    middle = float(offsets[len(offsets) // 2]) if len(offsets) % 2 else float(offsets.mean())
     cross = crossings(rotated, edges, offsets)
     return {
         "positions": (perspective(rotated, d) * scale).astype(np.float32),
-        "rgb": w_colours(rotated[:, 3], middle, size).astype(np.float32),
+        "rgb": w_colours(rotated[:, 3], middle_offset(offsets), size).astype(np.float32),
         "index": edges.reshape(-1).astype(np.uint32),
         "points": (perspective(cross, d) * scale).astype(np.float32),
         "distance": d,
@@ -183,46 +197,58 @@ def projection_arrays(source, matrix, c0, scale: float = 1.0) -> dict | None:
     }
 
 
-#: Where an unused crossing slot is put: far behind the projection's camera (on the +z axis,
-#: looking down -z), so it is clipped and never drawn.
-HIDDEN = (0.0, 0.0, 1.0e6)
+def _le_bytes(a, dtype) -> memoryview:
+    """``a`` as little-endian ``dtype`` bytes: a binary buffer of the widget message."""
+    return memoryview(np.ascontiguousarray(a, dtype=np.dtype(dtype).newbyteorder("<")).tobytes())
 
 
-def crossing_capacity(n_edges: int, n_offsets: int) -> int:
-    """Crossing slots kept in the buffer: every edge crossing every hyperplane once (an edge in a
-    hyperplane gives two ends, whose vertices other edges also cross: rarely more; more grows it)."""
-    return max(1, int(n_edges) * max(1, int(n_offsets)))
+def skeleton_message(source, scale: float = 1.0) -> dict:
+    """What the page needs once per source to project it (the scene's ``_rot4d_skeleton``):
+    ``n_vertices`` V, ``n_edges`` E, ``vertices`` (V, 4) float64 and ``edges`` (E, 2) uint32 as
+    little-endian bytes (`skeleton`), ``distance`` d, ``size``, ``scale`` (displayed units per
+    slice unit) and the colour map's ``below`` / ``on`` / ``above`` ends.  ``{"n_vertices": 0,
+    "n_edges": 0}`` for a source without a skeleton (the page draws nothing)."""
+    sk = skeleton(source)
+    if sk is None:
+        return {"n_vertices": 0, "n_edges": 0}
+    vertices, edges = sk
+    size = float(inner_source(source).size)
+    return {
+        "n_vertices": int(len(vertices)), "n_edges": int(len(edges)),
+        "vertices": _le_bytes(vertices, np.float64), "edges": _le_bytes(edges, np.uint32),
+        "distance": EYE_DISTANCE * size, "size": size, "scale": float(scale),
+        "below": BELOW_RGB.tolist(), "on": ON_RGB.tolist(), "above": ABOVE_RGB.tolist(),
+    }
 
 
-def pack_rows(arrays, capacity: int) -> np.ndarray:
-    """(V + capacity, 6) float32 rows ``x, y, z, r, g, b``: the projected vertices with their colours
-    (`projection_arrays`), then the crossings (colour unused: the balls have one), then `HIDDEN`
-    rows up to ``capacity`` crossings.  None: one hidden row per slot."""
-    if arrays is None:
-        rows = np.zeros((capacity, 6), dtype=np.float32)
-        rows[:, :3] = HIDDEN
-        return rows
-    pos, rgb, pts = arrays["positions"], arrays["rgb"], arrays["points"]
-    n = len(pos)
-    rows = np.zeros((n + capacity, 6), dtype=np.float32)
-    rows[:n, :3] = pos
-    rows[:n, 3:] = rgb
-    rows[n:n + len(pts), :3] = pts
-    rows[n + len(pts):, :3] = HIDDEN
-    return rows
+def state_message(source, matrix, c0) -> dict:
+    """What the page needs per update to project the skeleton (the scene's ``_rot4d_project``):
+    ``matrix`` the 16 entries of the 4x4 rotation, row by row (rotated = vertices @ matrix.T),
+    ``offsets`` the hyperplanes (`hyperplane_offsets`) and ``middle`` (`middle_offset`).  Python
+    floats: the page gets the very doubles (JSON round-trips them)."""
+    offsets = hyperplane_offsets(source, c0)
+    return {"matrix": np.asarray(matrix, dtype=np.float64).reshape(16).tolist(), "offsets": offsets.tolist(),
+            "middle": middle_offset(offsets)}
 
 
 class ProjectionView:
     """The projection's canvas, caption and pythreejs objects for one widget (``widget``): built
-    the first time it is shown, updated by `follow` in the painter's update, closed with the widget."""
+    the first time it is shown; `message` gives what each update of the slice view carries for
+    it; closed with the widget.
+
+    The pythreejs meshes hold placeholder geometries only: the companion draws them with
+    geometries of its own, filled in the page from the skeleton and the state (the kernel never
+    sends an array to them)."""
 
     def __init__(self, widget):
         self.w = widget
         self.box = None  # the ipywidgets VBox (caption + canvas), once built
-        self.shown_key = None  # (matrix, c0, version) last drawn
-        self.arrays = None  # what was last sent (`projection_arrays`), for tests and the readout
+        self.shown_key = None  # (matrix, c0, version) of the state last handed to the scene
+        self._skeleton_key = None  # (source, version, scale) whose skeleton the page was sent
+        self._arrays = (None, None)  # (shown_key, `projection_arrays`) computed on request
         self._widgets = []
         self.events = None  # the ipyevents listener on the projection's canvas, once built
+        self.canvas_class = f"rot4d-projection-{uuid.uuid4().hex[:12]}"
 
     @property
     def on(self) -> bool:
@@ -236,23 +262,17 @@ class ProjectionView:
         w = self.w
         scene = w.scene
         width, height = int(scene.width), int(scene.height)
-        # one interleaved float32 buffer (rows x, y, z, r, g, b): the V projected vertices, then
-        # `capacity` crossing slots; lines and balls index into it, so a held key's update of the
-        # projection is one message (positions, colours and balls together)
-        self._rows = pack_rows(None, 1)
-        self._buffer = p3.InterleavedBuffer(array=self._rows)
-        self._edge_index = p3.BufferAttribute(array=np.array([0, 0], dtype=np.uint32), normalized=False)
+
+        def placeholder(rows):  # plain attributes: the companion makes its geometries of their classes
+            return p3.BufferAttribute(array=np.zeros((rows, 3), dtype=np.float32), normalized=False)
+
         self._edge_geometry = p3.BufferGeometry(attributes={
-            "position": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=0),
-            "color": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=3),
-            "index": self._edge_index})
+            "position": placeholder(2), "color": placeholder(2),
+            "index": p3.BufferAttribute(array=np.array([0, 1], dtype=np.uint32), normalized=False)})
         self._edge_material = p3.LineBasicMaterial(vertexColors="VertexColors", linewidth=1)
         self._lines = p3.LineSegments(geometry=self._edge_geometry, material=self._edge_material,
                                       frustumCulled=False, name="projection edges")
-        self._point_index = p3.BufferAttribute(array=np.array([0], dtype=np.uint32), normalized=False)
-        self._point_geometry = p3.BufferGeometry(attributes={
-            "position": p3.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=0),
-            "index": self._point_index})
+        self._point_geometry = p3.BufferGeometry(attributes={"position": placeholder(1)})
         ball = 4.0 * float(getattr(w, "ball_radius", 0.07))
         self._point_material = p3.PointsMaterial(color=CROSSING_RGB, size=ball, sizeAttenuation=True)
         self._points = p3.Points(geometry=self._point_geometry, material=self._point_material,
@@ -268,6 +288,7 @@ class ProjectionView:
                                     width=width, height=height, background=background, background_opacity=1.0,
                                     clearColor=background)
         self.renderer.add_class("rot4d-projection")
+        self.renderer.add_class(self.canvas_class)
         from ipyevents import Event  # keys over the projection turn the object as over the slice
 
         self.events = Event(source=self.renderer, watched_events=list(KEY_EVENTS), prevent_default_action=True,
@@ -276,10 +297,13 @@ class ProjectionView:
         self.caption = widgets.HTML(self._caption_html())
         self.box = widgets.VBox([self.caption, self.renderer], layout=widgets.Layout(flex="0 0 auto"))
         self._widgets = [self.events, self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
-                         self._lines, self._points, self._edge_geometry, self._edge_material, self._buffer,
-                         self._edge_index, self._point_geometry, self._point_material, self._point_index]
-        self._widgets += [a for g in (self._edge_geometry, self._point_geometry) for a in g.attributes.values()
-                          if a not in self._widgets]
+                         self._lines, self._points, self._edge_geometry, self._edge_material,
+                         self._point_geometry, self._point_material]
+        self._widgets += [a for g in (self._edge_geometry, self._point_geometry) for a in g.attributes.values()]
+        # the companion finds the meshes and the scene it draws into, and the canvas (key guards)
+        with w.companion.hold_sync():
+            w.companion.projection_model_ids = [self._lines.model_id, self._points.model_id, self._scene.model_id]
+            w.companion.projection_class = self.canvas_class
 
     def _caption_html(self) -> str:
         d = EYE_DISTANCE
@@ -293,7 +317,8 @@ class ProjectionView:
     # -- showing --------------------------------------------------------------------------
     def changed(self, change=None) -> None:
         """The ``projection`` trait changed (or the widget was just wired): show or hide the canvas
-        beside the slice view, and draw it in the next update."""
+        beside the slice view; when it is turned on, send the state the slice view shows (one
+        message with the skeleton); later updates carry it with the slice (`message`)."""
         w = self.w
         if self.on and self.box is None:
             self._build()
@@ -303,41 +328,40 @@ class ProjectionView:
                 kids.insert(1, self.box)
             if tuple(kids) != tuple(w.children):
                 w.children = tuple(kids)
-        self.shown_key = None
-        if change is not None:
+        self._skeleton_key = None  # the next message carries the skeleton again
+        if change is not None and self.on:
             with w._pump.lock:
-                if not w._closed:
-                    w._pump.mark_dirty()
-                    w._pump.flush()
+                shown = w._painter.shown
+                if not w._closed and shown is not None:
+                    w.scene.project(self.message(shown.matrix, shown.c0, shown.version))
 
-    def follow(self, matrix, c0, version) -> None:
-        """Draw the state ``(matrix, c0)`` of the source at ``version`` if it is not drawn yet: the
-        painter calls this in every update, so both views change together."""
+    def message(self, matrix, c0, version) -> dict | None:
+        """What the slice view's update carries for the projection (`rot4d_widget.view.scene.Scene.show`'s
+        ``projection``), None when it is not shown: ``{"state": state_message(...)}``, with
+        ``"skeleton": skeleton_message(...)`` the first time and whenever the source, its version or
+        the scale changed.  Called just before the scene sends the update."""
         if not self.on or self.box is None:
-            return
-        key = (matrix, c0, version)
-        if self.shown_key is not None and self.shown_key[0] is matrix and self.shown_key[1:] == key[1:]:
-            return
+            return None
         w = self.w
-        arrays = projection_arrays(w.source, matrix, c0, w._scale)
-        self.shown_key, self.arrays = key, arrays
-        if arrays is None:
-            self._lines.visible = self._points.visible = False
-            return
-        index, pts = arrays["index"], arrays["points"]
-        n_vertices = len(arrays["positions"])
-        capacity = len(self._rows) - n_vertices
-        if len(pts) > capacity or len(index) != len(self._edge_index.array) or capacity < 1:
-            capacity = max(len(pts), crossing_capacity(len(index) // 2, len(arrays["offsets"])))
-        rows = pack_rows(arrays, capacity)
-        with self.renderer.hold_sync():
-            if len(rows) != len(self._rows) or not np.array_equal(index, self._edge_index.array):
-                # a new source (or more crossings than slots): its edges and the balls' slots, once
-                self._edge_index.array = index if len(index) else np.array([0, 0], dtype=np.uint32)
-                self._point_index.array = np.arange(n_vertices, len(rows), dtype=np.uint32)
-            self._buffer.array = self._rows = rows
-            self._lines.visible = bool(len(index))
-            self._points.visible = bool(len(pts))
+        out = {"state": state_message(w.source, matrix, c0)}
+        key = (w.source, version, w._scale)
+        if self._skeleton_key is None or any(a is not b and a != b for a, b in zip(key, self._skeleton_key)):
+            out["skeleton"] = skeleton_message(w.source, w._scale)
+            self._skeleton_key = key
+            self.caption.value = self._caption_html()
+        self.shown_key = (matrix, c0, version)
+        return out
+
+    @property
+    def arrays(self) -> dict | None:
+        """`projection_arrays` of the state last sent (what the page draws), computed here on
+        request: for tests, pictures and the readout; None before any or for a source without one."""
+        key = self.shown_key
+        if key is None:
+            return None
+        if self._arrays[0] is not key:
+            self._arrays = (key, projection_arrays(self.w.source, key[0], key[1], self.w._scale))
+        return self._arrays[1]
 
     def readout_row(self):
         """``(label, html)`` for the readout saying which view is which, or None when off."""

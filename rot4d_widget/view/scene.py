@@ -101,7 +101,9 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     applies the message); ``_rot4d_turn`` a 3-D turn of the whole view as a
     column-major 4x4 (the companion sets it on the meshes); ``_rot4d_surface``
     a smooth surface's quantised arrays (the companion uploads them); ``_rot4d_volume`` a
-    field's cut(s) on grids for the ray-cast renderings (`rot4d_widget.view.volume_layer`).
+    field's cut(s) on grids for the ray-cast renderings (`rot4d_widget.view.volume_layer`);
+    ``_rot4d_skeleton`` and ``_rot4d_project`` what the projection view draws (the companion
+    projects the skeleton in the page, `rot4d_widget.view.projection`).
     """
 
     _rot4d_seq = CInt(0).tag(sync=True)
@@ -115,6 +117,10 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str}): the
     #: companion draws them over the canvas where the points project, turned with the view.
     _rot4d_labels = List(Dict()).tag(sync=True)
+    #: The projection's skeleton, sent once per source (`projection.skeleton_message`).  {} = none.
+    _rot4d_skeleton = Dict().tag(sync=True)
+    #: The projection's state, with every update while it is shown (`projection.state_message`).
+    _rot4d_project = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
@@ -143,10 +149,6 @@ def _group_colors(value, n_groups):
                          f"got {len(items)}")
     rgb = [look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(items)]
     return np.asarray(rgb, dtype=np.float32)
-
-
-def _hex(rgb):
-    return "#" + "".join(f"{int(round(255 * c)):02x}" for c in rgb)
 
 
 #: Display options `set_display` accepts, with their validators.
@@ -354,7 +356,7 @@ class Scene:
             elif name == "face_opacity":
                 self._materials["face"].uniforms = self._face_uniforms(value)
             elif name == "background":
-                h = _hex(look.as_rgb(value, "background"))
+                h = look.hex_color(look.as_rgb(value, "background"))
                 with self._renderer.hold_sync():
                     self._renderer.background = h
                     self._renderer.clearColor = h
@@ -377,7 +379,8 @@ class Scene:
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None, labels=()) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None, labels=(),
+             projection=None) -> bool:
         """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
@@ -390,6 +393,8 @@ class Scene:
         rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
         of any surface (None: no volume; one shown before is hidden).  ``labels``: ``(point (3,)
         in the source's units, text)`` pairs drawn over the canvas where the points project.
+        ``projection``: what the projection view draws of this state (`ProjectionView.message`:
+        ``{"state": ..., "skeleton": ...}``, the skeleton only when new), in the same message.
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
@@ -399,7 +404,7 @@ class Scene:
             arrays = bf.surface_arrays(data, scale=self.scale, eye=self.eye, single_rgb=single_rgb,
                                        group_rgb=self.group_rgb if group_rgb is None else group_rgb)
             n_levels = len(np.unique(np.asarray(data.groups))) if len(data.groups) else 0
-            surface = _surface_message(arrays, 1.0 if n_levels <= 1 else look.SURFACE_OPACITY)
+            surface = bf.surface_message(arrays, 1.0 if n_levels <= 1 else look.SURFACE_OPACITY)
             data = bf.without_triangles(data)
         elif self._surface_shown or volume is not None:
             surface = {}
@@ -415,27 +420,40 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
             capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
+        projection = _projection_news(self._buffer, projection)
         if (not force and not self._unsent and surface is None and volume is None and pinned is None
-                and np.array_equal(rows, self._rows)
+                and projection is None and np.array_equal(rows, self._rows)
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
         n_points = len(data.points) if getattr(data, "show_points", True) else 0
         counts = [n_points, len(data.segments), len(data.triangles)]
-        self._assign(rows, self.update_id, counts, surface=surface, volume=volume, labels=pinned)
+        self._assign(rows, self.update_id, counts, surface=surface, volume=volume, labels=pinned,
+                     projection=projection)
         return True
+
+    def project(self, projection) -> bool:
+        """`show`'s ``projection`` alone (the projection turned on, the slice unchanged: no `update_id`)."""
+        if self._closed:
+            raise RuntimeError("this Scene is closed")
+        projection = _projection_news(self._buffer, projection)
+        if projection is not None:
+            with self._sending():
+                _put_projection(self._buffer, projection)
+        return projection is not None
 
     @property
     def surface(self) -> dict:
         """The smooth surface last sent: its quantised arrays and box (empty dict if none)."""
         return dict(self._buffer._rot4d_surface)
 
-    def turn(self, rotation) -> bool:
+    def turn(self, rotation, projection=None) -> bool:
         """Turn the whole view by the 3-D ``rotation`` (3, 3) relative to the rows shown; True if sent.
 
         One small message (no rows): the page turns the meshes as it applies
         it.  The next `show` resets the turn (its rows are in the new frame), in
         the same message.  The faces' back-to-front order stays that of the rows.
+        ``projection`` as in `show`, in the same message.
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
@@ -445,10 +463,13 @@ class Scene:
         m4 = np.eye(4)
         m4[:3, :3] = r
         turn = [float(x) for x in m4.flatten(order="F")]
-        if turn == self._buffer._rot4d_turn and not self._unsent:
+        projection = _projection_news(self._buffer, projection)
+        if turn == self._buffer._rot4d_turn and not self._unsent and projection is None:
             return False
         self.update_id += 1
         with self._sending():
+            if projection is not None:
+                _put_projection(self._buffer, projection)
             self._buffer._rot4d_turn = turn
             self._buffer._rot4d_seq = self.update_id
         return True
@@ -476,9 +497,11 @@ class Scene:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
         return self._buffer._rot4d_turn != _IDENTITY4
 
-    def _assign(self, rows, seq, counts=None, surface=None, volume=None, labels=None):
+    def _assign(self, rows, seq, counts=None, surface=None, volume=None, labels=None, projection=None):
         buf = self._buffer
         with self._sending():
+            if projection is not None:
+                _put_projection(self._buffer, projection)
             if labels is not None:
                 buf._rot4d_labels = labels
             if surface is not None:
@@ -625,7 +648,7 @@ def _build_three(scene, antialias, display):
     )
     scene._three_scene = p3.Scene(children=[*scene._meshes.values(), scene._camera], background=None)
     scene._controls = p3.OrbitControls(controlling=scene._camera, enableKeys=False)
-    background = _hex(look.as_rgb(display["background"], "background"))
+    background = look.hex_color(look.as_rgb(display["background"], "background"))
     scene._renderer = p3.Renderer(
         camera=scene._camera,
         scene=scene._three_scene,
@@ -656,18 +679,17 @@ def _build_three(scene, antialias, display):
     scene._camera.observe(scene._camera_moved, names="position")
 
 
-def _surface_message(arrays: dict, opacity) -> dict:
-    """`buffers.surface_arrays` as the synced dict: arrays as little-endian bytes (binary buffers)."""
-    n, k = len(arrays["position"]), len(arrays["index"])
-    return {
-        "n_vertices": int(n),
-        "n_indices": int(k),
-        "lo": list(arrays["lo"]),
-        "span": list(arrays["span"]),
-        "opacity": 1.0 if opacity is None else float(opacity),
-        **{name: memoryview(np.ascontiguousarray(arrays[name]).astype(arrays[name].dtype.newbyteorder("<")).tobytes())
-           for name in ("position", "normal", "rgb", "index")},
-    }
+def _projection_news(buffer, projection):
+    """``projection`` (`Scene.show`'s) if it changes what the page holds, else None."""
+    if projection is None or "skeleton" in projection or projection["state"] != buffer._rot4d_project:
+        return projection
+    return None
+
+
+def _put_projection(buffer, projection):
+    if "skeleton" in projection:
+        buffer._rot4d_skeleton = projection["skeleton"]
+    buffer._rot4d_project = projection["state"]
 
 
 def _register(callbacks, callback, remove):
