@@ -48,9 +48,12 @@ def test_projection_drawn_and_turned_with_the_slice(jupyter_server, page, artifa
     page.locator(PROJECTION).scroll_into_view_if_needed()
     _hover(jp, PROJECTION)
     m1 = jp.kernel_json("w.state.matrix.tolist()")
+    page.evaluate("() => { window.__executed.length = 0; }")
     page.keyboard.press("c")
     assert jp.wait_for(lambda: jp.kernel_json("w.state.matrix.tolist()") != m1, timeout=10), \
         "a key over the projection's canvas must turn the object"
+    # and no notebook shortcut fired (Notebook 7's "c" copies the cell unless the companion guards)
+    assert not [c for c in jp.executed_commands() if c.startswith("notebook:")], jp.executed_commands()
     host = page.locator(PROJECTION).locator("xpath=ancestor::div[contains(@class, 'widget-hbox')][1]")
     host.screenshot(path=str(artifacts / f"projection-{jupyter_server.kind}.png"))
     assert "right: the whole object projected" in jp.kernel_json("w.readout.value")
