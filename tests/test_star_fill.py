@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from reference_geometry import random_rotation
+from scipy.spatial import cKDTree
+
 from rot4d_widget import polytope, slice_polytope
+from rot4d_widget.geometry.starfill import arrangement_fill
 
 NAMES = ["great icosahedral 120-cell", "great grand 120-cell", "great 120-cell", "small stellated 120-cell",
          "great stellated 120-cell"]
@@ -131,3 +133,81 @@ def test_a_level_through_vertices_fills_alike():
     w = (np.asarray(p.vertices) @ m.T)[:, 3]
     c0 = float(np.sort(w)[len(w) // 3])
     assert _check_cells(p, m, c0, np.random.default_rng(5), n_cells=20) > 0
+
+
+def _section_crossings(s):
+    """(k, 3) the points where two edges of one cell's section polygons cross inside both, from
+    the slice's polygons alone (per cell, every pair of its polygons' edges)."""
+    v = np.asarray(s.vertices)
+    out = []
+    by_cell = {}
+    for q, c in zip(s.polygons, np.asarray(s.cell_ids).tolist()):
+        by_cell.setdefault(c, []).append(q)
+    for qs in by_cell.values():
+        a = np.concatenate(qs)
+        b = np.concatenate([np.roll(q, -1) for q in qs])
+        c0, ax = _frame(v[np.concatenate([a, b])])
+        A, B = (v[a] - c0) @ ax[:2].T, (v[b] - c0) @ ax[:2].T
+        i, j = np.triu_indices(len(a), 1)
+        d1, d2, e = B[i] - A[i], B[j] - A[j], A[j] - A[i]
+        den = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (e[:, 0] * d2[:, 1] - e[:, 1] * d2[:, 0]) / den
+            u = (e[:, 0] * d1[:, 1] - e[:, 1] * d1[:, 0]) / den
+        hit = (den != 0) & (t > 1e-9) & (t < 1 - 1e-9) & (u > 1e-9) & (u < 1 - 1e-9)
+        out.append(v[a[i[hit]]] + t[hit, None] * (v[b[i[hit]]] - v[a[i[hit]]]))
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("name", ["great icosahedral 120-cell", "great grand 120-cell", "great 120-cell"])
+@pytest.mark.parametrize("seed", [2, 9])
+def test_crossing_sections_fill_with_their_crossings_as_only_new_corners(name, seed):
+    """Sections of several crossing cycles are filled from their arrangement: the fill's new corners
+    are exactly the points where two of the cell's section edges cross (none where a slab line would
+    cut an edge), and the triangles about (edges + crossings) per cell, not slabs x edges."""
+    p = polytope(name)
+    s = slice_polytope(p, random_rotation(seed), 0.1 * p.circumradius)
+    v = np.asarray(s.vertices)
+    fill = v[len(v) - s.n_fill:]
+    want = _section_crossings(s)
+    assert len(fill) == len(want)
+    assert cKDTree(want).query(fill)[0].max() < 1e-9 and cKDTree(fill).query(want)[0].max() < 1e-9
+    n_edges = sum(len(q) for q in s.polygons)
+    assert len(s.triangles) <= n_edges + 2 * len(want)
+
+
+def _one_cycle(xy):
+    """arrangement_fill's inputs for one closed polygon ``xy`` (k, 2) in the plane z = 0, its one cell's
+    normal +z: record r is the side from corner r to r + 1 (ends 2r, 2r + 1), each end's partner the
+    touching end of the neighbouring side."""
+    k = len(xy)
+    pts = np.concatenate([xy, np.zeros((k, 1))], axis=1)
+    end_pt = np.stack([np.arange(k), (np.arange(k) + 1) % k], axis=1).ravel()
+    partner = np.empty(2 * k, dtype=np.intp)
+    partner[2 * np.arange(k) + 1] = 2 * ((np.arange(k) + 1) % k)
+    partner[2 * ((np.arange(k) + 1) % k)] = 2 * np.arange(k) + 1
+    return (np.arange(k), np.zeros(k, dtype=np.intp), end_pt, partner, pts, np.arange(k),
+            np.array([[0.0, 0.0, 1.0]]), np.zeros((1, 3)), k)
+
+
+def test_arrangement_fill_of_a_pentagram_and_a_dented_bowtie():
+    """A pentagram: its five points filled, a corner at each of its five crossings, each triangle
+    counter-clockwise about +z; a bowtie with one lobe dented (an odd face with a reflex corner):
+    left to the slab fill, not fanned."""
+    a = np.pi / 2 + 4 * np.pi * np.arange(5) / 5
+    star = np.stack([np.cos(a), np.sin(a)], axis=1)
+    tri, cells, extra, rest, _ = arrangement_fill(*_one_cycle(star))
+    assert not rest.any() and len(extra) == 5 and len(tri) == 5
+    v = np.concatenate([star, extra[:, :2]])
+    rng = np.random.default_rng(0)
+    sample = rng.uniform(-1.1, 1.1, size=(4000, 2))
+    inside = np.zeros(len(sample), dtype=int)
+    for (x1, y1), (x2, y2) in zip(star, np.roll(star, -1, axis=0)):
+        inside ^= ((y1 > sample[:, 1]) != (y2 > sample[:, 1])) & (
+            sample[:, 0] < x1 + (sample[:, 1] - y1) * (x2 - x1) / (y2 - y1))
+    assert (_drawn(sample, v[tri]) == inside).all()
+    e1, e2 = v[tri[:, 1]] - v[tri[:, 0]], v[tri[:, 2]] - v[tri[:, 0]]
+    assert (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0).all()
+    bowtie = np.array([[0, 0], [2, 2], [2, 0], [0, 2], [0.5, 1.0]])
+    tri, cells, extra, rest, _ = arrangement_fill(*_one_cycle(bowtie))
+    assert rest.all() and len(tri) == 0 and len(extra) == 0

@@ -46,6 +46,7 @@ from ..core import tolerances as tol_
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from .starfill import arrangement_fill
 
 __all__: list = []
 
@@ -64,8 +65,19 @@ class _StarTables:
         self.face_rho = st.pair_rho[order].reshape(-1, 2).astype(np.float64)  # aligned with p.face_cells
         self.face_basis = st.face_basis
         self.cell_convex = st.cell_convex
+        # each (face side k, cell j of the face) slot 2k + j: the slot of the other face of that cell
+        # at that edge (a closed cell has two faces at each of its edges), -1 where it has not one
         E = len(p.edges)
-        self.cell_ekey = np.repeat(np.arange(len(p.cells)), np.diff(inc.cell_eptr)) * E + inc.cell_eidx  # ascending
+        key = (p.face_cells[t.fe_face] * E + t.fe_edge[:, None]).ravel()
+        o = np.argsort(key, kind="stable")
+        ks = key[o]
+        new = np.ones(len(ks), dtype=bool)
+        new[1:] = ks[1:] != ks[:-1]
+        size = np.diff(np.append(np.flatnonzero(new), len(ks)))[np.cumsum(new) - 1]
+        pos = np.arange(len(ks)) - np.flatnonzero(new)[np.cumsum(new) - 1]
+        mate = np.where(size == 2, o[np.minimum(np.arange(len(ks)) + 1 - 2 * pos, len(ks) - 1)], -1)
+        self.slot_mate = np.empty(len(ks), dtype=np.intp)
+        self.slot_mate[o] = mate
 
 
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -142,10 +154,10 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     vertices = pts[first]
 
     # each crossing face's points along its line w = c0, sorted; paired even-odd
-    k = np.flatnonzero(cross[t.fe_edge])
-    fk = t.fe_face[k]
-    pk = cid[t.fe_edge[k]]
-    delta = np.where(above[t.fv_vert[st.fv_next[k]]], 1, -1)  # +1 where the side rises through H
+    ks = np.flatnonzero(cross[t.fe_edge])
+    fk = t.fe_face[ks]
+    pk = cid[t.fe_edge[ks]]
+    delta = np.where(above[t.fv_vert[st.fv_next[ks]]], 1, -1)  # +1 where the side rises through H
     newf = np.ones(len(fk), dtype=bool)
     newf[1:] = fk[1:] != fk[:-1]  # fk ascending (face sides in face order)
     uf = fk[newf]
@@ -195,18 +207,16 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     end_cell = np.repeat(rec_cell, 2)
     end_pt = seg[rec_seg].ravel()
     n_end = len(end_pt)
-    # the two ends at each (cell, crossing edge): found by its slot in the cell-edge table, no sort
-    slot = np.searchsorted(st.cell_ekey, end_cell * len(t.ea) + ce[end_pt])
-    slot = np.minimum(slot, len(st.cell_ekey) - 1)
-    if (st.cell_ekey[slot] != end_cell * len(t.ea) + ce[end_pt]).any():
-        raise _Inconsistent
-    last_in = np.full(len(st.cell_ekey), -1, dtype=np.intp)
-    last_in[slot] = np.arange(n_end)
-    second = last_in[slot] == np.arange(n_end)
-    first_in = np.full(len(st.cell_ekey), -1, dtype=np.intp)
-    first_in[slot[~second]] = np.flatnonzero(~second)
-    partner = np.where(second, first_in[slot], last_in[slot])
-    if (partner < 0).any() or (partner == np.arange(n_end)).any() or (partner[partner] != np.arange(n_end)).any():
+    # the two ends at each (cell, crossing edge): the other face of the cell at that edge
+    # (`_StarTables.slot_mate`), found by the face side's place in the sorted sides, no search
+    side = ks[order]  # the face side of each sorted crossing: end n of record r is side[2 (r >> 1) + (n & 1)]
+    at = np.full(len(t.fe_edge), -1, dtype=np.intp)
+    at[side] = np.arange(len(side))
+    q = np.arange(n_end)
+    mate = st.slot_mate[2 * side[((q >> 2) << 1) + (q & 1)] + ((q >> 1) & 1)]
+    q2 = at[mate >> 1]
+    partner = 4 * (q2 >> 1) + 2 * (mate & 1) + (q2 & 1)
+    if (mate < 0).any() or (q2 < 0).any() or (partner == q).any() or (partner[partner] != q).any():
         raise _Inconsistent
     nxt = partner ^ 1  # along the other segment at this point, to its far end
     lab = np.arange(n_end)
@@ -296,9 +306,20 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
                              np.where(ccw, flat[nxt[j]], flat[j])], axis=1))
         tcell.append(cell_ids[pid[j]])
     gen = ~(st.cell_convex[rec_cell] | done[rec_cell])
-    if gen.any():
-        ttri, tc, sx = _slabs(rec_cell[gen], seg[rec_seg[gen]], pts, vid, normals, anchor + centre,
-                              len(vertices) + len(sp))
+    g = np.flatnonzero(gen)
+    n_new = len(vertices) + len(sp)
+    if len(g) and not on.any():  # by the segments' arrangement; what it cannot fill, by slabs
+        atri, ac, ax, rest, xings = arrangement_fill(g, rec_cell[g], end_pt, partner, pts, vid, normals,
+                                                     anchor + centre, n_new)
+        tri.append(atri)
+        tcell.append(ac)
+        extra.append(ax)
+        n_new += len(ax)
+        g = g[rest]
+    else:
+        xings = None
+    if len(g):
+        ttri, tc, sx = _slabs(rec_cell[g], seg[rec_seg[g]], pts, vid, normals, anchor + centre, n_new, xings)
         tri.append(ttri)
         tcell.append(tc)
         extra.append(sx)
@@ -366,9 +387,10 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
     return turn, centroid
 
 
-def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
+def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices, crossings=None):
     """Even-odd fill of each cell's section from its segments: ((k, 3) triangles, (k,) cells,
-    (n, 3) extra vertices numbered from ``n_vertices``).
+    (n, 3) extra vertices numbered from ``n_vertices``).  ``crossings``: ((k,) cells, (k,) heights
+    v) where the cells' segments cross, if known (`starfill.arrangement_fill` gives them).
 
     In each cell's plane (axes u, v of `_inplane_axes`, right-handed about the outward normal),
     the segments are cut at every corner's height v; within each slab the segments crossing it,
@@ -388,7 +410,8 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices):
     keep = Yh > Yl  # level segments bound no slab
     rcell, lo_p, hi_p, Xl, Yl, Xh, Yh = (a[keep] for a in (rcell, lo_p, hi_p, Xl, Yl, Xh, Yh))
     nr = len(rcell)
-    ic, iy = _crossings(rcell, Xl, Yl, Xh, Yh)  # slab lines also where two segments cross
+    # slab lines also where two segments cross (found already by the arrangement fill if given)
+    ic, iy = _crossings(rcell, Xl, Yl, Xh, Yh) if crossings is None else crossings
     ev_cell = np.concatenate([rcell, rcell, ic])
     ev_y = np.concatenate([Yl, Yh, iy])
     o = np.argsort(ev_y)  # by cell, then height: a float sort, then a stable (radix) one by cell
