@@ -154,7 +154,7 @@ def test_an_oblique_cut_through_a_cap_is_each_cells_parity_region(hemi, seed):
             tri = v[s.triangles[s.triangle_cells == cell]]
             c, ax = plane_frame(tri.reshape(-1, 3))
             sample = rng.uniform(*(np.stack([((tri.reshape(-1, 3) - c) @ ax.T).min(axis=0) - 0.2,
-                                             ((tri.reshape(-1, 3) - c) @ ax.T).max(axis=0) + 0.2])), size=(200, 2))
+                                             ((tri.reshape(-1, 3) - c) @ ax.T).max(axis=0) + 0.2])), size=(120, 2))
             T2 = (tri - c) @ ax.T
             drawn = np.zeros(len(sample), dtype=int)
             for A, B, C in T2:

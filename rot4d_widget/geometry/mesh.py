@@ -165,7 +165,8 @@ class Polytope:
     the omnitruncated 120-cell: docs/uniform.md).  ``validate=False`` skips the per-cell
     closedness and convexity checks (for combinatorics known to be right, e.g. from a
     Wythoff construction); the faces' geometry and the orientation are still derived
-    and checked, and a non-convex cell then gives wrong normals or an orientation error.
+    and checked, and a non-convex cell with convex faces then gives wrong normals, or the
+    boundary seems not orientable (loaded with no volume).
 
     Attributes
     ----------
@@ -180,7 +181,8 @@ class Polytope:
         its inner side -- and every vertex on the inner side of every cell's hyperplane, so
         a self-intersecting star polychoron, locally convex everywhere, is not convex)
     self_intersecting : bool, found to wind round more than once: connected, closed and
-        locally convex but not convex (a star polychoron); False for a convex polytope and
+        locally convex but not convex (a star polychoron), or with star faces or cells, or with no
+        inside (hemi cells, not orientable: `volume_defined`); False for a convex polytope and
         where not detected (a polytope with reflex ridges is not checked for it).  A slice's
         volume is then the volume weighted by the winding number (the divergence theorem over
         its outward faces), each region counted as often as the boundary winds round it
