@@ -79,36 +79,42 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     dX = rel1[:, 0] * uv[:, 0] + rel1[:, 1] * uv[:, 1] + rel1[:, 2] * uv[:, 2] - X0
     dY = rel1[:, 0] * uv[:, 3] + rel1[:, 1] * uv[:, 4] + rel1[:, 2] * uv[:, 5] - Y0
 
-    # crossings: every pair of a cell's records, inside both
+    # crossings: every pair of a cell's records, inside both (e = P_j - P_i; s along i, u along j)
     i, j = _pairs(rcell, C)
     ex, ey = X0[j] - X0[i], Y0[j] - Y0[i]
-    den = dX[i] * dY[j] - dY[i] * dX[j]  # cross(d_i, d_j)
+    dxi, dyi, dxj, dyj = dX[i], dY[i], dX[j], dY[j]
+    den = dxi * dyj - dyi * dxj  # cross(d_i, d_j)
+    cej = ex * dyj - ey * dxj  # cross(e, d_j)
+    cei = ex * dyi - ey * dxi  # cross(e, d_i)
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = (ex * dY[j] - ey * dX[j]) / den
-        u = (ex * dY[i] - ey * dX[i]) / den
-    inner = (den != 0) & (s > 1e-12) & (s < 1 - 1e-12) & (u > 1e-12) & (u < 1 - 1e-12)  # (as the slab fill's)
-    near = (den != 0) & (s > -_EPS) & (s < 1 + _EPS) & (u > -_EPS) & (u < 1 + _EPS)
-    hit = inner & (s > _EPS) & (s < 1 - _EPS) & (u > _EPS) & (u < 1 - _EPS)
+        s = cej / den
+        u = cei / den
+    lo, hi = np.minimum(s, u), np.maximum(s, u)
+    inner = (lo > 1e-12) & (hi < 1 - 1e-12)  # (as the slab fill's; den == 0 gives nan or inf: never)
+    hit = inner & (lo > _EPS) & (hi < 1 - _EPS)
     # not generic: a crossing at (or near) a segment's end, other than the ends a cycle shares;
     # nor a section whose segments do not cross (cycles apart or nested: a hole is no convex face)
     bad = np.bincount(rcell[i[hit]], minlength=C) == 0
-    shared = (p0[i] == p0[j]) | (p0[i] == p1[j]) | (p1[i] == p0[j]) | (p1[i] == p1[j])
-    bad[rcell[i[near & ~hit & ~shared]]] = True
-    hit &= ~bad[rcell[i]]
+    nb = np.flatnonzero((lo > -_EPS) & (hi < 1 + _EPS) & ~hit)
+    ib, jb = i[nb], j[nb]
+    bad[rcell[ib[(p0[ib] != p0[jb]) & (p0[ib] != p1[jb]) & (p1[ib] != p0[jb]) & (p1[ib] != p1[jb])]]] = True
+    bad_pair = bad[rcell[i]]
     bad0 = bad.copy()
-    ii = np.flatnonzero(inner & bad[rcell[i]])  # the crossings of the cells left to the slab fill
-    slab_x = (rcell[i[ii]], Y0[i[ii]] + s[ii] * dY[i[ii]])
-    if not hit.any():
+    ii = np.flatnonzero(inner & bad_pair)  # the crossings of the cells left to the slab fill
+    slab_x = (rcell[i[ii]], Y0[i[ii]] + s[ii] * dyi[ii])
+    hx = np.flatnonzero(hit & ~bad_pair)
+    if not len(hx):
         return np.zeros((0, 3), dtype=np.intp), np.zeros(0, dtype=np.intp), np.zeros((0, 3)), bad[rcell], slab_x
-    ci, cj, cs, cu, cc = i[hit], j[hit], s[hit], u[hit], den[hit]
+    ci, cj, cs, cu, cc = i[hx], j[hx], s[hx], u[hx], den[hx]
     X = len(ci)
 
     # pieces: each record split at its crossings, in order along it
     orec = np.concatenate([ci, cj])
     order = np.argsort(orec + 0.5 * np.concatenate([cs, cu]))
     occ_rec = orec[order]
-    occ_x = np.concatenate([np.arange(X), np.arange(X)])[order]
-    occ_turn = np.concatenate([cc, -cc])[order] > 0  # cross(d_this, d_other) > 0: the other runs leftwards
+    on_j = order >= X
+    occ_x = order - X * on_j
+    occ_turn = (cc[occ_x] > 0) != on_j  # cross(d_this, d_other) > 0: the other runs leftwards
     pos = np.empty(2 * X, dtype=np.intp)
     pos[order] = np.arange(2 * X)
     other = np.empty(2 * X, dtype=np.intp)
@@ -121,92 +127,82 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     n_sub = int(base[-1])
     sub_rec = np.repeat(np.arange(nr), k + 1)
     sub_t = np.arange(n_sub) - base[sub_rec]
-
-    # half-pieces: 2e runs piece e along its record, 2e + 1 against; the next of each round its left face
-    def leave(q, turn):  # from occurrence q onto the other record, leftwards when ``turn``
-        q2 = other[q]
-        r2 = occ_rec[q2]
-        return np.where(turn, 2 * (base[r2] + occ_t[q2] + 1), 2 * (base[r2] + occ_t[q2]) + 1)
-
-    def at_end(r, kend):  # from record r's end kend onto its partner record, away from that end
-        pe = partner[2 * rec[r] + kend]
-        r2 = loc[pe >> 1]
-        return np.where((pe & 1) == 0, 2 * base[r2], 2 * (base[r2] + k[r2]) + 1)
-
-    nxt = np.empty(2 * n_sub, dtype=np.intp)
-    fwd_mid = sub_t < k[sub_rec]
-    e = np.flatnonzero(fwd_mid)
-    q = optr[sub_rec[e]] + sub_t[e]
-    nxt[2 * e] = leave(q, occ_turn[q])
-    e = np.flatnonzero(~fwd_mid)
-    nxt[2 * e] = at_end(sub_rec[e], 1)
-    bwd_mid = sub_t > 0
-    e = np.flatnonzero(bwd_mid)
-    q = optr[sub_rec[e]] + sub_t[e] - 1
-    nxt[2 * e + 1] = leave(q, ~occ_turn[q])
-    e = np.flatnonzero(~bwd_mid)
-    nxt[2 * e + 1] = at_end(sub_rec[e], 0)
+    so = optr[sub_rec] + sub_t  # the occurrence at each piece's high end (if it ends at a crossing)
+    mid = sub_t < k[sub_rec]  # piece e ends at a crossing (else at its record's end 1)
 
     # parity of each half-piece's left side: a ray square to its record, leftwards from the middle
-    # of the record's first piece, across the cell's other records (both ways of every pair)
+    # of the record's first piece, across the cell's other records (both ways of every pair); in
+    # the pair's terms (a0, a1 the other's ends along the ray's record from the ray's start, n0, n1
+    # along the ray) it crosses where a0, a1 differ in sign and (a0 n1 - a1 n0) / (a0 - a1) > 0
     first = np.ones(nr)
-    has = k > 0
-    fq = optr[:-1][has]
+    fq = optr[:-1][k > 0]
     fx = occ_x[fq]
-    first[has] = np.where(ci[fx] == np.flatnonzero(has), cs[fx], cu[fx])
-    Mx, My = X0 + 0.5 * first * dX, Y0 + 0.5 * first * dY
+    first[k > 0] = np.where(on_j[fq], cu[fx], cs[fx])
+    L2 = dX * dX + dY * dY
+    dd = dxi * dxj + dyi * dyj
     cnt = np.zeros(nr, dtype=np.intp)
-    for a, b in ((i, j), (j, i)):  # the ray of a against record b
-        ax, ay = dX[a], dY[a]
-        a0 = (X0[b] - Mx[a]) * ax + (Y0[b] - My[a]) * ay
-        a1 = a0 + dX[b] * ax + dY[b] * ay
-        n0 = (Y0[b] - My[a]) * ax - (X0[b] - Mx[a]) * ay  # along the left normal (-ay, ax)
-        n1 = n0 + dY[b] * ax - dX[b] * ay
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cr = ((a0 > 0) != (a1 > 0)) & (n0 + a0 / (a0 - a1) * (n1 - n0) > 0)
+    for a, a0, n0, dn in ((i, ex * dxi + ey * dyi - 0.5 * first[i] * L2[i], -cei, den),
+                          (j, -(ex * dxj + ey * dyj) - 0.5 * first[j] * L2[j], cej, -den)):
+        a1 = a0 + dd
+        cr = ((a0 > 0) != (a1 > 0)) & ((a0 * (n0 + dn) - a1 * n0) * (a0 - a1) > 0)
         cnt += np.bincount(a[cr], minlength=nr)
-    par = np.empty(2 * n_sub, dtype=bool)
-    par[0::2] = ((cnt[sub_rec] + sub_t) & 1) == 1
-    par[1::2] = ~par[0::2]
-    h_cell = np.repeat(rcell[sub_rec], 2)
-    bad[h_cell[par[nxt] != par]] = True
+    # each piece's odd half: along it (its left odd) or against it (``back``); the pieces stand for
+    # their odd halves from here on
+    back = ((cnt[sub_rec] + sub_t) & 1) == 0
+    p_cell = rcell[sub_rec]
 
-    # the odd faces, labelled by pointer jumping (each by its least half-piece)
-    odd = np.flatnonzero(par & ~bad[h_cell])
-    li = np.full(2 * n_sub, -1, dtype=np.intp)
-    li[odd] = np.arange(len(odd))
-    nx = li[nxt[odd]]
-    lab = np.arange(len(odd))
+    # the next odd half round its face: at a crossing onto the other record, the way that turns
+    # left; at a record's end onto the partner record, away from that end.  It must be that
+    # record's odd half (``expect``): the parity and the faces agree, else the cell is left out
+    nxt = np.empty(n_sub, dtype=np.intp)
+    expect = np.empty(n_sub, dtype=bool)
+    at_x = np.where(back, sub_t > 0, mid)  # the head is a crossing
+    e = np.flatnonzero(at_x)
+    q = so[e] - back[e]
+    q2 = other[q]
+    turn = occ_turn[q]
+    nxt[e] = base[occ_rec[q2]] + occ_t[q2] + (turn != back[e])
+    expect[e] = turn == back[e]
+    e = np.flatnonzero(~at_x)
+    r = sub_rec[e]
+    pe = partner[2 * rec[r] + 1 - back[e]]
+    r2 = loc[pe >> 1]
+    start = (pe & 1) == 0
+    nxt[e] = np.where(start, base[r2], base[r2 + 1] - 1)
+    expect[e] = ~start
+    bad[p_cell[back[nxt] != expect]] = True
+
+    # the odd faces, labelled by pointer jumping (each by its least piece)
+    live = ~bad[p_cell]
+    nx = np.where(live, nxt, np.arange(n_sub))
+    lab = np.arange(n_sub)
     J = nx
-    while len(odd) and (lab[nx] != lab).any():
+    for _ in range(2 + int(np.log2(max(n_sub, 2)))):
+        if (lab[nx] == lab).all():
+            break
         lab = np.minimum(lab, lab[J])
         J = J[J]
     # convex: every turn left, turning once in all
-    hr = sub_rec[odd >> 1]
-    sg = np.where(odd & 1, -1.0, 1.0)
-    hx, hy = sg * dX[hr], sg * dY[hr]
+    hx, hy = np.where(back, -dX[sub_rec], dX[sub_rec]), np.where(back, -dY[sub_rec], dY[sub_rec])
     cross = hx * hy[nx] - hy * hx[nx]
     turn = np.arctan2(cross, hx * hx[nx] + hy * hy[nx])
-    once = np.abs(np.bincount(lab, weights=turn, minlength=len(odd)) - 2 * np.pi) < 1e-6
-    ok = once[lab] & (cross > 0)
-    bad[h_cell[odd[~ok]]] = True
+    once = np.abs(np.bincount(lab, weights=turn, minlength=n_sub) - 2 * np.pi) < 1e-6
+    bad[p_cell[~(once[lab] & (cross > 0)) & live]] = True
 
-    # corners: a piece's low end (its record's start, or the crossing before it) and high end
+    # corners: each odd half's tail, the crossing before it or its record's end; fanned from the
+    # tail of its face's least piece
     good_x = ~bad[rcell[ci]]
     xnum = np.cumsum(good_x) - 1 + n_vertices
-    occ_node = np.append(xnum[occ_x], -1)  # (padded: read where a piece ends at its record's end)
-    so = optr[sub_rec] + sub_t  # the occurrence at each piece's high end (if any)
-    lo_node = np.where(sub_t > 0, occ_node[so - 1], vid[p0[sub_rec]])
-    hi_node = np.where(sub_t < k[sub_rec], occ_node[so], vid[p1[sub_rec]])
-    tail = np.where(odd & 1, hi_node[odd >> 1], lo_node[odd >> 1])
-    head = np.where(odd & 1, lo_node[odd >> 1], hi_node[odd >> 1])
-    use = np.flatnonzero(~bad[h_cell[odd]] & (lab != np.arange(len(odd))) & (nx != lab))
-    tri = np.stack([tail[lab[use]], tail[use], head[use]], axis=1)
-    tcell = h_cell[odd[use]]
-    gi = ci[good_x]
-    P = pts[p0[gi]]
-    extra = P + cs[good_x, None] * (pts[p1[gi]] - P)
+    tq = so - 1 + back  # the crossing at the tail: the low end along, the high end against
+    at_t = np.where(back, mid, sub_t > 0)
+    tail = np.where(at_t, xnum[occ_x[np.minimum(tq, 2 * X - 1)]], vid[np.where(back, p1[sub_rec], p0[sub_rec])])
+    use = np.flatnonzero(~bad[p_cell] & (lab != np.arange(n_sub)) & (nx != lab))
+    tri = np.stack([tail[lab[use]], tail[use], tail[nx[use]]], axis=1)
+    tcell = p_cell[use]
+    gi = np.flatnonzero(good_x)
+    P = pts[p0[ci[gi]]]
+    extra = P + cs[gi, None] * (pts[p1[ci[gi]]] - P)
     if (bad & ~bad0).any():  # cells found bad after their crossings were taken: theirs too
         ii = np.flatnonzero(inner & (bad & ~bad0)[rcell[i]])
-        slab_x = (np.concatenate([slab_x[0], rcell[i[ii]]]), np.concatenate([slab_x[1], Y0[i[ii]] + s[ii] * dY[i[ii]]]))
+        slab_x = (np.concatenate([slab_x[0], rcell[i[ii]]]), np.concatenate([slab_x[1], Y0[i[ii]] + s[ii] * dyi[ii]]))
     return tri, tcell, extra, bad[rcell], slab_x

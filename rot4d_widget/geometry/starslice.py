@@ -170,34 +170,42 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     dfr = d[fr]
     tpos = np.einsum("ij,ij->i", pts[pk], dfr)
     tie = -side * np.einsum("ij,ij->i", dpdc[pk], dfr)
-    order = np.argsort(tpos)  # by face, then along its line: a float sort, then a stable (radix) one by face
-    order = order[np.argsort(fr[order].astype(np.uint16) if len(uf) < 65536 else fr[order], kind="stable")]
-    if (tpos[order[1:]] == tpos[order[:-1]]).any():  # equal positions (a vertex on H): ordered as it moves
-        order = np.lexsort((tie, tpos, fr))
+    if len(fk) == 2 * len(uf):  # every face cut twice (convex faces always are): each pair in order
+        t0, t1, z0, z1 = tpos[0::2], tpos[1::2], tie[0::2], tie[1::2]
+        swap = (t0 > t1) | ((t0 == t1) & (z0 > z1))
+        order = np.empty(len(fk), dtype=np.intp)
+        order[0::2] = np.arange(0, len(fk), 2) + swap
+        order[1::2] = order[0::2] ^ 1
+    else:  # by face, then along its line: a float sort, then a stable (radix) one by face
+        order = np.argsort(tpos)
+        order = order[np.argsort(fr[order].astype(np.uint16) if len(uf) < 65536 else fr[order], kind="stable")]
+        if (tpos[order[1:]] == tpos[order[:-1]]).any():  # equal positions (a vertex on H): ordered as it moves
+            order = np.lexsort((tie, tpos, fr))
     pk, delta = pk[order], delta[order]
     seg = pk.reshape(-1, 2)  # even-odd: 1st-2nd, 3rd-4th, ... of each face (counts are even)
     seg_face = uf[fr[0::2]]
     fcells = t.face_cells[seg_face]  # (ns, 2)
 
     # volume: winding-weighted stretches of every crossing face, in both its cells
-    W = np.cumsum(delta)
-    ptr = _ptr(cnt)
-    base = np.zeros(len(uf), dtype=W.dtype)
-    base[1:] = W[ptr[1:-1] - 1]
-    W = W - base[fr]
-    last = np.zeros(len(pk), dtype=bool)
-    last[ptr[1:] - 1] = True
-    i = np.flatnonzero(~last & (W != 0))
+    if len(fk) == 2 * len(uf):  # a face cut twice winds once round its one stretch, the segment
+        W0 = Wi = delta[0::2]
+        fi, P, Q = seg_face, pts[seg[:, 0]], pts[seg[:, 1]]
+    else:
+        W = np.cumsum(delta)
+        ptr = _ptr(cnt)
+        base = np.zeros(len(uf), dtype=W.dtype)
+        base[1:] = W[ptr[1:-1] - 1]
+        W = W - base[fr]
+        W0 = W[0::2]  # the winding along each segment
+        last = np.zeros(len(pk), dtype=bool)
+        last[ptr[1:] - 1] = True
+        i = np.flatnonzero(~last & (W != 0))
+        Wi, fi, P, Q = W[i], uf[fr[i]], pts[pk[i]], pts[pk[i + 1]]
     centre = vertices.mean(axis=0)
     anchor = np.zeros((t.C, 3))
     anchor[fcells.ravel()] = np.repeat(pts[seg[:, 0]], 2, axis=0) - centre
-    P, Q = pts[pk[i]] - centre, pts[pk[i + 1]] - centre
-    PxQ = _cross(P, Q)
-    fi = uf[fr[i]]
-    vol = 0.0
-    for j in (0, 1):
-        c = t.face_cells[fi, j]
-        vol += float((W[i] * st.face_rho[fi, j] * np.einsum("ij,ij->i", anchor[c], PxQ)).sum())
+    PxQ = _cross(P - centre, Q - centre)
+    vol = float((Wi[:, None] * st.face_rho[fi] * np.einsum("ijk,ik->ij", anchor[t.face_cells[fi]], PxQ)).sum())
     volume = vol / 6.0
 
     # cycles of each cell: chain the segments' ends at the crossing points (pointer jumping)
@@ -230,7 +238,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     # each cycle run the way its segments bound the cell's section (rho times the sign of the face's
     # winding along the segment: for faces winding at most once every segment then runs opposite
     # ways in its two cells' cycles); by signed area where they disagree (a star face), then by label
-    nat = (st.face_rho[seg_face] * np.sign(W[0::2])[:, None]).ravel()  # per (segment, cell) record
+    nat = (st.face_rho[seg_face] * np.sign(W0)[:, None]).ravel()  # per (segment, cell) record
     agree = np.where(((np.arange(n_end) & 1) == 1) == (nat[np.arange(n_end) >> 1] > 0), 1.0, -1.0)
     rev_lab = lab[np.arange(n_end) ^ 1]
     score = np.bincount(lab, weights=agree, minlength=n_end)
