@@ -1,4 +1,5 @@
-"""The even-odd fill of a cell's section by its arrangement: the general slicer's fast fill.
+"""The even-odd fill of a cell's section by its segments' arrangement: the general slicer's fill
+for sections whose cycles cross.
 
 `rot4d_widget.geometry.starslice` cuts a non-convex cell into segments (one per stretch of a face's
 line inside the face) that chain into cycles; where the cycles cross, the section is their
@@ -6,30 +7,34 @@ line inside the face) that chain into cycles; where the cycles cross, the sectio
 segments' *arrangement*.  Its faces (the pieces of the plane the split segments bound) are
 alternately inside and outside (crossing any piece of a segment flips the parity), so the region
 is the disjoint union of its odd faces, which touch only at crossings.  Here, vectorised over
-every cell at once:
+every cell at once (no Python loop over geometry):
 
-* **crossings**: every pair of a cell's segments (rows of a padded table, as in `_pairs`),
-  crossing inside both; each crossing is one new corner (`Slice.n_fill`);
+* **crossings**: every pair of a cell's segments (rows of a padded table), crossing inside both;
+  each crossing is one new corner (`Slice.n_fill`);
 * **pieces**: each segment split at its crossings, in order along it (one float sort);
-* **faces**: a half-piece (a piece run one way, its face on the left) goes on, at a crossing, along
-  the other segment, the way that turns left (the sign of the two directions' cross product: no
-  sort by angle round a point), and at a segment's end along the other segment ending there in
-  the cell (the cycles' pairing); faces are labelled by pointer jumping, only the odd ones;
-* **parity**: a half-piece's left side is odd when a ray from its segment's first piece, square to
-  it on its left, crosses an odd number of the cell's other segments, each crossing along the
-  segment flipping it.  Every half-piece and the next must agree (a check of the whole
-  construction; a cell where they do not, or a crossing near a segment's end, goes to the slab
-  fill instead);
+* **parity**: a ray square to a segment, leftwards from the middle of its first piece, crosses the
+  cell's other segments an odd or even number of times: the parity on that piece's left; each
+  crossing along the segment flips it.  So exactly one way along each piece has the odd face on
+  its left (its *odd half*): from here on a piece stands for its odd half;
+* **faces**: an odd half goes on, at a crossing, along the other segment the way that turns left
+  (the sign of the two directions' cross product: no sort by angle round a point), and at a
+  segment's end along the other segment ending there in the cell (the cycles' pairing).  That
+  next piece's odd half must run that way (the parity and the faces agree: a check of the whole
+  construction); the faces are labelled by pointer jumping (each by its least piece);
 * **triangles**: an odd face that is a convex polygon (every turn left, turning once) is fanned
-  from its first corner, counter-clockwise about the cell's normal like its boundary; a cell with
-  any other odd face (a reflex corner, a hole, a pinch) goes to the slab fill.
+  from its first corner, counter-clockwise about the cell's normal like its boundary.
 
-The fill's corners are the section's points and the crossings: no corner where a slab line
-would cut a segment, and triangles about (segments + crossings) per cell, against slabs x
-segments for the slab fill.
+A cell whose segments do not cross (its cycles apart or nested: a hole is no convex face), where
+a crossing falls within `_EPS` of a segment's end, or where any check fails or any odd face is
+not convex, is left whole to the slab fill (`starslice._slabs`), with the crossings found here.
+The fill's corners are the section's points and the crossings: none where a slab line would cut
+a segment, and about (segments + crossings) triangles a cell, against slabs x segments for the
+slab fill.
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 
@@ -41,6 +46,15 @@ __all__: list = []
 _EPS = 1e-9  # a crossing this close (in segment parameter) to a segment's end: the cell goes to the slab fill
 
 
+@functools.lru_cache(maxsize=64)
+def _upper(n: int) -> tuple:
+    """``np.triu_indices(n, 1)``, read-only and kept (it costs more than the table it indexes)."""
+    iu, ju = np.triu_indices(n, 1)
+    iu.flags.writeable = False
+    ju.flags.writeable = False
+    return iu, ju
+
+
 def _pairs(rcell, n_cells):
     """Every pair of records of one cell: ((k,) i, (k,) j), i before j in the cell's row of a padded table."""
     o = np.argsort(rcell.astype(np.uint16) if n_cells < 65536 else rcell, kind="stable")
@@ -48,7 +62,7 @@ def _pairs(rcell, n_cells):
     start = _ptr(cnt)[:-1]
     table = np.full((n_cells, int(cnt.max(initial=0))), -1, dtype=np.intp)
     table[rcell[o], np.arange(len(o)) - start[rcell[o]]] = o
-    iu, ju = np.triu_indices(table.shape[1], 1)
+    iu, ju = _upper(table.shape[1])
     i, j = table[:, iu].ravel(), table[:, ju].ravel()
     ok = j >= 0  # (a row's entries are packed to the left)
     return i[ok], j[ok]
@@ -64,7 +78,8 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     cell's plane, n_vertices the number of the first new corner.
 
     Returns ((k, 3) triangles, (k,) their cells, (x, 3) new corners numbered from ``n_vertices``,
-    (r,) bool: the records whose cell was not filled here, for the slab fill).
+    (r,) bool: the records whose cell was not filled here, ((m,) cells, (m,) heights v): where
+    those cells' segments cross, in `starslice._slabs`' frame (`_inplane_axes` about ``anchor``)).
     """
     nr = len(rec)
     C = len(normals)

@@ -14,12 +14,16 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
   edge), each run the way the boundary's orientation runs its segments (so a segment runs opposite
   ways in its two cells' cycles, as on a convex polytope's slice); where a star face's segments
   disagree about it, the way that winds counter-clockwise about the cell's outward normal;
-* **triangles**: a convex cell's one cycle is fanned as before; any other cell's cycles are filled
-  by the even-odd rule with a slab decomposition (the plane cut into slabs at the corners'
-  heights, the segments crossing each slab paired left to right into trapezoids), vectorised over
-  every slab of every cell.  A trapezoid's corners off the segments' ends are extra vertices,
-  appended after the slice's points (`Slice.n_fill` says how many); a non-convex polygon is never
-  fanned;
+* **triangles**: a convex cell's one cycle is fanned as before; a non-convex cell's section whose
+  cycles are each star-shaped round their corners' centroid (and apart) is fanned from those
+  centroids; a section of cycles that cross is filled even-odd from its segments' arrangement
+  (`rot4d_widget.geometry.starfill`: its odd faces, convex, fanned; the crossings are the new
+  corners); any other section (nested cycles, a polygon star-shaped round no such point, an odd
+  face that is not convex) by the even-odd rule with a slab decomposition (the plane cut into
+  slabs at the corners' and crossings' heights, the segments crossing each slab paired left to
+  right into trapezoids), vectorised over every slab of every cell.  Centroids, crossings and
+  trapezoid corners off the segments' ends are extra vertices, appended after the slice's points
+  (`Slice.n_fill` says how many); a non-convex polygon is never fanned from a corner;
 * **volume**: winding-weighted, ``(1/6) sum over cells, faces, stretches k of rho * W_k *
   det(a_c, p_k, p_k+1)``, where W_k is the number of times the face winds round the stretch
   p_k -> p_k+1 of its line (the running sum of the +-1 its sides add where they cross H), rho the
@@ -46,7 +50,7 @@ from ..core import tolerances as tol_
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
-from .starfill import arrangement_fill
+from .starfill import _upper, arrangement_fill
 
 __all__: list = []
 
@@ -363,12 +367,12 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
     cnt = counts[cand]
     off = _ptr(cnt)
     P = vertices[flat[sel]]
-    cen = np.stack([np.bincount(q, weights=P[:, i], minlength=len(cnt)) for i in range(3)], axis=1) / cnt[:, None]
+    cen = np.add.reduceat(P, off[:-1], axis=0) / cnt[:, None]  # (each polygon's corners are together)
     nxt = np.arange(1, len(q) + 1)
     nxt[off[1:] - 1] = off[:-1]
     rel = P - cen[q]
     n = normals[cell_ids[cand]]
-    n = (n * (1 / np.sqrt(np.einsum("ij,ij->i", n, n)))[:, None])[q]
+    n = (n / np.sqrt(np.einsum("ij,ij->i", n, n))[:, None])[q]
     y = np.einsum("ij,ij->i", _cross(rel, rel[nxt]), n)
     ang = np.arctan2(y, np.einsum("ij,ij->i", rel, rel[nxt]))
     once = np.abs(np.abs(np.bincount(q, weights=ang, minlength=len(cnt))) - 2 * np.pi) < 1e-6
@@ -385,7 +389,7 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
         k = np.bincount(mc, minlength=C)
         table = np.full((C, int(k.max())), -1, dtype=np.intp)
         table[mc[o], np.arange(len(o)) - _ptr(k)[:-1][mc[o]]] = o
-        iu, ju = np.triu_indices(table.shape[1], 1)
+        iu, ju = _upper(table.shape[1])
         i, j = table[:, iu].ravel(), table[:, ju].ravel()
         i, j = i[j >= 0], j[j >= 0]
         meet = ((lo[i] <= hi[j]) & (lo[j] <= hi[i])).all(axis=1)
@@ -489,7 +493,7 @@ def _crossings(rcell, Xl, Yl, Xh, Yh):
     start = _ptr(cnt)[:-1]
     table = np.full((len(cnt), int(cnt.max(initial=0))), -1, dtype=np.intp)
     table[rcell[o], np.arange(len(o)) - start[rcell[o]]] = o
-    iu, ju = np.triu_indices(table.shape[1], 1)
+    iu, ju = _upper(table.shape[1])
     i, j = table[:, iu].ravel(), table[:, ju].ravel()
     ok = j >= 0  # (a row's entries are packed to the left)
     i, j = i[ok], j[ok]
