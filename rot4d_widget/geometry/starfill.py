@@ -137,12 +137,13 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     other[pos[X:]] = pos[:X]
     k = np.bincount(occ_rec, minlength=nr)
     optr = _ptr(k)
-    occ_t = np.arange(2 * X) - optr[occ_rec]  # its rank along its record
     base = _ptr(k + 1)  # record r's pieces base[r] .. base[r] + k[r]
     n_sub = int(base[-1])
     sub_rec = np.repeat(np.arange(nr), k + 1)
     sub_t = np.arange(n_sub) - base[sub_rec]
-    so = optr[sub_rec] + sub_t  # the occurrence at each piece's high end (if it ends at a crossing)
+    # (base[r] = optr[r] + r: occurrence q sits at the high end of piece q + its record, and piece e
+    # ends at occurrence e - its record if it ends at a crossing)
+    so = np.arange(n_sub) - sub_rec
     mid = sub_t < k[sub_rec]  # piece e ends at a crossing (else at its record's end 1)
 
     # parity of each half-piece's left side: a ray square to its record, leftwards from the middle
@@ -176,7 +177,7 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     q = so[e] - back[e]
     q2 = other[q]
     turn = occ_turn[q]
-    nxt[e] = base[occ_rec[q2]] + occ_t[q2] + (turn != back[e])
+    nxt[e] = q2 + occ_rec[q2] + (turn != back[e])
     expect[e] = turn == back[e]
     e = np.flatnonzero(~at_x)
     r = sub_rec[e]
@@ -215,8 +216,9 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     tri = np.stack([tail[lab[use]], tail[use], tail[nx[use]]], axis=1)
     tcell = p_cell[use]
     gi = np.flatnonzero(good_x)
-    P = pts[p0[ci[gi]]]
-    extra = P + cs[gi, None] * (pts[p1[ci[gi]]] - P)
+    cg = ci[gi]
+    R0 = pts[p0]
+    extra = np.take(R0, cg, axis=0) + cs[gi, None] * np.take(pts[p1] - R0, cg, axis=0)
     if (bad & ~bad0).any():  # cells found bad after their crossings were taken: theirs too
         ii = np.flatnonzero(inner & (bad & ~bad0)[rcell[i]])
         slab_x = (np.concatenate([slab_x[0], rcell[i[ii]]]), np.concatenate([slab_x[1], Y0[i[ii]] + s[ii] * dyi[ii]]))
