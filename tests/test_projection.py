@@ -194,7 +194,8 @@ import { readFileSync } from "node:fs";
 const m = await import(pathToFileURL(process.argv[2]).href);
 const cases = JSON.parse(readFileSync(0, "utf8"));
 const out = cases.map(({ skeleton, state }) => {
-  const sk = { ...skeleton, vertices: Buffer.from(skeleton.vertices, "base64"), edges: Buffer.from(skeleton.edges, "base64") };
+  const sk = { ...skeleton, vertices: Buffer.from(skeleton.vertices, "base64"),
+               edges: Buffer.from(skeleton.edges, "base64") };
   const r = m.projectSkeleton(m.decodeSkeleton(sk), state);
   return r && { positions: Array.from(r.positions), rgb: Array.from(r.rgb), index: Array.from(r.index),
                 points: Array.from(r.points) };

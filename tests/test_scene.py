@@ -17,8 +17,6 @@ import pathlib
 import re
 
 import numpy as np
-
-from rot4d_widget.core.rotation import random_rotation
 import pytest
 import pythreejs as p3
 from ipywidgets.widgets import widget as ipywidget_module
@@ -26,9 +24,10 @@ from ipywidgets.widgets import widget as ipywidget_module
 import rot4d_widget
 from rot4d_widget import buffers as bf
 from rot4d_widget import look, polytope
+from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
-from rot4d_widget.view.scene import Scene, shader_source
 from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.view.scene import Scene, shader_source
 
 #: The shipped GLSL files (package data).
 GLSL = pathlib.Path(rot4d_widget.__file__).parent / "view" / "glsl"

@@ -631,9 +631,11 @@ async function render({ model, el }) {
             set(g.lines.index, out.index);
             set(g.points.attributes.position, out.points);
           }
-          lo.visible = !!out && out.index.length > 0;
-          po.visible = !!out && out.points.length > 0;
         }
+        // every frame: an object pythreejs rebuilt from its model comes back with its placeholder
+        const out = g.result;
+        lo.visible = !!out && out.index.length > 0;
+        po.visible = !!out && out.points.length > 0;
         if (lo.geometry !== g.lines) lo.geometry = g.lines;
         if (po.geometry !== g.points) po.geometry = g.points;
       };

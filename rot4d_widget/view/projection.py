@@ -4,7 +4,7 @@
 It shows the source's skeleton -- a polytope's edges, a field's data box (a tesseract: 16
 corners, 32 edges) -- rotated by the same matrix as the slice and projected to 3-D, its edges
 coloured by w on a diverging map (blue below the hyperplane w = c0, grey on it, red above),
-and the points where the hyperplane cuts the edges (the slice's points) as yellow balls.  A
+and the points where the hyperplane cuts the edges (the slice's points) as orange points.  A
 stack (parallel slices) marks every slice's crossings.
 
 **Which projection, and why.**  A perspective projection from the point (0, 0, 0, d) on the
@@ -25,10 +25,11 @@ skeleton (`skeleton_message`: vertices (V, 4) float64, edges (E, 2) uint32, d, s
 colours); per update only the state (`state_message`: the 4x4 matrix, the hyperplanes' offsets and
 the middle one) -- as fields of the slice view's own update message (the scene's row buffer,
 `rot4d_widget.view.scene.Scene.show` / ``turn`` with ``projection=``), so a held key costs no
-second widget message and both canvases change from the same message: they never show
-different states.  The companion (``companion.js``: ``decodeSkeleton``, ``projectSkeleton``)
-rotates, projects, colours and finds the crossings in the page, as `projection_arrays` does here,
-and writes them into the projection's own three.js geometries.  The geometry functions
+second widget message, and both canvases are updated from the same message, in the same task
+of the page: neither gets a state the other does not.  The companion (``companion.js``:
+``decodeSkeleton``, ``projectSkeleton``) rotates, projects, colours and finds the crossings in
+the page, as `projection_arrays` does here, and writes them into the projection's own three.js
+geometries.  The geometry functions
 (`skeleton`, `hyperplane_offsets`, `perspective`, `crossings`, `w_colours`, `projection_arrays`)
 need no browser: they serve static pictures and exports, and are the reference the page's
 arrays are tested against (tests/test_projection.py under Node, the browser suite in the page).
