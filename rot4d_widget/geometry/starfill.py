@@ -21,7 +21,8 @@ every cell at once (no Python loop over geometry):
   segment's end along the other segment ending there in the cell (the cycles' pairing).  That
   next piece's odd half must run that way (the parity and the faces agree: a check of the whole
   construction); the faces are labelled by pointer jumping (each by its least piece);
-* **triangles**: an odd face that is a convex polygon (every turn left, turning once) is fanned
+* **triangles**: an odd face that is a convex polygon (every turn left, its heading passing any
+  one direction once) is fanned
   from its first corner, counter-clockwise about the cell's normal like its boundary.
 
 A cell whose segments do not cross (its cycles apart or nested: a hole is no convex face), where
@@ -198,11 +199,12 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
             break
         lab = np.minimum(lab, lab[J])
         J = J[J]
-    # convex: every turn left, turning once in all
+    # convex: every turn left (by less than a half turn), turning once in all: the heading passes
+    # the direction +u once (from below the u axis to on or above it)
     hx, hy = np.where(back, -dX[sub_rec], dX[sub_rec]), np.where(back, -dY[sub_rec], dY[sub_rec])
-    cross = hx * hy[nx] - hy * hx[nx]
-    turn = np.arctan2(cross, hx * hx[nx] + hy * hy[nx])
-    once = np.abs(np.bincount(lab, weights=turn, minlength=n_sub) - 2 * np.pi) < 1e-6
+    hy2 = hy[nx]
+    cross = hx * hy2 - hy * hx[nx]
+    once = np.bincount(lab, weights=(hy < 0) & (hy2 >= 0), minlength=n_sub) == 1
     bad[p_cell[~(once[lab] & (cross > 0)) & live]] = True
 
     # corners: each odd half's tail, the crossing before it or its record's end; fanned from the
