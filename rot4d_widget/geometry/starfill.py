@@ -22,8 +22,8 @@ every cell at once (no Python loop over geometry):
   next piece's odd half must run that way (the parity and the faces agree: a check of the whole
   construction); the faces are labelled by pointer jumping (each by its least piece);
 * **triangles**: an odd face that is a convex polygon (every turn left, its heading passing any
-  one direction once) is fanned
-  from its first corner, counter-clockwise about the cell's normal like its boundary.
+  one direction once) is fanned from its first corner, counter-clockwise about the cell's
+  normal like its boundary.
 
 A cell whose segments do not cross (its cycles apart or nested: a hole is no convex face), where
 a crossing falls within `_EPS` of a segment's end, or where any check fails or any odd face is
