@@ -1,6 +1,6 @@
 // rot4d_widget companion (anywidget ES module, no build step).
 //
-// Four jobs for one Scene, per displayed view of this invisible widget (job 1 also
+// Jobs for one Scene, per displayed view of this invisible widget (job 1 also
 // applies, as it arrives, what travels with each update: the rows each layer draws,
 // `_rot4d_counts`, and a 3-D turn of the whole view, `_rot4d_turn`; and it stops the
 // page from sending the row buffer's three.js `version` back after every update):

@@ -2,7 +2,7 @@
 
 An invisible widget (display it next to the scene's renderer, e.g. in the
 same box) whose module, ``companion.js``, ships in the package (no build
-step) and does four things in JupyterLab 4 and Notebook 7 alike:
+step) and does these things in JupyterLab 4 and Notebook 7 alike:
 
 1. **drawn acknowledgement** -- after the page has *rendered* a frame
    containing the latest buffer assignment (not merely on arrival): at the
