@@ -69,6 +69,8 @@ class _StarTables:
         self.face_rho = st.pair_rho[order].reshape(-1, 2).astype(np.float64)  # aligned with p.face_cells
         self.face_basis = st.face_basis
         self.cell_convex = st.cell_convex
+        # no star face: fill the crossing sections first (see `_cut`; only the speed depends on it)
+        self.crossing_first = not np.any(st.face_star)
         # each (face side k, cell j of the face) slot 2k + j: the slot of the other face of that cell
         # at that edge (a closed cell has two faces at each of its edges), -1 where it has not one
         E = len(p.edges)
@@ -302,40 +304,53 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     ftri, fpoly = _fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
     tri = [ftri]
     tcell = [cell_ids[conv][fpoly]]
-    turn, centroid = _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, t.C, conv)
-    sp = np.flatnonzero(turn)
-    done = np.zeros(t.C, dtype=bool)
-    extra = [centroid[sp]]
-    if len(sp):
-        done[cell_ids[sp]] = True
-        rank = np.full(len(counts), -1, dtype=np.intp)
-        rank[sp] = len(vertices) + np.arange(len(sp))
-        nxt = np.arange(1, len(flat) + 1)
-        nxt[offsets[1:] - 1] = offsets[:-1]
-        j = np.flatnonzero(turn[pid])
-        ccw = turn[pid[j]] > 0
-        tri.append(np.stack([rank[pid[j]], np.where(ccw, flat[j], flat[nxt[j]]),
-                             np.where(ccw, flat[nxt[j]], flat[j])], axis=1))
-        tcell.append(cell_ids[pid[j]])
-    gen = ~(st.cell_convex[rec_cell] | done[rec_cell])
-    g = np.flatnonzero(gen)
-    n_new = len(vertices) + len(sp)
-    if len(g) and not on.any():  # by the segments' arrangement; what it cannot fill, by slabs
-        atri, ac, ax, rest, xings = arrangement_fill(g, rec_cell[g], end_pt, partner, pts, vid, normals,
-                                                     anchor + centre, n_new)
-        tri.append(atri)
-        tcell.append(ac)
-        extra.append(ax)
-        n_new += len(ax)
-        g = g[rest]
-    else:
-        xings = None
+    # the sections of crossing cycles by the segments' arrangement, the others star-shaped round
+    # centroids by fans, the rest by slabs.  The first two take disjoint cells (crossing cycles
+    # are never star-shaped apart), so their order is only for speed: with convex faces (and star
+    # cells) most sections cross, and the arrangement goes first; with star faces most are
+    # star-shaped tips, and the fans go first
+    g = np.flatnonzero(~st.cell_convex[rec_cell])
+    n_new = len(vertices)
+    extra = []
+    xings = None
+    for step in ("arrangement", "fans") if st.crossing_first else ("fans", "arrangement"):
+        if step == "fans":
+            filled = np.zeros(t.C, dtype=bool)
+            filled[rec_cell] = True
+            filled[rec_cell[g]] = False  # (cells filled already, or convex)
+            turn, centroid = _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, t.C,
+                                         conv | filled[cell_ids])
+            sp = np.flatnonzero(turn)
+            if not len(sp):
+                continue
+            done = np.zeros(t.C, dtype=bool)
+            done[cell_ids[sp]] = True
+            rank = np.full(len(counts), -1, dtype=np.intp)
+            rank[sp] = n_new + np.arange(len(sp))
+            nxt = np.arange(1, len(flat) + 1)
+            nxt[offsets[1:] - 1] = offsets[:-1]
+            j = np.flatnonzero(turn[pid])
+            ccw = turn[pid[j]] > 0
+            tri.append(np.stack([rank[pid[j]], np.where(ccw, flat[j], flat[nxt[j]]),
+                                 np.where(ccw, flat[nxt[j]], flat[j])], axis=1))
+            tcell.append(cell_ids[pid[j]])
+            extra.append(centroid[sp])
+            n_new += len(sp)
+            g = g[~done[rec_cell[g]]]
+        elif len(g) and not on.any():
+            atri, ac, ax, rest, xings = arrangement_fill(g, rec_cell[g], end_pt, partner, pts, vid, normals,
+                                                         anchor + centre, n_new)
+            tri.append(atri)
+            tcell.append(ac)
+            extra.append(ax)
+            n_new += len(ax)
+            g = g[rest]
     if len(g):
         ttri, tc, sx = _slabs(rec_cell[g], seg[rec_seg[g]], pts, vid, normals, anchor + centre, n_new, xings)
         tri.append(ttri)
         tcell.append(tc)
         extra.append(sx)
-    extra = np.concatenate(extra)
+    extra = np.concatenate(extra) if extra else t.empty3
     triangles = np.concatenate(tri)
     triangle_cells = np.concatenate(tcell)
     all_v = np.concatenate([vertices, extra]) if len(extra) else vertices
