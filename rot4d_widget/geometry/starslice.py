@@ -170,30 +170,36 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     cnt = np.diff(np.append(np.flatnonzero(newf), len(fk)))
     if (cnt % 2).any():
         raise _Inconsistent
-    rb = st.face_basis[uf] @ m.T  # (nf, 2, 4) each face's plane, rotated
+    rb = (st.face_basis[uf].reshape(-1, 4) @ m.T).reshape(-1, 2, 4)  # (nf, 2, 4) each face's plane, rotated
     d = rb[:, 1, :3] * rb[:, 0, 3:4] - rb[:, 0, :3] * rb[:, 1, 3:4]  # the line's direction (J grad w)
-    fr = np.repeat(np.arange(len(uf)), cnt)
-    dfr = d[fr]
-    tpos = np.einsum("ij,ij->i", pts[pk], dfr)
-    tie = -side * np.einsum("ij,ij->i", dpdc[pk], dfr)
-    if len(fk) == 2 * len(uf):  # every face cut twice (convex faces always are): each pair in order
-        t0, t1, z0, z1 = tpos[0::2], tpos[1::2], tie[0::2], tie[1::2]
-        swap = (t0 > t1) | ((t0 == t1) & (z0 > z1))
+    two = len(fk) == 2 * len(uf)  # every face cut twice (convex faces always are)
+    if two:  # each pair in order along its line; equal positions (a vertex on H) as they move
+        t0, t1 = np.einsum("ij,ij->i", pts[pk[0::2]], d), np.einsum("ij,ij->i", pts[pk[1::2]], d)
+        swap = t0 > t1
+        eq = np.flatnonzero(t0 == t1)
+        if len(eq):
+            z = -side * np.einsum("ijk,ik->ij", dpdc[pk.reshape(-1, 2)[eq]], d[eq])
+            swap[eq] = z[:, 0] > z[:, 1]
         order = np.empty(len(fk), dtype=np.intp)
         order[0::2] = np.arange(0, len(fk), 2) + swap
         order[1::2] = order[0::2] ^ 1
+        fr = None
     else:  # by face, then along its line: a float sort, then a stable (radix) one by face
+        fr = np.repeat(np.arange(len(uf)), cnt)
+        dfr = d[fr]
+        tpos = np.einsum("ij,ij->i", pts[pk], dfr)
         order = np.argsort(tpos)
         order = order[np.argsort(fr[order].astype(np.uint16) if len(uf) < 65536 else fr[order], kind="stable")]
         if (tpos[order[1:]] == tpos[order[:-1]]).any():  # equal positions (a vertex on H): ordered as it moves
+            tie = -side * np.einsum("ij,ij->i", dpdc[pk], dfr)
             order = np.lexsort((tie, tpos, fr))
     pk, delta = pk[order], delta[order]
     seg = pk.reshape(-1, 2)  # even-odd: 1st-2nd, 3rd-4th, ... of each face (counts are even)
-    seg_face = uf[fr[0::2]]
+    seg_face = uf if two else uf[fr[0::2]]
     fcells = t.face_cells[seg_face]  # (ns, 2)
 
     # volume: winding-weighted stretches of every crossing face, in both its cells
-    if len(fk) == 2 * len(uf):  # a face cut twice winds once round its one stretch, the segment
+    if two:  # a face cut twice winds once round its one stretch, the segment
         W0 = Wi = delta[0::2]
         fi, P, Q = seg_face, pts[seg[:, 0]], pts[seg[:, 1]]
     else:
