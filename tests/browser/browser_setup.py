@@ -138,6 +138,27 @@ class JupyterServer:
             return f"{self.url}/lab/tree/{name}?token={self.token}&reset"
         return f"{self.url}/notebooks/{name}?token={self.token}"
 
+    def _api(self, method: str, path: str):
+        req = urllib.request.Request(f"{self.url}/api/{path}", method=method,
+                                     headers={"Authorization": f"token {self.token}"})
+        with urllib.request.urlopen(req, timeout=30) as r:
+            body = r.read()
+        return json.loads(body) if body else None
+
+    def kernels(self) -> list:
+        """The ids of the kernels running on this server."""
+        return [k["id"] for k in self._api("GET", "kernels")]
+
+    def shutdown_kernels(self) -> int:
+        """Shut down every session and kernel (a closed page leaves its kernel running, widgets,
+        tickers and all, and the server buffers what it sends): how many kernels there were."""
+        n = len(self.kernels())
+        for s in self._api("GET", "sessions"):
+            self._api("DELETE", f"sessions/{s['id']}")
+        for k in self.kernels():
+            self._api("DELETE", f"kernels/{k}")
+        return n
+
     def stop(self) -> None:
         if self.proc and self.proc.poll() is None:
             self.proc.terminate()

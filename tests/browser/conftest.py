@@ -87,6 +87,15 @@ def page(browser_context):
     yield pg
 
 
+@pytest.fixture(autouse=True)
+def _fresh_kernels(request):
+    """After each test on a server (its page closed), shut its kernels down: each test starts from
+    a fresh kernel, and none left running (a notebook's widgets, a ticker) loads the tests after."""
+    yield
+    if "jupyter_server" in request.fixturenames:
+        request.getfixturevalue("jupyter_server").shutdown_kernels()
+
+
 @pytest.fixture(scope="session")
 def artifacts() -> pathlib.Path:
     ARTIFACTS.mkdir(exist_ok=True)
