@@ -338,17 +338,33 @@ async function render({ model, el }) {
   };
 
   // 1. drawn acknowledgement, drawn counts, 3-D turn
+  // Where this stands, on the (hidden) element for whoever inspects the page: the scene's
+  // models still awaited (their ids), "attached", or why not.
+  const waiting = new Set();
+  const status = (text) => {
+    el.dataset.rot4dCompanion = text;
+  };
+  const awaited = (manager, id, isAlive) => {
+    waiting.add(id);
+    status("waiting for models " + [...waiting].join(" "));
+    return getModel(manager, id, isAlive).then((m) => {
+      waiting.delete(id);
+      status(waiting.size ? "waiting for models " + [...waiting].join(" ") : "models found");
+      return m;
+    });
+  };
   try {
     const manager = model.widget_manager;
     const isAlive = () => alive;
     const ids = (name) => (model.get(name) || []).map(modelId);
     const [buffer, scene, geometries, meshes, textures] = await Promise.all([
-      getModel(manager, modelId(model.get("buffer_model_id")), isAlive),
-      getModel(manager, modelId(model.get("scene_model_id")), isAlive),
-      Promise.all(ids("geometry_model_ids").map((id) => getModel(manager, id, isAlive))),
-      Promise.all(ids("mesh_model_ids").map((id) => getModel(manager, id, isAlive))),
-      Promise.all(ids("texture_model_ids").map((id) => getModel(manager, id, isAlive))),
+      awaited(manager, modelId(model.get("buffer_model_id")), isAlive),
+      awaited(manager, modelId(model.get("scene_model_id")), isAlive),
+      Promise.all(ids("geometry_model_ids").map((id) => awaited(manager, id, isAlive))),
+      Promise.all(ids("mesh_model_ids").map((id) => awaited(manager, id, isAlive))),
+      Promise.all(ids("texture_model_ids").map((id) => awaited(manager, id, isAlive))),
     ]);
+    status(alive ? "attached" : "removed");
     if (alive) {
       // The kernel owns the row buffer's state.  pythreejs would send the three.js buffer's
       // `version` back after every update (syncToModel -> save_changes): one more message
@@ -892,6 +908,7 @@ async function render({ model, el }) {
       cleanups.push(() => model.off("msg:custom", onMessage));
     }
   } catch (e) {
+    status("failed: " + String(e));
     console.warn("rot4d_widget companion: scene models not found; no drawn acknowledgements", e);
   }
   return cleanup;

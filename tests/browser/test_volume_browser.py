@@ -72,7 +72,11 @@ def _page_state(jp):
         "(cls) => { const c = document.querySelector('.' + cls + ' canvas'); if (!c) return 'no canvas';"
         " const gl = c.getContext('webgl'); return {w: c.width, h: c.height,"
         " lost: gl ? gl.isContextLost() : null}; }", sel)
-    return {"canvas": gl, "stats": jp.canvas_stats(f".{sel} canvas"), "console": jp.page.console_messages[-12:],
+    companions = jp.page.evaluate(
+        "() => Array.from(document.querySelectorAll('[data-rot4d-companion]'), (e) => e.dataset.rot4dCompanion)")
+    rot4d = [m for m in jp.page.console_messages if "rot4d" in m[1]][-6:]
+    return {"companions": companions, "rot4d console": rot4d, "canvas": gl, "stats": jp.canvas_stats(f".{sel} canvas"),
+            "console": jp.page.console_messages[-12:],
             "errors": jp.page.page_errors[-5:]}
 
 
