@@ -342,7 +342,7 @@ async function render({ model, el }) {
   // models still awaited (their ids), "attached", or why not.
   const waiting = new Set();
   const status = (text) => {
-    el.dataset.rot4dCompanion = text;
+    if (el && el.dataset) el.dataset.rot4dCompanion = text;
   };
   const awaited = (manager, id, isAlive) => {
     waiting.add(id);
