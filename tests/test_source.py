@@ -233,3 +233,27 @@ def test_display_traits_reach_the_scene_and_color_by_repaints_the_faces(make):
     service(w, w._pump.clock() + 1.0)
     rows = buffer_rows(w)
     assert set(rows[:nt, 19].tolist()) == {float(0xFF0000)}
+
+
+class SlowTube(Tube):
+    """A Tube whose slice takes a while (a big field's would): the ticker thread is mid-send for long."""
+
+    def slice(self, matrix, c0):
+        import time
+
+        time.sleep(0.15)
+        return super().slice(matrix, c0)
+
+
+def test_press_from_code_returns_once_its_step_is_in_the_readout():
+    # the real ticker thread: with a slow slice, the send it computes outside the lock is under way
+    # when `press` has flushed; `press` waits for it, so the readout read next shows the new c0
+    w = Rot4DWidget(SlowTube())
+    try:
+        for key, want in (("l", 1), ("l", 2), ("h", 1)):
+            assert w.press(key)
+            c0 = w.c0
+            assert c0 == pytest.approx(want * w.state.c0_step)
+            assert f"{c0:.4f}" in w.readout.value, (c0, w.readout.value)
+    finally:
+        w.close()

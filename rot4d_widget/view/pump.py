@@ -194,6 +194,29 @@ class UpdatePump:
                 return
             self._flush(self.clock() if now is None else now)
 
+    def wait_sent(self, timeout: float = 60.0) -> bool:
+        """From code on another thread than the ticker's: wait until the latest state has left
+        (True), or flow control holds it (updates in flight await the page), or ``timeout`` seconds
+        passed (False).  The ticker thread computes a send outside the lock, so without this a
+        caller could read the widget (its readout, its buffers) before the update it asked for."""
+        if not self.autotick or threading.current_thread() is self._thread:
+            return not self._dirty
+        end = time.monotonic() + timeout
+        while True:
+            with self.lock:
+                if self._closed or not (self._dirty or self._sending):
+                    return not self._dirty
+                if not self._sending and not self._failed and len(self._flight) >= self.max_in_flight:
+                    oldest = next(iter(self._flight.values()))
+                    if self.clock() - oldest < self.timeout:
+                        return False  # held by flow control: sent when the page answers
+                if self._failed:
+                    return False  # the send raised: reported, retried on the next key
+                self.wake()
+            if time.monotonic() > end:
+                return False
+            time.sleep(0.002)
+
     def _may_send(self, now) -> bool:
         """Flow control: True if an update may leave now (gives up the oldest after the timeout)."""
         if self._sending:

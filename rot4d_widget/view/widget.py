@@ -281,11 +281,7 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             return self._painter.current_slice()
 
-    @property
-    def stats(self):
-        """Counters of the update pump (`rot4d_widget.view.pump.PumpStats`): ``updates`` sent, ``acks``
-        and the updates they ``acknowledged``, ``timeouts``."""
-        return self._pump.stats
+    stats = property(lambda self: self._pump.stats, doc="Counters of the update pump (`pump.PumpStats`).")
 
     @property
     def held_keys(self) -> tuple:
@@ -310,7 +306,8 @@ class Rot4DWidget(widgets.HBox):
         self.help_panel.layout.display = None if value else "none"
 
     def press(self, key: str, shift: bool = False) -> bool:
-        """Press ``key`` once from code (one step; no hold); redraws. False if unbound or no change."""
+        """Press ``key`` once from code (one step; no hold); False if unbound or no change.  Returns once
+        the step is sent (readout and buffers show it), unless updates in flight hold it back."""
         found = self.state.keymap.resolve(key, shift)
         if found is None:
             return False
@@ -322,7 +319,8 @@ class Rot4DWidget(widgets.HBox):
                 return True
             changed = self._keys.step(action, inverted)
             self._pump.flush()
-            return changed
+        self._pump.wait_sent()  # sent by the ticker thread: readout and buffers show the step (unless held back)
+        return changed
 
     def screenshot(self, path=None, callback=None):
         """Ask the page for a PNG of the view as shown; returns at once (the request id, or None).
