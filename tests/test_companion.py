@@ -313,6 +313,13 @@ window.fire("blur", {});
 hovered = true;
 out.afterCleanupPrevented = key("keydown");
 step("afterCleanup");
+
+// a view opened on a state the kernel sent before any view was shown: acknowledged once drawn
+const cleanup2 = await mod.default.render({ model, el: { style: {} } });
+step("openedBeforeRender");
+scene.trigger("afterRender"); frame();
+step("openedOnState");
+cleanup2();
 console.log(JSON.stringify(out));
 """
 
@@ -391,6 +398,13 @@ def test_js_drawn_ack_needs_the_array_in_the_three_js_buffer(js_run):
     # held but its version did not move: not uploaded, not drawn
     assert js_run["notUploaded"] == []
     assert js_run["uploaded"] == [{"event": "drawn", "seq": 11}]
+
+
+def test_js_a_view_opened_on_a_sent_state_acknowledges_it_once_drawn(js_run):
+    # keys pressed from code before the widget is displayed: the kernel awaits those updates, and
+    # the view that opens draws the latest of them (so acknowledges them all), not before a render
+    assert js_run["openedBeforeRender"] == []
+    assert js_run["openedOnState"] == [{"event": "drawn", "seq": 14}]
 
 
 def test_js_draws_only_the_rows_in_use_set_with_the_rows(js_run):

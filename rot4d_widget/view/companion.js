@@ -14,7 +14,8 @@
 //     the one seen at the previous render (three.js uploads a buffer to the
 //     GPU when its version moves).  The ack then leaves in the next
 //     animation frame, once that frame has been presented.  An arrival that
-//     is never rendered is never acknowledged; an id is acknowledged once.
+//     is never rendered is never acknowledged; an id is acknowledged once.  A view
+//     acknowledges the state it opens on once drawn (updates sent before it was shown).
 //  2. focus loss: window blur or document hidden -> {event: "focus_lost", reason}.
 //  3. Notebook 7 shortcut guard: a capture-phase key listener on `window`
 //     calls preventDefault() while the pointer is over the canvas (the
@@ -699,9 +700,17 @@ async function render({ model, el }) {
         if (projCleanup) projCleanup();
       });
       onProjectionIds();
+      // what became of each rendered frame, on the hidden element for whoever inspects the page
+      const acks = {};
+      if (el) el.rot4dAcks = acks;
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
+      // The state this view opens on (updates the kernel sent before any view was shown, e.g.
+      // keys pressed from code in the displaying cell): acknowledged once drawn, or the kernel
+      // would await them until a newer update leaves.
+      const seq0 = buffer.get("_rot4d_seq");
+      if (Number.isInteger(seq0) && seq0 > 0) pending = { seq: seq0, data: null, after: undefined };
       // The attributes of one message arrive as one synchronous burst of change:<name>
       // events (pythreejs applies the array in its own); collect them and act once,
       // in a microtask, or at the next render if that comes first.
@@ -819,12 +828,18 @@ async function render({ model, el }) {
         const obj = buffer.obj;
         const p = pending;
         renderedVersion = version();
-        if (p === null || !obj) return;
+        const why = (k) => {
+          acks[k] = (acks[k] || 0) + 1;
+        };
+        why("renders");
+        if (p === null || !obj) return why(p === null ? "nothing pending" : "no buffer object");
         // not in this frame unless three.js holds the new array and re-uploaded it
-        if (p.data !== null && (obj.array !== p.data || (p.after !== undefined && !(obj.version > p.after)))) return;
+        if (p.data !== null && obj.array !== p.data) return why("another array");
+        if (p.data !== null && p.after !== undefined && !(obj.version > p.after)) return why("not re-uploaded");
         pending = null;
-        if (p.seq === lastSent) return;
+        if (p.seq === lastSent) return why("sent already");
         lastSent = p.seq;
+        acks.last = p.seq;
         // The canvas holds the new pixels now; wait one more frame so that the
         // frame has been presented (and any rAF read-back has seen it).
         requestAnimationFrame(() => send({ event: "drawn", seq: p.seq }));

@@ -117,6 +117,7 @@ class Companion(anywidget.AnyWidget):
         self._drawn_handlers = CallbackDispatcher()
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
+        self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.on_msg(self._handle_message)
 
     def request_screenshot(self, request_id: int) -> None:
@@ -142,6 +143,7 @@ class Companion(anywidget.AnyWidget):
         if event == "drawn":
             seq = content.get("seq")
             if isinstance(seq, int) and not isinstance(seq, bool):
+                self.last_drawn = seq
                 self._drawn_handlers(seq)
         elif event == "screenshot":
             rid = content.get("id")
