@@ -73,7 +73,10 @@ def _page_state(jp):
         " const gl = c.getContext('webgl'); return {w: c.width, h: c.height,"
         " lost: gl ? gl.isContextLost() : null}; }", sel)
     companions = jp.page.evaluate(
-        "() => Array.from(document.querySelectorAll('[data-rot4d-companion]'), (e) => e.dataset.rot4dCompanion)")
+        "() => Array.from(document.querySelectorAll('[data-rot4d-companion]'),"
+        " (e) => [e.dataset.rot4dCompanion, e.rot4dAcks || null])")
+    companions.append({"kernel: last drawn from the page": jp.kernel_json("getattr(w.companion, 'last_drawn', None)"),
+                       "kernel: update id": jp.kernel_json("w.scene.update_id")})
     rot4d = [m for m in jp.page.console_messages if "rot4d" in m[1]][-6:]
     return {"companions": companions, "rot4d console": rot4d, "canvas": gl, "stats": jp.canvas_stats(f".{sel} canvas"),
             "console": jp.page.console_messages[-12:],
@@ -87,13 +90,6 @@ def _shot(jp, rendering):
     if not jp.wait_for(lambda: jp.kernel_json(f"{shown} and not w.in_flight"), timeout=90):
         kernel = jp.kernel_json("[str(w._painter.shown and w._painter.shown.scale), w.in_flight, w.stats.as_dict()]")
         state = _page_state(jp)
-        if kernel[2]["acks"] == 0:
-            # Known, not yet understood: in some full browser runs (both front ends: 2 of 3 CI runs in
-            # Notebook 7 before 0b7c1e8, 2 of 6 local runs of the JupyterLab sequence), never alone, the
-            # page drew the view and acknowledged no update at all.  Only that symptom is excused, with
-            # what the page said (the companion's status on its element, its console lines); any other
-            # failure of this test fails.
-            pytest.xfail(f"no drawn acknowledgement at all (known flake): {kernel} {state}")
         raise AssertionError((kernel, state))
     jp.kernel("w.last_screenshot = None")
     jp.kernel_json("w.screenshot()")
