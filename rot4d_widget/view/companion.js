@@ -703,6 +703,9 @@ async function render({ model, el }) {
       // what became of each rendered frame, on the hidden element for whoever inspects the page
       const acks = {};
       if (el) el.rot4dAcks = acks;
+      const why = (k) => {
+        acks[k] = (acks[k] || 0) + 1;
+      };
       let pending = null; // {seq, data, after}: the latest update not yet acknowledged
       let lastSent = null;
       let renderedVersion = version(); // three.js buffer version at the previous render
@@ -828,9 +831,6 @@ async function render({ model, el }) {
         const obj = buffer.obj;
         const p = pending;
         renderedVersion = version();
-        const why = (k) => {
-          acks[k] = (acks[k] || 0) + 1;
-        };
         why("renders");
         if (p === null || !obj) return why(p === null ? "nothing pending" : "no buffer object");
         // not in this frame unless three.js holds the new array and re-uploaded it

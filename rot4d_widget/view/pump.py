@@ -196,36 +196,35 @@ class UpdatePump:
 
     def wait_sent(self, timeout: float = 60.0) -> bool:
         """From code on another thread than the ticker's: wait until the latest state has left
-        (True), or flow control holds it (updates in flight await the page), or ``timeout`` seconds
-        passed (False).  The ticker thread computes a send outside the lock, so without this a
-        caller could read the widget (its readout, its buffers) before the update it asked for."""
+        (True), or flow control holds it (updates in flight await the page), or the send failed, or
+        ``timeout`` seconds passed (False).  The ticker thread computes a send outside the lock, so
+        without this a caller could read the widget (its readout, its buffers) before the update
+        it asked for.  Woken by the ticker's `wake` when a send ends (at most every 50 ms otherwise)."""
         if not self.autotick or threading.current_thread() is self._thread:
             return not self._dirty
         end = time.monotonic() + timeout
-        while True:
-            with self.lock:
+        with self.lock:
+            while True:
                 if self._closed or not (self._dirty or self._sending):
                     return not self._dirty
-                if not self._sending and not self._failed and len(self._flight) >= self.max_in_flight:
-                    oldest = next(iter(self._flight.values()))
-                    if self.clock() - oldest < self.timeout:
-                        return False  # held by flow control: sent when the page answers
-                if self._failed:
-                    return False  # the send raised: reported, retried on the next key
-                self.wake()
-            if time.monotonic() > end:
-                return False
-            time.sleep(0.002)
+                if self._failed or (not self._sending and self._held(self.clock())):
+                    return False  # failed (reported, retried on the next key), or sent when the page answers
+                left = end - time.monotonic()
+                if left <= 0:
+                    return False
+                self._wakeup.wait(min(left, 0.05))
+
+    def _held(self, now) -> bool:
+        """Flow control holds the next update: ``max_in_flight`` await the page, the oldest for less
+        than the timeout."""
+        return len(self._flight) >= self.max_in_flight and now - next(iter(self._flight.values())) < self.timeout
 
     def _may_send(self, now) -> bool:
         """Flow control: True if an update may leave now (gives up the oldest after the timeout)."""
-        if self._sending:
+        if self._sending or self._held(now):
             return False
         if len(self._flight) >= self.max_in_flight:
-            oldest, sent = next(iter(self._flight.items()))
-            if now - sent < self.timeout:
-                return False
-            del self._flight[oldest]  # the page does not answer: stop waiting for the oldest
+            del self._flight[next(iter(self._flight))]  # the page does not answer: stop waiting for the oldest
             self.stats.timeouts += 1
         return True
 

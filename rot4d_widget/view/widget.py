@@ -281,7 +281,7 @@ class Rot4DWidget(widgets.HBox):
         with self._pump.lock:
             return self._painter.current_slice()
 
-    stats = property(lambda self: self._pump.stats, doc="Counters of the update pump (`pump.PumpStats`).")
+    stats = property(lambda self: self._pump.stats, doc="The pump's counters: updates, acks, acknowledged, timeouts.")
 
     @property
     def held_keys(self) -> tuple:
