@@ -11,6 +11,9 @@ Renderer with the widget's settings (600 x 500, no multisampling) -- and
         [--nagle] [--runs 1] [--json out.json] [--ceiling] [--trace [--profile]]
         [--targets own|slow|issue4] [--cpus 0 [--busy 1]] [--in-flight N] [--volume-step S]
 
+Issue 22's cases ``proj120`` (the 120-cell with ``projection=True``), ``sstel120`` and ``gicos120``
+(the small stellated and great icosahedral 120-cells): judged as the 600- and 120-cell are.
+
 Issue 21's cases ``blob64-surface``, ``blob64-volume``, ``blob64-mip``: a 64^4 field (a Gaussian
 blob travelling along x as w grows, the array of benchmarks/volume_step.py) in each rendering,
 with a table of held fps, its ratio to the same run's baseline (target >= 0.6x for volume and
@@ -197,8 +200,17 @@ STACK_CASES = {
 UNIFORM_CASES = {
     "omni120": "'omnitruncated 120-cell'",
 }
-ALL_CASES = POLYCHORA + list(FIELD_CASES) + list(STACK_CASES) + list(UNIFORM_CASES)
-LARGE = {"600-cell", "120-cell", *FIELD_CASES, *STACK_CASES, *UNIFORM_CASES}
+#: Issue 22: the 120-cell with its projection beside the slice (the page also projects and draws the
+#: 4-D skeleton each update), and two regular star polychora: the small stellated 120-cell (star
+#: faces; 1,200 triangles a slice) and the great icosahedral 120-cell (12,000 fill triangles, 1.5 MB
+#: an update).  Judged as the large cases (no target of their own).
+ISSUE22_CASES = {
+    "proj120": "'120-cell', projection=True",
+    "sstel120": "'small stellated 120-cell'",
+    "gicos120": "'great icosahedral 120-cell'",
+}
+ALL_CASES = POLYCHORA + list(FIELD_CASES) + list(STACK_CASES) + list(UNIFORM_CASES) + list(ISSUE22_CASES)
+LARGE = {"600-cell", "120-cell", *FIELD_CASES, *STACK_CASES, *UNIFORM_CASES, *ISSUE22_CASES}
 #: Cases with an absolute held-fps target of their own issue (distinct frames/s on software
 #: WebGL): issue 10's 12 slices of the 24-cell, issue 11's largest uniform polychoron.
 ABSOLUTE_FPS = {"oval24": 10.0, "omni120": 5.0}
@@ -567,8 +579,9 @@ def run_case(context, server, case: str, args, rng: random.Random, hold_baseline
     cells = [c.format(name=case) for c in CELLS]
     if case in STACK_CASES:
         cells[1] = f"from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({STACK_CASES[case]}))\nw"
-    if case in UNIFORM_CASES:
-        cells[1] = f"from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({UNIFORM_CASES[case]}))\nw"
+    if case in UNIFORM_CASES or case in ISSUE22_CASES:
+        args_ = UNIFORM_CASES.get(case) or ISSUE22_CASES[case]
+        cells[1] = f"from rot4d_widget import Rot4DWidget\nw = bench.probe(Rot4DWidget({args_}))\nw"
     if case in FIELD_CASES:
         rendering = f", rendering={FIELD_RENDERING[case]!r}" if case in FIELD_RENDERING else ""
         step = ""
@@ -1411,7 +1424,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six), "
                          "fields (sphere64, waves128, allen-cahn, "
                          "blob64-surface, blob64-volume, blob64-mip) or "
-                         "parallel slices (oval24, oval600) or the largest uniform polychoron (omni120)")
+                         "parallel slices (oval24, oval600) or the largest uniform polychoron (omni120) or "
+                         "issue 22's projection and star polychora (proj120, sstel120, gicos120)")
     ap.add_argument("--tap", default="60-120",
                     help="ms between keydown and keyup of a single press, a range drawn uniformly "
                          "(default 60-120, a human tap; 0 = Playwright's instant press)")
