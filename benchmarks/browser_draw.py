@@ -1,6 +1,6 @@
 """What each draw call of the widget costs on the page (headless Chromium, SwiftShader).
 
-    python benchmarks/browser_draw.py [--cases 24-cell,600-cell]
+    python benchmarks/browser_draw.py [--cases 24-cell,600-cell]  (or star polychora by name)
         [--variants default,msaa] [--hold 2] [--rounds 1] [--screenshots DIR [--compare OTHER]]
         [--rev HEAD]
 
@@ -40,6 +40,7 @@ from __future__ import annotations
 import argparse
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -60,9 +61,12 @@ from browser_latency import (  # noqa: E402
     median,
     working_tree_description,
 )
+from rot4d_widget.geometry.star_regular import SPECS  # noqa: E402
 from browser_setup import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
 from jupyter_page import JupyterPage, write_notebook  # noqa: E402
 
+#: the ten regular star polychora (issue 22) may be cases too, by name
+STAR = list(SPECS)
 VARIANTS = {"default": {}, "msaa": {"antialias": True}}
 PASSES = ["clear", "balls", "bars", "faces"]
 
@@ -112,7 +116,7 @@ CELLS = [
 
 
 def run_one(context, server, case: str, variant: str, hold: float, shots: pathlib.Path | None) -> dict:
-    name = f"draw_{case.replace('-', '_')}_{variant}.ipynb"
+    name = f"draw_{re.sub(r'[^A-Za-z0-9]+', '_', case)}_{variant}.ipynb"
     write_notebook(server.root / name, [c.format(name=case, options=VARIANTS[variant]) for c in CELLS])
     page = context.new_page()
     try:
@@ -177,8 +181,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     variants = [v.strip() for v in args.variants.split(",") if v.strip()]
-    if not cases or any(c not in POLYCHORA for c in cases):
-        ap.error(f"choose cases from {', '.join(POLYCHORA)}")
+    if not cases or any(c not in POLYCHORA + STAR for c in cases):
+        ap.error(f"choose cases from {', '.join(POLYCHORA + STAR)}")
     if not variants or any(v not in VARIANTS for v in variants) or len(set(variants)) != len(variants):
         ap.error(f"choose distinct variants from {', '.join(VARIANTS)}")
     if args.rounds < 1:

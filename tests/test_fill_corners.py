@@ -16,7 +16,8 @@ from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 from rot4d_widget.keep.drawing import _slice_collection, draw_slice  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402
-from rot4d_widget.view.buffers import slice_rows  # noqa: E402
+from rot4d_widget.view.buffers import ball_count, slice_rows  # noqa: E402
+from rot4d_widget.view.scene import Scene  # noqa: E402
 
 NAME = "small stellated 120-cell"  # pentagram faces, star cells: sections filled even-odd
 
@@ -44,11 +45,28 @@ def test_the_rows_show_balls_only_at_the_edges_crossings(cut):
     flags = data.corner_only
     assert flags is not None and flags.sum() == s.n_fill and not flags.flags.writeable
     rows = slice_rows(data)
-    shown = rows[: len(data.points)][rows[: len(data.points), 3] == 1.0, :3]
     want = _crossings(p, m, 0.0)
-    assert len(shown) == len(want)
+    n = ball_count(data)
+    # the balls are the first rows, every one shown, and no row after them is a ball: the layer
+    # draws ``n`` (the scene's count) and never a hidden ball at a fill corner
+    assert n == len(want) == len(data.points) - s.n_fill
+    assert (rows[:n, 3] == 1.0).all() and (rows[n:, :4] == 0.0).all()
+    shown = rows[:n, :3]
     d = np.linalg.norm(shown[:, None].astype(np.float64) - want[None], axis=-1)
     assert d.min(axis=1).max() < 1e-5 and d.min(axis=0).max() < 1e-5
+
+
+def test_the_scene_draws_as_many_balls_as_crossings(cut):
+    """What the page's ball layer draws (`Scene.counts`, sent with the rows) is the crossings, not
+    the points with the fill corners: the great icosahedral 120-cell's 10,000 fill corners were
+    drawn as hidden balls (22 ms of a frame on software WebGL, docs/meshes.md)."""
+    p, m, data = cut
+    scene = Scene(scale=1.0, n_groups=int(np.max(data.groups)) + 1)
+    try:
+        scene.show(data)
+        assert scene.counts == [len(_crossings(p, m, 0.0)), len(data.segments), len(data.triangles)]
+    finally:
+        scene.close()
 
 
 def test_a_stack_keeps_each_slices_fill_flags():
@@ -64,6 +82,13 @@ def test_a_stack_keeps_each_slices_fill_flags():
         assert flags.sum() == pc.n_fill and (pc.n_fill == 0 or flags[-pc.n_fill:].all())
     turned = data.turned(np.eye(3)[[1, 0, 2]] * [1, 1, -1])
     assert np.array_equal(turned.corner_only, data.corner_only)
+    # the rows' balls: every slice's points but its fill corners, in order (the corners sit
+    # between the slices' points here, not only at the end)
+    rows = slice_rows(data)
+    n = ball_count(data)
+    assert n == len(data.points) - want
+    assert np.allclose(rows[:n, :3], np.asarray(data.points)[~data.corner_only], atol=1e-6)
+    assert (rows[:n, 3] == 1.0).all() and (rows[n:, :4] == 0.0).all()
 
 
 def test_static_pictures_draw_no_ball_at_a_fill_corner_and_fill_from_triangles(cut):

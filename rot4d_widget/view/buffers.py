@@ -15,7 +15,10 @@ triangle ``i`` at once::
     column 16-18  triangle corner c                  ``TRI_C`` (itemSize 3)
     column 19     triangle colour, 0xRRGGBB as float ``TRI_RGB`` (itemSize 1)
 
-Rows ``0 .. n_points-1`` hold the slice's points (balls), rows
+Rows ``0 .. n_balls-1`` hold the slice's points that get a ball, in order
+(`ball_count`: every point, or none when ``show_points`` is False, less the
+fill corners flagged ``corner_only``, which carry a face's corner only, so
+a layer never draws hidden balls), rows
 ``0 .. n_segments-1`` its segments (bars, as end points), rows
 ``0 .. n_triangles-1`` its triangles (corners counter-clockwise seen from
 outside, and the colour of the group -- a polytope's 4-D cell -- each comes
@@ -48,6 +51,7 @@ __all__ = [
     "ROW_BYTES",
     "COLUMNS",
     "rows_needed",
+    "ball_count",
     "capacity_for",
     "estimate_capacity",
     "slice_rows",
@@ -85,15 +89,28 @@ ROW_QUANTUM = 16
 HEADROOM = 0.125
 
 
+def _shown(data):
+    """(n,) bool: the points that get a ball, or None for all of them (``show_points`` aside)."""
+    corner = getattr(data, "corner_only", None)
+    return None if corner is None else ~np.asarray(corner, dtype=bool)
+
+
+def ball_count(data) -> int:
+    """Balls a slice draws: its points, less the fill corners (``corner_only``); 0 without ``show_points``."""
+    if not getattr(data, "show_points", True):
+        return 0
+    shown = _shown(data)
+    return len(data.points) if shown is None else int(shown.sum())
+
+
 def rows_needed(data) -> int:
     """Rows a slice needs: ``max(n_balls, n_segments, n_triangles)``.
 
     A smooth surface's triangles (a slice with ``normals``) travel in the surface
     layer (`surface_arrays`), not in rows: they do not count.
     """
-    n_points = len(data.points) if getattr(data, "show_points", True) else 0
     n_triangles = 0 if getattr(data, "normals", None) is not None else len(data.triangles)
-    return max(n_points, len(data.segments), n_triangles)
+    return max(ball_count(data), len(data.segments), n_triangles)
 
 
 def capacity_for(rows: int, headroom: float = HEADROOM, quantum: int = ROW_QUANTUM) -> int:
@@ -159,7 +176,10 @@ def slice_rows(
         raise ValueError(f"Expected `triangles` to have shape (k, 3), got {t.shape}")
     if tc.shape != (len(t),):
         raise ValueError(f"Expected `groups` to have shape ({len(t)},), got {tc.shape}")
-    nv = len(v) if getattr(data, "show_points", True) else 0
+    shown = _shown(data) if getattr(data, "show_points", True) else np.zeros(len(v), dtype=bool)
+    if shown is not None and shown.shape != (len(v),):
+        raise ValueError(f"Expected `corner_only` to have one flag per point ({len(v)}), got {shown.shape}")
+    nv = len(v) if shown is None else int(shown.sum())
     ne, nt = len(e), len(t)
     need = max(nv, ne, nt)
     if capacity is None:
@@ -199,11 +219,8 @@ def slice_rows(
         t, tc = t[order], tc[order]
 
     out = np.zeros((capacity, ROW_FLOATS), dtype=np.float32)
-    out[:nv, 0:3] = p[:nv]
+    out[:nv, 0:3] = p if shown is None else p[shown]  # the balls, in point order (no fill corner)
     out[:nv, 3] = 1.0
-    corner = getattr(data, "corner_only", None)
-    if nv and corner is not None:
-        out[:nv, 3][np.asarray(corner, dtype=bool)] = 0.0  # a fill corner: no ball
     out[:ne, 4:7] = p[e[:, 0]]
     out[:ne, 7:10] = p[e[:, 1]]
     out[:nt, 10:19] = p[t].reshape(nt, 9)

@@ -426,8 +426,7 @@ class Scene:
                 and self._buffer._rot4d_turn == _IDENTITY4):
             return False
         self.update_id += 1
-        n_points = len(data.points) if getattr(data, "show_points", True) else 0
-        counts = [n_points, len(data.segments), len(data.triangles)]
+        counts = [bf.ball_count(data), len(data.segments), len(data.triangles)]
         self._assign(rows, self.update_id, counts, surface=surface, volume=volume, labels=pinned,
                      projection=projection)
         return True
