@@ -373,3 +373,28 @@ def test_the_widget_shows_a_polytope_at_the_ends_of_the_range(make, target):
     p = polytope("24-cell")
     v, s = scaled(p, target)
     widget_case(make, Polytope(v), p, s)
+
+
+STAR = ("small stellated 120-cell", "great 120-cell", "great stellated 120-cell")  # star faces / star cells
+
+
+@settings(max_examples=20, **SETTINGS)
+@given(name=st.sampled_from(STAR), target=targets, seed=seeds, frac=fractions)
+def test_a_scaled_star_polychoron_slices_as_the_unit_one_scaled(name, target, seed, frac):
+    """The general slicer (star faces, non-convex cells: even-odd segments, cycles, the fills and
+    their extra corners, the winding-weighted volume) is scale-free too: the same picture, scaled,
+    anywhere in the range."""
+    p = polytope(name)
+    v, s = scaled(p, target)
+    ps = Polytope(v, [f.tolist() for f in p.faces], [list(c) for c in p.cells])
+    assert ps.star is not None and not ps.convex
+    m = rotation(seed)
+    c0 = frac * p.circumradius
+    a, b = slice_polytope(p, m, c0), slice_polytope(ps, m, c0 * s)
+    assert (b.dim, b.n_fill, len(b.vertices)) == (a.dim, a.n_fill, len(a.vertices))
+    assert np.all(np.isfinite(b.vertices))
+    np.testing.assert_allclose(b.vertices / s, a.vertices, rtol=0, atol=1e-10 * p.circumradius)
+    np.testing.assert_array_equal(b.edges, a.edges)
+    np.testing.assert_array_equal(b.triangles, a.triangles)
+    assert cycles(b) == cycles(a)
+    check_volume(b.volume, a.volume, s)
