@@ -66,6 +66,20 @@ def test_reads_a_real_scene_s_interface():
         sc.close()
 
 
+def test_the_pages_time_for_an_update_is_kept_in_seconds_if_it_is_one():
+    c = Companion(FakeScene())
+    try:
+        from_page(c, {"event": "drawn", "seq": 7, "draw_ms": 42.5})
+        assert (c.last_drawn, c.last_draw_time) == (7, 0.0425)
+        for bad in ("42", -1, True, None, float("nan")):
+            from_page(c, {"event": "drawn", "seq": 8, "draw_ms": bad})
+            assert (c.last_drawn, c.last_draw_time) == (8, None)
+        from_page(c, {"event": "drawn", "seq": 9})
+        assert (c.last_drawn, c.last_draw_time) == (9, None)
+    finally:
+        c.close()
+
+
 def test_on_drawn_and_on_focus_lost_dispatch_and_can_be_removed():
     c = Companion(FakeScene())
     drawn, lost = [], []
@@ -150,6 +164,8 @@ globalThis.document = Object.assign(target(), {
 globalThis.CSS = { escape: (s) => s };
 let raf = [];
 globalThis.requestAnimationFrame = (f) => raf.push(f);
+let clock = 1000;  // the page's clock (performance.now), moved by hand
+Object.defineProperty(globalThis.performance, "now", { value: () => clock, configurable: true });
 const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
 
 // the pythreejs buffer model: its three.js object (`obj`) takes a new array on "change"
@@ -214,9 +230,12 @@ hovered = false;
 const step = (label) => { out[label] = sent.splice(0); };
 const set = (seq, name) => buffer.setState(seq === null ? { array: wrap(name) } : { _rot4d_seq: seq, array: wrap(name) });
 set(5, "a1");
+await null;  // the message's burst of changes settled: the update has arrived (at 1000)
 step("beforeRender");
+clock += 30;
 scene.trigger("afterRender");
 step("sameFrame");
+clock += 12.5;
 frame();
 step("nextFrame");
 scene.trigger("afterRender"); frame();
@@ -380,44 +399,57 @@ def test_js_shortcut_guard_prevents_only_while_hovered(js_run):
     assert js_run["ctrl"] is False and js_run["meta"] is False
 
 
+def _acks(msgs):
+    """The page's messages without ``draw_ms`` (checked on its own)."""
+    return [{k: v for k, v in m.items() if k != "draw_ms"} for m in msgs]
+
+
+def test_js_drawn_ack_says_how_long_the_page_took_since_the_update_arrived(js_run):
+    # arrived at 1000, rendered at 1030, acknowledged at the next frame, 1042.5: the kernel's pump
+    # gives a page this slow fewer updates in flight
+    assert js_run["nextFrame"][0]["draw_ms"] == 42.5
+    assert all(m["draw_ms"] >= 0 for k in ("coalesced", "late", "uploaded") for m in js_run[k])
+    assert "draw_ms" not in js_run["openedOnState"][0]  # the state a view opens on: no arrival time
+
+
 def test_js_drawn_ack_waits_for_a_rendered_and_presented_frame(js_run):
     assert js_run["beforeRender"] == []  # arrival is not drawing
     assert js_run["sameFrame"] == []  # rendered; sent once that frame is presented
-    assert js_run["nextFrame"] == [{"event": "drawn", "seq": 5}]
+    assert _acks(js_run["nextFrame"]) == [{"event": "drawn", "seq": 5}]
     assert js_run["renderWithoutChange"] == []  # orbiting the camera acknowledges nothing
-    assert js_run["coalesced"] == [{"event": "drawn", "seq": 7}]
+    assert _acks(js_run["coalesced"]) == [{"event": "drawn", "seq": 7}]
     assert js_run["sameId"] == []  # a re-sent picture keeps its id: acknowledged once already
     assert js_run["noRenderNoAck"] == []
-    assert js_run["late"] == [{"event": "drawn", "seq": 8}]
+    assert _acks(js_run["late"]) == [{"event": "drawn", "seq": 8}]
 
 
 def test_js_drawn_ack_needs_the_array_in_the_three_js_buffer(js_run):
     # rendered before three.js held the new array: that frame shows the old picture
     assert js_run["notYetInThree"] == []
-    assert js_run["nowInThree"] == [{"event": "drawn", "seq": 9}]
+    assert _acks(js_run["nowInThree"]) == [{"event": "drawn", "seq": 9}]
     # held but its version did not move: not uploaded, not drawn
     assert js_run["notUploaded"] == []
-    assert js_run["uploaded"] == [{"event": "drawn", "seq": 11}]
+    assert _acks(js_run["uploaded"]) == [{"event": "drawn", "seq": 11}]
 
 
 def test_js_a_view_opened_on_a_sent_state_acknowledges_it_once_drawn(js_run):
     # keys pressed from code before the widget is displayed: the kernel awaits those updates, and
     # the view that opens draws the latest of them (so acknowledges them all), not before a render
     assert js_run["openedBeforeRender"] == []
-    assert js_run["openedOnState"] == [{"event": "drawn", "seq": 14}]
+    assert _acks(js_run["openedOnState"]) == [{"event": "drawn", "seq": 14}]
 
 
 def test_js_draws_only_the_rows_in_use_set_with_the_rows(js_run):
     # counts arrive in the buffer's message; never more than the rows the array holds (7 here)
     assert js_run["counts"] == [3, 5, 7]
-    assert js_run["countsAck"] == [{"event": "drawn", "seq": 12}]
+    assert _acks(js_run["countsAck"]) == [{"event": "drawn", "seq": 12}]
 
 
 def test_js_a_turn_alone_turns_every_mesh_and_is_acknowledged_when_drawn(js_run):
     assert js_run["turned"] == [True, True, True, True]  # balls, bars, faces, surface
     assert js_run["rerendered"] == 1  # no buffer changed: the scene is asked to render
     assert js_run["turnBeforeRender"] == []
-    assert js_run["turnAck"] == [{"event": "drawn", "seq": 13}]
+    assert _acks(js_run["turnAck"]) == [{"event": "drawn", "seq": 13}]
 
 
 def test_js_retries_get_model_until_the_model_is_registered(js_run):
@@ -446,6 +478,8 @@ globalThis.document = Object.assign(target(), { visibilityState: "visible", quer
   getElementsByClassName: () => [] });
 let raf = [];
 globalThis.requestAnimationFrame = (f) => raf.push(f);
+let clock = 1000;  // the page's clock (performance.now), moved by hand
+Object.defineProperty(globalThis.performance, "now", { value: () => clock, configurable: true });
 const frame = () => { const q = raf; raf = []; q.forEach((f) => f(0)); };
 function backbone(attrs) {
   const L = {};
@@ -581,8 +615,8 @@ def test_js_each_frame_draws_the_rows_of_its_update_without_instancing(js_expand
     # the frame right after an update draws that update's rows, as plain vertices (no instancing)
     _check(js_expand["first"], _rows(4, 100), [2, 3, 1])
     _check(js_expand["second"], _rows(4, 200), [1, 1, 2])
-    assert js_expand["firstAck"] == [{"event": "drawn", "seq": 1}]
-    assert js_expand["secondAck"] == [{"event": "drawn", "seq": 2}]
+    assert _acks(js_expand["firstAck"]) == [{"event": "drawn", "seq": 1}]
+    assert _acks(js_expand["secondAck"]) == [{"event": "drawn", "seq": 2}]
 
 
 def test_js_unchanged_rows_are_not_uploaded_again(js_expand):
@@ -594,7 +628,7 @@ def test_js_unchanged_rows_are_not_uploaded_again(js_expand):
 
 def test_js_a_grown_capacity_gets_new_geometries(js_expand):
     _check(js_expand["grown"], _rows(9, 300), [9, 7, 8])
-    assert js_expand["grownAck"] == [{"event": "drawn", "seq": 3}]
+    assert _acks(js_expand["grownAck"]) == [{"event": "drawn", "seq": 3}]
     assert js_expand["oldDisposed"] == [True, True, True]  # a GL buffer cannot take a longer array in place
     assert js_expand["rebuilt"] == 9 * 6  # a geometry pythreejs rebuilt is expanded too
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget.view.keyhold import KeyRepeater
-from rot4d_widget.view.pump import UpdatePump
+from rot4d_widget.view.pump import PAGE_BUDGET, UpdatePump
 from rot4d_widget import readout as ro
 from rot4d_widget.core.rotation import simple_rotation
 
@@ -83,6 +83,41 @@ def test_at_most_max_in_flight_updates_and_the_next_is_the_latest(max_in_flight)
     assert pump.acknowledge(99) is False and pump.acknowledge(True) is False  # unknown / not an id
     assert pump.acknowledge(page.sent[-1][0]) is True  # the newest retires every older one
     assert pump.in_flight is None and pump.stats.acks == 2
+
+
+def test_a_slow_page_gets_fewer_in_flight_but_never_fewer_than_two():
+    """What is in flight at a key's release is drawn after it: a page that says it takes 0.12 s an
+    update gets two in flight (what fits in PAGE_BUDGET), not three; a quick one three again; a very
+    slow one still two (one drawn while the next travels).  What is not a time is ignored."""
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=5.0, max_in_flight=3)
+
+    def burst():
+        for _ in range(5):
+            page.changes += 1
+            pump.mark_dirty()
+            pump.flush()
+
+    def page_says(seconds, times):
+        for _ in range(times):
+            assert pump.acknowledge(page.sent[-1][0], draw_time=seconds)
+            burst()
+
+    burst()
+    assert pump.limit == 3 and pump.n_in_flight == 3  # the page said nothing yet
+    page_says(0.12, 3)
+    assert PAGE_BUDGET / 0.12 < 3 and pump.limit == 2 and pump.n_in_flight == 2
+    page_says(0.02, 8)
+    assert pump.limit == 3 and pump.n_in_flight == 3
+    page_says(3.0, 8)
+    assert pump.limit == 2 and pump.n_in_flight == 2
+    page_says(0.02, 8)
+    for bad in (math.nan, -1.0, math.inf, True, "0.5", None):
+        page_says(bad, 1)
+    assert pump.limit == 3 and pump.n_in_flight == 3 and pump.stats.timeouts == 0  # held back, none given up
+    one = make_pump(Page(), lambda: t[0], max_in_flight=1)
+    assert one.acknowledge(1, draw_time=1.0) is False and one.limit == 1  # a bound of one stays one
 
 
 def test_without_an_ack_the_oldest_is_given_up_after_the_timeout():

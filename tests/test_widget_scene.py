@@ -224,6 +224,22 @@ def test_the_companion_acknowledgement_releases_the_next_update(make, clock, rec
     up(w, "4")
 
 
+def test_a_page_slow_to_draw_gets_fewer_updates_in_flight(make, clock, recording_comms):
+    """The page's "drawn" says how long it took since the update arrived (``draw_ms``); the
+    widget hands that to its pump: at 0.12 s an update, two in flight while a key is held (at its
+    release two frames still to come, not three), none given up."""
+    w = make()
+    t0 = clock.t
+    down(w, "4")
+    run_ticker(w, clock, t0 + 0.45)
+    assert w._pump.n_in_flight == 3
+    for k in range(4):
+        companion_says(w, {"event": "drawn", "seq": w.scene.update_id, "draw_ms": 120.0})
+        run_ticker(w, clock, t0 + 0.5 + 0.1 * k)
+    assert w._pump.limit == 2 and w._pump.n_in_flight == 2 and w.stats.timeouts == 0
+    up(w, "4")
+
+
 @pytest.mark.parametrize("reason", ["blur", "hidden"])
 def test_focus_loss_from_the_page_stops_rotation(make, clock, reason):
     w = make()

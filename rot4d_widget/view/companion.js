@@ -6,8 +6,9 @@
 // page from sending the row buffer's three.js `version` back after every update):
 //  1. "drawn": after the pythreejs Scene has rendered a frame that contains
 //     the latest assignment to the shared row buffer, send
-//     {event: "drawn", seq} where seq is the buffer's `_rot4d_seq` (sent in
-//     the same message as the array).  "Contains" is checked on the three.js
+//     {event: "drawn", seq, draw_ms} where seq is the buffer's `_rot4d_seq` (sent in
+//     the same message as the array) and draw_ms the time since it arrived (the
+//     kernel gives a slow page fewer updates in flight).  "Contains" is checked on the three.js
 //     object itself (`buffer.obj`, a THREE.InterleavedBuffer): at the Scene's
 //     `afterRender` (fired right after `renderer.render(...)`) its `array`
 //     must be the array that arrived, and its `version` must have moved past
@@ -734,9 +735,9 @@ async function render({ model, el }) {
         if (b.seq) {
           // `after`: the version before this array can have been uploaded; a turn alone
           // (data null) is in the next frame drawn.
-          pending = { seq: buffer.get("_rot4d_seq"), data, after: renderedVersion };
+          pending = { seq: buffer.get("_rot4d_seq"), data, after: renderedVersion, at: performance.now() };
         } else if (b.array && pending !== null && pending.data !== null) {
-          pending = { seq: pending.seq, data, after: renderedVersion }; // a growth step re-sent the rows
+          pending = { seq: pending.seq, data, after: renderedVersion, at: pending.at }; // a growth step re-sent the rows
         }
       };
       const note = (what) => () => {
@@ -842,7 +843,12 @@ async function render({ model, el }) {
         acks.last = p.seq;
         // The canvas holds the new pixels now; wait one more frame so that the
         // frame has been presented (and any rAF read-back has seen it).
-        requestAnimationFrame(() => send({ event: "drawn", seq: p.seq }));
+        // With it, the time since the update arrived: the kernel gives a slow page fewer in flight.
+        requestAnimationFrame(() => {
+          const msg = { event: "drawn", seq: p.seq };
+          if (Number.isFinite(p.at)) msg.draw_ms = Math.max(0, performance.now() - p.at);
+          send(msg);
+        });
       };
       for (const [name, f] of Object.entries(watched)) {
         buffer.on("change:" + name, f);

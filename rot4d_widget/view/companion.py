@@ -10,8 +10,10 @@ step) and does these things in JupyterLab 4 and Notebook 7 alike:
    the array that arrived with ``change:array`` and its ``version`` must
    have moved since the previous render (so three.js uploaded it); one
    animation frame later it sends ``{"event": "drawn", "seq": n}``, n being
-   the scene's ``update_id`` of that buffer.  Callbacks registered with
-   `on_drawn` get ``n``.  Acknowledgements coalesce: if two updates arrive
+   the scene's ``update_id`` of that buffer, and ``draw_ms``, the page's
+   milliseconds from the update's arrival to that message (`last_draw_time`,
+   in seconds: the pump gives a slow page fewer updates in flight).  Callbacks
+   registered with `on_drawn` get ``n``.  Acknowledgements coalesce: if two updates arrive
    before one frame, only the later one is acknowledged; an id is
    acknowledged once per view (a growth step re-sending the shown picture
    with the same id is not).  Each displayed view of the companion
@@ -70,6 +72,7 @@ from __future__ import annotations
 
 import base64
 import binascii
+import math
 import pathlib
 
 import anywidget
@@ -118,6 +121,7 @@ class Companion(anywidget.AnyWidget):
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
+        self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
 
     def request_screenshot(self, request_id: int) -> None:
@@ -143,7 +147,9 @@ class Companion(anywidget.AnyWidget):
         if event == "drawn":
             seq = content.get("seq")
             if isinstance(seq, int) and not isinstance(seq, bool):
-                self.last_drawn = seq
+                ms = content.get("draw_ms")
+                ok = isinstance(ms, (int, float)) and not isinstance(ms, bool) and 0 <= ms < math.inf
+                self.last_drawn, self.last_draw_time = seq, float(ms) / 1e3 if ok else None
                 self._drawn_handlers(seq)
         elif event == "screenshot":
             rid = content.get("id")

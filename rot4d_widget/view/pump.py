@@ -15,6 +15,14 @@ one (the page acknowledges only the newest of several arriving before a frame).
 With several views the first acknowledgement counts; stale and unknown ones
 are ignored.
 
+**A slow page gets fewer in flight** (never fewer than two, which keep it busy while the next
+update travels): the page says with each acknowledgement how long it took from the update's
+arrival to the acknowledgement (``draw_time``), and while the recent median of that times
+``max_in_flight`` exceeds `PAGE_BUDGET` the bound in force (`limit`) is what fits in it.  What
+is in flight when a key is released is drawn after the release, so this bounds how long the
+picture goes on moving then; a page drawing ~0.1 s a frame (software WebGL, a slice of 12,000
+translucent triangles) settled 0.5-0.6 s after the release with three (docs/meshes.md).
+
 Without an answer (no view: scripting, nbval; a hidden tab) the latest state
 is sent anyway once the oldest update in flight is ``timeout`` old, where
 ``timeout`` is ``ack_timeout`` or, when the page has been slower than that,
@@ -59,11 +67,12 @@ The rules that keep a slow kernel from freezing the keys:
 from __future__ import annotations
 
 import inspect
+import math
 import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_ACK_TIMEOUT", "MAX_IN_FLIGHT"]
+__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_ACK_TIMEOUT", "MAX_IN_FLIGHT", "PAGE_BUDGET"]
 
 ACK_TIMEOUT = 0.5
 #: The adaptive acknowledgement timeout never exceeds this (s).
@@ -72,7 +81,9 @@ MAX_ACK_TIMEOUT = 5.0
 MIN_WAIT = 0.001
 #: Updates allowed in flight at once (1: strictly one at a time).
 MAX_IN_FLIGHT = 3
-#: Recent acknowledgement times the adaptive timeout looks at.
+#: The page's time for what is in flight, at most (s): a slow page gets fewer updates in flight.
+PAGE_BUDGET = 0.25
+#: Recent acknowledgement times the adaptive timeout (and the page's times the bound) look at.
 _ACK_WINDOW = 8
 
 
@@ -148,6 +159,7 @@ class UpdatePump:
         self._dirty = False
         self._flight = {}  # update id -> clock time sent, oldest first
         self._ack_times = []  # recent send -> acknowledgement durations
+        self._draw_times = []  # recent arrival -> acknowledgement durations the page reported
         self._thread = None
         self._closed = False
         self._sending = False  # a send is being computed outside the lock (ticker thread)
@@ -162,6 +174,17 @@ class UpdatePump:
     @property
     def n_in_flight(self) -> int:
         return len(self._flight)
+
+    @property
+    def limit(self) -> int:
+        """Updates allowed in flight now: ``max_in_flight``, or as many as the page draws in
+        `PAGE_BUDGET` by its recent median ``draw_time`` (at least two; module docs)."""
+        if not self._draw_times or self.max_in_flight <= 2:
+            return self.max_in_flight
+        times = sorted(self._draw_times)
+        t = times[(len(times) - 1) // 2]
+        fits = int(PAGE_BUDGET / t) if t > 0 else self.max_in_flight
+        return max(2, min(self.max_in_flight, fits))
 
     @property
     def timeout(self) -> float:
@@ -182,7 +205,7 @@ class UpdatePump:
 
     # -- entry points -----------------------------------------------------------
     def flush(self, now=None) -> None:
-        """Send the latest state unless ``max_in_flight`` updates are in flight (and none timed out).
+        """Send the latest state unless `limit` updates are in flight (and none timed out).
 
         With ``autotick`` the ticker thread sends (this wakes it); otherwise it sends here."""
         with self.lock:
@@ -215,15 +238,15 @@ class UpdatePump:
                 self._wakeup.wait(min(left, 0.05))
 
     def _held(self, now) -> bool:
-        """Flow control holds the next update: ``max_in_flight`` await the page, the oldest for less
-        than the timeout."""
-        return len(self._flight) >= self.max_in_flight and now - next(iter(self._flight.values())) < self.timeout
+        """Flow control holds the next update: `limit` await the page, the oldest for less than the
+        timeout."""
+        return len(self._flight) >= self.limit and now - next(iter(self._flight.values())) < self.timeout
 
     def _may_send(self, now) -> bool:
         """Flow control: True if an update may leave now (gives up the oldest after the timeout)."""
         if self._sending or self._held(now):
             return False
-        if len(self._flight) >= self.max_in_flight:
+        if len(self._flight) >= self.limit:
             del self._flight[next(iter(self._flight))]  # the page does not answer: stop waiting for the oldest
             self.stats.timeouts += 1
         return True
@@ -291,8 +314,10 @@ class UpdatePump:
                 self._sending = False
                 self.wake()  # the latest state may be waiting
 
-    def acknowledge(self, seq) -> bool:
-        """The page drew update ``seq`` (and so every older one); True if it was awaited."""
+    def acknowledge(self, seq, draw_time=None) -> bool:
+        """The page drew update ``seq`` (and so every older one); True if it was awaited.
+        ``draw_time``: the page's seconds from the update's arrival to this acknowledgement, if it
+        said (a finite number >= 0, else ignored): a slow page gets fewer in flight (`limit`)."""
         if isinstance(seq, bool) or not isinstance(seq, int):
             return False
         with self.lock:
@@ -303,6 +328,9 @@ class UpdatePump:
                 del self._flight[k]
                 self.stats.acknowledged += 1
             self._ack_times = (self._ack_times + [min(max(0.0, self.clock() - sent), MAX_ACK_TIMEOUT)])[-_ACK_WINDOW:]
+            if (isinstance(draw_time, (int, float)) and not isinstance(draw_time, bool)
+                    and 0.0 <= draw_time < math.inf):
+                self._draw_times = (self._draw_times + [min(float(draw_time), MAX_ACK_TIMEOUT)])[-_ACK_WINDOW:]
             self.stats.acks += 1
             self._failed = False
             self.flush()
@@ -333,7 +361,7 @@ class UpdatePump:
             d = self._deadline()
             if d is not None:
                 deadlines.append(d)
-        if self._dirty and len(self._flight) >= self.max_in_flight:
+        if self._dirty and len(self._flight) >= self.limit:
             deadlines.append(next(iter(self._flight.values())) + self.timeout)
         elif self._dirty and self.autotick and not self._sending and not self._failed:
             deadlines.append(self.clock())  # a flush woke the thread: send now
