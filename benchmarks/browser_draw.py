@@ -61,9 +61,10 @@ from browser_latency import (  # noqa: E402
     median,
     working_tree_description,
 )
-from rot4d_widget.geometry.star_regular import SPECS  # noqa: E402
 from browser_setup import CHROMIUM_FLAGS, JupyterServer  # noqa: E402
 from jupyter_page import JupyterPage, write_notebook  # noqa: E402
+
+from rot4d_widget.geometry.star_regular import SPECS  # noqa: E402
 
 #: the ten regular star polychora (issue 22) may be cases too, by name
 STAR = list(SPECS)
