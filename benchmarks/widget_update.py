@@ -109,7 +109,8 @@ def main(argv=None):
     rows = [bench(name, args.presses, rng) for name in names]
     print(f"Rot4DWidget: event dict -> update handed to the comm, {args.presses} presses at random orientations")
     width = max(len(n) for n in names)
-    print(f"{'polytope':<{width}} {'median ms':>10} {'p90 ms':>8} {'msgs':>5} {'KB/update':>10} {'max KB':>7}  last slice")
+    print(f"{'polytope':<{width}} {'median ms':>10} {'p90 ms':>8} {'msgs':>5} {'KB/update':>10} "
+          f"{'max KB':>7}  last slice")
     ok = True
     for r in rows:
         print(
