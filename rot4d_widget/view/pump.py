@@ -20,8 +20,7 @@ update travels): the page says with each acknowledgement how long it took from t
 arrival to the acknowledgement (``draw_time``), and while the recent median of that times
 ``max_in_flight`` exceeds `PAGE_BUDGET` the bound in force (`limit`) is what fits in it.  What
 is in flight when a key is released is drawn after the release, so this bounds how long the
-picture goes on moving then; a page drawing ~0.1 s a frame (software WebGL, a slice of 12,000
-translucent triangles) settled 0.5-0.6 s after the release with three (docs/meshes.md).
+picture goes on moving then (measurements: docs/design.md, "Fewer in flight for a slow page").
 
 Without an answer (no view: scripting, nbval; a hidden tab) the latest state
 is sent anyway once the oldest update in flight is ``timeout`` old, where
