@@ -17,8 +17,8 @@ close together send the buffer alone, and the readout follows at rest.
 
 Targets (issue 3): <= 2 ms for the 120-cell and 600-cell, <= 64 KB per update.  ``--star`` adds
 the ten regular star polychora (issue 22) after the six convex ones, reported against no target:
-their slices have up to 80 times the 600-cell's triangles (the even-odd fill of star sections),
-and an update's bytes grow with them.
+the great icosahedral 120-cell's slice has some 40 times the 600-cell's triangles (the even-odd
+fill of star sections; this benchmark's last-slice column), and an update's bytes grow with them.
 """
 
 from __future__ import annotations

@@ -125,6 +125,7 @@ class FakeCompanion(ipywidgets.DOMWidget):
         self.scene = scene
         self._drawn = CallbackDispatcher()
         self._focus = CallbackDispatcher()
+        self.last_draw_time = None  # as `Companion`: the page's time for the last update it drew
 
     def on_drawn(self, callback, remove=False):
         self._drawn.register_callback(callback, remove=remove)

@@ -481,7 +481,7 @@ class Rot4DWidget(widgets.HBox):
     def _handle_drawn(self, seq=None) -> None:
         """Companion: the page rendered a frame containing update ``seq`` (``scene.update_id``)."""
         try:
-            self._pump.acknowledge(seq, draw_time=getattr(self.companion, "last_draw_time", None))
+            self._pump.acknowledge(seq, draw_time=self.companion.last_draw_time)
         except Exception as exc:
             self._report_error(exc)
 
