@@ -44,6 +44,7 @@ from .slicetables import _inplane_axes
 
 __all__: list = []
 
+_PARALLEL = 1e-12  # |d_i x d_j| below this times |d_i| |d_j|: two segments are parallel
 _EPS = 1e-9  # a crossing this close (in segment parameter) to a segment's end: the cell goes to the slab fill
 
 
@@ -102,11 +103,14 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     den = dxi * dyj - dyi * dxj  # cross(d_i, d_j)
     cej = ex * dyj - ey * dxj  # cross(e, d_j)
     cei = ex * dyi - ey * dxi  # cross(e, d_i)
+    # parallel (to rounding: a star face's line holds several segments, den ~ 1e-17 between them):
+    # no crossing and no contact, not the quotient of two roundings
+    dcut = np.where(np.abs(den) > _PARALLEL * np.sqrt((dxi * dxi + dyi * dyi) * (dxj * dxj + dyj * dyj)), den, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = cej / den
-        u = cei / den
+        s = cej / dcut
+        u = cei / dcut
     lo, hi = np.minimum(s, u), np.maximum(s, u)
-    inner = (lo > 1e-12) & (hi < 1 - 1e-12)  # (as the slab fill's; den == 0 gives nan or inf: never)
+    inner = (lo > 1e-12) & (hi < 1 - 1e-12)  # (as the slab fill's; nan: never)
     hit = inner & (lo > _EPS) & (hi < 1 - _EPS)
     # not generic: a crossing at (or near) a segment's end, other than the ends a cycle shares;
     # nor a section whose segments do not cross (cycles apart or nested: a hole is no convex face)
