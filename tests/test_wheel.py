@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import email
 import json
+import shlex
+import shutil
 import subprocess
 import sys
+import sysconfig
 import tarfile
 import time
 try:
@@ -27,6 +30,9 @@ ROOT = Path(__file__).resolve().parents[1]
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 NAME, VERSION = PROJECT["name"], PROJECT["version"]
 SERVER_CONFIG = "etc/jupyter/jupyter_server_config.d/rot4d_widget.json"
+#: the compiled star slicer (hatch_build.py), built where a C compiler is found
+LIBRARY = "rot4d_widget/geometry/_starcut.so"
+COMPILER = shutil.which(shlex.split(sysconfig.get_config_var("CC") or "cc")[0]) is not None
 
 
 def build_dists(outdir: Path) -> tuple[Path, Path]:
@@ -69,7 +75,9 @@ def _package_files() -> set[str]:
 def test_names_and_version(dists):
     sdist, wheel = dists
     assert sdist.name == f"{NAME}-{VERSION}.tar.gz"
-    assert wheel.name == f"{NAME}-{VERSION}-py3-none-any.whl"  # pure Python: installs anywhere
+    # with the C library (no Python API: any Python 3) the wheel is the platform's; without, pure
+    plat = sysconfig.get_platform().replace("-", "_").replace(".", "_") if COMPILER else "any"
+    assert wheel.name == f"{NAME}-{VERSION}-py3-none-{plat}.whl"
     init = (ROOT / "rot4d_widget" / "__init__.py").read_text()
     assert f'__version__ = "{VERSION}"' in init, "rot4d_widget.__version__ differs from pyproject's version"
 
@@ -95,6 +103,17 @@ def test_wheel_carries_the_server_extension_config_and_the_license(dists, wheel_
     assert license_text == (ROOT / "LICENSE").read_text()
     assert license_text.startswith("BSD 3-Clause License") and "rot4d_widget developers" in license_text
     assert meta["License-Expression"] == "BSD-3-Clause" and meta.get_all("License-File") == ["LICENSE"]
+
+
+@pytest.mark.skipif(not COMPILER, reason="no C compiler here: the wheel is pure")
+def test_wheel_carries_the_compiled_star_slicer_built_from_its_source(dists, wheel_names):
+    assert LIBRARY in wheel_names and "rot4d_widget/geometry/_starcut.c" in wheel_names
+    with zipfile.ZipFile(dists[1]) as z:
+        lib = z.read(LIBRARY)
+    assert lib[:4] == b"\x7fELF" if sys.platform.startswith("linux") else len(lib) > 1000
+    with tarfile.open(dists[0]) as t:  # the sdist carries the source and the hook, not a binary
+        names = {n.split("/", 1)[1] for n in t.getnames() if "/" in n}
+    assert {"hatch_build.py", "rot4d_widget/geometry/_starcut.c"} <= names and LIBRARY not in names
 
 
 def test_wheel_has_nothing_from_tests_notebooks_or_caches(wheel_names):

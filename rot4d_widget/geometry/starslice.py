@@ -47,6 +47,7 @@ import weakref
 import numpy as np
 
 from ..core import tolerances as tol_
+from . import _cstar
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
@@ -84,6 +85,7 @@ class _StarTables:
         mate = np.where(size == 2, o[np.minimum(np.arange(len(ks)) + 1 - 2 * pos, len(ks) - 1)], -1)
         self.slot_mate = np.empty(len(ks), dtype=np.intp)
         self.slot_mate[o] = mate
+        self.c = _cstar.CTables(p, t, self) if _cstar.available else None
 
 
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -99,6 +101,11 @@ def star_tables(p, t: _Tables) -> _StarTables:
 def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
     st = star_tables(p, t)
+    if st.c is not None:  # the compiled generic level; None where it declines (a vertex on H, a tie)
+        r = _cstar.cut(st.c, x, m, c0, t.tol)
+        if r is not None:
+            v, edges, flat, offsets, cells, tri, tcell, volume, n_fill = r
+            return Slice(_scaled(t, v), edges, flat, offsets, cells, tri, tcell, _scaled_volume(t, volume), 3, n_fill)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol
     out = None

@@ -1,0 +1,131 @@
+"""The compiled generic level of the general slicer (`rot4d_widget.geometry._cstar`, ``_starcut.c``)
+against the numpy slicer it stands in for (issue 22's speed target).
+
+The same polytope, orientation and level are cut twice: by the C code and, with the polytope's
+compiled tables switched off, by `starslice._cut` (the reference, itself checked against
+independent computation in test_star_cells.py, test_star_fill.py, test_nonconvex.py).  They must
+agree on everything a slice is, up to the order of its parts: the points (the edges' crossings),
+the segments, every cell's cycles (as cyclic sequences, either start), the volume, and each cell's
+fill (the area its triangles cover, signed about the cell's normal: the even-odd region, counter-
+clockwise), with every fill corner on the cell's segments' plane.
+
+Shapes: the seven regular star polychora with star faces or star cells (the other three have
+convex faces and cells and go through the convex slicer) and non-convex polytopes (4-D prisms over a dented
+octahedron, a great icosahedron and a small stellated dodecahedron: non-convex, star-celled) and
+the {5/2}-{5} duoprism (pentagram faces).
+"""
+
+from __future__ import annotations
+
+import shutil
+import sysconfig
+import zlib
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from mesh_shapes import prism_mesh
+from reference_geometry import random_rotation
+from test_star_cells import dented_octahedron, great_icosahedron, small_stellated_dodecahedron, star_duoprism_mesh
+from rot4d_widget import Polytope, polytope
+from rot4d_widget.geometry import _cstar, starslice
+from rot4d_widget.geometry.slicetables import tables
+from rot4d_widget.geometry.star_regular import SPECS
+
+pytestmark = pytest.mark.skipif(not _cstar.available, reason="the compiled level is not built here")
+
+
+def test_the_compiled_level_is_built_where_there_is_a_c_compiler():
+    """The install builds it (hatch_build.py) wherever a C compiler is found, as on this machine."""
+    cc = (sysconfig.get_config_var("CC") or "cc").split()[0]
+    if shutil.which(cc) is None and shutil.which("cc") is None:
+        pytest.skip("no C compiler here")
+    assert _cstar.available
+
+
+def _polytopes():
+    out = [(name, lambda n=name: polytope(n)) for name in SPECS]
+    for solid in (dented_octahedron, great_icosahedron, small_stellated_dodecahedron):
+        out.append((f"prism over {solid.__name__}", lambda s=solid: Polytope(*prism_mesh(*s()))))
+    out.append(("{5/2}-{5} duoprism", lambda: Polytope(*star_duoprism_mesh()[:3])))
+    return out
+
+
+def _both(p, m, c0):
+    """(C slice, numpy slice) of one level, or (None, numpy) where the C code declines it."""
+    t = tables(p)
+    st = starslice.star_tables(p, t)
+    assert st.c is not None
+    x = t.vertices @ m.T
+    level = c0 / t.unit
+    r = _cstar.cut(st.c, x, m, level, t.tol)
+    keep, st.c = st.c, None
+    try:
+        ref = starslice.slice_star(p, t, x, m, level)
+    finally:
+        st.c = keep
+    return r, ref
+
+
+def _cycles(flat, offsets, cells):
+    out = Counter()
+    for i, c in enumerate(cells):
+        cyc = [int(v) for v in flat[offsets[i]:offsets[i + 1]]]
+        k = cyc.index(min(cyc))
+        out[(int(c), tuple(cyc[k:] + cyc[:k]))] += 1
+    return out
+
+
+def _fill_area(v, tri, tcell, normals):
+    """Per cell: the triangles' area, signed about the cell's unit normal."""
+    a, b, c = v[tri[:, 0]], v[tri[:, 1]], v[tri[:, 2]]
+    n = normals[tcell] / np.linalg.norm(normals[tcell], axis=1)[:, None]
+    area = 0.5 * np.einsum("ij,ij->i", np.cross(b - a, c - a), n)
+    return np.bincount(tcell, weights=area, minlength=len(normals))
+
+
+@pytest.mark.parametrize("name,make", _polytopes(), ids=[n for n, _ in _polytopes()])
+def test_the_compiled_level_is_the_numpy_slicers(name, make):
+    p = make()
+    if p.star is None:
+        pytest.skip("convex faces and cells (self-intersecting only as a whole): the convex slicer's")
+    t = tables(p)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    done = 0
+    for _ in range(6):
+        m = random_rotation(rng)
+        for frac in (-0.37, 0.05, 0.51):
+            c0 = frac * p.circumradius
+            r, ref = _both(p, m, c0)
+            if r is None:  # declined: the numpy slicer does it (a tie or a check the C code does not make)
+                continue
+            if ref is None or ref.dim != 3:
+                continue
+            v, edges, flat, offsets, cells, tri, tcell, volume, n_fill = r
+            v = v * t.unit
+            n = len(v) - n_fill
+            assert n == len(ref.vertices) - ref.n_fill
+            # the same fills chosen (fans, arrangement, slabs): as many fill corners and triangles
+            assert (n_fill, len(tri)) == (ref.n_fill, len(ref.triangles))
+            np.testing.assert_array_equal(v[:n], ref.vertices[:n])  # the same crossings, in edge order
+            assert Counter(map(tuple, np.sort(edges, axis=1).tolist())) == \
+                Counter(map(tuple, np.sort(ref.edges, axis=1).tolist()))
+            assert _cycles(flat, offsets, cells) == _cycles(ref.polygon_indices, ref.polygon_offsets, ref.cell_ids)
+            vol = volume * t.unit ** 3
+            assert vol == pytest.approx(ref.volume if ref.volume is not None else vol, rel=1e-9, abs=1e-12)
+            normals = t.cell_normals @ m[:3].T
+            got = _fill_area(v, tri, tcell, normals)
+            want = _fill_area(ref.vertices, ref.triangles, ref.triangle_cells, normals)
+            scale = max(1.0, float(np.abs(want).max()))
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * scale)
+            assert (got >= -1e-12 * scale).all()  # counter-clockwise about the normal: no negative cover
+            # every fill corner lies in its cell's plane (on the cell's segments, not off in space)
+            corners = np.unique(np.concatenate([tri.ravel(), tcell.repeat(3)]).reshape(2, -1).T, axis=0)
+            cn = normals / np.linalg.norm(normals, axis=1)[:, None]
+            anchor = np.zeros((len(normals), 3))
+            anchor[cells] = v[flat[offsets[:-1]]]
+            off = np.einsum("ij,ij->i", v[corners[:, 0]] - anchor[corners[:, 1]], cn[corners[:, 1]])
+            assert np.abs(off).max(initial=0) <= 1e-9 * max(1.0, float(np.abs(v).max()))
+            done += 1
+    assert done >= 6, "the compiled level declined nearly every level"
