@@ -200,62 +200,82 @@ done:
     return st;
 }
 
-/* Even-odd fill of one cell's section by its segments' arrangement (starfill.arrangement_fill).
- * Returns OK with the triangles added, NOT_GENERIC when the cell is left to the slab fill (its
- * crossing heights in xs_out), or NO_MEMORY. */
 typedef struct { char *buf; size_t cap; } Work;  /* scratch memory, grown as needed, freed by the caller */
 
-static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, Result *R, dvec *xs_out, Work *ws) {
+/* The heights where a cell's segments cross inside both (the slab fill's extra slab lines), as
+ * the arrangement computes them. */
+static int inner_crossings(const Cell2D *c, dvec *xs) {
+    xs->n = 0;
+    for (I a = 0; a < c->m; a++) {
+        double L2a = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
+        for (I b = a + 1; b < c->m; b++) {
+            double ex = c->X0[b] - c->X0[a], ey = c->Y0[b] - c->Y0[a];
+            double den = c->dX[a] * c->dY[b] - c->dY[a] * c->dX[b];
+            if (!(den * den > PARALLEL * PARALLEL * L2a * (c->dX[b] * c->dX[b] + c->dY[b] * c->dY[b]))) continue;
+            double cb = ex * c->dY[b] - ey * c->dX[b], ca = ex * c->dY[a] - ey * c->dX[a], ad = fabs(den);
+            if (den < 0) { cb = -cb; ca = -ca; }
+            double s = cb / ad, u = ca / ad, lo = s < u ? s : u, hi = s < u ? u : s;
+            if (lo > EPS_IN && hi < 1 - EPS_IN) {
+                if (!dgrow(xs, 1)) return NO_MEMORY;
+                xs->a[xs->n++] = c->Y0[a] + s * c->dY[a];
+            }
+        }
+    }
+    return OK;
+}
+
+/* Even-odd fill of one cell's section by its segments' arrangement (starfill.arrangement_fill).
+ * Returns OK with the triangles added, NOT_GENERIC when the cell is left to the slab fill (its
+ * crossings by `inner_crossings`), or NO_MEMORY. */
+
+static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, Result *R, Work *ws) {
     int st = OK, bad = 0;
     I m = c->m;
     I nxmax = m * (m - 1) / 2 + 1, nsmax = m + 2 * nxmax + 1;
     /* one block for the cell: its crossings, occurrences and pieces at their most */
-    size_t need = (size_t)(8 * nxmax + 4 * (m + 1) + 5 * nsmax) * sizeof(I)
-                + (size_t)(4 * nxmax) * sizeof(double) + (size_t)nsmax;
+    size_t need = (size_t)(8 * nxmax + 4 * (m + 1) + 4 * nsmax) * sizeof(I)
+                + (size_t)(4 * nxmax + (m + 1) + 2 * nsmax) * sizeof(double) + (size_t)nsmax;
     if (ws->cap < need) {
         char *b = realloc(ws->buf, need);
         if (!b) return NO_MEMORY;
         ws->buf = b; ws->cap = need;
     }
     double *xsp = (double *)ws->buf, *xup = xsp + nxmax, *occ_t = xup + nxmax;
-    I *xa = (I *)(occ_t + 2 * nxmax), *xb = xa + nxmax, *xid = xb + nxmax, *xsp_at = xid + nxmax;
+    double *L2 = occ_t + 2 * nxmax, *hx = L2 + (m + 1), *hy = hx + nsmax;
+    I *xa = (I *)(hy + nsmax), *xb = xa + nxmax, *xid = xb + nxmax, *xsp_at = xid + nxmax;
     I *k = xsp_at + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
     I *occ_x = cnt + (m + 1), *occ_other = occ_x + nxmax * 2;
-    I *nxt = occ_other + nxmax * 2, *lab = nxt + nsmax, *tail = lab + nsmax, *prec = tail + nsmax, *fillp = prec + nsmax;
-    unsigned char *back = (unsigned char *)(fillp + nsmax);
+    I *nxt = occ_other + nxmax * 2, *lab = nxt + nsmax, *tail = lab + nsmax, *fillp = tail + nsmax;
+    unsigned char *back = (unsigned char *)(fillp + m + 1);
     memset(k, 0, (m + 1) * sizeof(I));
-    I nx = 0, nhit = 0;
-    xs_out->n = 0;
+    I nx = 0;
+    for (I a = 0; a < m; a++) L2[a] = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
     for (I a = 0; a < m; a++) {
+        double xa0 = c->X0[a], ya0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a];
         for (I b = a + 1; b < m; b++) {
-            double ex = c->X0[b] - c->X0[a], ey = c->Y0[b] - c->Y0[a];
-            double den = c->dX[a] * c->dY[b] - c->dY[a] * c->dX[b];
+            double ex = c->X0[b] - xa0, ey = c->Y0[b] - ya0, dxb = c->dX[b], dyb = c->dY[b];
+            double den = dxa * dyb - dya * dxb;
             /* parallel to rounding (a star face's line holds several segments): no crossing, no contact */
-            if (!(fabs(den) > PARALLEL * sqrt((c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a]) * (c->dX[b] * c->dX[b] + c->dY[b] * c->dY[b])))) continue;
-            double cb = ex * c->dY[b] - ey * c->dX[b], ca = ex * c->dY[a] - ey * c->dX[a], ad = fabs(den);
+            if (!(den * den > PARALLEL * PARALLEL * L2[a] * L2[b])) continue;
+            double cb = ex * dyb - ey * dxb, ca = ex * dya - ey * dxa, ad = fabs(den);
             if (den < 0) { cb = -cb; ca = -ca; }
             if (cb < -0.5 * ad || cb > 1.5 * ad || ca < -0.5 * ad || ca > 1.5 * ad) continue;  /* far from both */
-            double s = (ex * c->dY[b] - ey * c->dX[b]) / den, u = (ex * c->dY[a] - ey * c->dX[a]) / den;
+            double s = cb / ad, u = ca / ad;  /* (= cej / den, cei / den exactly: negation is exact) */
             double lo = s < u ? s : u, hi = s < u ? u : s;
-            if (!(lo == lo) || !(hi == hi)) continue;
-            int inner = lo > EPS_IN && hi < 1 - EPS_IN;
-            int hit = inner && lo > EPS_ARR && hi < 1 - EPS_ARR;
-            if (inner) { if (!dgrow(xs_out, 1)) { st = NO_MEMORY; goto done; } xs_out->a[xs_out->n++] = c->Y0[a] + s * c->dY[a]; }
-            if (hit) { xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u; nx++; nhit++; }
+            if (lo > EPS_ARR && hi < 1 - EPS_ARR) { xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u; nx++; }
             else if (lo > -EPS_ARR && hi < 1 + EPS_ARR) {
                 /* at (or near) an end: only where the two share that end (consecutive in a cycle) */
                 if (c->p0[a] != c->p0[b] && c->p0[a] != c->p1[b] && c->p1[a] != c->p0[b] && c->p1[a] != c->p1[b]) bad = 1;
             }
         }
     }
-    if (!nhit || bad) { st = NOT_GENERIC; goto done; }
+    if (!nx || bad) { st = NOT_GENERIC; goto done; }
     /* occurrences: each record's crossings in order along it */
     for (I x = 0; x < nx; x++) { k[xa[x]]++; k[xb[x]]++; }
     optr[0] = 0; base[0] = 0;
     for (I a = 0; a < m; a++) { optr[a + 1] = optr[a] + k[a]; base[a + 1] = base[a] + k[a] + 1; }
     I nocc = optr[m], nsub = base[m];
     (void)nocc;
-    for (I a = 0; a < m; a++) for (I t = 0; t <= k[a]; t++) prec[base[a] + t] = a;
     memset(fillp, 0, m * sizeof(I));
     for (I x = 0; x < nx; x++) {
         I ia = optr[xa[x]] + fillp[xa[x]]++, ib = optr[xb[x]] + fillp[xb[x]]++;
@@ -271,12 +291,12 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         }
         for (I i = s0 + 1; i < s1; i++) if (occ_t[i] == occ_t[i - 1]) { st = NOT_GENERIC; goto done; }
     }
-    for (I a = 0; a < m; a++)  /* where each crossing sits on its first record */
-        for (I i = optr[a]; i < optr[a + 1]; i++)
-            if (xa[occ_x[i]] == a) xsp_at[occ_x[i]] = i;
-    for (I a = 0; a < m; a++)  /* the same crossing on the other record */
-        for (I i = optr[a]; i < optr[a + 1]; i++)
-            if (xa[occ_x[i]] != a) { occ_other[i] = xsp_at[occ_x[i]]; occ_other[xsp_at[occ_x[i]]] = i; }
+    for (I x = 0; x < nx; x++) xsp_at[x] = -1;  /* each crossing's two occurrences, each the other's */
+    for (I i = 0; i < optr[m]; i++) {
+        I x = occ_x[i];
+        if (xsp_at[x] < 0) xsp_at[x] = i;
+        else { occ_other[i] = xsp_at[x]; occ_other[xsp_at[x]] = i; }
+    }
     /* parity left of each record's first piece: a ray square to it, leftwards from that piece's middle */
     memset(cnt, 0, m * sizeof(I));
     for (I a = 0; a < m; a++) {
@@ -285,16 +305,20 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         double dx = c->dX[a], dy = c->dY[a], nx_ = -dy, ny_ = dx;
         I n = 0;
         for (I b = 0; b < m; b++) {
-            if (b == a) continue;
             double Ax = c->X0[b] - ox, Ay = c->Y0[b] - oy, Bx = Ax + c->dX[b], By = Ay + c->dY[b];
             double a0 = Ax * dx + Ay * dy, a1 = Bx * dx + By * dy;
             double n0 = Ax * nx_ + Ay * ny_, n1 = Bx * nx_ + By * ny_;
-            if ((a0 > 0) != (a1 > 0) && (a0 * n1 - a1 * n0) * (a0 - a1) > 0) n++;
+            n += ((a0 > 0) != (a1 > 0)) & ((a0 * n1 - a1 * n0) * (a0 - a1) > 0) & (b != a);
         }
         cnt[a] = n;
     }
     for (I a = 0; a < m; a++)
-        for (I t = 0; t <= k[a]; t++) back[base[a] + t] = ((cnt[a] + t) & 1) == 0;
+        for (I t = 0; t <= k[a]; t++) {
+            I e = base[a] + t;
+            back[e] = ((cnt[a] + t) & 1) == 0;
+            hx[e] = back[e] ? -c->dX[a] : c->dX[a];
+            hy[e] = back[e] ? -c->dY[a] : c->dY[a];
+        }
     /* the next odd half round its face */
     for (I a = 0; a < m; a++) {
         for (I t = 0; t <= k[a]; t++) {
@@ -328,20 +352,20 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         do {
             if (lab[e] >= 0 || ++steps > nsub) { st = NOT_GENERIC; goto done; }
             lab[e] = e0;
-            I a = prec[e], e2 = nxt[e], b = prec[e2];
-            double hx = back[e] ? -c->dX[a] : c->dX[a], hy = back[e] ? -c->dY[a] : c->dY[a];
-            double hx2 = back[e2] ? -c->dX[b] : c->dX[b], hy2 = back[e2] ? -c->dY[b] : c->dY[b];
-            if (!(hx * hy2 - hy * hx2 > 0)) { st = NOT_GENERIC; goto done; }
-            if (hy < 0 && hy2 >= 0) ups++;
+            I e2 = nxt[e];
+            if (!(hx[e] * hy[e2] - hy[e] * hx[e2] > 0)) { st = NOT_GENERIC; goto done; }
+            ups += hy[e] < 0 && hy[e2] >= 0;
             e = e2;
         } while (e != e0);
         if (ups != 1) { st = NOT_GENERIC; goto done; }
     }
     /* generic: the crossings become corners; each odd half's tail; fans from each face's first */
+    if (!dgrow(&R->verts, 3 * nx) || !igrow(&R->tri, 3 * nsub) || !igrow(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
     for (I x = 0; x < nx; x++) {
-        if (!dgrow(&R->verts, 3)) { st = NO_MEMORY; goto done; }
         const double *A = R->verts.a + 3 * c->p0[xa[x]], *B = R->verts.a + 3 * c->p1[xa[x]];
-        for (int q = 0; q < 3; q++) R->verts.a[R->verts.n++] = A[q] + xsp[x] * (B[q] - A[q]);
+        double *o = R->verts.a + R->verts.n;
+        for (int q = 0; q < 3; q++) o[q] = A[q] + xsp[x] * (B[q] - A[q]);
+        R->verts.n += 3;
         xid[x] = R->n_points + R->n_extra++;
     }
     for (I a = 0; a < m; a++)
@@ -352,8 +376,11 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         }
     for (I e0 = 0; e0 < nsub; e0++) {
         if (lab[e0] != e0) continue;
-        for (I e = nxt[e0]; nxt[e] != e0; e = nxt[e]) {
-            IPUSH(R->tri, tail[e0]); IPUSH(R->tri, tail[e]); IPUSH(R->tri, tail[nxt[e]]); IPUSH(R->tcell, cell);
+        for (I e = nxt[e0]; nxt[e] != e0; e = nxt[e]) {  /* (room reserved: fewer triangles than pieces) */
+            I *o = R->tri.a + R->tri.n;
+            o[0] = tail[e0]; o[1] = tail[e]; o[2] = tail[nxt[e]];
+            R->tri.n += 3;
+            R->tcell.a[R->tcell.n++] = cell;
         }
     }
 done:
@@ -589,16 +616,19 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
             for (I j = o0; j < o1; j++) for (int q = 0; q < 3; q++) cen[q] += PTS[3 * R->flat.a[j] + q];
             for (int q = 0; q < 3; q++) cen[q] /= (double)kk;
             I left = 0, right = 0;
-            for (I j = o0; j < o1; j++) {
-                I jn = j + 1 < o1 ? j + 1 : o0;
-                double a[3], b[3], ab[3];
-                for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[j] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[jn] + q] - cen[q]; }
-                cross3(a, b, ab);
-                double y = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
-                ang += atan2(y, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-                left += y > 0; right += y < 0;
+            for (int pass = 0; pass < 2 && ok; pass++) {  /* every turn one way first; then the angle */
+                for (I j = o0; j < o1; j++) {
+                    I jn = j + 1 < o1 ? j + 1 : o0;
+                    double a[3], b[3], ab[3];
+                    for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[j] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[jn] + q] - cen[q]; }
+                    cross3(a, b, ab);
+                    double y = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
+                    if (pass) ang += atan2(y, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+                    else { left += y > 0; right += y < 0; }
+                }
+                if (!pass && left != kk && right != kk) ok = 0;
             }
-            if (!(fabs(fabs(ang) - 2 * M_PI) < 1e-6 && (left == kk || right == kk))) ok = 0;
+            if (ok && !(fabs(fabs(ang) - 2 * M_PI) < 1e-6)) ok = 0;
         }
         for (I i = p0; i < p1 && ok; i++)
             for (I j = i + 1; j < p1 && ok; j++) {
@@ -671,10 +701,11 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
         }
         /* the record ends' partners are global end numbers: the end 2g + n of record g */
         I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
-        int s2 = arrangement(&c2, loc, partner, cc, R, &xs, &ws);
+        int s2 = arrangement(&c2, loc, partner, cc, R, &ws);
         if (s2 == NOT_GENERIC) {
             R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
-            s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
+            s2 = inner_crossings(&c2, &xs);
+            if (s2 == OK) s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
         }
         for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
         if (s2 != OK) st = s2;
