@@ -103,7 +103,8 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
     int st = OK;
     I m = c->m;
     I *lo_p = NULL, *hi_p = NULL, *keep = NULL, *ylo = NULL, *yhi = NULL, *pstart = NULL, *pid = NULL;
-    double *Xl = NULL, *Yl = NULL, *Xh = NULL, *Yh = NULL, *uy = NULL, *key = NULL;
+    double *Xl = NULL, *Yl = NULL, *Xh = NULL, *Yh = NULL, *uy = NULL, *key = NULL, *slope = NULL;
+    I *bylo = NULL, *act = NULL;
     I *order = NULL, *openL = NULL, *openR = NULL, *openY = NULL, *nopenL = NULL, *nopenR = NULL, *nopenY = NULL;
     lo_p = malloc(m * sizeof(I)); hi_p = malloc(m * sizeof(I)); keep = malloc(m * sizeof(I));
     Xl = malloc(m * sizeof(double)); Yl = malloc(m * sizeof(double));
@@ -133,18 +134,30 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
     ylo = malloc((nk + 1) * sizeof(I)); yhi = malloc((nk + 1) * sizeof(I)); pstart = malloc((nk + 1) * sizeof(I));
     if (!ylo || !yhi || !pstart) { st = NO_MEMORY; goto done; }
     I npieces = 0;
-    for (I a = 0; a < nk; a++) {
-        I lo = 0, hi = nl - 1;  /* exact members of uy */
-        while (uy[lo] != Yl[a]) lo++;
-        while (uy[hi] != Yh[a]) hi--;
-        ylo[a] = lo; yhi[a] = hi; pstart[a] = npieces; npieces += hi - lo;
+    for (I a = 0; a < nk; a++) {  /* (exact members of uy: binary search) */
+        I lo = 0, hi = nl - 1;
+        while (lo < hi) { I mid = (lo + hi) / 2; if (uy[mid] < Yl[a]) lo = mid + 1; else hi = mid; }
+        ylo[a] = lo;
+        lo = 0; hi = nl - 1;
+        while (lo < hi) { I mid = (lo + hi) / 2; if (uy[mid] < Yh[a]) lo = mid + 1; else hi = mid; }
+        yhi[a] = lo; pstart[a] = npieces; npieces += yhi[a] - ylo[a];
     }
     pid = malloc((npieces + 1) * sizeof(I));  /* the extra corner on segment a at line y, -1 none yet */
     order = malloc((nk + 1) * sizeof(I)); key = malloc((nk + 1) * sizeof(double));
     openL = malloc((nk + 1) * sizeof(I)); openR = malloc((nk + 1) * sizeof(I)); openY = malloc((nk + 1) * sizeof(I));
     nopenL = malloc((nk + 1) * sizeof(I)); nopenR = malloc((nk + 1) * sizeof(I)); nopenY = malloc((nk + 1) * sizeof(I));
-    if (!pid || !order || !key || !openL || !openR || !openY || !nopenL || !nopenR || !nopenY) { st = NO_MEMORY; goto done; }
+    slope = malloc((nk + 1) * sizeof(double)); bylo = malloc((nk + 1) * sizeof(I)); act = malloc((nk + 1) * sizeof(I));
+    if (!pid || !order || !key || !openL || !openR || !openY || !nopenL || !nopenR || !nopenY || !slope || !bylo || !act) {
+        st = NO_MEMORY; goto done;
+    }
     for (I q = 0; q < npieces; q++) pid[q] = -1;
+    for (I a = 0; a < nk; a++) {  /* slopes; the segments by their lowest slab (insertion: a few dozen) */
+        slope[a] = (Xh[a] - Xl[a]) / (Yh[a] - Yl[a]);
+        I j = a - 1;
+        while (j >= 0 && ylo[bylo[j]] > ylo[a]) { bylo[j + 1] = bylo[j]; j--; }
+        bylo[j + 1] = a;
+    }
+    I nact = 0, next_in = 0;
     I nopen = 0;
 #define CORNER(seg, line, out) do { \
         I s_ = (seg), l_ = (line); \
@@ -166,11 +179,14 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
         if (a_ != c_ && c_ != d_ && a_ != d_) { IPUSH(R->tri, a_); IPUSH(R->tri, c_); IPUSH(R->tri, d_); IPUSH(R->tcell, cell); } \
     } while (0)
     for (I k = 0; k + 1 < nl; k++) {
-        I n = 0;
-        for (I a = 0; a < nk; a++) {
-            if (ylo[a] <= k && k < yhi[a]) {
-                double slope = (Xh[a] - Xl[a]) / (Yh[a] - Yl[a]);
-                double xa = Xl[a] + (uy[k] - Yl[a]) * slope, xb = Xl[a] + (uy[k + 1] - Yl[a]) * slope;
+        I n = 0, keepn = 0;
+        for (I i = 0; i < nact; i++) if (yhi[act[i]] > k) act[keepn++] = act[i];  /* the segments across slab k */
+        nact = keepn;
+        while (next_in < nk && ylo[bylo[next_in]] == k) act[nact++] = bylo[next_in++];
+        for (I i = 0; i < nact; i++) {
+            I a = act[i];
+            {
+                double xa = Xl[a] + (uy[k] - Yl[a]) * slope[a], xb = Xl[a] + (uy[k + 1] - Yl[a]) * slope[a];
                 double kv = xa + xb;
                 I j = n - 1;
                 while (j >= 0 && key[j] > kv) { key[j + 1] = key[j]; order[j + 1] = order[j]; j--; }
@@ -196,7 +212,7 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
 done:
     free(lo_p); free(hi_p); free(keep); free(Xl); free(Yl); free(Xh); free(Yh); free(uy); free(ylo); free(yhi);
     free(pstart); free(pid); free(order); free(key); free(openL); free(openR); free(openY);
-    free(nopenL); free(nopenR); free(nopenY);
+    free(nopenL); free(nopenR); free(nopenY); free(slope); free(bylo); free(act);
     return st;
 }
 
