@@ -14,6 +14,12 @@ speed hits all alike):
 
 Medians over ``--repeats`` runs; the ratio is each one's over the 600-cell's of the same runs.
 
+A star polychoron's level is cut by the compiled level (`rot4d_widget.geometry._cstar`, built from
+``_starcut.c`` at install) when no vertex lies on H; the **numpy slicer** column times the same
+slices with the compiled tables switched off (the pure-numpy slicer the C code stands in for, and
+what an install without a C compiler runs), in the same runs; ``C levels`` says how many of the
+``--steps`` slices the C code did (the rest it declined to numpy: a vertex on H, a tie).
+
     python benchmarks/star_load.py [--steps 20] [--repeats 5] [--names all|three]
 
 Target (issue 22): a star polychoron of 120 vertices loads and slices within 2x a convex one of
@@ -30,6 +36,8 @@ import numpy as np
 
 from rot4d_widget import Polytope, polytope
 from rot4d_widget.core.rotation import random_rotation
+from rot4d_widget.geometry import _cstar, starslice
+from rot4d_widget.geometry.slicetables import tables
 from rot4d_widget.geometry.slicing import slice_polytope
 from rot4d_widget.geometry.star_regular import SPECS, star_arrays
 
@@ -61,8 +69,23 @@ def one_run(name: str, mats: list) -> dict:
         s = slice_polytope(p, m, 0.1)
         times.append(time.perf_counter() - a)
         fill = max(fill, s.n_fill)
-    return {"build": t1 - t0, "load": t2 - t0, "slice": statistics.median(times), "counts": p.counts,
-            "points": len(s.vertices) - s.n_fill, "fill": fill}
+    out = {"build": t1 - t0, "load": t2 - t0, "slice": statistics.median(times), "counts": p.counts,
+           "points": len(s.vertices) - s.n_fill, "fill": fill, "numpy": float("nan"), "c_levels": None}
+    st = starslice.star_tables(p, tables(p)) if p.star is not None else None
+    if st is not None and st.c is not None:
+        t = tables(p)
+        out["c_levels"] = sum(_cstar.cut(st.c, t.vertices @ m.T, m, 0.1 / t.unit, t.tol) is not None for m in mats)
+        keep, st.c = st.c, None  # the numpy slicer alone, on the same slices
+        try:
+            nt = []
+            for m in mats:
+                a = time.perf_counter()
+                slice_polytope(p, m, 0.1)
+                nt.append(time.perf_counter() - a)
+        finally:
+            st.c = keep
+        out["numpy"] = statistics.median(nt)
+    return out
 
 
 def main() -> None:
@@ -87,24 +110,27 @@ def main() -> None:
                 runs[n].append(one_run(n, mats))
             except ValueError as exc:
                 refused[n] = str(exc).splitlines()[0][:90]
-    med = {n: {k: statistics.median(r[k] for r in rs) for k in ("build", "load", "slice")}
+    med = {n: {k: statistics.median(r[k] for r in rs) for k in ("build", "load", "slice", "numpy")}
            for n, rs in runs.items() if rs}
     base = med["600-cell"]
     print(f"build (Polytope from arrays, validated), load (build + first slice: the slicing tables) and "
           f"slice_polytope at {args.steps} random orientations, c0 = 0.1 (median per slice); medians of "
-          f"{args.repeats} interleaved runs")
+          f"{args.repeats} interleaved runs; compiled level {'built' if _cstar.available else 'NOT built'}")
     print("| polychoron | symbol | V, E, F, C | build (ms) | load (ms) | x 600-cell | slice (ms) | x 600-cell "
-          "| slice points, fill corners |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|")
+          "| C levels | numpy slicer (ms) | x 600-cell | slice points, fill corners |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n in names:
         sym = SPECS[n].symbol if n in SPECS else "{3,3,5}"
         if n in refused:
-            print(f"| {n} | {sym} | | refused: {refused[n]} | | | | | |")
+            print(f"| {n} | {sym} | | refused: {refused[n]} | | | | | | | | |")
             continue
         m, last = med[n], runs[n][-1]
         print(f"| {n} | {sym} | {', '.join(map(str, last['counts']))} | {1e3 * m['build']:.1f} "
               f"| {1e3 * m['load']:.1f} | {m['load'] / base['load']:.2f} | {1e3 * m['slice']:.2f} "
-              f"| {m['slice'] / base['slice']:.2f} | {last['points']}, {last['fill']} |")
+              f"| {m['slice'] / base['slice']:.2f} "
+              + (f"| {last['c_levels']}/{args.steps} | {1e3 * m['numpy']:.2f} | {m['numpy'] / base['slice']:.2f} "
+                 if last["c_levels"] is not None else "| | | ")
+              + f"| {last['points']}, {last['fill']} |")
     print(f"(whole run {time.perf_counter() - t:.0f} s)")
 
 
