@@ -17,6 +17,7 @@ the {5/2}-{5} duoprism (pentagram faces).
 
 from __future__ import annotations
 
+import pathlib
 import shutil
 import sysconfig
 import zlib
@@ -42,6 +43,36 @@ def test_the_compiled_level_is_built_where_there_is_a_c_compiler():
     if shutil.which(cc) is None and shutil.which("cc") is None:
         pytest.skip("no C compiler here")
     assert _cstar.available
+
+
+def test_a_library_built_from_another_source_is_not_used(tmp_path):
+    """An edited _starcut.c beside an old build: the build is refused, with a warning saying why."""
+    here = pathlib.Path(_cstar.__file__).parent
+    lib = next(p for p in here.iterdir() if p.name.startswith("_starcut.") and p.suffix != ".c")
+    shutil.copy(lib, tmp_path / lib.name)
+    shutil.copy(here / "_starcut.c", tmp_path / "_starcut.c")
+    assert _cstar._load(tmp_path) is not None  # the same source: used
+    with open(tmp_path / "_starcut.c", "a") as f:
+        f.write("/* edited */\n")
+    with pytest.warns(UserWarning, match="built from another _starcut.c"):
+        assert _cstar._load(tmp_path) is None
+
+
+def test_the_compiled_level_declines_what_is_not_a_number_or_on_the_hyperplane():
+    """NaN or infinite coordinates or level, a vertex on H: None (the numpy slicer's), no crash."""
+    p = polytope("small stellated 120-cell")
+    t = tables(p)
+    st = starslice.star_tables(p, t)
+    m = np.eye(4)
+    x = t.vertices @ m.T
+    assert _cstar.cut(st.c, x, m, 0.1, t.tol) is not None
+    for level in (np.nan, np.inf, -np.inf, float(x[7, 3])):
+        assert _cstar.cut(st.c, x, m, level, t.tol) is None, level
+    bad = x.copy()
+    bad[3, 0] = np.nan
+    assert _cstar.cut(st.c, bad, m, 0.1, t.tol) is None
+    bad[3] = [0, 0, 0, np.inf]
+    assert _cstar.cut(st.c, bad, m, 0.1, t.tol) is None
 
 
 def _polytopes():

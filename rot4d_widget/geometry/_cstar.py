@@ -26,10 +26,11 @@ __all__: list = []
 _LIB_NAMES = ("_starcut.so", "_starcut.dylib", "_starcut.dll")
 
 
-def _load():
+def _load(here: pathlib.Path | None = None):
+    """The library beside this module (or in ``here``), checked against its source; None without."""
     if os.environ.get("ROT4D_NO_C"):
         return None
-    here = pathlib.Path(__file__).parent
+    here = pathlib.Path(__file__).parent if here is None else pathlib.Path(here)
     for name in _LIB_NAMES:
         path = here / name
         if path.exists():

@@ -141,6 +141,7 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
         lo = 0; hi = nl - 1;
         while (lo < hi) { I mid = (lo + hi) / 2; if (uy[mid] < Yh[a]) lo = mid + 1; else hi = mid; }
         yhi[a] = lo; pstart[a] = npieces; npieces += yhi[a] - ylo[a];
+        if (yhi[a] <= ylo[a] || uy[ylo[a]] != Yl[a] || uy[yhi[a]] != Yh[a]) { st = INCONSISTENT; goto done; }
     }
     pid = malloc((npieces + 1) * sizeof(I));  /* the extra corner on segment a at line y, -1 none yet */
     order = malloc((nk + 1) * sizeof(I)); key = malloc((nk + 1) * sizeof(double));
@@ -426,9 +427,12 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     if (!R) { *status = NO_MEMORY; return NULL; }
     above = malloc(V + 1); cid = malloc((E + 1) * sizeof(I));
     if (!above || !cid) { st = NO_MEMORY; goto done; }
+    if (!isfinite(c0) || !isfinite(tol)) { st = NOT_GENERIC; goto done; }
     for (I v = 0; v < V; v++) {
         double h = x[4 * v + 3] - c0;
-        if (fabs(h) <= tol) { st = NOT_GENERIC; goto done; }
+        if (fabs(h) <= tol || !isfinite(h) || !isfinite(x[4 * v]) || !isfinite(x[4 * v + 1]) || !isfinite(x[4 * v + 2])) {
+            st = NOT_GENERIC; goto done;  /* on H (or not a number: the numpy slicer says what) */
+        }
         above[v] = h > 0;
     }
     /* points: where edges cross H, in edge order */
@@ -693,11 +697,12 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     I mmax = 0;
     for (I cc = 0; cc < C; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
     I *cg = malloc((3 * mmax + 1) * sizeof(I));
-    if (!cg) { st = NO_MEMORY; goto done; }
+    double *cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
+    if (!cg || !cd) { free(cg); free(cd); st = NO_MEMORY; goto done; }
     for (I cc = 0; cc < C && st == OK; cc++) {
         I r0 = crec_ptr[cc], m = crec_ptr[cc + 1] - r0;
         if (!m || cdone[cc]) continue;
-        double X0[m], Y0[m], dX[m], dY[m], X1[m], Y1[m];
+        double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
         Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
         double uv[6], org[3];
         inplane(normals + 3 * cc, uv);
@@ -726,7 +731,7 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
         for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
         if (s2 != OK) st = s2;
     }
-    free(cg);
+    free(cg); free(cd);
     if (st != OK) goto done;
 
 done:
