@@ -23,6 +23,14 @@ SOURCE = "rot4d_widget/geometry/_starcut.c"
 LIBRARY = "rot4d_widget/geometry/_starcut.so"
 
 
+def _compilers():
+    seen = []
+    for cmd in (os.environ.get("CC"), sysconfig.get_config_var("CC"), "cc", "gcc", "clang"):
+        if cmd and shlex.split(cmd) not in seen:
+            seen.append(shlex.split(cmd))
+    return seen
+
+
 class CompiledLevel(BuildHookInterface):
     PLUGIN_NAME = "custom"
 
@@ -30,15 +38,19 @@ class CompiledLevel(BuildHookInterface):
         if self.target_name != "wheel" or os.environ.get("ROT4D_NO_C"):
             return
         src, out = Path(self.root) / SOURCE, Path(self.root) / LIBRARY
-        cc = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
         sha = hashlib.sha256(src.read_bytes()).hexdigest()  # the library names its source: a stale one is not used
-        cmd = [*cc, "-O2", "-shared", "-fPIC", f'-DSTARCUT_SOURCE="{sha}"', "-o", str(out), str(src), "-lm"]
-        try:
-            subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=300)
-        except (OSError, subprocess.SubprocessError) as err:
-            detail = getattr(err, "stderr", "") or str(err)
-            print(f"rot4d_widget: no compiled star slicer ({' '.join(cmd)} failed: {detail.strip()[:500]}); "
-                  "the numpy slicer does every level", file=sys.stderr)
+        tried = []
+        for cc in _compilers():  # $CC, Python's own, then the usual names (a conda Python's may be absent)
+            cmd = [*cc, "-O2", "-shared", "-fPIC", f'-DSTARCUT_SOURCE="{sha}"', "-o", str(out), str(src), "-lm"]
+            try:
+                subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=300)
+                break
+            except (OSError, subprocess.SubprocessError) as err:
+                detail = getattr(err, "stderr", "") or str(err)
+                tried.append(f"{' '.join(cc)}: {detail.strip()[:300]}")
+        else:
+            print("rot4d_widget: no compiled star slicer (" + "; ".join(tried) + "); the numpy slicer does every level",
+                  file=sys.stderr)
             return
         if version != "editable":
             build_data["force_include"][str(out)] = LIBRARY

@@ -17,8 +17,12 @@ the {5/2}-{5} duoprism (pentagram faces).
 
 from __future__ import annotations
 
+import json
+import os
 import pathlib
 import shutil
+import subprocess
+import sys
 import sysconfig
 import zlib
 from collections import Counter
@@ -56,6 +60,26 @@ def test_a_library_built_from_another_source_is_not_used(tmp_path):
         f.write("/* edited */\n")
     with pytest.warns(UserWarning, match="built from another _starcut.c"):
         assert _cstar._load(tmp_path) is None
+
+
+def test_without_the_library_the_numpy_slicer_gives_the_same_slices():
+    """ROT4D_NO_C=1 (as an install without a C compiler): not available, and the same slice."""
+    code = ("import json, numpy as np\n"
+            "from rot4d_widget import polytope\n"
+            "from rot4d_widget.geometry import _cstar\n"
+            "from rot4d_widget.geometry.slicing import slice_polytope\n"
+            "from rot4d_widget.core.rotation import random_rotation\n"
+            "s = slice_polytope(polytope('great stellated 120-cell'), random_rotation(np.random.default_rng(3)), 0.2)\n"
+            "print(json.dumps([_cstar.available, s.volume, s.vertices[:len(s.vertices) - s.n_fill].tolist()]))\n")
+    out = {}
+    for flag in ("", "1"):
+        env = dict(os.environ, ROT4D_NO_C=flag)
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        out[flag] = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out[""][0] is True and out["1"][0] is False
+    assert out["1"][1] == pytest.approx(out[""][1], rel=1e-9)
+    assert out["1"][2] == out[""][2]
 
 
 def test_the_compiled_level_declines_what_is_not_a_number_or_on_the_hyperplane():

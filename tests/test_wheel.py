@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import email
 import json
+import os
+import pathlib
 import shlex
 import shutil
 import subprocess
@@ -114,6 +116,20 @@ def test_wheel_carries_the_compiled_star_slicer_built_from_its_source(dists, whe
     with tarfile.open(dists[0]) as t:  # the sdist carries the source and the hook, not a binary
         names = {n.split("/", 1)[1] for n in t.getnames() if "/" in n}
     assert {"hatch_build.py", "rot4d_widget/geometry/_starcut.c"} <= names and LIBRARY not in names
+
+
+def test_without_a_c_compiler_the_wheel_is_pure_and_says_why(tmp_path):
+    """No compiler on PATH and a $CC that does not exist: the build goes on, pure, with a message."""
+    env = {k: v for k, v in os.environ.items() if k not in ("CC",)}
+    env.update(CC="/nonexistent/cc", PATH=str(pathlib.Path(sys.executable).parent))
+    proc = subprocess.run([sys.executable, "-m", "build", "--no-isolation", "--wheel", "--outdir", str(tmp_path), str(ROOT)],
+                          capture_output=True, text=True, timeout=600, env=env)
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    (wheel,) = tmp_path.glob("*.whl")
+    assert wheel.name == f"{NAME}-{VERSION}-py3-none-any.whl"
+    with zipfile.ZipFile(wheel) as z:
+        assert LIBRARY not in z.namelist()
+    assert "no compiled star slicer" in proc.stdout + proc.stderr
 
 
 def test_wheel_has_nothing_from_tests_notebooks_or_caches(wheel_names):
