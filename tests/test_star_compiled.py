@@ -100,7 +100,8 @@ def test_the_compiled_level_declines_what_is_not_a_number_or_on_the_hyperplane()
 
 
 def _polytopes():
-    out = [(name, lambda n=name: polytope(n)) for name in SPECS]
+    # the seven with star faces ({5/2,...}) or star cells ({p,5/2,...}); the other three go through the convex slicer
+    out = [(name, lambda n=name: polytope(n)) for name, spec in SPECS.items() if "/" in "".join(spec.symbol.split(",")[:2])]
     for solid in (dented_octahedron, great_icosahedron, small_stellated_dodecahedron):
         out.append((f"prism over {solid.__name__}", lambda s=solid: Polytope(*prism_mesh(*s()))))
     out.append(("{5/2}-{5} duoprism", lambda: Polytope(*star_duoprism_mesh()[:3])))
@@ -143,8 +144,7 @@ def _fill_area(v, tri, tcell, normals):
 @pytest.mark.parametrize("name,make", _polytopes(), ids=[n for n, _ in _polytopes()])
 def test_the_compiled_level_is_the_numpy_slicers(name, make):
     p = make()
-    if p.star is None:
-        pytest.skip("convex faces and cells (self-intersecting only as a whole): the convex slicer's")
+    assert p.star is not None
     t = tables(p)
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     done = 0
