@@ -52,8 +52,7 @@ def test_the_compiled_level_is_built_where_there_is_a_c_compiler():
 def test_a_library_built_from_another_source_is_not_used(tmp_path):
     """An edited _starcut.c beside an old build: the build is refused, with a warning saying why."""
     here = pathlib.Path(_cstar.__file__).parent
-    lib = next(p for p in here.iterdir() if p.name.startswith("_starcut.") and p.suffix != ".c")
-    shutil.copy(lib, tmp_path / lib.name)
+    shutil.copy(here / _cstar.LIBRARY, tmp_path / _cstar.LIBRARY)
     shutil.copy(here / "_starcut.c", tmp_path / "_starcut.c")
     assert _cstar._load(tmp_path) is not None  # the same source: used
     with open(tmp_path / "_starcut.c", "a") as f:

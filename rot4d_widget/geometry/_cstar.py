@@ -23,7 +23,8 @@ import numpy as np
 
 __all__: list = []
 
-_LIB_NAMES = ("_starcut.so", "_starcut.dylib", "_starcut.dll")
+#: what hatch_build.py compiles ``_starcut.c`` to, beside it (one name on every platform: ctypes loads any)
+LIBRARY = "_starcut.so"
 
 
 def _load(here: pathlib.Path | None = None):
@@ -31,26 +32,26 @@ def _load(here: pathlib.Path | None = None):
     if os.environ.get("ROT4D_NO_C"):
         return None
     here = pathlib.Path(__file__).parent if here is None else pathlib.Path(here)
-    for name in _LIB_NAMES:
-        path = here / name
-        if path.exists():
-            try:
-                lib = ctypes.CDLL(str(path))
-            except OSError:  # pragma: no cover - built for another platform
-                return None
-            lib.starcut_source.restype = ctypes.c_char_p
-            src = here / "_starcut.c"
-            if src.exists() and lib.starcut_source().decode() != hashlib.sha256(src.read_bytes()).hexdigest():
-                warnings.warn(f"{path} was built from another _starcut.c: not used (the numpy slicer does every "
-                              "level); reinstall the package (pip install -e .) to build it again", stacklevel=2)
-                return None
-            P, N, D = ctypes.c_void_p, ctypes.c_int64, ctypes.c_double
-            lib.starcut.restype = P
-            lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, P, P, P]
-            lib.starcut_take.restype = None
-            lib.starcut_take.argtypes = [P] * 8
-            return lib
-    return None
+    path = here / LIBRARY
+    if not path.exists():
+        return None
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError:  # pragma: no cover - built for another platform
+        return None
+    lib.starcut_source.restype = ctypes.c_char_p
+    src = here / "_starcut.c"
+    if src.exists() and lib.starcut_source().decode() != hashlib.sha256(src.read_bytes()).hexdigest():
+        warnings.warn(f"{path} was built from another _starcut.c: not used (the numpy slicer does every "
+                      "level); reinstall the package (pip install -e .) to build it again", stacklevel=2)
+        return None
+    P, N, D = ctypes.c_void_p, ctypes.c_int64, ctypes.c_double
+    lib.starcut.restype = P
+    #    V  x  c0 tol E  ea eb F  S  fe_face fe_edge fv_vert fv_next basis m  f_cells rho mate C  convex normals out...
+    lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, P, P, P]
+    lib.starcut_take.restype = None
+    lib.starcut_take.argtypes = [P] * 8
+    return lib
 
 
 _lib = _load()
@@ -63,24 +64,33 @@ def _ptr(a: np.ndarray) -> int:
 
 
 class CTables:
-    """The per-polytope arrays the C level reads, contiguous int64 / float64, and their addresses."""
+    """The per-polytope arrays the C level reads (`slicetables._Tables` and `starslice._StarTables`
+    as contiguous int64 / float64 / uint8, kept alive here) and their addresses, in the C
+    function's order."""
 
     def __init__(self, p, t, st):
-        i8 = np.int64
-        self.keep = [
-            np.ascontiguousarray(t.ea, dtype=i8), np.ascontiguousarray(t.eb, dtype=i8),
-            np.ascontiguousarray(t.fe_face, dtype=i8), np.ascontiguousarray(t.fe_edge, dtype=i8),
-            np.ascontiguousarray(t.fv_vert, dtype=i8), np.ascontiguousarray(st.fv_next, dtype=i8),
-            np.ascontiguousarray(st.face_basis, dtype=np.float64).reshape(-1, 8),
-            np.ascontiguousarray(p.face_cells, dtype=i8), np.ascontiguousarray(st.face_rho, dtype=np.float64),
-            np.ascontiguousarray(st.slot_mate, dtype=i8),
-            np.ascontiguousarray(st.cell_convex, dtype=np.uint8),
-            np.ascontiguousarray(t.cell_normals, dtype=np.float64),
-        ]
-        if not np.all(np.diff(self.keep[2]) >= 0):  # pragma: no cover - the incidence keeps faces in order
+        def ints(a):
+            return np.ascontiguousarray(a, dtype=np.int64)
+
+        def floats(a):
+            return np.ascontiguousarray(a, dtype=np.float64)
+
+        self.edges_a, self.edges_b = ints(t.ea), ints(t.eb)
+        self.fe_face, self.fe_edge = ints(t.fe_face), ints(t.fe_edge)  # face sides, face by face
+        self.fv_vert, self.fv_next = ints(t.fv_vert), ints(st.fv_next)
+        self.face_basis = floats(st.face_basis).reshape(len(p.face_cells), 8)  # (F, 2, 4) rows
+        self.face_cells, self.face_rho = ints(p.face_cells), floats(st.face_rho)
+        self.slot_mate = ints(st.slot_mate)
+        self.cell_convex = np.ascontiguousarray(st.cell_convex, dtype=np.uint8)
+        self.cell_normals = floats(t.cell_normals)
+        if not np.all(np.diff(self.fe_face) >= 0):  # pragma: no cover - the incidence keeps faces in order
             raise ValueError("face sides out of face order")
-        self.E, self.F, self.S, self.C = len(t.ea), len(self.keep[6]), len(t.fe_face), len(self.keep[10])
-        self.args = [_ptr(a) for a in self.keep]
+        self.E, self.F = len(self.edges_a), len(self.face_basis)
+        self.S, self.C = len(self.fe_face), len(self.cell_convex)
+        self.edge_ptrs = [_ptr(a) for a in (self.edges_a, self.edges_b)]
+        self.face_ptrs = [_ptr(a) for a in (self.fe_face, self.fe_edge, self.fv_vert, self.fv_next, self.face_basis)]
+        self.cell_ptrs = [_ptr(a) for a in (self.face_cells, self.face_rho, self.slot_mate)]
+        self.conv_ptrs = [_ptr(a) for a in (self.cell_convex, self.cell_normals)]
 
 
 def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float):
@@ -92,11 +102,8 @@ def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float):
     counts = np.zeros(6, dtype=np.int64)
     vol = ctypes.c_double()
     status = ctypes.c_int()
-    ea, eb, fe_face, fe_edge, fv_vert, fv_next, fb, fm, fc, fr, sm, cc, cn = (
-        ct.args[0], ct.args[1], ct.args[2], ct.args[3], ct.args[4], ct.args[5], ct.args[6], _ptr(m),
-        ct.args[7], ct.args[8], ct.args[9], ct.args[10], ct.args[11])
-    res = _lib.starcut(len(x), _ptr(x), c0, tol, ct.E, ea, eb, ct.F, ct.S, fe_face, fe_edge, fv_vert, fv_next,
-                       fb, fm, fc, fr, sm, ct.C, cc, cn, _ptr(counts), ctypes.addressof(vol),
+    res = _lib.starcut(len(x), _ptr(x), c0, tol, ct.E, *ct.edge_ptrs, ct.F, ct.S, *ct.face_ptrs, _ptr(m),
+                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, _ptr(counts), ctypes.addressof(vol),
                        ctypes.addressof(status))
     if not res:
         return None

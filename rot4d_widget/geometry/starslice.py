@@ -33,6 +33,10 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
   so the slices' volumes integrate over c0 to the 4-volume the divergence theorem gives
   (Cavalieri).
 
+A level with no vertex on H is cut by the same rules in C when the package was built with a C
+compiler (`rot4d_widget.geometry._cstar`, ``_starcut.c``: one pass instead of some 250 array
+steps); this module stays the reference and does every level the C code declines.
+
 Vertices on H are resolved by simulation of simplicity: they count as above H (the slice just
 below c0, as a limit) unless some cell lies in H, when the side whose slice has the larger volume
 is kept (so the cap of a prism at its end level is there).  The crossing points of the edges at
