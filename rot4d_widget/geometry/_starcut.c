@@ -11,8 +11,8 @@
  * a face's line, a check that fails) returns a status and the numpy slicer does the level.
  *
  * Plain C, no Python API: loaded with ctypes (rot4d_widget/geometry/_cstar.py).  Indices int64,
- * coordinates float64, row-major.  Thread-safe: every call owns its memory (a `Result` freed by
- * starcut_take or starcut_free). */
+ * coordinates float64, row-major.  Thread-safe: every call owns its memory (a `Result`, freed by
+ * starcut_take; a declined level frees its own). */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -404,79 +404,98 @@ done:
     return st;
 }
 
-/* The level; see the file's comment.  Arguments: x (V, 4) the rotated unit vertices; c0, tol the
- * level and the on-H tolerance; ea, eb (E,) edges; fe_face, fe_edge, fv_vert, fv_next (S,) the face
- * sides (faces ascending); face_basis (F, 2, 4); m (4, 4) the rotation; face_cells (F, 2),
- * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4).  counts (out):
- * points, extra corners, segments, polygon corners, polygons, triangles; status (out). */
-void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, const I *eb, I F, I S,
-              const I *fe_face, const I *fe_edge, const I *fv_vert, const I *fv_next, const double *face_basis,
-              const double *mrot, const I *face_cells, const double *face_rho, const I *slot_mate, I C,
-              const unsigned char *cell_convex, const double *cell_normals, I *counts, double *volume, int *status) {
-    int st = OK;
-    Result *R = calloc(1, sizeof(Result));
-    unsigned char *above = NULL, *cdone = NULL;
-    I *cid = NULL, *sortk = NULL, *seg_pt = NULL, *seg_side = NULL, *seg_face = NULL, *at = NULL, *partner = NULL;
-    I *rec_cell = NULL, *W0 = NULL, *str_f = NULL, *str_p = NULL, *str_q = NULL, *str_w = NULL;
-    I *loc = NULL, *crec_ptr = NULL, *crec = NULL, *pstart_c = NULL;
-    double *anchor = NULL, *normals = NULL, *tpos = NULL;
-    I *cI = NULL;
-    unsigned char *visited = NULL;
-    dvec xs = {0};
-    Work ws = {0};
-    if (!R) { *status = NO_MEMORY; return NULL; }
-    above = malloc(V + 1); cid = malloc((E + 1) * sizeof(I));
-    if (!above || !cid) { st = NO_MEMORY; goto done; }
-    if (!isfinite(c0) || !isfinite(tol)) { st = NOT_GENERIC; goto done; }
-    for (I v = 0; v < V; v++) {
-        double h = x[4 * v + 3] - c0;
-        if (fabs(h) <= tol || !isfinite(h) || !isfinite(x[4 * v]) || !isfinite(x[4 * v + 1]) || !isfinite(x[4 * v + 2])) {
-            st = NOT_GENERIC; goto done;  /* on H (or not a number: the numpy slicer says what) */
-        }
-        above[v] = h > 0;
-    }
-    /* points: where edges cross H, in edge order */
-    I np = 0;
-    for (I e = 0; e < E; e++) {
-        if (above[ea[e]] != above[eb[e]]) {
-            const double *A = x + 4 * ea[e], *B = x + 4 * eb[e];
-            double ha = A[3] - c0, hb = B[3] - c0, s = ha / (ha - hb);
-            if (!dgrow(&R->verts, 3)) { st = NO_MEMORY; goto done; }
-            for (int k = 0; k < 3; k++) R->verts.a[R->verts.n++] = A[k] + s * (B[k] - A[k]);
-            cid[e] = np++;
-        } else cid[e] = -1;
-    }
-    if (!np) { st = NO_CROSSING; goto done; }
-    R->n_points = np;
-    double centre[3] = {0, 0, 0};
-    for (I i = 0; i < np; i++) for (int k = 0; k < 3; k++) centre[k] += R->verts.a[3 * i + k];
-    for (int k = 0; k < 3; k++) centre[k] /= (double)np;
-#define PTS (R->verts.a) /* (grows: re-read after every push) */
+/* What one level holds while it is cut: the inputs (see `starcut`) and what each stage leaves
+ * for the next.  Segment r joins points seg_pt[2r], seg_pt[2r + 1] (crossings of the face sides
+ * seg_side[2r], seg_side[2r + 1]) of face seg_face[r], the face winding W0[r] times round it;
+ * record g = 2r + j is segment r in cell j of its face, and end q is end q & 1 of record q >> 1,
+ * partner[q] the other end at that point in that cell. */
+typedef struct {
+    I V, E, F, S, C;
+    const double *x, *face_basis, *mrot, *face_rho, *cell_normals;
+    const I *ea, *eb, *fe_face, *fe_edge, *fv_vert, *fv_next, *face_cells, *slot_mate;
+    const unsigned char *cell_convex;
+    double c0, tol;
+    unsigned char *above;     /* (V,) each vertex above H */
+    I *cid;                   /* (E,) each edge's point, -1 if it does not cross */
+    double centre[3];         /* the points' mean: coordinates about it keep the volume's sums small */
+    I ns, *seg_pt, *seg_side, *seg_face, *W0;
+    double *anchor;           /* (C, 3) a point of each cell's section plane, less `centre` */
+    double *normals;          /* (C, 3) each cell's outward normal in H */
+    I *partner, *rec_cell;
+    Result *R;
+} Level;
 
-    /* each crossing face's points along its line, sorted, paired even-odd; its winding stretches */
-    sortk = malloc((S + 1) * sizeof(I)); tpos = malloc((S + 1) * sizeof(double));
-    seg_pt = malloc((S + 1) * sizeof(I)); seg_side = malloc((S + 1) * sizeof(I)); seg_face = malloc((S / 2 + 1) * sizeof(I));
-    W0 = malloc((S / 2 + 1) * sizeof(I));
-    str_f = malloc((S + 1) * sizeof(I)); str_p = malloc((S + 1) * sizeof(I)); str_q = malloc((S + 1) * sizeof(I));
-    str_w = malloc((S + 1) * sizeof(I));
-    if (!sortk || !tpos || !seg_pt || !seg_side || !seg_face || !W0 || !str_f || !str_p || !str_q || !str_w) { st = NO_MEMORY; goto done; }
+static void level_free(Level *L) {
+    free(L->above); free(L->cid); free(L->seg_pt); free(L->seg_side); free(L->seg_face); free(L->W0);
+    free(L->anchor); free(L->normals); free(L->partner); free(L->rec_cell);
+}
+
+#define PTS (L->R->verts.a) /* the points, then the fill corners (grows: re-read after every push) */
+
+/* The points where edges cross H, in edge order; NOT_GENERIC for a vertex on H (or a coordinate
+ * that is not a number), NO_CROSSING when no edge crosses. */
+static int cut_edges(Level *L) {
+    Result *R = L->R;
+    L->above = malloc(L->V + 1); L->cid = malloc((L->E + 1) * sizeof(I));
+    if (!L->above || !L->cid) return NO_MEMORY;
+    if (!isfinite(L->c0) || !isfinite(L->tol)) return NOT_GENERIC;
+    for (I v = 0; v < L->V; v++) {
+        const double *X = L->x + 4 * v;
+        double h = X[3] - L->c0;
+        if (fabs(h) <= L->tol || !isfinite(h) || !isfinite(X[0]) || !isfinite(X[1]) || !isfinite(X[2]))
+            return NOT_GENERIC;  /* on H (or not a number: the numpy slicer says what) */
+        L->above[v] = h > 0;
+    }
+    I np = 0;
+    for (I e = 0; e < L->E; e++) {
+        if (L->above[L->ea[e]] != L->above[L->eb[e]]) {
+            const double *A = L->x + 4 * L->ea[e], *B = L->x + 4 * L->eb[e];
+            double ha = A[3] - L->c0, hb = B[3] - L->c0, s = ha / (ha - hb);
+            if (!dgrow(&R->verts, 3)) return NO_MEMORY;
+            for (int k = 0; k < 3; k++) R->verts.a[R->verts.n++] = A[k] + s * (B[k] - A[k]);
+            L->cid[e] = np++;
+        } else L->cid[e] = -1;
+    }
+    if (!np) return NO_CROSSING;
+    R->n_points = np;
+    for (int k = 0; k < 3; k++) L->centre[k] = 0;
+    for (I i = 0; i < np; i++) for (int k = 0; k < 3; k++) L->centre[k] += R->verts.a[3 * i + k];
+    for (int k = 0; k < 3; k++) L->centre[k] /= (double)np;
+    return OK;
+}
+
+/* Each crossing face's points sorted along its line and paired even-odd into segments; the
+ * winding-weighted volume of its stretches; the cells' anchors and normals. */
+static int pair_faces(Level *L) {
+    int st = OK;
+    Result *R = L->R;
+    const I S = L->S, *cid = L->cid;
+    I *sortk = malloc((S + 1) * sizeof(I)), *str_f = malloc((S + 1) * sizeof(I)), *str_p = malloc((S + 1) * sizeof(I));
+    I *str_q = malloc((S + 1) * sizeof(I)), *str_w = malloc((S + 1) * sizeof(I));
+    double *tpos = malloc((S + 1) * sizeof(double));
+    L->seg_pt = malloc((S + 1) * sizeof(I)); L->seg_side = malloc((S + 1) * sizeof(I));
+    L->seg_face = malloc((S / 2 + 1) * sizeof(I)); L->W0 = malloc((S / 2 + 1) * sizeof(I));
+    L->anchor = calloc(3 * (L->C + 1), sizeof(double)); L->normals = malloc(3 * (L->C + 1) * sizeof(double));
+    if (!sortk || !str_f || !str_p || !str_q || !str_w || !tpos || !L->seg_pt || !L->seg_side || !L->seg_face ||
+        !L->W0 || !L->anchor || !L->normals) { st = NO_MEMORY; goto done; }
     I ns = 0, nstr = 0;
     for (I s0 = 0; s0 < S;) {
-        I f = fe_face[s0], s1 = s0;
-        while (s1 < S && fe_face[s1] == f) s1++;
+        I f = L->fe_face[s0], s1 = s0;
+        while (s1 < S && L->fe_face[s1] == f) s1++;
         I n = 0;
-        for (I s = s0; s < s1; s++) if (cid[fe_edge[s]] >= 0) sortk[n++] = s;
+        for (I s = s0; s < s1; s++) if (cid[L->fe_edge[s]] >= 0) sortk[n++] = s;
         if (n) {
             if (n & 1) { st = INCONSISTENT; goto done; }
-            const double *b0 = face_basis + 8 * f, *b1 = b0 + 4;
+            /* the line's direction in H: J grad w of the face's plane, turned */
+            const double *b0 = L->face_basis + 8 * f, *b1 = b0 + 4, *m = L->mrot;
             double r0[4], r1[4], d[3];
             for (int i = 0; i < 4; i++) {
-                r0[i] = mrot[4 * i] * b0[0] + mrot[4 * i + 1] * b0[1] + mrot[4 * i + 2] * b0[2] + mrot[4 * i + 3] * b0[3];
-                r1[i] = mrot[4 * i] * b1[0] + mrot[4 * i + 1] * b1[1] + mrot[4 * i + 2] * b1[2] + mrot[4 * i + 3] * b1[3];
+                r0[i] = m[4 * i] * b0[0] + m[4 * i + 1] * b0[1] + m[4 * i + 2] * b0[2] + m[4 * i + 3] * b0[3];
+                r1[i] = m[4 * i] * b1[0] + m[4 * i + 1] * b1[1] + m[4 * i + 2] * b1[2] + m[4 * i + 3] * b1[3];
             }
             for (int i = 0; i < 3; i++) d[i] = r1[i] * r0[3] - r0[i] * r1[3];
             for (I i = 0; i < n; i++) {
-                const double *P = PTS + 3 * cid[fe_edge[sortk[i]]];
+                const double *P = PTS + 3 * cid[L->fe_edge[sortk[i]]];
                 double tv = P[0] * d[0] + P[1] * d[1] + P[2] * d[2];
                 I sv = sortk[i], j = i - 1;
                 while (j >= 0 && tpos[j] > tv) { tpos[j + 1] = tpos[j]; sortk[j + 1] = sortk[j]; j--; }
@@ -486,56 +505,65 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
             I W = 0;
             for (I i = 0; i < n; i++) {
                 I s = sortk[i];
-                W += above[fv_vert[fv_next[s]]] ? 1 : -1;  /* +1 where the side rises through H */
-                if (!(i & 1)) { seg_face[ns] = f; W0[ns] = W; seg_pt[2 * ns] = cid[fe_edge[s]]; seg_side[2 * ns] = s; }
-                else { seg_pt[2 * ns + 1] = cid[fe_edge[s]]; seg_side[2 * ns + 1] = s; ns++; }
+                W += L->above[L->fv_vert[L->fv_next[s]]] ? 1 : -1;  /* +1 where the side rises through H */
+                if (!(i & 1)) {
+                    L->seg_face[ns] = f; L->W0[ns] = W; L->seg_pt[2 * ns] = cid[L->fe_edge[s]]; L->seg_side[2 * ns] = s;
+                } else { L->seg_pt[2 * ns + 1] = cid[L->fe_edge[s]]; L->seg_side[2 * ns + 1] = s; ns++; }
                 if (i + 1 < n && W != 0) {
                     str_f[nstr] = f; str_w[nstr] = W;
-                    str_p[nstr] = cid[fe_edge[s]]; str_q[nstr] = cid[fe_edge[sortk[i + 1]]]; nstr++;
+                    str_p[nstr] = cid[L->fe_edge[s]]; str_q[nstr] = cid[L->fe_edge[sortk[i + 1]]]; nstr++;
                 }
             }
         }
         s0 = s1;
     }
-    /* volume: winding-weighted stretches in both cells of each face, about a point of each cell's plane */
-    anchor = calloc(3 * (C + 1), sizeof(double));
-    normals = malloc(3 * (C + 1) * sizeof(double));
-    if (!anchor || !normals) { st = NO_MEMORY; goto done; }
+    L->ns = ns;
+    const double *c = L->centre;
     for (I r = 0; r < ns; r++)
         for (int j = 0; j < 2; j++) {
-            I cc = face_cells[2 * seg_face[r] + j];
-            for (int k = 0; k < 3; k++) anchor[3 * cc + k] = PTS[3 * seg_pt[2 * r] + k] - centre[k];
+            I cc = L->face_cells[2 * L->seg_face[r] + j];
+            for (int k = 0; k < 3; k++) L->anchor[3 * cc + k] = PTS[3 * L->seg_pt[2 * r] + k] - c[k];
         }
     double vol = 0.0;
     for (I i = 0; i < nstr; i++) {
         double P[3], Q[3], PxQ[3];
-        for (int k = 0; k < 3; k++) { P[k] = PTS[3 * str_p[i] + k] - centre[k]; Q[k] = PTS[3 * str_q[i] + k] - centre[k]; }
+        for (int k = 0; k < 3; k++) { P[k] = PTS[3 * str_p[i] + k] - c[k]; Q[k] = PTS[3 * str_q[i] + k] - c[k]; }
         cross3(P, Q, PxQ);
         for (int j = 0; j < 2; j++) {
-            const double *A = anchor + 3 * face_cells[2 * str_f[i] + j];
-            vol += (double)str_w[i] * face_rho[2 * str_f[i] + j] * (A[0] * PxQ[0] + A[1] * PxQ[1] + A[2] * PxQ[2]);
+            const double *A = L->anchor + 3 * L->face_cells[2 * str_f[i] + j];
+            vol += (double)str_w[i] * L->face_rho[2 * str_f[i] + j] * (A[0] * PxQ[0] + A[1] * PxQ[1] + A[2] * PxQ[2]);
         }
     }
     R->volume = vol / 6.0;
-    for (I cc = 0; cc < C; cc++)
+    for (I cc = 0; cc < L->C; cc++) {
+        const double *n = L->cell_normals + 4 * cc, *m = L->mrot;
         for (int i = 0; i < 3; i++)
-            normals[3 * cc + i] = mrot[4 * i] * cell_normals[4 * cc] + mrot[4 * i + 1] * cell_normals[4 * cc + 1]
-                                + mrot[4 * i + 2] * cell_normals[4 * cc + 2] + mrot[4 * i + 3] * cell_normals[4 * cc + 3];
-    for (I r = 0; r < ns; r++) {
-        IPUSH(R->edges, seg_pt[2 * r]); IPUSH(R->edges, seg_pt[2 * r + 1]);
+            L->normals[3 * cc + i] = m[4 * i] * n[0] + m[4 * i + 1] * n[1] + m[4 * i + 2] * n[2] + m[4 * i + 3] * n[3];
     }
+    for (I r = 0; r < ns; r++) { IPUSH(R->edges, L->seg_pt[2 * r]); IPUSH(R->edges, L->seg_pt[2 * r + 1]); }
+done:
+    free(sortk); free(str_f); free(str_p); free(str_q); free(str_w); free(tpos);
+    return st;
+}
 
-    /* cycles: end q is end q & 1 of record q >> 1 (segment q >> 2 in its face's cell (q >> 1) & 1) */
-    I n_end = 4 * ns;
-    at = malloc((S + 1) * sizeof(I)); partner = malloc((n_end + 1) * sizeof(I)); rec_cell = malloc((2 * ns + 1) * sizeof(I));
-    visited = calloc(n_end + 1, 1);
-    if (!at || !partner || !rec_cell || !visited) { st = NO_MEMORY; goto done; }
-    for (I s = 0; s < S; s++) at[s] = -1;
-    for (I k = 0; k < 2 * ns; k++) at[seg_side[k]] = k;
-    for (I r = 0; r < 2 * ns; r++) rec_cell[r] = face_cells[2 * seg_face[r >> 1] + (r & 1)];
+/* Each cell's cycles: the segments' ends chained through the other face of the cell at each
+ * crossing edge, each cycle run the way the boundary runs its segments (the votes of its faces'
+ * windings, else its signed area), corners from its least end; NO_CROSSING when none is left. */
+static int chain_cycles(Level *L) {
+    int st = OK;
+    Result *R = L->R;
+    const I ns = L->ns, n_end = 4 * ns, *seg_pt = L->seg_pt;
+    I *at = malloc((L->S + 1) * sizeof(I));
+    unsigned char *visited = calloc(n_end + 1, 1);
+    L->partner = malloc((n_end + 1) * sizeof(I)); L->rec_cell = malloc((2 * ns + 1) * sizeof(I));
+    if (!at || !visited || !L->partner || !L->rec_cell) { st = NO_MEMORY; goto done; }
+    I *partner = L->partner, *rec_cell = L->rec_cell;
+    for (I s = 0; s < L->S; s++) at[s] = -1;
+    for (I k = 0; k < 2 * ns; k++) at[L->seg_side[k]] = k;
+    for (I r = 0; r < 2 * ns; r++) rec_cell[r] = L->face_cells[2 * L->seg_face[r >> 1] + (r & 1)];
     for (I q = 0; q < n_end; q++) {
-        I side = seg_side[2 * (q >> 2) + (q & 1)];
-        I mate = slot_mate[2 * side + ((q >> 1) & 1)];
+        I side = L->seg_side[2 * (q >> 2) + (q & 1)];
+        I mate = L->slot_mate[2 * side + ((q >> 1) & 1)];  /* the cell's other face at that edge */
         if (mate < 0) { st = INCONSISTENT; goto done; }
         I q2 = at[mate >> 1];
         if (q2 < 0) { st = INCONSISTENT; goto done; }
@@ -547,13 +575,12 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     for (I q0 = 0; q0 < n_end; q0++) {
         if (visited[q0]) continue;
         I cc = rec_cell[q0 >> 1], score = 0, rev = n_end, len = 0;
-        double area = 0.0;
-        const double *A = anchor + 3 * cc, *N = normals + 3 * cc;
+        const double *A = L->anchor + 3 * cc, *N = L->normals + 3 * cc, *c = L->centre;
         I q = q0;
         do {
             visited[q] = 1; len++;
             I r = q >> 1;
-            double nat = face_rho[2 * seg_face[r >> 1] + (r & 1)] * (double)((W0[r >> 1] > 0) - (W0[r >> 1] < 0));
+            double nat = L->face_rho[2 * L->seg_face[r >> 1] + (r & 1)] * (double)((L->W0[r >> 1] > 0) - (L->W0[r >> 1] < 0));
             score += (((q & 1) == 1) == (nat > 0)) ? 1 : -1;
             if ((q ^ 1) < rev) rev = q ^ 1;
             q = partner[q] ^ 1;
@@ -561,19 +588,20 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
         } while (q != q0);
         int keep = score > 0;
         if (score == 0 && rev != q0) {
+            double area = 0.0;
             q = q0;
             do {
                 I q1 = partner[q] ^ 1;
                 double a[3], b[3], ab[3];
                 I ia = seg_pt[2 * (q >> 2) + (q & 1)], ib = seg_pt[2 * (q1 >> 2) + (q1 & 1)];
-                for (int k = 0; k < 3; k++) { a[k] = PTS[3 * ia + k] - centre[k] - A[k]; b[k] = PTS[3 * ib + k] - centre[k] - A[k]; }
+                for (int k = 0; k < 3; k++) { a[k] = PTS[3 * ia + k] - c[k] - A[k]; b[k] = PTS[3 * ib + k] - c[k] - A[k]; }
                 cross3(a, b, ab);
                 area += N[0] * ab[0] + N[1] * ab[1] + N[2] * ab[2];
                 q = q1;
             } while (q != q0);
             keep = area > 0 || (area == 0 && q0 < rev);
         }
-        if (!keep || rev == q0) continue;
+        if (!keep || rev == q0) continue;  /* (rev == q0: an orbit that is its own reverse) */
         /* its corners from its least end; repeats dropped, fewer than 3 corners: none */
         I n0 = R->flat.n;
         q = q0;
@@ -587,129 +615,142 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
         IPUSH(R->offsets, R->flat.n);
         IPUSH(R->cells, cc);
     }
-    I npoly = R->cells.n;
-    if (!npoly) { st = NO_CROSSING; goto done; }
+    if (!R->cells.n) st = NO_CROSSING;
+done:
+    free(at); free(visited);
+    return st;
+}
 
-    /* triangles: a convex cell's cycle fanned from its first corner */
+/* The section of cell cc, polygons cI[p0 .. p1): if every one winds once round its corners'
+ * centroid, always the same way, and their boxes are apart, fanned from the centroids (1); else
+ * nothing done (0); NO_MEMORY as -1. */
+static int star_shaped_fan(Level *L, const I *cI, I p0, I p1, I cc) {
+    int st = OK;
+    Result *R = L->R;
+    const double *Nr = L->normals + 3 * cc;
+    double nl = sqrt(Nr[0] * Nr[0] + Nr[1] * Nr[1] + Nr[2] * Nr[2]), n[3] = {Nr[0] / nl, Nr[1] / nl, Nr[2] / nl};
+    for (I i = p0; i < p1; i++) {
+        I o0 = R->offsets.a[cI[i]], o1 = R->offsets.a[cI[i] + 1], kk = o1 - o0;
+        double cen[3] = {0, 0, 0}, ang = 0.0;
+        for (I j = o0; j < o1; j++) for (int q = 0; q < 3; q++) cen[q] += PTS[3 * R->flat.a[j] + q];
+        for (int q = 0; q < 3; q++) cen[q] /= (double)kk;
+        I left = 0, right = 0;
+        for (int pass = 0; pass < 2; pass++) {  /* every turn one way first; then the angle */
+            for (I j = o0; j < o1; j++) {
+                I jn = j + 1 < o1 ? j + 1 : o0;
+                double a[3], b[3], ab[3];
+                for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[j] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[jn] + q] - cen[q]; }
+                cross3(a, b, ab);
+                double y = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
+                if (pass) ang += atan2(y, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+                else { left += y > 0; right += y < 0; }
+            }
+            if (!pass && left != kk && right != kk) return 0;
+        }
+        if (!(fabs(fabs(ang) - 2 * M_PI) < 1e-6)) return 0;
+    }
+    for (I i = p0; i < p1; i++)
+        for (I j = i + 1; j < p1; j++) {
+            double lo1[3], hi1[3], lo2[3], hi2[3];
+            for (int w = 0; w < 2; w++) {
+                I pp = cI[w ? j : i];
+                double *lo = w ? lo2 : lo1, *hi = w ? hi2 : hi1;
+                for (int q = 0; q < 3; q++) { lo[q] = INFINITY; hi[q] = -INFINITY; }
+                for (I z = R->offsets.a[pp]; z < R->offsets.a[pp + 1]; z++)
+                    for (int q = 0; q < 3; q++) {
+                        double v = PTS[3 * R->flat.a[z] + q];
+                        if (v < lo[q]) lo[q] = v;
+                        if (v > hi[q]) hi[q] = v;
+                    }
+            }
+            if (lo1[0] <= hi2[0] && lo2[0] <= hi1[0] && lo1[1] <= hi2[1] && lo2[1] <= hi1[1] &&
+                lo1[2] <= hi2[2] && lo2[2] <= hi1[2]) return 0;
+        }
+    for (I i = p0; i < p1; i++) {
+        I o0 = R->offsets.a[cI[i]], o1 = R->offsets.a[cI[i] + 1], kk = o1 - o0;
+        double cen[3] = {0, 0, 0}, y0 = 0;
+        for (I j = o0; j < o1; j++) for (int q = 0; q < 3; q++) cen[q] += PTS[3 * R->flat.a[j] + q];
+        for (int q = 0; q < 3; q++) cen[q] /= (double)kk;
+        {   /* the way it winds (every turn agrees): the first corner's */
+            double a[3], b[3], ab[3];
+            for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[o0] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[o0 + 1] + q] - cen[q]; }
+            cross3(a, b, ab);
+            y0 = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
+        }
+        if (!dgrow(&R->verts, 3)) return -1;
+        for (int q = 0; q < 3; q++) R->verts.a[R->verts.n++] = cen[q];
+        I centroid = R->n_points + R->n_extra++;
+        for (I j = o0; j < o1; j++) {
+            I jn = j + 1 < o1 ? j + 1 : o0;
+            IPUSH(R->tri, centroid);
+            IPUSH(R->tri, y0 > 0 ? R->flat.a[j] : R->flat.a[jn]);
+            IPUSH(R->tri, y0 > 0 ? R->flat.a[jn] : R->flat.a[j]);
+            IPUSH(R->tcell, cc);
+        }
+    }
+done:
+    return st == OK ? 1 : -1;
+}
+
+/* Triangles: a convex cell's cycle fanned from its first corner; a non-convex cell's section fanned
+ * from its polygons' centroids where it is star-shaped (`star_shaped_fan`), else filled even-odd by
+ * its arrangement, else by slabs. */
+static int fill_sections(Level *L) {
+    int st = OK;
+    Result *R = L->R;
+    const I C = L->C, ns = L->ns, npoly = R->cells.n, *rec_cell = L->rec_cell;
+    I *crec_ptr = NULL, *crec = NULL, *pstart_c = NULL, *cI = NULL, *loc = NULL, *fill = NULL, *cg = NULL;
+    double *cd = NULL;
+    unsigned char *cdone = NULL;
+    dvec xs = {0};
+    Work ws = {0};
     for (I p = 0; p < npoly; p++) {
-        if (!cell_convex[R->cells.a[p]]) continue;
+        if (!L->cell_convex[R->cells.a[p]]) continue;
         I o0 = R->offsets.a[p], o1 = R->offsets.a[p + 1];
         for (I j = o0 + 1; j + 1 < o1; j++) {
             IPUSH(R->tri, R->flat.a[o0]); IPUSH(R->tri, R->flat.a[j]); IPUSH(R->tri, R->flat.a[j + 1]);
             IPUSH(R->tcell, R->cells.a[p]);
         }
     }
-    /* a non-convex cell's records, by cell; its polygons */
-    crec_ptr = calloc(C + 2, sizeof(I)); crec = malloc((2 * ns + 1) * sizeof(I));
-    pstart_c = calloc(C + 2, sizeof(I)); cI = malloc((npoly + 1) * sizeof(I));
-    cdone = calloc(C + 1, 1); loc = malloc((2 * ns + 1) * sizeof(I));
-    if (!crec_ptr || !crec || !pstart_c || !cI || !cdone || !loc) { st = NO_MEMORY; goto done; }
-    for (I r = 0; r < 2 * ns; r++) if (!cell_convex[rec_cell[r]]) crec_ptr[rec_cell[r] + 1]++;
+    /* a non-convex cell's records, by cell (crec), and its polygons (cI) */
+    crec_ptr = calloc(C + 2, sizeof(I)); crec = malloc((2 * ns + 1) * sizeof(I)); pstart_c = calloc(C + 2, sizeof(I));
+    cI = malloc((npoly + 1) * sizeof(I)); loc = malloc((2 * ns + 1) * sizeof(I)); fill = calloc(C + 1, sizeof(I));
+    cdone = calloc(C + 1, 1);
+    if (!crec_ptr || !crec || !pstart_c || !cI || !loc || !fill || !cdone) { st = NO_MEMORY; goto done; }
+    for (I r = 0; r < 2 * ns; r++) if (!L->cell_convex[rec_cell[r]]) crec_ptr[rec_cell[r] + 1]++;
     for (I cc = 0; cc < C; cc++) crec_ptr[cc + 1] += crec_ptr[cc];
-    {
-        I *fill = calloc(C + 1, sizeof(I));
-        if (!fill) { st = NO_MEMORY; goto done; }
-        for (I r = 0; r < 2 * ns; r++)
-            if (!cell_convex[rec_cell[r]]) crec[crec_ptr[rec_cell[r]] + fill[rec_cell[r]]++] = r;
-        free(fill);
-        for (I p = 0; p < npoly; p++) pstart_c[R->cells.a[p] + 1]++;
-        for (I cc = 0; cc < C; cc++) pstart_c[cc + 1] += pstart_c[cc];
-        fill = calloc(C + 1, sizeof(I));
-        if (!fill) { st = NO_MEMORY; goto done; }
-        for (I p = 0; p < npoly; p++) cI[pstart_c[R->cells.a[p]] + fill[R->cells.a[p]]++] = p;
-        free(fill);
-    }
-    /* star-shaped sections: every polygon of the cell winds once round its centroid, always the
-     * same way, the cell's polygons' boxes apart and holding all its records: fanned from centroids */
-    for (I cc = 0; cc < C; cc++) {
-        I nrec = crec_ptr[cc + 1] - crec_ptr[cc];
-        if (!nrec) continue;
-        I p0 = pstart_c[cc], p1 = pstart_c[cc + 1], corners = 0;
+    for (I r = 0; r < 2 * ns; r++)
+        if (!L->cell_convex[rec_cell[r]]) crec[crec_ptr[rec_cell[r]] + fill[rec_cell[r]]++] = r;
+    for (I p = 0; p < npoly; p++) pstart_c[R->cells.a[p] + 1]++;
+    for (I cc = 0; cc < C; cc++) pstart_c[cc + 1] += pstart_c[cc];
+    memset(fill, 0, (C + 1) * sizeof(I));
+    for (I p = 0; p < npoly; p++) cI[pstart_c[R->cells.a[p]] + fill[R->cells.a[p]]++] = p;
+    for (I cc = 0; cc < C; cc++) {  /* star-shaped: only where the polygons hold all the cell's records */
+        I nrec = crec_ptr[cc + 1] - crec_ptr[cc], p0 = pstart_c[cc], p1 = pstart_c[cc + 1], corners = 0;
+        if (!nrec || p1 == p0) continue;
         for (I i = p0; i < p1; i++) corners += R->offsets.a[cI[i] + 1] - R->offsets.a[cI[i]];
-        if (corners != nrec || p1 == p0) continue;
-        const double *Nr = normals + 3 * cc;
-        double nl = sqrt(Nr[0] * Nr[0] + Nr[1] * Nr[1] + Nr[2] * Nr[2]), n[3] = {Nr[0] / nl, Nr[1] / nl, Nr[2] / nl};
-        int ok = 1;
-        for (I i = p0; i < p1 && ok; i++) {
-            I o0 = R->offsets.a[cI[i]], o1 = R->offsets.a[cI[i] + 1], kk = o1 - o0;
-            double cen[3] = {0, 0, 0}, ang = 0.0;
-            for (I j = o0; j < o1; j++) for (int q = 0; q < 3; q++) cen[q] += PTS[3 * R->flat.a[j] + q];
-            for (int q = 0; q < 3; q++) cen[q] /= (double)kk;
-            I left = 0, right = 0;
-            for (int pass = 0; pass < 2 && ok; pass++) {  /* every turn one way first; then the angle */
-                for (I j = o0; j < o1; j++) {
-                    I jn = j + 1 < o1 ? j + 1 : o0;
-                    double a[3], b[3], ab[3];
-                    for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[j] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[jn] + q] - cen[q]; }
-                    cross3(a, b, ab);
-                    double y = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
-                    if (pass) ang += atan2(y, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
-                    else { left += y > 0; right += y < 0; }
-                }
-                if (!pass && left != kk && right != kk) ok = 0;
-            }
-            if (ok && !(fabs(fabs(ang) - 2 * M_PI) < 1e-6)) ok = 0;
-        }
-        for (I i = p0; i < p1 && ok; i++)
-            for (I j = i + 1; j < p1 && ok; j++) {
-                double lo1[3], hi1[3], lo2[3], hi2[3];
-                for (int w = 0; w < 2; w++) {
-                    I pp = cI[w ? j : i];
-                    double *lo = w ? lo2 : lo1, *hi = w ? hi2 : hi1;
-                    for (int q = 0; q < 3; q++) { lo[q] = INFINITY; hi[q] = -INFINITY; }
-                    for (I z = R->offsets.a[pp]; z < R->offsets.a[pp + 1]; z++)
-                        for (int q = 0; q < 3; q++) {
-                            double v = PTS[3 * R->flat.a[z] + q];
-                            if (v < lo[q]) lo[q] = v;
-                            if (v > hi[q]) hi[q] = v;
-                        }
-                }
-                if (lo1[0] <= hi2[0] && lo2[0] <= hi1[0] && lo1[1] <= hi2[1] && lo2[1] <= hi1[1] &&
-                    lo1[2] <= hi2[2] && lo2[2] <= hi1[2]) ok = 0;
-            }
-        if (!ok) continue;
-        for (I i = p0; i < p1; i++) {
-            I o0 = R->offsets.a[cI[i]], o1 = R->offsets.a[cI[i] + 1], kk = o1 - o0;
-            double cen[3] = {0, 0, 0}, y0 = 0;
-            for (I j = o0; j < o1; j++) for (int q = 0; q < 3; q++) cen[q] += PTS[3 * R->flat.a[j] + q];
-            for (int q = 0; q < 3; q++) cen[q] /= (double)kk;
-            {   /* the way it winds (every turn agrees): the first corner's */
-                double a[3], b[3], ab[3];
-                for (int q = 0; q < 3; q++) { a[q] = PTS[3 * R->flat.a[o0] + q] - cen[q]; b[q] = PTS[3 * R->flat.a[o0 + 1] + q] - cen[q]; }
-                cross3(a, b, ab);
-                y0 = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
-            }
-            if (!dgrow(&R->verts, 3)) { st = NO_MEMORY; goto done; }
-            for (int q = 0; q < 3; q++) R->verts.a[R->verts.n++] = cen[q];
-            I cid_ = R->n_points + R->n_extra++;
-            for (I j = o0; j < o1; j++) {
-                I jn = j + 1 < o1 ? j + 1 : o0;
-                IPUSH(R->tri, cid_);
-                IPUSH(R->tri, y0 > 0 ? R->flat.a[j] : R->flat.a[jn]);
-                IPUSH(R->tri, y0 > 0 ? R->flat.a[jn] : R->flat.a[j]);
-                IPUSH(R->tcell, cc);
-            }
-        }
-        cdone[cc] = 1;
+        if (corners != nrec) continue;
+        int done_ = star_shaped_fan(L, cI, p0, p1, cc);
+        if (done_ < 0) { st = NO_MEMORY; goto done; }
+        cdone[cc] = (unsigned char)done_;
     }
-    /* the others: by their arrangement, else by slabs */
     for (I r = 0; r < 2 * ns; r++) loc[r] = -1;
     I mmax = 0;
     for (I cc = 0; cc < C; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
-    I *cg = malloc((3 * mmax + 1) * sizeof(I));
-    double *cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
-    if (!cg || !cd) { free(cg); free(cd); st = NO_MEMORY; goto done; }
+    cg = malloc((3 * mmax + 1) * sizeof(I));
+    cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
+    if (!cg || !cd) { st = NO_MEMORY; goto done; }
     for (I cc = 0; cc < C && st == OK; cc++) {
         I r0 = crec_ptr[cc], m = crec_ptr[cc + 1] - r0;
         if (!m || cdone[cc]) continue;
         double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
         Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
         double uv[6], org[3];
-        inplane(normals + 3 * cc, uv);
-        for (int q = 0; q < 3; q++) org[q] = anchor[3 * cc + q] + centre[q];
+        inplane(L->normals + 3 * cc, uv);
+        for (int q = 0; q < 3; q++) org[q] = L->anchor[3 * cc + q] + L->centre[q];
         for (I i = 0; i < m; i++) {
             I g = crec[r0 + i], seg = g >> 1;
-            c2.g[i] = g; c2.p0[i] = seg_pt[2 * seg]; c2.p1[i] = seg_pt[2 * seg + 1];
+            c2.g[i] = g; c2.p0[i] = L->seg_pt[2 * seg]; c2.p1[i] = L->seg_pt[2 * seg + 1];
             loc[g] = i;
             double a[3], b[3];
             for (int q = 0; q < 3; q++) { a[q] = PTS[3 * c2.p0[i] + q] - org[q]; b[q] = PTS[3 * c2.p1[i] + q] - org[q]; }
@@ -720,10 +761,9 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
             dX[i] = X1[i] - X0[i];
             dY[i] = Y1[i] - Y0[i];
         }
-        /* the record ends' partners are global end numbers: the end 2g + n of record g */
         I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
-        int s2 = arrangement(&c2, loc, partner, cc, R, &ws);
-        if (s2 == NOT_GENERIC) {
+        int s2 = arrangement(&c2, loc, L->partner, cc, R, &ws);
+        if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
             R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
             s2 = inner_crossings(&c2, &xs);
             if (s2 == OK) s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
@@ -731,22 +771,40 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
         for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
         if (s2 != OK) st = s2;
     }
-    free(cg); free(cd);
-    if (st != OK) goto done;
-
 done:
-    if (st == OK) {
-        counts[0] = R->n_points; counts[1] = R->n_extra; counts[2] = R->edges.n / 2; counts[3] = R->flat.n;
-        counts[4] = R->cells.n; counts[5] = R->tcell.n;
-        *volume = R->volume;
-    }
+    free(crec_ptr); free(crec); free(pstart_c); free(cI); free(loc); free(fill); free(cg); free(cd); free(cdone);
+    free(xs.a); free(ws.buf);
+    return st;
+}
+
 #undef PTS
-    free(above); free(cdone); free(cid); free(sortk); free(seg_pt); free(seg_side); free(seg_face); free(at);
-    free(partner); free(rec_cell); free(W0); free(str_f); free(str_p); free(str_q); free(str_w); free(loc);
-    free(crec_ptr); free(crec); free(pstart_c); free(anchor); free(normals); free(tpos);
-    free(cI); free(visited); free(xs.a); free(ws.buf);
+
+/* The level; see the file's comment.  Arguments: x (V, 4) the rotated unit vertices; c0, tol the
+ * level and the on-H tolerance; ea, eb (E,) edges; fe_face, fe_edge, fv_vert, fv_next (S,) the face
+ * sides (faces ascending); face_basis (F, 2, 4); m (4, 4) the rotation; face_cells (F, 2),
+ * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4).  counts (out):
+ * points, extra corners, segments, polygon corners, polygons, triangles; volume, status (out).
+ * Returns the result for `starcut_take`, or NULL (the status says why: the numpy slicer's level). */
+void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, const I *eb, I F, I S,
+              const I *fe_face, const I *fe_edge, const I *fv_vert, const I *fv_next, const double *face_basis,
+              const double *mrot, const I *face_cells, const double *face_rho, const I *slot_mate, I C,
+              const unsigned char *cell_convex, const double *cell_normals, I *counts, double *volume, int *status) {
+    Level L = {.V = V, .E = E, .F = F, .S = S, .C = C, .x = x, .face_basis = face_basis, .mrot = mrot,
+               .face_rho = face_rho, .cell_normals = cell_normals, .ea = ea, .eb = eb, .fe_face = fe_face,
+               .fe_edge = fe_edge, .fv_vert = fv_vert, .fv_next = fv_next, .face_cells = face_cells,
+               .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol};
+    L.R = calloc(1, sizeof(Result));
+    int st = L.R ? cut_edges(&L) : NO_MEMORY;
+    if (st == OK) st = pair_faces(&L);
+    if (st == OK) st = chain_cycles(&L);
+    if (st == OK) st = fill_sections(&L);
+    level_free(&L);
     *status = st;
-    if (st != OK) { result_free(R); return NULL; }
+    if (st != OK) { result_free(L.R); return NULL; }
+    Result *R = L.R;
+    counts[0] = R->n_points; counts[1] = R->n_extra; counts[2] = R->edges.n / 2; counts[3] = R->flat.n;
+    counts[4] = R->cells.n; counts[5] = R->tcell.n;
+    *volume = R->volume;
     return R;
 }
 
