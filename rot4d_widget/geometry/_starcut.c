@@ -28,6 +28,26 @@ const char *starcut_source(void) { return STARCUT_SOURCE; }
 
 enum { OK = 0, NO_CROSSING = 1, INCONSISTENT = 2, NOT_GENERIC = 3, NO_MEMORY = 4 };
 
+/* Built with -DSTARCUT_TIMING (benchmarks/star_stages.py only): seconds spent in each stage, summed
+ * over calls, in starcut_times[]; otherwise the marks compile to nothing. */
+#ifdef STARCUT_TIMING
+#include <time.h>
+double starcut_times[16];
+long starcut_counts[4];  /* cells tried by the arrangement fill, cells it filled */
+#define COUNT(k) (starcut_counts[k]++)
+static double stage_clock(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+#define MARK_START double mark_t_ = stage_clock()
+#define MARK(k) do { double t_ = stage_clock(); starcut_times[k] += t_ - mark_t_; mark_t_ = t_; } while (0)
+#else
+#define MARK_START do { } while (0)
+#define MARK(k) do { } while (0)
+#define COUNT(k) do { } while (0)
+#endif
+/* the stages starcut_times counts: */
+enum { T_EDGES, T_FACES, T_CYCLES, T_FANS, T_ARR_PAIRS, T_ARR_ORDER, T_ARR_PARITY, T_ARR_NEXT, T_ARR_FACES,
+       T_ARR_OUTPUT, T_SLABS };
+enum { C_ARR_TRIED, C_ARR_FILLED };
+
 typedef struct { I *a; I n, cap; } ivec;
 typedef struct { double *a; I n, cap; } dvec;
 
@@ -265,6 +285,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I *nxt = occ_other + nxmax * 2, *lab = nxt + nsmax, *tail = lab + nsmax, *fillp = tail + nsmax;
     unsigned char *back = (unsigned char *)(fillp + m + 1);
     memset(k, 0, (m + 1) * sizeof(I));
+    MARK_START;
     I nx = 0;
     for (I a = 0; a < m; a++) L2[a] = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
     for (I a = 0; a < m; a++) {
@@ -286,6 +307,8 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             }
         }
     }
+    MARK(T_ARR_PAIRS);
+    COUNT(C_ARR_TRIED);
     if (!nx || bad) { st = NOT_GENERIC; goto done; }
     /* occurrences: each record's crossings in order along it */
     for (I x = 0; x < nx; x++) { k[xa[x]]++; k[xb[x]]++; }
@@ -314,6 +337,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         if (xsp_at[x] < 0) xsp_at[x] = i;
         else { occ_other[i] = xsp_at[x]; occ_other[xsp_at[x]] = i; }
     }
+    MARK(T_ARR_ORDER);
     /* parity left of each record's first piece: a ray square to it, leftwards from that piece's middle */
     memset(cnt, 0, m * sizeof(I));
     for (I a = 0; a < m; a++) {
@@ -336,6 +360,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             hx[e] = back[e] ? -c->dX[a] : c->dX[a];
             hy[e] = back[e] ? -c->dY[a] : c->dY[a];
         }
+    MARK(T_ARR_PARITY);
     /* the next odd half round its face */
     for (I a = 0; a < m; a++) {
         for (I t = 0; t <= k[a]; t++) {
@@ -361,6 +386,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             nxt[e] = nx2;
         }
     }
+    MARK(T_ARR_NEXT);
     /* faces: each by its least piece; convex (every turn left, the heading passing +u once) */
     for (I e = 0; e < nsub; e++) lab[e] = -1;
     for (I e0 = 0; e0 < nsub; e0++) {
@@ -376,6 +402,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         } while (e != e0);
         if (ups != 1) { st = NOT_GENERIC; goto done; }
     }
+    MARK(T_ARR_FACES);
     /* generic: the crossings become corners; each odd half's tail; fans from each face's first */
     if (!dgrow(&R->verts, 3 * nx) || !igrow(&R->tri, 3 * nsub) || !igrow(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
     for (I x = 0; x < nx; x++) {
@@ -400,6 +427,8 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             R->tcell.a[R->tcell.n++] = cell;
         }
     }
+    MARK(T_ARR_OUTPUT);
+    COUNT(C_ARR_FILLED);
 done:
     return st;
 }
@@ -725,6 +754,7 @@ static int fill_sections(Level *L) {
     for (I cc = 0; cc < C; cc++) pstart_c[cc + 1] += pstart_c[cc];
     memset(fill, 0, (C + 1) * sizeof(I));
     for (I p = 0; p < npoly; p++) cI[pstart_c[R->cells.a[p]] + fill[R->cells.a[p]]++] = p;
+    MARK_START;
     for (I cc = 0; cc < C; cc++) {  /* star-shaped: only where the polygons hold all the cell's records */
         I nrec = crec_ptr[cc + 1] - crec_ptr[cc], p0 = pstart_c[cc], p1 = pstart_c[cc + 1], corners = 0;
         if (!nrec || p1 == p0) continue;
@@ -734,6 +764,7 @@ static int fill_sections(Level *L) {
         if (done_ < 0) { st = NO_MEMORY; goto done; }
         cdone[cc] = (unsigned char)done_;
     }
+    MARK(T_FANS);
     for (I r = 0; r < 2 * ns; r++) loc[r] = -1;
     I mmax = 0;
     for (I cc = 0; cc < C; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
@@ -765,8 +796,10 @@ static int fill_sections(Level *L) {
         int s2 = arrangement(&c2, loc, L->partner, cc, R, &ws);
         if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
             R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
+            MARK_START;
             s2 = inner_crossings(&c2, &xs);
             if (s2 == OK) s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
+            MARK(T_SLABS);
         }
         for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
         if (s2 != OK) st = s2;
@@ -794,9 +827,13 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
                .fe_edge = fe_edge, .fv_vert = fv_vert, .fv_next = fv_next, .face_cells = face_cells,
                .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol};
     L.R = calloc(1, sizeof(Result));
+    MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
+    MARK(T_EDGES);
     if (st == OK) st = pair_faces(&L);
+    MARK(T_FACES);
     if (st == OK) st = chain_cycles(&L);
+    MARK(T_CYCLES);
     if (st == OK) st = fill_sections(&L);
     level_free(&L);
     *status = st;
