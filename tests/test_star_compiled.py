@@ -113,14 +113,14 @@ def _polytopes():
     return out
 
 
-def _both(p, m, c0):
+def _both(p, m, c0, slabs_only=False):
     """(C slice, numpy slice) of one level, or (None, numpy) where the C code declines it."""
     t = tables(p)
     st = starslice.star_tables(p, t)
     assert st.c is not None
     x = t.vertices @ m.T
     level = c0 / t.unit
-    r = _cstar.cut(st.c, x, m, level, t.tol)
+    r = _cstar.cut(st.c, x, m, level, t.tol, slabs_only=slabs_only)
     keep, st.c = st.c, None
     try:
         ref = starslice.slice_star(p, t, x, m, level)
@@ -190,3 +190,26 @@ def test_the_compiled_level_is_the_numpy_slicers(name, make):
             assert np.abs(off).max(initial=0) <= 1e-9 * max(1.0, float(np.abs(v).max()))
             done += 1
     assert done >= 6, "the compiled level declined nearly every level"
+
+
+@needs_c
+@pytest.mark.parametrize("name", ["great icosahedral 120-cell", "great grand 120-cell", "great 120-cell"])
+def test_the_compiled_slab_fill_of_crossing_sections_covers_what_the_arrangement_does(name):
+    """The slab fill, which takes a section the arrangement fill leaves (rare: a crossing at a
+    segment's end, an odd face that is not convex), made to take all of them: on these polychora
+    every such section's segments cross, so each crossing must be a slab line.  The area covered per
+    cell (signed about its normal) is the numpy slicer's, with more fill corners."""
+    p = polytope(name)
+    t = tables(p)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    for _ in range(3):
+        m = random_rotation(rng)
+        r, ref = _both(p, m, 0.05 * p.circumradius, slabs_only=True)
+        assert r is not None and ref.dim == 3
+        v, edges, flat, offsets, cells, tri, tcell, volume, n_fill = r
+        normals = t.cell_normals @ m[:3].T
+        got = _fill_area(v * t.unit, tri, tcell, normals)
+        want = _fill_area(ref.vertices, ref.triangles, ref.triangle_cells, normals)
+        scale = max(1.0, float(np.abs(want).max()))
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * scale)
+        assert n_fill > ref.n_fill  # the slabs' corners, not the crossings alone

@@ -47,8 +47,9 @@ def _load(here: pathlib.Path | None = None):
         return None
     P, N, D = ctypes.c_void_p, ctypes.c_int64, ctypes.c_double
     lib.starcut.restype = P
-    #    V  x  c0 tol E  ea eb F  S  fe_face fe_edge fv_vert fv_next basis m  f_cells rho mate C  convex normals out...
-    lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, P, P, P]
+    #    V  x  c0 tol E  ea eb F  S  fe_face fe_edge fv_vert fv_next basis m  f_cells rho mate C  convex normals
+    #    slabs_only out...
+    lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, ctypes.c_int, P, P, P]
     lib.starcut_take.restype = None
     lib.starcut_take.argtypes = [P] * 8
     return lib
@@ -93,17 +94,18 @@ class CTables:
         self.conv_ptrs = [_ptr(a) for a in (self.cell_convex, self.cell_normals)]
 
 
-def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float):
+def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float, slabs_only: bool = False):
     """The level ``c0`` of the unit vertices ``x`` (V, 4) turned by ``m``: (vertices (n, 3), edges,
     polygon corners, offsets, polygon cells, triangles, triangle cells, volume, n_fill), or None
-    when the C code declines it (the numpy slicer then does it)."""
+    when the C code declines it (the numpy slicer then does it).  ``slabs_only``: the slab fill
+    takes every section the arrangement fill would (so tests reach it with crossing segments)."""
     x = np.ascontiguousarray(x, dtype=np.float64)
     m = np.ascontiguousarray(m, dtype=np.float64)
     counts = np.zeros(6, dtype=np.int64)
     vol = ctypes.c_double()
     status = ctypes.c_int()
     res = _lib.starcut(len(x), _ptr(x), c0, tol, ct.E, *ct.edge_ptrs, ct.F, ct.S, *ct.face_ptrs, _ptr(m),
-                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, _ptr(counts), ctypes.addressof(vol),
+                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, int(slabs_only), _ptr(counts), ctypes.addressof(vol),
                        ctypes.addressof(status))
     if not res:
         return None

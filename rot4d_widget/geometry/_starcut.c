@@ -51,24 +51,18 @@ enum { C_ARR_TRIED, C_ARR_FILLED };
 typedef struct { I *a; I n, cap; } ivec;
 typedef struct { double *a; I n, cap; } dvec;
 
-static int igrow(ivec *v, I extra) {
-    if (v->n + extra <= v->cap) return 1;
-    I cap = v->cap ? v->cap : 64;
-    while (cap < v->n + extra) cap *= 2;
-    I *a = (I *)realloc(v->a, (size_t)cap * sizeof(I));
-    if (!a) return 0;
-    v->a = a; v->cap = cap; return 1;
+/* Room for `extra` more elements of `size` bytes after the `n` in *a (capacity *cap, doubled as
+ * needed); 0 when memory runs out (*a unchanged). */
+static int grow(void **a, I *cap, I n, I extra, size_t size) {
+    if (n + extra <= *cap) return 1;
+    I c = *cap ? *cap : 64;
+    while (c < n + extra) c *= 2;
+    void *b = realloc(*a, (size_t)c * size);
+    if (!b) return 0;
+    *a = b; *cap = c; return 1;
 }
-static int dgrow(dvec *v, I extra) {
-    if (v->n + extra <= v->cap) return 1;
-    I cap = v->cap ? v->cap : 64;
-    while (cap < v->n + extra) cap *= 2;
-    double *a = (double *)realloc(v->a, (size_t)cap * sizeof(double));
-    if (!a) return 0;
-    v->a = a; v->cap = cap; return 1;
-}
-#define IPUSH(v, x) do { if (!igrow(&(v), 1)) { st = NO_MEMORY; goto done; } (v).a[(v).n++] = (x); } while (0)
-#define DPUSH(v, x) do { if (!dgrow(&(v), 1)) { st = NO_MEMORY; goto done; } (v).a[(v).n++] = (x); } while (0)
+#define GROW(v, extra) grow((void **)&(v)->a, &(v)->cap, (v)->n, (extra), sizeof *(v)->a)
+#define PUSH(v, x) do { if (!GROW(&(v), 1)) { st = NO_MEMORY; goto done; } (v).a[(v).n++] = (x); } while (0)
 
 typedef struct {
     int status;
@@ -187,7 +181,7 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
         else { I q_ = pstart[s_] + l_ - ylo[s_]; \
             if (pid[q_] < 0) { \
                 double lam_ = (uy[l_] - Yl[s_]) / (Yh[s_] - Yl[s_]); \
-                if (!dgrow(&R->verts, 3)) { st = NO_MEMORY; goto done; } \
+                if (!GROW(&R->verts, 3)) { st = NO_MEMORY; goto done; } \
                 const double *A_ = R->verts.a + 3 * lo_p[s_], *B_ = R->verts.a + 3 * hi_p[s_]; \
                 for (int k_ = 0; k_ < 3; k_++) R->verts.a[R->verts.n++] = A_[k_] + lam_ * (B_[k_] - A_[k_]); \
                 pid[q_] = R->n_points + R->n_extra++; } \
@@ -196,8 +190,8 @@ static int slab_fill(const Cell2D *c, const double *xs, I nx, I cell, Result *R)
 #define TRAP(L, Rr, y0, y1) do { \
         I a_, b_, c_, d_; \
         CORNER(L, y0, a_); CORNER(Rr, y0, b_); CORNER(Rr, y1, c_); CORNER(L, y1, d_); \
-        if (a_ != b_ && b_ != c_ && a_ != c_) { IPUSH(R->tri, a_); IPUSH(R->tri, b_); IPUSH(R->tri, c_); IPUSH(R->tcell, cell); } \
-        if (a_ != c_ && c_ != d_ && a_ != d_) { IPUSH(R->tri, a_); IPUSH(R->tri, c_); IPUSH(R->tri, d_); IPUSH(R->tcell, cell); } \
+        if (a_ != b_ && b_ != c_ && a_ != c_) { PUSH(R->tri, a_); PUSH(R->tri, b_); PUSH(R->tri, c_); PUSH(R->tcell, cell); } \
+        if (a_ != c_ && c_ != d_ && a_ != d_) { PUSH(R->tri, a_); PUSH(R->tri, c_); PUSH(R->tri, d_); PUSH(R->tcell, cell); } \
     } while (0)
     for (I k = 0; k + 1 < nl; k++) {
         I n = 0, keepn = 0;
@@ -239,21 +233,32 @@ done:
 
 typedef struct { char *buf; size_t cap; } Work;  /* scratch memory, grown as needed, freed by the caller */
 
+/* Where records a and b of a cell cross, as parameters s along a and u along b (cross(e, d_b) / den
+ * and cross(e, d_a) / den, den = cross(d_a, d_b), e = P_b - P_a: starfill's, to the bit); 0 when
+ * they are parallel to rounding (a star face's line holds several segments: no crossing, no
+ * contact) or the crossing is far outside both (neither parameter in [-0.5, 1.5]). */
+static int pair_params(const Cell2D *c, I a, I b, double L2a, double L2b, double *s, double *u) {
+    double ex = c->X0[b] - c->X0[a], ey = c->Y0[b] - c->Y0[a], dxa = c->dX[a], dya = c->dY[a], dxb = c->dX[b], dyb = c->dY[b];
+    double den = dxa * dyb - dya * dxb;
+    if (!(den * den > PARALLEL * PARALLEL * L2a * L2b)) return 0;
+    double cb = ex * dyb - ey * dxb, ca = ex * dya - ey * dxa, ad = fabs(den);
+    if (den < 0) { cb = -cb; ca = -ca; }
+    if (cb < -0.5 * ad || cb > 1.5 * ad || ca < -0.5 * ad || ca > 1.5 * ad) return 0;
+    *s = cb / ad; *u = ca / ad;  /* (negation is exact) */
+    return 1;
+}
+
 /* The heights where a cell's segments cross inside both (the slab fill's extra slab lines), as
  * the arrangement computes them. */
 static int inner_crossings(const Cell2D *c, dvec *xs) {
     xs->n = 0;
     for (I a = 0; a < c->m; a++) {
-        double L2a = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
+        double L2a = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a], s, u;
         for (I b = a + 1; b < c->m; b++) {
-            double ex = c->X0[b] - c->X0[a], ey = c->Y0[b] - c->Y0[a];
-            double den = c->dX[a] * c->dY[b] - c->dY[a] * c->dX[b];
-            if (!(den * den > PARALLEL * PARALLEL * L2a * (c->dX[b] * c->dX[b] + c->dY[b] * c->dY[b]))) continue;
-            double cb = ex * c->dY[b] - ey * c->dX[b], ca = ex * c->dY[a] - ey * c->dX[a], ad = fabs(den);
-            if (den < 0) { cb = -cb; ca = -ca; }
-            double s = cb / ad, u = ca / ad, lo = s < u ? s : u, hi = s < u ? u : s;
+            if (!pair_params(c, a, b, L2a, c->dX[b] * c->dX[b] + c->dY[b] * c->dY[b], &s, &u)) continue;
+            double lo = s < u ? s : u, hi = s < u ? u : s;
             if (lo > EPS_IN && hi < 1 - EPS_IN) {
-                if (!dgrow(xs, 1)) return NO_MEMORY;
+                if (!GROW(xs, 1)) return NO_MEMORY;
                 xs->a[xs->n++] = c->Y0[a] + s * c->dY[a];
             }
         }
@@ -289,16 +294,9 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I nx = 0;
     for (I a = 0; a < m; a++) L2[a] = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
     for (I a = 0; a < m; a++) {
-        double xa0 = c->X0[a], ya0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a];
         for (I b = a + 1; b < m; b++) {
-            double ex = c->X0[b] - xa0, ey = c->Y0[b] - ya0, dxb = c->dX[b], dyb = c->dY[b];
-            double den = dxa * dyb - dya * dxb;
-            /* parallel to rounding (a star face's line holds several segments): no crossing, no contact */
-            if (!(den * den > PARALLEL * PARALLEL * L2[a] * L2[b])) continue;
-            double cb = ex * dyb - ey * dxb, ca = ex * dya - ey * dxa, ad = fabs(den);
-            if (den < 0) { cb = -cb; ca = -ca; }
-            if (cb < -0.5 * ad || cb > 1.5 * ad || ca < -0.5 * ad || ca > 1.5 * ad) continue;  /* far from both */
-            double s = cb / ad, u = ca / ad;  /* (= cej / den, cei / den exactly: negation is exact) */
+            double s, u;
+            if (!pair_params(c, a, b, L2[a], L2[b], &s, &u)) continue;
             double lo = s < u ? s : u, hi = s < u ? u : s;
             if (lo > EPS_ARR && hi < 1 - EPS_ARR) { xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u; nx++; }
             else if (lo > -EPS_ARR && hi < 1 + EPS_ARR) {
@@ -404,7 +402,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     }
     MARK(T_ARR_FACES);
     /* generic: the crossings become corners; each odd half's tail; fans from each face's first */
-    if (!dgrow(&R->verts, 3 * nx) || !igrow(&R->tri, 3 * nsub) || !igrow(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
+    if (!GROW(&R->verts, 3 * nx) || !GROW(&R->tri, 3 * nsub) || !GROW(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
     for (I x = 0; x < nx; x++) {
         const double *A = R->verts.a + 3 * c->p0[xa[x]], *B = R->verts.a + 3 * c->p1[xa[x]];
         double *o = R->verts.a + R->verts.n;
@@ -444,6 +442,7 @@ typedef struct {
     const I *ea, *eb, *fe_face, *fe_edge, *fv_vert, *fv_next, *face_cells, *slot_mate;
     const unsigned char *cell_convex;
     double c0, tol;
+    int slabs_only;           /* every non-star-shaped section by slabs (tests of the slab fill) */
     unsigned char *above;     /* (V,) each vertex above H */
     I *cid;                   /* (E,) each edge's point, -1 if it does not cross */
     double centre[3];         /* the points' mean: coordinates about it keep the volume's sums small */
@@ -480,7 +479,7 @@ static int cut_edges(Level *L) {
         if (L->above[L->ea[e]] != L->above[L->eb[e]]) {
             const double *A = L->x + 4 * L->ea[e], *B = L->x + 4 * L->eb[e];
             double ha = A[3] - L->c0, hb = B[3] - L->c0, s = ha / (ha - hb);
-            if (!dgrow(&R->verts, 3)) return NO_MEMORY;
+            if (!GROW(&R->verts, 3)) return NO_MEMORY;
             for (int k = 0; k < 3; k++) R->verts.a[R->verts.n++] = A[k] + s * (B[k] - A[k]);
             L->cid[e] = np++;
         } else L->cid[e] = -1;
@@ -569,7 +568,7 @@ static int pair_faces(Level *L) {
         for (int i = 0; i < 3; i++)
             L->normals[3 * cc + i] = m[4 * i] * n[0] + m[4 * i + 1] * n[1] + m[4 * i + 2] * n[2] + m[4 * i + 3] * n[3];
     }
-    for (I r = 0; r < ns; r++) { IPUSH(R->edges, L->seg_pt[2 * r]); IPUSH(R->edges, L->seg_pt[2 * r + 1]); }
+    for (I r = 0; r < ns; r++) { PUSH(R->edges, L->seg_pt[2 * r]); PUSH(R->edges, L->seg_pt[2 * r + 1]); }
 done:
     free(sortk); free(str_f); free(str_p); free(str_q); free(str_w); free(tpos);
     return st;
@@ -600,7 +599,7 @@ static int chain_cycles(Level *L) {
     }
     for (I q = 0; q < n_end; q++)
         if (partner[q] == q || partner[partner[q]] != q) { st = INCONSISTENT; goto done; }
-    IPUSH(R->offsets, 0);
+    PUSH(R->offsets, 0);
     for (I q0 = 0; q0 < n_end; q0++) {
         if (visited[q0]) continue;
         I cc = rec_cell[q0 >> 1], score = 0, rev = n_end, len = 0;
@@ -636,13 +635,13 @@ static int chain_cycles(Level *L) {
         q = q0;
         do {
             I pid = seg_pt[2 * (q >> 2) + (q & 1)];
-            if (R->flat.n == n0 || R->flat.a[R->flat.n - 1] != pid) IPUSH(R->flat, pid);
+            if (R->flat.n == n0 || R->flat.a[R->flat.n - 1] != pid) PUSH(R->flat, pid);
             q = partner[q] ^ 1;
         } while (q != q0);
         if (R->flat.n - n0 > 1 && R->flat.a[R->flat.n - 1] == R->flat.a[n0]) R->flat.n--;
         if (R->flat.n - n0 < 3) { R->flat.n = n0; continue; }
-        IPUSH(R->offsets, R->flat.n);
-        IPUSH(R->cells, cc);
+        PUSH(R->offsets, R->flat.n);
+        PUSH(R->cells, cc);
     }
     if (!R->cells.n) st = NO_CROSSING;
 done:
@@ -706,15 +705,15 @@ static int star_shaped_fan(Level *L, const I *cI, I p0, I p1, I cc) {
             cross3(a, b, ab);
             y0 = ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
         }
-        if (!dgrow(&R->verts, 3)) return -1;
+        if (!GROW(&R->verts, 3)) return -1;
         for (int q = 0; q < 3; q++) R->verts.a[R->verts.n++] = cen[q];
         I centroid = R->n_points + R->n_extra++;
         for (I j = o0; j < o1; j++) {
             I jn = j + 1 < o1 ? j + 1 : o0;
-            IPUSH(R->tri, centroid);
-            IPUSH(R->tri, y0 > 0 ? R->flat.a[j] : R->flat.a[jn]);
-            IPUSH(R->tri, y0 > 0 ? R->flat.a[jn] : R->flat.a[j]);
-            IPUSH(R->tcell, cc);
+            PUSH(R->tri, centroid);
+            PUSH(R->tri, y0 > 0 ? R->flat.a[j] : R->flat.a[jn]);
+            PUSH(R->tri, y0 > 0 ? R->flat.a[jn] : R->flat.a[j]);
+            PUSH(R->tcell, cc);
         }
     }
 done:
@@ -737,8 +736,8 @@ static int fill_sections(Level *L) {
         if (!L->cell_convex[R->cells.a[p]]) continue;
         I o0 = R->offsets.a[p], o1 = R->offsets.a[p + 1];
         for (I j = o0 + 1; j + 1 < o1; j++) {
-            IPUSH(R->tri, R->flat.a[o0]); IPUSH(R->tri, R->flat.a[j]); IPUSH(R->tri, R->flat.a[j + 1]);
-            IPUSH(R->tcell, R->cells.a[p]);
+            PUSH(R->tri, R->flat.a[o0]); PUSH(R->tri, R->flat.a[j]); PUSH(R->tri, R->flat.a[j + 1]);
+            PUSH(R->tcell, R->cells.a[p]);
         }
     }
     /* a non-convex cell's records, by cell (crec), and its polygons (cI) */
@@ -793,7 +792,7 @@ static int fill_sections(Level *L) {
             dY[i] = Y1[i] - Y0[i];
         }
         I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
-        int s2 = arrangement(&c2, loc, L->partner, cc, R, &ws);
+        int s2 = L->slabs_only ? NOT_GENERIC : arrangement(&c2, loc, L->partner, cc, R, &ws);
         if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
             R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
             MARK_START;
@@ -815,17 +814,19 @@ done:
 /* The level; see the file's comment.  Arguments: x (V, 4) the rotated unit vertices; c0, tol the
  * level and the on-H tolerance; ea, eb (E,) edges; fe_face, fe_edge, fv_vert, fv_next (S,) the face
  * sides (faces ascending); face_basis (F, 2, 4); m (4, 4) the rotation; face_cells (F, 2),
- * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4).  counts (out):
+ * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4); slabs_only: no
+ * arrangement fill (every section it would take goes to the slabs: for tests).  counts (out):
  * points, extra corners, segments, polygon corners, polygons, triangles; volume, status (out).
  * Returns the result for `starcut_take`, or NULL (the status says why: the numpy slicer's level). */
 void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, const I *eb, I F, I S,
               const I *fe_face, const I *fe_edge, const I *fv_vert, const I *fv_next, const double *face_basis,
               const double *mrot, const I *face_cells, const double *face_rho, const I *slot_mate, I C,
-              const unsigned char *cell_convex, const double *cell_normals, I *counts, double *volume, int *status) {
+              const unsigned char *cell_convex, const double *cell_normals, int slabs_only, I *counts, double *volume,
+              int *status) {
     Level L = {.V = V, .E = E, .F = F, .S = S, .C = C, .x = x, .face_basis = face_basis, .mrot = mrot,
                .face_rho = face_rho, .cell_normals = cell_normals, .ea = ea, .eb = eb, .fe_face = fe_face,
                .fe_edge = fe_edge, .fv_vert = fv_vert, .fv_next = fv_next, .face_cells = face_cells,
-               .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol};
+               .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol, .slabs_only = slabs_only};
     L.R = calloc(1, sizeof(Result));
     MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
