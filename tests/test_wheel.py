@@ -9,10 +9,10 @@ archives; tests/test_binder.py installs the built wheel into a fresh venv (slow)
 from __future__ import annotations
 
 import email
+import importlib.util
 import json
 import os
 import pathlib
-import shlex
 import shutil
 import subprocess
 import sys
@@ -34,7 +34,17 @@ NAME, VERSION = PROJECT["name"], PROJECT["version"]
 SERVER_CONFIG = "etc/jupyter/jupyter_server_config.d/rot4d_widget.json"
 #: the compiled star slicer (hatch_build.py), built where a C compiler is found
 LIBRARY = "rot4d_widget/geometry/_starcut.so"
-COMPILER = shutil.which(shlex.split(sysconfig.get_config_var("CC") or "cc")[0]) is not None
+
+def _hook():
+    """hatch_build.py, the build hook (it names the compilers the install tries)."""
+    spec = importlib.util.spec_from_file_location("hatch_build", ROOT / "hatch_build.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: a compiler the build hook would try is here (then the wheel carries the library)
+COMPILER = any(shutil.which(cc[0]) for cc in _hook()._compilers())
 
 
 def build_dists(outdir: Path) -> tuple[Path, Path]:
