@@ -268,88 +268,107 @@ static int inner_crossings(const Cell2D *c, dvec *xs) {
 
 /* Even-odd fill of one cell's section by its segments' arrangement (starfill.arrangement_fill).
  * Returns OK with the triangles added, NOT_GENERIC when the cell is left to the slab fill (its
- * crossings by `inner_crossings`), or NO_MEMORY. */
-
+ * crossings by `inner_crossings`; the caller drops what was added), or NO_MEMORY.
+ *
+ * Loops are written without data-dependent branches where the data are random (which pairs cross,
+ * the order of crossings along a segment): a mispredicted branch costs more than the arithmetic. */
 static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, Result *R, Work *ws) {
     int st = OK, bad = 0;
     I m = c->m;
     I nxmax = m * (m - 1) / 2 + 1, nsmax = m + 2 * nxmax + 1;
     /* one block for the cell: its crossings, occurrences and pieces at their most */
-    size_t need = (size_t)(8 * nxmax + 4 * (m + 1) + 4 * nsmax) * sizeof(I)
-                + (size_t)(4 * nxmax + (m + 1) + 2 * nsmax) * sizeof(double) + (size_t)nsmax;
+    size_t need = (size_t)(3 * nxmax + 4 * (m + 1) + 6 * nxmax + 3 * nsmax) * sizeof(I)
+                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1) + 2 * nsmax) * sizeof(double) + 2 * (size_t)nsmax;
     if (ws->cap < need) {
         char *b = realloc(ws->buf, need);
         if (!b) return NO_MEMORY;
         ws->buf = b; ws->cap = need;
     }
-    double *xsp = (double *)ws->buf, *xup = xsp + nxmax, *occ_t = xup + nxmax;
-    double *L2 = occ_t + 2 * nxmax, *hx = L2 + (m + 1), *hy = hx + nsmax;
-    I *xa = (I *)(hy + nsmax), *xb = xa + nxmax, *xid = xb + nxmax, *xsp_at = xid + nxmax;
-    I *k = xsp_at + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
-    I *occ_x = cnt + (m + 1), *occ_other = occ_x + nxmax * 2;
-    I *nxt = occ_other + nxmax * 2, *lab = nxt + nsmax, *tail = lab + nsmax, *fillp = tail + nsmax;
-    unsigned char *back = (unsigned char *)(fillp + m + 1);
-    memset(k, 0, (m + 1) * sizeof(I));
+    double *xsp = (double *)ws->buf, *xup = xsp + nxmax, *occ_t = xup + nxmax, *ut = occ_t + 2 * nxmax;
+    double *L2 = ut + 2 * nxmax, *hx = L2 + (m + 1), *hy = hx + nsmax;
+    I *xa = (I *)(hy + nsmax), *xb = xa + nxmax, *xid = xb + nxmax;
+    I *k = xid + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
+    I *occ_x = cnt + (m + 1), *ux = occ_x + 2 * nxmax, *pos = ux + 2 * nxmax;
+    I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax;
+    unsigned char *back = (unsigned char *)(fillp + nsmax), *seen = back + nsmax;
     MARK_START;
     I nx = 0;
     for (I a = 0; a < m; a++) L2[a] = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
-    for (I a = 0; a < m; a++) {
+    /* every pair: s along a, u along b (starfill's, to the bit: cb / den equals the sign-corrected
+     * quotient exactly); a crossing inside both is kept (nx counts it), one at an end must be where
+     * the two share that end (consecutive in a cycle), a parallel pair (den ~ 0) neither */
+    for (I a = 0; a + 1 < m; a++) {
+        const double x0 = c->X0[a], y0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a], lim = PARALLEL * PARALLEL * L2[a];
+        const I pa0 = c->p0[a], pa1 = c->p1[a];
         for (I b = a + 1; b < m; b++) {
-            double s, u;
-            if (!pair_params(c, a, b, L2[a], L2[b], &s, &u)) continue;
+            double ex = c->X0[b] - x0, ey = c->Y0[b] - y0, dxb = c->dX[b], dyb = c->dY[b];
+            double den = dxa * dyb - dya * dxb;
+            double s = (ex * dyb - ey * dxb) / den, u = (ex * dya - ey * dxa) / den;
             double lo = s < u ? s : u, hi = s < u ? u : s;
-            if (lo > EPS_ARR && hi < 1 - EPS_ARR) { xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u; nx++; }
-            else if (lo > -EPS_ARR && hi < 1 + EPS_ARR) {
-                /* at (or near) an end: only where the two share that end (consecutive in a cycle) */
-                if (c->p0[a] != c->p0[b] && c->p0[a] != c->p1[b] && c->p1[a] != c->p0[b] && c->p1[a] != c->p1[b]) bad = 1;
-            }
+            int okd = den * den > lim * L2[b];
+            int in = okd & (lo > EPS_ARR) & (hi < 1 - EPS_ARR);
+            int near = okd & (lo > -EPS_ARR) & (hi < 1 + EPS_ARR);
+            int shared = (pa0 == c->p0[b]) | (pa0 == c->p1[b]) | (pa1 == c->p0[b]) | (pa1 == c->p1[b]);
+            bad |= near & !in & !shared;
+            xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u;  /* (a slot to spare: nx < nxmax) */
+            nx += in;
         }
     }
     MARK(T_ARR_PAIRS);
     COUNT(C_ARR_TRIED);
     if (!nx || bad) { st = NOT_GENERIC; goto done; }
-    /* occurrences: each record's crossings in order along it */
+    /* occurrences: each record's crossings in order along it (by rank; equal parameters: not
+     * generic); occurrence 2x + j of crossing x is its place on xa[x] (j = 0) or xb[x] (j = 1),
+     * at index pos[2x + j] of occ_x, occ_t */
+    memset(k, 0, (m + 1) * sizeof(I));
     for (I x = 0; x < nx; x++) { k[xa[x]]++; k[xb[x]]++; }
     optr[0] = 0; base[0] = 0;
     for (I a = 0; a < m; a++) { optr[a + 1] = optr[a] + k[a]; base[a + 1] = base[a] + k[a] + 1; }
-    I nocc = optr[m], nsub = base[m];
-    (void)nocc;
+    I nsub = base[m];
     memset(fillp, 0, m * sizeof(I));
     for (I x = 0; x < nx; x++) {
         I ia = optr[xa[x]] + fillp[xa[x]]++, ib = optr[xb[x]] + fillp[xb[x]]++;
-        occ_x[ia] = x; occ_t[ia] = xsp[x];
-        occ_x[ib] = x; occ_t[ib] = xup[x];
+        ut[ia] = xsp[x]; ux[ia] = 2 * x;
+        ut[ib] = xup[x]; ux[ib] = 2 * x + 1;
     }
-    for (I a = 0; a < m; a++) {  /* sort each record's occurrences by parameter; equal ones: not generic */
+    for (I a = 0; a < m; a++) {
         I s0 = optr[a], s1 = optr[a + 1];
-        for (I i = s0 + 1; i < s1; i++) {
-            double tv = occ_t[i]; I xv = occ_x[i]; I j = i - 1;
-            while (j >= s0 && occ_t[j] > tv) { occ_t[j + 1] = occ_t[j]; occ_x[j + 1] = occ_x[j]; j--; }
-            occ_t[j + 1] = tv; occ_x[j + 1] = xv;
+        I rsum = 0, kk = s1 - s0;
+        for (I i = s0; i < s1; i++) {
+            double ti = ut[i];
+            I r = 0;
+            for (I j = s0; j < s1; j++) r += ut[j] < ti;
+            rsum += r; r += s0;
+            occ_t[r] = ti; occ_x[r] = ux[i] >> 1; pos[ux[i]] = r;
         }
-        for (I i = s0 + 1; i < s1; i++) if (occ_t[i] == occ_t[i - 1]) { st = NOT_GENERIC; goto done; }
-    }
-    for (I x = 0; x < nx; x++) xsp_at[x] = -1;  /* each crossing's two occurrences, each the other's */
-    for (I i = 0; i < optr[m]; i++) {
-        I x = occ_x[i];
-        if (xsp_at[x] < 0) xsp_at[x] = i;
-        else { occ_other[i] = xsp_at[x]; occ_other[xsp_at[x]] = i; }
+        if (2 * rsum != kk * (kk - 1)) { st = NOT_GENERIC; goto done; }  /* equal parameters share a rank */
     }
     MARK(T_ARR_ORDER);
-    /* parity left of each record's first piece: a ray square to it, leftwards from that piece's middle */
-    memset(cnt, 0, m * sizeof(I));
-    for (I a = 0; a < m; a++) {
-        double f = k[a] ? occ_t[optr[a]] : 1.0;
-        double ox = c->X0[a] + 0.5 * f * c->dX[a], oy = c->Y0[a] + 0.5 * f * c->dY[a];
-        double dx = c->dX[a], dy = c->dY[a], nx_ = -dy, ny_ = dx;
+    /* parity left of each record's first piece: a ray square to it, leftwards from that piece's
+     * middle, for the first record of a cycle; the others along it: left of the way walked into a
+     * corner is left of the way walked out (the corner is generic, no other segment through it;
+     * the next pointers check every parity against its neighbours') */
+    for (I a = 0; a < m; a++) cnt[a] = -1;
+    for (I a0 = 0; a0 < m; a0++) {
+        if (cnt[a0] >= 0) continue;
+        double f = k[a0] ? occ_t[optr[a0]] : 1.0;
+        double ox = c->X0[a0] + 0.5 * f * c->dX[a0], oy = c->Y0[a0] + 0.5 * f * c->dY[a0];
+        double dx = c->dX[a0], dy = c->dY[a0], nx_ = -dy, ny_ = dx;
         I n = 0;
         for (I b = 0; b < m; b++) {
             double Ax = c->X0[b] - ox, Ay = c->Y0[b] - oy, Bx = Ax + c->dX[b], By = Ay + c->dY[b];
-            double a0 = Ax * dx + Ay * dy, a1 = Bx * dx + By * dy;
+            double a0_ = Ax * dx + Ay * dy, a1 = Bx * dx + By * dy;
             double n0 = Ax * nx_ + Ay * ny_, n1 = Bx * nx_ + By * ny_;
-            n += ((a0 > 0) != (a1 > 0)) & ((a0 * n1 - a1 * n0) * (a0 - a1) > 0) & (b != a);
+            n += ((a0_ > 0) != (a1 > 0)) & ((a0_ * n1 - a1 * n0) * (a0_ - a1) > 0) & (b != a0);
         }
-        cnt[a] = n;
+        cnt[a0] = n & 1;
+        for (I a = a0, q = 1;;) {  /* leaving a at its end q: the parity left of the way walked there */
+            I w = q ? cnt[a] + k[a] : cnt[a] + 1;
+            I pe = partner[2 * c->g[a] + q], b = loc[pe >> 1];
+            if (b < 0 || cnt[b] >= 0) break;
+            cnt[b] = (pe & 1 ? w + k[b] + 1 : w) & 1;  /* entered at b's end: walking it backwards */
+            a = b; q = 1 - (pe & 1);
+        }
     }
     for (I a = 0; a < m; a++)
         for (I t = 0; t <= k[a]; t++) {
@@ -366,8 +385,9 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             int bk = back[e], expect;
             int at_x = bk ? t > 0 : t < k[a];
             if (at_x) {
-                I oc = optr[a] + (bk ? t - 1 : t), o2 = occ_other[oc];
-                I b = xa[occ_x[oc]] == a ? xb[occ_x[oc]] : xa[occ_x[oc]];
+                I oc = optr[a] + (bk ? t - 1 : t), x = occ_x[oc];
+                I o2 = pos[2 * x] == oc ? pos[2 * x + 1] : pos[2 * x];
+                I b = xa[x] == a ? xb[x] : xa[x];
                 I t2 = o2 - optr[b];
                 int turn = c->dX[a] * c->dY[b] - c->dY[a] * c->dX[b] > 0;
                 nx2 = base[b] + t2 + (turn != bk);
@@ -385,23 +405,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         }
     }
     MARK(T_ARR_NEXT);
-    /* faces: each by its least piece; convex (every turn left, the heading passing +u once) */
-    for (I e = 0; e < nsub; e++) lab[e] = -1;
-    for (I e0 = 0; e0 < nsub; e0++) {
-        if (lab[e0] >= 0) continue;
-        I e = e0, steps = 0, ups = 0;
-        do {
-            if (lab[e] >= 0 || ++steps > nsub) { st = NOT_GENERIC; goto done; }
-            lab[e] = e0;
-            I e2 = nxt[e];
-            if (!(hx[e] * hy[e2] - hy[e] * hx[e2] > 0)) { st = NOT_GENERIC; goto done; }
-            ups += hy[e] < 0 && hy[e2] >= 0;
-            e = e2;
-        } while (e != e0);
-        if (ups != 1) { st = NOT_GENERIC; goto done; }
-    }
-    MARK(T_ARR_FACES);
-    /* generic: the crossings become corners; each odd half's tail; fans from each face's first */
+    /* the crossings become corners; each odd half's tail */
     if (!GROW(&R->verts, 3 * nx) || !GROW(&R->tri, 3 * nsub) || !GROW(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
     for (I x = 0; x < nx; x++) {
         const double *A = R->verts.a + 3 * c->p0[xa[x]], *B = R->verts.a + 3 * c->p1[xa[x]];
@@ -416,16 +420,30 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             if (!back[e]) tail[e] = t > 0 ? xid[occ_x[optr[a] + t - 1]] : c->p0[a];
             else tail[e] = t < k[a] ? xid[occ_x[optr[a] + t]] : c->p1[a];
         }
-    for (I e0 = 0; e0 < nsub; e0++) {
-        if (lab[e0] != e0) continue;
-        for (I e = nxt[e0]; nxt[e] != e0; e = nxt[e]) {  /* (room reserved: fewer triangles than pieces) */
-            I *o = R->tri.a + R->tri.n;
-            o[0] = tail[e0]; o[1] = tail[e]; o[2] = tail[nxt[e]];
-            R->tri.n += 3;
-            R->tcell.a[R->tcell.n++] = cell;
-        }
-    }
     MARK(T_ARR_OUTPUT);
+    /* faces, each from its least piece: convex (every turn left, the heading passing +u once),
+     * fanned from that piece's tail as it is walked (a face that fails leaves the cell to the slabs) */
+    memset(seen, 0, nsub);
+    I *tri = R->tri.a + R->tri.n, *tc = R->tcell.a + R->tcell.n, ntri = 0;  /* (room: fewer triangles than pieces) */
+    for (I e0 = 0; e0 < nsub; e0++) {
+        if (seen[e0]) continue;
+        I e = e0, ups = 0, t0 = tail[e0];
+        do {
+            if (seen[e]) { st = NOT_GENERIC; goto done; }
+            seen[e] = 1;
+            I e2 = nxt[e];
+            if (!(hx[e] * hy[e2] - hy[e] * hx[e2] > 0)) { st = NOT_GENERIC; goto done; }
+            ups += hy[e] < 0 && hy[e2] >= 0;
+            if (e != e0 && e2 != e0) {
+                tri[3 * ntri] = t0; tri[3 * ntri + 1] = tail[e]; tri[3 * ntri + 2] = tail[e2];
+                tc[ntri++] = cell;
+            }
+            e = e2;
+        } while (e != e0);
+        if (ups != 1) { st = NOT_GENERIC; goto done; }
+    }
+    R->tri.n += 3 * ntri; R->tcell.n += ntri;
+    MARK(T_ARR_FACES);
     COUNT(C_ARR_FILLED);
 done:
     return st;
