@@ -41,7 +41,8 @@ class CompiledLevel(BuildHookInterface):
         sha = hashlib.sha256(src.read_bytes()).hexdigest()  # the library names its source: a stale one is not used
         tried = []
         for cc in _compilers():  # $CC, Python's own, then the usual names (a conda Python's may be absent)
-            cmd = [*cc, "-O2", "-shared", "-fPIC", f'-DSTARCUT_SOURCE="{sha}"', "-o", str(out), str(src), "-lm"]
+            cmd = [*cc, "-O2", "-shared", "-fPIC", "-pthread", f'-DSTARCUT_SOURCE="{sha}"', "-o", str(out), str(src),
+                   "-lm"]
             try:
                 subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=300)
                 break

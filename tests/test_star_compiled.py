@@ -212,3 +212,64 @@ def test_the_compiled_slab_fill_of_crossing_sections_covers_what_the_arrangement
         scale = max(1.0, float(np.abs(want).max()))
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * scale)
         assert n_fill > ref.n_fill  # the slabs' corners, not the crossings alone
+
+
+def _same(a, b):
+    """Two results of `_cstar.cut`, bit for bit."""
+    assert a is not None and b is not None
+    for x, y in zip(a, b):
+        if isinstance(x, np.ndarray):
+            assert x.dtype == y.dtype and x.shape == y.shape
+            np.testing.assert_array_equal(x, y)
+        else:
+            assert x == y
+
+
+@needs_c
+@pytest.mark.parametrize("slabs_only", [False, True], ids=["arrangement", "slabs"])
+def test_two_threads_give_the_slice_one_thread_gives(slabs_only):
+    """A level with many crossing sections has half of their fills made by a second thread (its own
+    corners numbered after the first's when the two are joined): the same arrays, in the same order,
+    as one thread's, for the arrangement fill and for the slab fill.  A level with few stays on one."""
+    name = "great icosahedral 120-cell"
+    p = polytope(name)
+    t = tables(p)
+    st = starslice.star_tables(p, t)
+    rng = np.random.default_rng(zlib.crc32(name.encode()) + slabs_only)
+    for _ in range(4):
+        m = random_rotation(rng)
+        x = t.vertices @ m.T
+        one = _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=1)
+        assert st.c.threads_used == 1
+        two = _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2)
+        assert st.c.threads_used == 2  # (the split happened: this level is over the threshold)
+        assert one[8] > 0  # fill corners made, some by the second thread
+        _same(one, two)
+    small = polytope("great grand 120-cell")  # its crossing sections are few and small: not worth a thread
+    t = tables(small)
+    _cstar.cut(starslice.star_tables(small, t).c, t.vertices @ m.T, m, 0.07, t.tol, threads=2)
+    assert starslice.star_tables(small, t).c.threads_used == 1
+
+
+@needs_c
+def test_a_level_reuses_the_last_ones_memory_and_nothing_else():
+    """Levels cut one after another reuse the arrays the last one grew (a pool per polytope): a
+    large level, then a small one, then the large one again give what fresh memory gives (the pool
+    held by another caller), whatever was left in it."""
+    p = polytope("great icosahedral 120-cell")
+    t = tables(p)
+    st = starslice.star_tables(p, t)
+    m = random_rotation(np.random.default_rng(11))
+    x = t.vertices @ m.T
+    top = float(x[:, 3].max())
+    big = _cstar.cut(st.c, x, m, 0.05, t.tol)
+    small = _cstar.cut(st.c, x, m, top - 0.05 * (top - float(x[:, 3].min())), t.tol)
+    again = _cstar.cut(st.c, x, m, 0.05, t.tol)
+    assert len(small[0]) < len(big[0]) / 4
+    with st.c.pool_lock:  # another thread has the pool: this level takes fresh memory
+        fresh_big = _cstar.cut(st.c, x, m, 0.05, t.tol)
+        fresh_small = _cstar.cut(st.c, x, m, top - 0.05 * (top - float(x[:, 3].min())), t.tol)
+    _same(big, fresh_big)
+    _same(again, fresh_big)
+    _same(small, fresh_small)
+    assert not np.shares_memory(big[0], again[0])  # the caller's own arrays, not the pool's

@@ -8,7 +8,9 @@ The library is built when the package is installed (``hatch_build.py``, with the
 compiler); where there is none, `available` is False and every level goes to numpy (the same
 slices, slower).  A library built from another version of ``_starcut.c`` than the one beside it is
 not used (a warning says to reinstall).  ``ROT4D_NO_C=1`` in the environment turns it off (for
-comparing the two).
+comparing the two).  Where the machine has two or more cores, a level with many crossing sections
+has half of their fills done by a second thread (the same slice); ``ROT4D_C_THREADS=1`` keeps it to
+one.
 """
 
 from __future__ import annotations
@@ -17,7 +19,9 @@ import ctypes
 import hashlib
 import os
 import pathlib
+import threading
 import warnings
+import weakref
 
 import numpy as np
 
@@ -48,8 +52,13 @@ def _load(here: pathlib.Path | None = None):
     P, N, D = ctypes.c_void_p, ctypes.c_int64, ctypes.c_double
     lib.starcut.restype = P
     #    V  x  c0 tol E  ea eb F  S  fe_face fe_edge fv_vert fv_next basis m  f_cells rho mate C  convex normals
-    #    slabs_only out...
-    lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, ctypes.c_int, P, P, P]
+    #    slabs_only threads pool out...
+    lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, ctypes.c_int, ctypes.c_int,
+                            P, P, P, P]
+    lib.starcut_pool_new.restype = P
+    lib.starcut_pool_new.argtypes = []
+    lib.starcut_pool_free.restype = None
+    lib.starcut_pool_free.argtypes = [P]
     lib.starcut_take.restype = None
     lib.starcut_take.argtypes = [P] * 8
     return lib
@@ -58,6 +67,8 @@ def _load(here: pathlib.Path | None = None):
 _lib = _load()
 #: True when the compiled level is there (the package was built with a C compiler).
 available = _lib is not None
+#: threads a level may use: 2 on a machine with two or more cores, unless ROT4D_C_THREADS=1
+THREADS = 1 if os.environ.get("ROT4D_C_THREADS") == "1" or (os.cpu_count() or 1) < 2 else 2
 
 
 def _ptr(a: np.ndarray) -> int:
@@ -92,24 +103,41 @@ class CTables:
         self.face_ptrs = [_ptr(a) for a in (self.fe_face, self.fe_edge, self.fv_vert, self.fv_next, self.face_basis)]
         self.cell_ptrs = [_ptr(a) for a in (self.face_cells, self.face_rho, self.slot_mate)]
         self.conv_ptrs = [_ptr(a) for a in (self.cell_convex, self.cell_normals)]
+        # memory one level leaves for the next (freed with these tables); one level at a time holds it
+        self.pool = _lib.starcut_pool_new()
+        self.pool_lock = threading.Lock()
+        self.threads_used = 0  # how many threads the last level's fills took (for tests and benchmarks)
+        weakref.finalize(self, _lib.starcut_pool_free, self.pool)
 
 
-def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float, slabs_only: bool = False):
+def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float, slabs_only: bool = False,
+        threads: int | None = None):
     """The level ``c0`` of the unit vertices ``x`` (V, 4) turned by ``m``: (vertices (n, 3), edges,
     polygon corners, offsets, polygon cells, triangles, triangle cells, volume, n_fill), or None
     when the C code declines it (the numpy slicer then does it).  ``slabs_only``: the slab fill
-    takes every section the arrangement fill would (so tests reach it with crossing segments)."""
+    takes every section the arrangement fill would (so tests reach it with crossing segments);
+    ``threads`` (1 or 2, default `THREADS`): the same slice either way."""
     x = np.ascontiguousarray(x, dtype=np.float64)
     m = np.ascontiguousarray(m, dtype=np.float64)
-    counts = np.zeros(6, dtype=np.int64)
+    counts = np.zeros(7, dtype=np.int64)
     vol = ctypes.c_double()
     status = ctypes.c_int()
+    pooled = ct.pool_lock.acquire(blocking=False)  # another thread on the same tables: fresh memory
+    try:
+        return _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, ct.pool if pooled else None)
+    finally:
+        if pooled:
+            ct.pool_lock.release()
+
+
+def _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, pool):
+    threads = THREADS if threads is None else int(threads)
     res = _lib.starcut(len(x), _ptr(x), c0, tol, ct.E, *ct.edge_ptrs, ct.F, ct.S, *ct.face_ptrs, _ptr(m),
-                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, int(slabs_only), _ptr(counts), ctypes.addressof(vol),
-                       ctypes.addressof(status))
+                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, int(slabs_only), threads, pool, _ptr(counts),
+                       ctypes.addressof(vol), ctypes.addressof(status))
     if not res:
         return None
-    n_pts, n_extra, n_seg, n_flat, n_poly, n_tri = (int(c) for c in counts)
+    n_pts, n_extra, n_seg, n_flat, n_poly, n_tri, ct.threads_used = (int(c) for c in counts)
     verts = np.empty((n_pts + n_extra, 3))
     edges = np.empty((n_seg, 2), dtype=np.int64)
     flat = np.empty(n_flat, dtype=np.int64)

@@ -18,6 +18,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Two threads for the crossing sections' fills where there is enough work (PARALLEL_WORK: the
+ * sum over those cells of their records squared); none in the timing build, whose clock marks are
+ * one thread's, nor on Windows. */
+#if !defined(STARCUT_TIMING) && !defined(_WIN32)
+#define STARCUT_THREADS
+#include <pthread.h>
+#endif
+#define PARALLEL_WORK 20000.0
+
 typedef int64_t I;
 
 #ifndef STARCUT_SOURCE
@@ -65,7 +74,7 @@ static int grow(void **a, I *cap, I n, I extra, size_t size) {
 #define PUSH(v, x) do { if (!GROW(&(v), 1)) { st = NO_MEMORY; goto done; } (v).a[(v).n++] = (x); } while (0)
 
 typedef struct {
-    int status;
+    int status, pooled;          /* pooled: its arrays belong to a Pool, kept for the next level */
     double volume;
     I n_points, n_extra;
     dvec verts;                  /* 3 per vertex: the points, then the extra fill corners */
@@ -74,10 +83,38 @@ typedef struct {
     ivec tri, tcell;             /* 3 per triangle, its cell */
 } Result;
 
-static void result_free(Result *r) {
-    if (!r) return;
+static void result_free_arrays(Result *r) {
     free(r->verts.a); free(r->edges.a); free(r->flat.a); free(r->offsets.a); free(r->cells.a);
-    free(r->tri.a); free(r->tcell.a); free(r);
+    free(r->tri.a); free(r->tcell.a);
+}
+
+static void result_free(Result *r) {
+    if (!r || r->pooled) return;
+    result_free_arrays(r);
+    free(r);
+}
+
+/* Two results' arrays kept from one level to the next (a polytope's; starcut_pool_new), so that a
+ * level reuses memory it has touched instead of growing fresh pages: R[0] the level's, R[1] the
+ * second thread's.  One level at a time (the caller holds a lock). */
+typedef struct { Result R[2]; } Pool;
+
+void *starcut_pool_new(void) {
+    Pool *p = calloc(1, sizeof(Pool));
+    if (p) p->R[0].pooled = p->R[1].pooled = 1;
+    return p;
+}
+
+void starcut_pool_free(void *p) {
+    if (!p) return;
+    result_free_arrays(&((Pool *)p)->R[0]); result_free_arrays(&((Pool *)p)->R[1]);
+    free(p);
+}
+
+static Result *result_reset(Result *r) {  /* empty, its arrays' room kept */
+    r->status = 0; r->volume = 0; r->n_points = r->n_extra = 0;
+    r->verts.n = r->edges.n = r->flat.n = r->offsets.n = r->cells.n = r->tri.n = r->tcell.n = 0;
+    return r;
 }
 
 /* u, v of rot4d_widget.geometry.slicetables._inplane_axes for one normal n */
@@ -291,9 +328,10 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I *occ_x = cnt + (m + 1), *ux = occ_x + 2 * nxmax, *pos = ux + 2 * nxmax;
     I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax;
     unsigned char *back = (unsigned char *)(fillp + nsmax), *seen = back + nsmax;
+    const double *restrict X0 = c->X0, *restrict Y0 = c->Y0, *restrict DX = c->dX, *restrict DY = c->dY;
     MARK_START;
     I nx = 0;
-    for (I a = 0; a < m; a++) L2[a] = c->dX[a] * c->dX[a] + c->dY[a] * c->dY[a];
+    for (I a = 0; a < m; a++) L2[a] = DX[a] * DX[a] + DY[a] * DY[a];
     /* every pair: s along a, u along b (starfill's, to the bit: cb / den equals the sign-corrected
      * quotient exactly); a crossing inside both is kept (nx counts it), one at an end must be where
      * the two share that end (consecutive in a cycle), a parallel pair (den ~ 0) neither */
@@ -301,7 +339,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         const double x0 = c->X0[a], y0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a], lim = PARALLEL * PARALLEL * L2[a];
         const I pa0 = c->p0[a], pa1 = c->p1[a];
         for (I b = a + 1; b < m; b++) {
-            double ex = c->X0[b] - x0, ey = c->Y0[b] - y0, dxb = c->dX[b], dyb = c->dY[b];
+            double ex = X0[b] - x0, ey = Y0[b] - y0, dxb = DX[b], dyb = DY[b];
             double den = dxa * dyb - dya * dxb;
             double s = (ex * dyb - ey * dxb) / den, u = (ex * dya - ey * dxa) / den;
             double lo = s < u ? s : u, hi = s < u ? u : s;
@@ -461,6 +499,9 @@ typedef struct {
     const unsigned char *cell_convex;
     double c0, tol;
     int slabs_only;           /* every non-star-shaped section by slabs (tests of the slab fill) */
+    int threads;              /* 2: the crossing sections' fills split between this thread and one more */
+    int used;                 /* threads the fills took */
+    Result *spare;            /* the second thread's result (a pool's), or NULL: its own */
     unsigned char *above;     /* (V,) each vertex above H */
     I *cid;                   /* (E,) each edge's point, -1 if it does not cross */
     double centre[3];         /* the points' mean: coordinates about it keep the volume's sums small */
@@ -738,6 +779,88 @@ done:
     return st == OK ? 1 : -1;
 }
 
+/* Cells [lo, hi) whose sections neither a convex cycle nor a star-shaped fan filled: by their
+ * arrangement, else by slabs, into R (its points read, its fill corners, triangles grown).  Each
+ * range owns its scratch and R; `loc` is shared, each cell writing only its own records'. */
+typedef struct {
+    Level *L;
+    Result *R;
+    I lo, hi;
+    const I *crec_ptr, *crec;
+    const unsigned char *cdone;
+    I *loc;
+    int st;
+} Range;
+
+static void fill_cells(Range *g) {
+    Level *L = g->L;
+    Result *R = g->R;
+    const I *crec_ptr = g->crec_ptr, *crec = g->crec;
+    I *loc = g->loc, *cg = NULL, mmax = 0;
+    double *cd = NULL;
+    dvec xs = {0};
+    Work ws = {0};
+    int st = OK;
+    for (I cc = g->lo; cc < g->hi; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
+    cg = malloc((3 * mmax + 1) * sizeof(I));
+    cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
+    if (!cg || !cd) { st = NO_MEMORY; goto done; }
+    for (I cc = g->lo; cc < g->hi && st == OK; cc++) {
+        I r0 = crec_ptr[cc], m = crec_ptr[cc + 1] - r0;
+        if (!m || g->cdone[cc]) continue;
+        double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
+        Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
+        double uv[6], org[3];
+        const double *pts = R->verts.a;  /* (the points: not moved until this cell adds its corners) */
+        inplane(L->normals + 3 * cc, uv);
+        for (int q = 0; q < 3; q++) org[q] = L->anchor[3 * cc + q] + L->centre[q];
+        for (I i = 0; i < m; i++) {
+            I gi = crec[r0 + i], seg = gi >> 1;
+            c2.g[i] = gi; c2.p0[i] = L->seg_pt[2 * seg]; c2.p1[i] = L->seg_pt[2 * seg + 1];
+            loc[gi] = i;
+            double a[3], b[3];
+            for (int q = 0; q < 3; q++) { a[q] = pts[3 * c2.p0[i] + q] - org[q]; b[q] = pts[3 * c2.p1[i] + q] - org[q]; }
+            X0[i] = a[0] * uv[0] + a[1] * uv[1] + a[2] * uv[2];
+            Y0[i] = a[0] * uv[3] + a[1] * uv[4] + a[2] * uv[5];
+            X1[i] = b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2];
+            Y1[i] = b[0] * uv[3] + b[1] * uv[4] + b[2] * uv[5];
+            dX[i] = X1[i] - X0[i];
+            dY[i] = Y1[i] - Y0[i];
+        }
+        I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
+        int s2 = L->slabs_only ? NOT_GENERIC : arrangement(&c2, loc, L->partner, cc, R, &ws);
+        if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
+            R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
+            MARK_START;
+            s2 = inner_crossings(&c2, &xs);
+            if (s2 == OK) s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
+            MARK(T_SLABS);
+        }
+        for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
+        if (s2 != OK) st = s2;
+    }
+done:
+    free(cg); free(cd); free(xs.a); free(ws.buf);
+    g->st = st;
+}
+
+#ifdef STARCUT_THREADS
+static void *fill_thread(void *p) { fill_cells((Range *)p); return NULL; }
+
+/* W's fill corners and triangles after R's, in that order (as one thread would have made them):
+ * W numbers its corners from the points' count, R from its own corners' end. */
+static int merge(Result *R, const Result *W) {
+    I np = R->n_points, off = R->n_extra, nw = W->verts.n - 3 * np;
+    if (!GROW(&R->verts, nw) || !GROW(&R->tri, W->tri.n) || !GROW(&R->tcell, W->tcell.n)) return NO_MEMORY;
+    memcpy(R->verts.a + R->verts.n, W->verts.a + 3 * np, nw * sizeof(double));
+    R->verts.n += nw; R->n_extra += W->n_extra;
+    for (I i = 0; i < W->tri.n; i++) { I v = W->tri.a[i]; R->tri.a[R->tri.n++] = v >= np ? v + off : v; }
+    memcpy(R->tcell.a + R->tcell.n, W->tcell.a, W->tcell.n * sizeof(I));
+    R->tcell.n += W->tcell.n;
+    return OK;
+}
+#endif
+
 /* Triangles: a convex cell's cycle fanned from its first corner; a non-convex cell's section fanned
  * from its polygons' centroids where it is star-shaped (`star_shaped_fan`), else filled even-odd by
  * its arrangement, else by slabs. */
@@ -745,11 +868,8 @@ static int fill_sections(Level *L) {
     int st = OK;
     Result *R = L->R;
     const I C = L->C, ns = L->ns, npoly = R->cells.n, *rec_cell = L->rec_cell;
-    I *crec_ptr = NULL, *crec = NULL, *pstart_c = NULL, *cI = NULL, *loc = NULL, *fill = NULL, *cg = NULL;
-    double *cd = NULL;
+    I *crec_ptr = NULL, *crec = NULL, *pstart_c = NULL, *cI = NULL, *loc = NULL, *fill = NULL;
     unsigned char *cdone = NULL;
-    dvec xs = {0};
-    Work ws = {0};
     for (I p = 0; p < npoly; p++) {
         if (!L->cell_convex[R->cells.a[p]]) continue;
         I o0 = R->offsets.a[p], o1 = R->offsets.a[p + 1];
@@ -783,47 +903,41 @@ static int fill_sections(Level *L) {
     }
     MARK(T_FANS);
     for (I r = 0; r < 2 * ns; r++) loc[r] = -1;
-    I mmax = 0;
-    for (I cc = 0; cc < C; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
-    cg = malloc((3 * mmax + 1) * sizeof(I));
-    cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
-    if (!cg || !cd) { st = NO_MEMORY; goto done; }
-    for (I cc = 0; cc < C && st == OK; cc++) {
-        I r0 = crec_ptr[cc], m = crec_ptr[cc + 1] - r0;
-        if (!m || cdone[cc]) continue;
-        double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
-        Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
-        double uv[6], org[3];
-        inplane(L->normals + 3 * cc, uv);
-        for (int q = 0; q < 3; q++) org[q] = L->anchor[3 * cc + q] + L->centre[q];
-        for (I i = 0; i < m; i++) {
-            I g = crec[r0 + i], seg = g >> 1;
-            c2.g[i] = g; c2.p0[i] = L->seg_pt[2 * seg]; c2.p1[i] = L->seg_pt[2 * seg + 1];
-            loc[g] = i;
-            double a[3], b[3];
-            for (int q = 0; q < 3; q++) { a[q] = PTS[3 * c2.p0[i] + q] - org[q]; b[q] = PTS[3 * c2.p1[i] + q] - org[q]; }
-            X0[i] = a[0] * uv[0] + a[1] * uv[1] + a[2] * uv[2];
-            Y0[i] = a[0] * uv[3] + a[1] * uv[4] + a[2] * uv[5];
-            X1[i] = b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2];
-            Y1[i] = b[0] * uv[3] + b[1] * uv[4] + b[2] * uv[5];
-            dX[i] = X1[i] - X0[i];
-            dY[i] = Y1[i] - Y0[i];
+    /* the rest by arrangement or slabs; with two threads, split where half the work (~ m^2 a cell) is done */
+    Range g[2] = {{L, R, 0, C, crec_ptr, crec, cdone, loc, OK}, {L, NULL, C, C, crec_ptr, crec, cdone, loc, OK}};
+    double work = 0, half = 0;
+    for (I cc = 0; cc < C; cc++) if (!cdone[cc]) { double mm = (double)(crec_ptr[cc + 1] - crec_ptr[cc]); work += mm * mm; }
+#ifdef STARCUT_THREADS
+    Result own = {0}, *W = L->spare ? result_reset(L->spare) : &own;
+    pthread_t th;
+    int two = L->threads > 1 && work >= PARALLEL_WORK;
+    if (two) {
+        for (I cc = 0; cc < C; cc++) {
+            double mm = cdone[cc] ? 0 : (double)(crec_ptr[cc + 1] - crec_ptr[cc]);
+            if ((half += mm * mm) >= 0.5 * work) { g[0].hi = g[1].lo = cc + 1; break; }
         }
-        I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
-        int s2 = L->slabs_only ? NOT_GENERIC : arrangement(&c2, loc, L->partner, cc, R, &ws);
-        if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
-            R->verts.n = nv0; R->n_extra = ne0; R->tri.n = nt0; R->tcell.n = nc0;
-            MARK_START;
-            s2 = inner_crossings(&c2, &xs);
-            if (s2 == OK) s2 = slab_fill(&c2, xs.a, xs.n, cc, R);
-            MARK(T_SLABS);
-        }
-        for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
-        if (s2 != OK) st = s2;
+        W->n_points = R->n_points;
+        if (!GROW(&W->verts, 3 * R->n_points)) two = 0;  /* the points, for the other thread to read */
+        else { memcpy(W->verts.a, R->verts.a, 3 * R->n_points * sizeof(double)); W->verts.n = 3 * R->n_points; g[1].R = W; }
+        if (two && pthread_create(&th, NULL, fill_thread, &g[1]) != 0) two = 0;
+        if (!two) g[0].hi = C;
     }
+    L->used = 1 + two;
+    fill_cells(&g[0]);
+    if (two) {
+        pthread_join(th, NULL);
+        if (g[0].st == OK && g[1].st == OK) g[0].st = merge(R, W);
+        else if (g[1].st != OK) g[0].st = g[1].st;
+    }
+    result_free_arrays(&own);
+#else
+    (void)half;
+    L->used = 1;
+    fill_cells(&g[0]);
+#endif
+    st = g[0].st;
 done:
-    free(crec_ptr); free(crec); free(pstart_c); free(cI); free(loc); free(fill); free(cg); free(cd); free(cdone);
-    free(xs.a); free(ws.buf);
+    free(crec_ptr); free(crec); free(pstart_c); free(cI); free(loc); free(fill); free(cdone);
     return st;
 }
 
@@ -833,19 +947,25 @@ done:
  * level and the on-H tolerance; ea, eb (E,) edges; fe_face, fe_edge, fv_vert, fv_next (S,) the face
  * sides (faces ascending); face_basis (F, 2, 4); m (4, 4) the rotation; face_cells (F, 2),
  * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4); slabs_only: no
- * arrangement fill (every section it would take goes to the slabs: for tests).  counts (out):
- * points, extra corners, segments, polygon corners, polygons, triangles; volume, status (out).
+ * arrangement fill (every section it would take goes to the slabs: for tests); threads: 2 lets a
+ * second thread fill half the crossing sections (the same result as 1); pool: a `starcut_pool_new`
+ * (its memory reused; the result is the pool's until starcut_take), or NULL.  counts (out):
+ * points, extra corners, segments, polygon corners, polygons, triangles, threads the fills took;
+ * volume, status (out).
  * Returns the result for `starcut_take`, or NULL (the status says why: the numpy slicer's level). */
 void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, const I *eb, I F, I S,
               const I *fe_face, const I *fe_edge, const I *fv_vert, const I *fv_next, const double *face_basis,
               const double *mrot, const I *face_cells, const double *face_rho, const I *slot_mate, I C,
-              const unsigned char *cell_convex, const double *cell_normals, int slabs_only, I *counts, double *volume,
-              int *status) {
+              const unsigned char *cell_convex, const double *cell_normals, int slabs_only, int threads, void *pool,
+              I *counts, double *volume, int *status) {
     Level L = {.V = V, .E = E, .F = F, .S = S, .C = C, .x = x, .face_basis = face_basis, .mrot = mrot,
                .face_rho = face_rho, .cell_normals = cell_normals, .ea = ea, .eb = eb, .fe_face = fe_face,
                .fe_edge = fe_edge, .fv_vert = fv_vert, .fv_next = fv_next, .face_cells = face_cells,
-               .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol, .slabs_only = slabs_only};
-    L.R = calloc(1, sizeof(Result));
+               .slot_mate = slot_mate, .cell_convex = cell_convex, .c0 = c0, .tol = tol, .slabs_only = slabs_only,
+               .threads = threads};
+    Pool *P = (Pool *)pool;
+    L.R = P ? result_reset(&P->R[0]) : calloc(1, sizeof(Result));
+    L.spare = P ? &P->R[1] : NULL;
     MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
     MARK(T_EDGES);
@@ -859,12 +979,12 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     if (st != OK) { result_free(L.R); return NULL; }
     Result *R = L.R;
     counts[0] = R->n_points; counts[1] = R->n_extra; counts[2] = R->edges.n / 2; counts[3] = R->flat.n;
-    counts[4] = R->cells.n; counts[5] = R->tcell.n;
+    counts[4] = R->cells.n; counts[5] = R->tcell.n; counts[6] = L.used;
     *volume = R->volume;
     return R;
 }
 
-/* Copy a result into the caller's arrays (sized by its counts) and free it. */
+/* Copy a result into the caller's arrays (sized by its counts) and free it (a pool's: keep its room). */
 void starcut_take(void *p, double *verts, I *edges, I *flat, I *offsets, I *cells, I *tri, I *tcell) {
     Result *R = (Result *)p;
     memcpy(verts, R->verts.a, (size_t)R->verts.n * sizeof(double));
