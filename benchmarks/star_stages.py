@@ -9,9 +9,11 @@ and how many cells a slice fills by arrangement and how many the arrangement lea
 
 Stages: the edges' crossing points; the faces' pairing and the volume; the cycles; the fans from
 centroids of star-shaped sections; the arrangement fill, split into its pair tests, the crossings
-ordered along each segment, the parity rays, the next-piece pointers, the faces' walk and the
-output; the slab fill.  The marks cost a few percent: compare stages, not the total with
-star_load.py's.
+ordered along each segment, the parity (a ray per cycle), the next-piece pointers, the output of
+the crossings as fill corners ("arr: output") and the faces' walk with their fans ("arr: faces");
+the slab fill.  The timing build runs on one thread (the package's may split a level's fills
+between two: see _cstar.THREADS), with the package's memory pool.  The marks cost a few percent:
+compare stages, not the total with star_load.py's.
 
     python benchmarks/star_stages.py [--names "great icosahedral 120-cell,..."] [--steps 20] [--repeats 10]
 """
