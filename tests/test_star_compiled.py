@@ -273,3 +273,32 @@ def test_a_level_reuses_the_last_ones_memory_and_nothing_else():
     _same(again, fresh_big)
     _same(small, fresh_small)
     assert not np.shares_memory(big[0], again[0])  # the caller's own arrays, not the pool's
+
+
+@needs_c
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork here")
+def test_a_forked_process_slices_with_a_second_thread_of_its_own():
+    """The pool's second thread, started in the parent, is not in a forked child (multiprocessing's
+    fork): the child starts its own, gets the parent's slice, and both exit (no wait on a thread
+    that is not there)."""
+    code = ("import multiprocessing as mp, numpy as np\n"
+            "from rot4d_widget import polytope\n"
+            "from rot4d_widget.geometry import _cstar, starslice\n"
+            "from rot4d_widget.geometry.slicing import slice_polytope\n"
+            "from rot4d_widget.core.rotation import random_rotation\n"
+            "p = polytope('great icosahedral 120-cell')\n"
+            "m = random_rotation(np.random.default_rng(1))\n"
+            "a = slice_polytope(p, m, 0.1)\n"
+            "def child(q):\n"
+            "    s = slice_polytope(p, m, 0.1)\n"
+            "    q.put((s.volume, s.triangles.tolist() == a.triangles.tolist(), starslice.star_tables(p, None).c.threads_used))\n"
+            "if __name__ == '__main__':\n"
+            "    q = mp.get_context('fork').Queue()\n"
+            "    pr = mp.get_context('fork').Process(target=child, args=(q,))\n"
+            "    pr.start()\n"
+            "    vol, same, used = q.get(timeout=120)\n"
+            "    pr.join(60)\n"
+            "    print(vol == a.volume, same, used if _cstar.THREADS == 2 else 2, pr.exitcode)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.split() == ["True", "True", "2", "0"]

@@ -17,6 +17,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 /* Two threads for the crossing sections' fills where there is enough work (PARALLEL_WORK: the
  * sum over those cells of their records squared); none in the timing build, whose clock marks are
@@ -24,6 +27,7 @@
 #if !defined(STARCUT_TIMING) && !defined(_WIN32)
 #define STARCUT_THREADS
 #include <pthread.h>
+#include <unistd.h>
 #endif
 #define PARALLEL_WORK 20000.0
 
@@ -94,10 +98,28 @@ static void result_free(Result *r) {
     free(r);
 }
 
+#ifdef STARCUT_THREADS
+/* A pool's second thread, started with its first two-thread level and then waiting for the next
+ * (starting a thread costs tens of microseconds a level); `pid`: a forked child has no such thread. */
+typedef struct {
+    pthread_t th;
+    pthread_mutex_t mu;
+    pthread_cond_t go, fin;
+    int up, has_job, done, quit;
+    pid_t pid;
+    void *job;  /* the Range to fill */
+} Worker;
+#endif
+
 /* Two results' arrays kept from one level to the next (a polytope's; starcut_pool_new), so that a
  * level reuses memory it has touched instead of growing fresh pages: R[0] the level's, R[1] the
- * second thread's.  One level at a time (the caller holds a lock). */
-typedef struct { Result R[2]; } Pool;
+ * second thread's, and that thread.  One level at a time (the caller holds a lock). */
+typedef struct {
+    Result R[2];
+#ifdef STARCUT_THREADS
+    Worker w;
+#endif
+} Pool;
 
 void *starcut_pool_new(void) {
     Pool *p = calloc(1, sizeof(Pool));
@@ -107,6 +129,14 @@ void *starcut_pool_new(void) {
 
 void starcut_pool_free(void *p) {
     if (!p) return;
+#ifdef STARCUT_THREADS
+    Worker *w = &((Pool *)p)->w;
+    if (w->up && w->pid == getpid()) {
+        pthread_mutex_lock(&w->mu); w->quit = 1; pthread_cond_signal(&w->go); pthread_mutex_unlock(&w->mu);
+        pthread_join(w->th, NULL);
+        pthread_mutex_destroy(&w->mu); pthread_cond_destroy(&w->go); pthread_cond_destroy(&w->fin);
+    }
+#endif
     result_free_arrays(&((Pool *)p)->R[0]); result_free_arrays(&((Pool *)p)->R[1]);
     free(p);
 }
@@ -338,7 +368,34 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     for (I a = 0; a + 1 < m; a++) {
         const double x0 = c->X0[a], y0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a], lim = PARALLEL * PARALLEL * L2[a];
         const I pa0 = c->p0[a], pa1 = c->p1[a];
-        for (I b = a + 1; b < m; b++) {
+        I b = a + 1;
+#ifdef __SSE2__
+        /* two pairs at a time: the same IEEE operations as the loop below (min/max as its ?:) */
+        const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vdxa = _mm_set1_pd(dxa), vdya = _mm_set1_pd(dya);
+        const __m128d vlim = _mm_set1_pd(lim), e_lo = _mm_set1_pd(EPS_ARR), e_hi = _mm_set1_pd(1 - EPS_ARR);
+        const __m128d n_lo = _mm_set1_pd(-EPS_ARR), n_hi = _mm_set1_pd(1 + EPS_ARR);
+        for (; b + 1 < m; b += 2) {
+            __m128d ex = _mm_sub_pd(_mm_loadu_pd(X0 + b), vx0), ey = _mm_sub_pd(_mm_loadu_pd(Y0 + b), vy0);
+            __m128d dxb = _mm_loadu_pd(DX + b), dyb = _mm_loadu_pd(DY + b);
+            __m128d den = _mm_sub_pd(_mm_mul_pd(vdxa, dyb), _mm_mul_pd(vdya, dxb));
+            __m128d sv = _mm_div_pd(_mm_sub_pd(_mm_mul_pd(ex, dyb), _mm_mul_pd(ey, dxb)), den);
+            __m128d uv = _mm_div_pd(_mm_sub_pd(_mm_mul_pd(ex, vdya), _mm_mul_pd(ey, vdxa)), den);
+            __m128d lo = _mm_min_pd(sv, uv), hi = _mm_max_pd(sv, uv);
+            __m128d okd = _mm_cmpgt_pd(_mm_mul_pd(den, den), _mm_mul_pd(vlim, _mm_loadu_pd(L2 + b)));
+            int in = _mm_movemask_pd(_mm_and_pd(okd, _mm_and_pd(_mm_cmpgt_pd(lo, e_lo), _mm_cmplt_pd(hi, e_hi))));
+            int near = _mm_movemask_pd(_mm_and_pd(okd, _mm_and_pd(_mm_cmpgt_pd(lo, n_lo), _mm_cmplt_pd(hi, n_hi)))) & ~in;
+            double s2[2], u2[2];
+            _mm_storeu_pd(s2, sv); _mm_storeu_pd(u2, uv);
+            for (int j = 0; j < 2; j++) {
+                I bj = b + j;
+                if (near >> j & 1)
+                    bad |= !((pa0 == c->p0[bj]) | (pa0 == c->p1[bj]) | (pa1 == c->p0[bj]) | (pa1 == c->p1[bj]));
+                xa[nx] = a; xb[nx] = bj; xsp[nx] = s2[j]; xup[nx] = u2[j];
+                nx += in >> j & 1;
+            }
+        }
+#endif
+        for (; b < m; b++) {
             double ex = X0[b] - x0, ey = Y0[b] - y0, dxb = DX[b], dyb = DY[b];
             double den = dxa * dyb - dya * dxb;
             double s = (ex * dyb - ey * dxb) / den, u = (ex * dya - ey * dxa) / den;
@@ -374,8 +431,16 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
         I rsum = 0, kk = s1 - s0;
         for (I i = s0; i < s1; i++) {
             double ti = ut[i];
-            I r = 0;
-            for (I j = s0; j < s1; j++) r += ut[j] < ti;
+            I r = 0, j = s0;
+#ifdef __SSE2__
+            __m128i cnt2 = _mm_setzero_si128();  /* each lane: minus its count of smaller (true is -1) */
+            const __m128d vt = _mm_set1_pd(ti);
+            for (; j + 1 < s1; j += 2) cnt2 = _mm_add_epi64(cnt2, _mm_castpd_si128(_mm_cmplt_pd(_mm_loadu_pd(ut + j), vt)));
+            int64_t c2[2];
+            _mm_storeu_si128((__m128i *)c2, cnt2);
+            r = -(c2[0] + c2[1]);
+#endif
+            for (; j < s1; j++) r += ut[j] < ti;
             rsum += r; r += s0;
             occ_t[r] = ti; occ_x[r] = ux[i] >> 1; pos[ux[i]] = r;
         }
@@ -502,6 +567,7 @@ typedef struct {
     int threads;              /* 2: the crossing sections' fills split between this thread and one more */
     int used;                 /* threads the fills took */
     Result *spare;            /* the second thread's result (a pool's), or NULL: its own */
+    void *worker;             /* the pool's second thread (a Worker), or NULL: one started for the level */
     unsigned char *above;     /* (V,) each vertex above H */
     I *cid;                   /* (E,) each edge's point, -1 if it does not cross */
     double centre[3];         /* the points' mean: coordinates about it keep the volume's sums small */
@@ -847,6 +913,46 @@ done:
 #ifdef STARCUT_THREADS
 static void *fill_thread(void *p) { fill_cells((Range *)p); return NULL; }
 
+static void *worker_loop(void *p) {
+    Worker *w = (Worker *)p;
+    pthread_mutex_lock(&w->mu);
+    for (;;) {
+        while (!w->has_job && !w->quit) pthread_cond_wait(&w->go, &w->mu);
+        if (w->quit) break;
+        w->has_job = 0;
+        pthread_mutex_unlock(&w->mu);
+        fill_cells((Range *)w->job);
+        pthread_mutex_lock(&w->mu);
+        w->done = 1;
+        pthread_cond_signal(&w->fin);
+    }
+    pthread_mutex_unlock(&w->mu);
+    return NULL;
+}
+
+/* Hand g to the pool's thread (started if it is not up in this process); 0 if it cannot be. */
+static int worker_start(Worker *w, Range *g) {
+    if (!w->up || w->pid != getpid()) {
+        w->up = 0;
+        if (pthread_mutex_init(&w->mu, NULL) || pthread_cond_init(&w->go, NULL) || pthread_cond_init(&w->fin, NULL))
+            return 0;
+        w->has_job = w->done = w->quit = 0;
+        if (pthread_create(&w->th, NULL, worker_loop, w) != 0) return 0;
+        w->up = 1; w->pid = getpid();
+    }
+    pthread_mutex_lock(&w->mu);
+    w->job = g; w->done = 0; w->has_job = 1;
+    pthread_cond_signal(&w->go);
+    pthread_mutex_unlock(&w->mu);
+    return 1;
+}
+
+static void worker_wait(Worker *w) {
+    pthread_mutex_lock(&w->mu);
+    while (!w->done) pthread_cond_wait(&w->fin, &w->mu);
+    pthread_mutex_unlock(&w->mu);
+}
+
 /* W's fill corners and triangles after R's, in that order (as one thread would have made them):
  * W numbers its corners from the points' count, R from its own corners' end. */
 static int merge(Result *R, const Result *W) {
@@ -919,13 +1025,15 @@ static int fill_sections(Level *L) {
         W->n_points = R->n_points;
         if (!GROW(&W->verts, 3 * R->n_points)) two = 0;  /* the points, for the other thread to read */
         else { memcpy(W->verts.a, R->verts.a, 3 * R->n_points * sizeof(double)); W->verts.n = 3 * R->n_points; g[1].R = W; }
-        if (two && pthread_create(&th, NULL, fill_thread, &g[1]) != 0) two = 0;
+        Worker *wk = (Worker *)L->worker;
+        if (two && !(wk ? worker_start(wk, &g[1]) : pthread_create(&th, NULL, fill_thread, &g[1]) == 0)) two = 0;
         if (!two) g[0].hi = C;
     }
     L->used = 1 + two;
     fill_cells(&g[0]);
     if (two) {
-        pthread_join(th, NULL);
+        if (L->worker) worker_wait((Worker *)L->worker);
+        else pthread_join(th, NULL);
         if (g[0].st == OK && g[1].st == OK) g[0].st = merge(R, W);
         else if (g[1].st != OK) g[0].st = g[1].st;
     }
@@ -966,6 +1074,9 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     Pool *P = (Pool *)pool;
     L.R = P ? result_reset(&P->R[0]) : calloc(1, sizeof(Result));
     L.spare = P ? &P->R[1] : NULL;
+#ifdef STARCUT_THREADS
+    L.worker = P ? &P->w : NULL;
+#endif
     MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
     MARK(T_EDGES);
