@@ -42,7 +42,7 @@ class CompiledLevel(BuildHookInterface):
         tried = []
         for cc in _compilers():  # $CC, Python's own, then the usual names (a conda Python's may be absent)
             # no fused multiply-adds: the points are numpy's to the bit on every platform
-            cmd = [*cc, "-O2", "-ffp-contract=off", "-shared", "-fPIC", "-pthread", f'-DSTARCUT_SOURCE="{sha}"', "-o",
+            cmd = [*cc, "-O3", "-ffp-contract=off", "-shared", "-fPIC", "-pthread", f'-DSTARCUT_SOURCE="{sha}"', "-o",
                    str(out), str(src), "-lm"]
             try:
                 subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=300)

@@ -53,7 +53,7 @@ def timing_build(folder: pathlib.Path):
     shutil.copy(SOURCE, folder / SOURCE.name)
     sha = hashlib.sha256(SOURCE.read_bytes()).hexdigest()
     cc = shlex.split(sysconfig.get_config_var("CC") or "cc")
-    subprocess.run([*cc, "-O2", "-ffp-contract=off", "-shared", "-fPIC", "-DSTARCUT_TIMING", f'-DSTARCUT_SOURCE="{sha}"',
+    subprocess.run([*cc, "-O3", "-ffp-contract=off", "-shared", "-fPIC", "-DSTARCUT_TIMING", f'-DSTARCUT_SOURCE="{sha}"',
                     "-o", str(folder / _cstar.LIBRARY), str(SOURCE), "-lm"], check=True)
     lib = _cstar._load(folder)
     if lib is None:

@@ -137,13 +137,20 @@ def _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, pool):
                        ctypes.addressof(vol), ctypes.addressof(status))
     if not res:
         return None
-    n_pts, n_extra, n_seg, n_flat, n_poly, n_tri, ct.threads_used = (int(c) for c in counts)
+    n_pts, n_extra, n_seg, n_flat, n_poly, n_tri, ct.threads_used = counts.tolist()
     verts = np.empty((n_pts + n_extra, 3))
-    edges = np.empty((n_seg, 2), dtype=np.int64)
-    flat = np.empty(n_flat, dtype=np.int64)
-    offsets = np.empty(n_poly + 1, dtype=np.int64)
-    cells = np.empty(n_poly, dtype=np.int64)
-    tri = np.empty((n_tri, 3), dtype=np.int64)
-    tcell = np.empty(n_tri, dtype=np.int64)
-    _lib.starcut_take(res, _ptr(verts), _ptr(edges), _ptr(flat), _ptr(offsets), _ptr(cells), _ptr(tri), _ptr(tcell))
+    # the index arrays: one block, locked before its parts are cut from it (so they are handed out
+    # read-only without a copy), in the order starcut_take fills them
+    sizes = (2 * n_seg, n_flat, n_poly + 1, n_poly, 3 * n_tri, n_tri)
+    block = np.empty(sum(sizes), dtype=np.int64)
+    at, ptrs = _ptr(block), []
+    for n in sizes:
+        ptrs.append(at)
+        at += 8 * n
+    _lib.starcut_take(res, _ptr(verts), *ptrs)
+    block.flags.writeable = False
+    ends = np.cumsum(sizes).tolist()
+    edges = block[:ends[0]].reshape(n_seg, 2)
+    flat, offsets, cells = block[ends[0]:ends[1]], block[ends[1]:ends[2]], block[ends[2]:ends[3]]
+    tri, tcell = block[ends[3]:ends[4]].reshape(n_tri, 3), block[ends[4]:ends[5]]
     return verts, edges, flat, offsets, cells, tri, tcell, vol.value, n_extra

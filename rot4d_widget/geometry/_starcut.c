@@ -77,7 +77,7 @@ static int grow(void **a, I *cap, I n, I extra, size_t size) {
 #define GROW(v, extra) grow((void **)&(v)->a, &(v)->cap, (v)->n, (extra), sizeof *(v)->a)
 #define PUSH(v, x) do { if (!GROW(&(v), 1)) { st = NO_MEMORY; goto done; } (v).a[(v).n++] = (x); } while (0)
 
-typedef struct {
+typedef struct Result_ {
     int status, pooled;          /* pooled: its arrays belong to a Pool, kept for the next level */
     double volume;
     I n_points, n_extra;
@@ -85,6 +85,8 @@ typedef struct {
     ivec edges;                  /* 2 per segment */
     ivec flat, offsets, cells;   /* the polygons */
     ivec tri, tcell;             /* 3 per triangle, its cell */
+    struct Result_ *more;        /* a second thread's fill corners and triangles, to follow these (or NULL) */
+    I more_off;                  /* added to its corners' numbers (those from n_points up) */
 } Result;
 
 static void result_free_arrays(Result *r) {
@@ -144,6 +146,7 @@ void starcut_pool_free(void *p) {
 static Result *result_reset(Result *r) {  /* empty, its arrays' room kept */
     r->status = 0; r->volume = 0; r->n_points = r->n_extra = 0;
     r->verts.n = r->edges.n = r->flat.n = r->offsets.n = r->cells.n = r->tri.n = r->tcell.n = 0;
+    r->more = NULL; r->more_off = 0;
     return r;
 }
 
@@ -1034,7 +1037,10 @@ static int fill_sections(Level *L) {
     if (two) {
         if (L->worker) worker_wait((Worker *)L->worker);
         else pthread_join(th, NULL);
-        if (g[0].st == OK && g[1].st == OK) g[0].st = merge(R, W);
+        if (g[0].st == OK && g[1].st == OK) {
+            if (W == &own) g[0].st = merge(R, W);
+            else { R->more = W; R->more_off = R->n_extra; R->n_extra += W->n_extra; }  /* joined in starcut_take */
+        }
         else if (g[1].st != OK) g[0].st = g[1].st;
     }
     result_free_arrays(&own);
@@ -1090,20 +1096,26 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     if (st != OK) { result_free(L.R); return NULL; }
     Result *R = L.R;
     counts[0] = R->n_points; counts[1] = R->n_extra; counts[2] = R->edges.n / 2; counts[3] = R->flat.n;
-    counts[4] = R->cells.n; counts[5] = R->tcell.n; counts[6] = L.used;
+    counts[4] = R->cells.n; counts[5] = R->tcell.n + (R->more ? R->more->tcell.n : 0); counts[6] = L.used;
     *volume = R->volume;
     return R;
 }
 
 /* Copy a result into the caller's arrays (sized by its counts) and free it (a pool's: keep its room). */
 void starcut_take(void *p, double *verts, I *edges, I *flat, I *offsets, I *cells, I *tri, I *tcell) {
-    Result *R = (Result *)p;
+    Result *R = (Result *)p, *M = R->more;
     memcpy(verts, R->verts.a, (size_t)R->verts.n * sizeof(double));
+    if (M) memcpy(verts + R->verts.n, M->verts.a + 3 * M->n_points, (size_t)(M->verts.n - 3 * M->n_points) * sizeof(double));
     memcpy(edges, R->edges.a, (size_t)R->edges.n * sizeof(I));
     memcpy(flat, R->flat.a, (size_t)R->flat.n * sizeof(I));
     memcpy(offsets, R->offsets.a, (size_t)R->offsets.n * sizeof(I));
     memcpy(cells, R->cells.a, (size_t)R->cells.n * sizeof(I));
     memcpy(tri, R->tri.a, (size_t)R->tri.n * sizeof(I));
     memcpy(tcell, R->tcell.a, (size_t)R->tcell.n * sizeof(I));
+    if (M) {  /* as `merge` would have joined them */
+        I np = M->n_points, off = R->more_off, *o = tri + R->tri.n;
+        for (I i = 0; i < M->tri.n; i++) { I v = M->tri.a[i]; o[i] = v >= np ? v + off : v; }
+        memcpy(tcell + R->tcell.n, M->tcell.a, (size_t)M->tcell.n * sizeof(I));
+    }
     result_free(R);
 }
