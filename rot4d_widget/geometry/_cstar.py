@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import itertools
 import os
 import pathlib
 import threading
@@ -149,7 +150,7 @@ def _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, pool):
         at += 8 * n
     _lib.starcut_take(res, _ptr(verts), *ptrs)
     block.flags.writeable = False
-    ends = np.cumsum(sizes).tolist()
+    ends = list(itertools.accumulate(sizes))
     edges = block[:ends[0]].reshape(n_seg, 2)
     flat, offsets, cells = block[ends[0]:ends[1]], block[ends[1]:ends[2]], block[ends[2]:ends[3]]
     tri, tcell = block[ends[3]:ends[4]].reshape(n_tri, 3), block[ends[4]:ends[5]]
