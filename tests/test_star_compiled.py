@@ -23,6 +23,7 @@ import pathlib
 import shutil
 import subprocess
 import sys
+import time
 import zlib
 from collections import Counter
 
@@ -228,9 +229,10 @@ def _same(a, b):
 @needs_c
 @pytest.mark.parametrize("slabs_only", [False, True], ids=["arrangement", "slabs"])
 def test_two_threads_give_the_slice_one_thread_gives(slabs_only):
-    """A level with many crossing sections has half of their fills made by a second thread (its own
-    corners numbered after the first's when the two are joined): the same arrays, in the same order,
-    as one thread's, for the arrangement fill and for the slab fill.  A level with few stays on one."""
+    """A level with many crossing sections has some of their fills made by a second thread, which
+    takes cells as the first does (its corners renumbered in cell order when the two are joined):
+    the same arrays, in the same order, as one thread's, for the arrangement fill and for the slab
+    fill.  A level with few stays on one."""
     name = "great icosahedral 120-cell"
     p = polytope(name)
     t = tables(p)
@@ -241,10 +243,19 @@ def test_two_threads_give_the_slice_one_thread_gives(slabs_only):
         x = t.vertices @ m.T
         one = _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=1)
         assert st.c.threads_used == 1
-        two = _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2)
-        assert st.c.threads_used == 2  # (the split happened: this level is over the threshold)
-        assert one[8] > 0  # fill corners made, some by the second thread
-        _same(one, two)
+        assert one[8] > 0  # fill corners made
+        # levels back to back (a batch: two threads; levels further apart stay on one), the second
+        # taking cells once it is awake: the same arrays either way
+        runs, used = [], []
+        for _ in range(12):
+            runs.append(_cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2))
+            used.append(st.c.threads_used)
+        for two in runs:
+            _same(one, two)
+        assert 2 in used  # (it did take some: this level is over the threshold)
+        time.sleep(0.01)  # a level on its own (a key's next step): one thread
+        _same(one, _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2))
+        assert st.c.threads_used == 1
     small = polytope("great grand 120-cell")  # its crossing sections are few and small: not worth a thread
     t = tables(small)
     _cstar.cut(starslice.star_tables(small, t).c, t.vertices @ m.T, m, 0.07, t.tol, threads=2)
@@ -290,8 +301,12 @@ def test_a_forked_process_slices_with_a_second_thread_of_its_own():
             "m = random_rotation(np.random.default_rng(1))\n"
             "a = slice_polytope(p, m, 0.1)\n"
             "def child(q):\n"
-            "    s = slice_polytope(p, m, 0.1)\n"
-            "    q.put((s.volume, s.triangles.tolist() == a.triangles.tolist(), starslice.star_tables(p, None).c.threads_used))\n"
+            "    ss, used = [], []\n"
+            "    for _ in range(30):  # back to back (two threads for a batch); the first levels may\n"
+            "        ss.append(slice_polytope(p, m, 0.1))  # end before the new thread takes a cell\n"
+            "        used.append(starslice.star_tables(p, None).c.threads_used)\n"
+            "    same = all(s.volume == a.volume and np.array_equal(s.triangles, a.triangles) for s in ss)\n"
+            "    q.put((ss[-1].volume, same, max(used)))\n"
             "if __name__ == '__main__':\n"
             "    q = mp.get_context('fork').Queue()\n"
             "    pr = mp.get_context('fork').Process(target=child, args=(q,))\n"

@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <stdatomic.h>
 #include <string.h>
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -27,6 +28,7 @@
 #if !defined(STARCUT_TIMING) && !defined(_WIN32)
 #define STARCUT_THREADS
 #include <pthread.h>
+#include <time.h>
 #include <unistd.h>
 #endif
 #define PARALLEL_WORK 20000.0
@@ -85,13 +87,18 @@ typedef struct Result_ {
     ivec edges;                  /* 2 per segment */
     ivec flat, offsets, cells;   /* the polygons */
     ivec tri, tcell;             /* 3 per triangle, its cell */
-    struct Result_ *more;        /* a second thread's fill corners and triangles, to follow these (or NULL) */
-    I more_off;                  /* added to its corners' numbers (those from n_points up) */
+    /* where a second thread filled some cells (`more`, its result): what the fills before the
+     * cells' own took (pre_extra corners, pre_tri triangles, all here), and each cell's corners and
+     * triangles, [5c .. 5c + 5) of `cell_out`: whose (0 here, 1 `more`, -1 none), its corners'
+     * [from, to) and its triangles' [from, to) there; starcut_take joins them in cell order */
+    struct Result_ *more;
+    I pre_extra, pre_tri;
+    ivec cell_out;
 } Result;
 
 static void result_free_arrays(Result *r) {
     free(r->verts.a); free(r->edges.a); free(r->flat.a); free(r->offsets.a); free(r->cells.a);
-    free(r->tri.a); free(r->tcell.a);
+    free(r->tri.a); free(r->tcell.a); free(r->cell_out.a);
 }
 
 static void result_free(Result *r) {
@@ -102,12 +109,25 @@ static void result_free(Result *r) {
 
 #ifdef STARCUT_THREADS
 /* A pool's second thread, started with its first two-thread level and then waiting for the next
- * (starting a thread costs tens of microseconds a level); `pid`: a forked child has no such thread. */
+ * (starting a thread costs tens of microseconds a level).  Waking a sleeping thread costs as much
+ * again or far more (an idle virtual processor), so a level after a two-thread one pings it first
+ * (W_PINGED): it wakes while this thread does the stages before the fills, and waits for the cells
+ * spinning (at most SPIN_S).  Both threads then take cells as they go (`Range.next`): a thread
+ * that wakes late takes few or none, and one that has not taken the job when the cells are all
+ * done is not waited for (W_JOB taken back).  `pid`: a forked child has no such thread. */
+enum { W_IDLE, W_PINGED, W_JOB, W_RUNNING, W_DONE };
+#define SPIN_S 0.002
+/* Two threads only for a level that follows the last within RECENT_S (a batch: a stack of levels,
+ * a benchmark): between levels further apart (a key's steps) the second processor goes to sleep,
+ * and waking it costs more than it saves (docs/meshes.md: one 2-processor virtual machine). */
+#define RECENT_S 0.001
 typedef struct {
     pthread_t th;
     pthread_mutex_t mu;
     pthread_cond_t go, fin;
-    int up, has_job, done, quit;
+    int up, quit, two_last;  /* two_last: the last level took two threads */
+    double last_end;         /* when the last level ended (wall(), s) */
+    _Atomic int state;
     pid_t pid;
     void *job;  /* the Range to fill */
 } Worker;
@@ -134,7 +154,7 @@ void starcut_pool_free(void *p) {
 #ifdef STARCUT_THREADS
     Worker *w = &((Pool *)p)->w;
     if (w->up && w->pid == getpid()) {
-        pthread_mutex_lock(&w->mu); w->quit = 1; pthread_cond_signal(&w->go); pthread_mutex_unlock(&w->mu);
+        pthread_mutex_lock(&w->mu); w->quit = 1; pthread_cond_broadcast(&w->go); pthread_mutex_unlock(&w->mu);
         pthread_join(w->th, NULL);
         pthread_mutex_destroy(&w->mu); pthread_cond_destroy(&w->go); pthread_cond_destroy(&w->fin);
     }
@@ -146,7 +166,7 @@ void starcut_pool_free(void *p) {
 static Result *result_reset(Result *r) {  /* empty, its arrays' room kept */
     r->status = 0; r->volume = 0; r->n_points = r->n_extra = 0;
     r->verts.n = r->edges.n = r->flat.n = r->offsets.n = r->cells.n = r->tri.n = r->tcell.n = 0;
-    r->more = NULL; r->more_off = 0;
+    r->more = NULL; r->pre_extra = r->pre_tri = 0; r->cell_out.n = 0;
     return r;
 }
 
@@ -570,7 +590,8 @@ typedef struct {
     int threads;              /* 2: the crossing sections' fills split between this thread and one more */
     int used;                 /* threads the fills took */
     Result *spare;            /* the second thread's result (a pool's), or NULL: its own */
-    void *worker;             /* the pool's second thread (a Worker), or NULL: one started for the level */
+    void *worker;             /* the pool's second thread (a Worker), or NULL: one thread */
+    int recent;               /* this level follows the last closely (two threads may pay) */
     unsigned char *above;     /* (V,) each vertex above H */
     I *cid;                   /* (E,) each edge's point, -1 if it does not cross */
     double centre[3];         /* the points' mean: coordinates about it keep the volume's sums small */
@@ -848,35 +869,47 @@ done:
     return st == OK ? 1 : -1;
 }
 
-/* Cells [lo, hi) whose sections neither a convex cycle nor a star-shaped fan filled: by their
- * arrangement, else by slabs, into R (its points read, its fill corners, triangles grown).  Each
- * range owns its scratch and R; `loc` is shared, each cell writing only its own records'. */
+/* The cells whose sections neither a convex cycle nor a star-shaped fan filled, by their
+ * arrangement, else by slabs: each thread (`Filler`) takes the next CHUNK cells (`Range.next`)
+ * until none is left, into its result R (its points read, its fill corners, triangles grown),
+ * noting each cell's parts in `cell_out`.  Each thread owns its scratch and R; `loc` is shared,
+ * each cell writing only its own records'. */
+#define CHUNK 2
 typedef struct {
     Level *L;
-    Result *R;
-    I lo, hi;
+    I C, mmax;
     const I *crec_ptr, *crec;
     const unsigned char *cdone;
-    I *loc;
-    int st;
+    I *loc, *cell_out;      /* (5C,) see Result */
+    _Atomic I next;         /* the next cell not yet taken */
+    _Atomic int took2;      /* the second thread took cells */
 } Range;
 
-static void fill_cells(Range *g) {
+typedef struct {
+    Range *g;
+    Result *R;
+    int who, st;
+} Filler;
+
+static void fill_cells(Filler *f) {
+    Range *g = f->g;
     Level *L = g->L;
-    Result *R = g->R;
-    const I *crec_ptr = g->crec_ptr, *crec = g->crec;
-    I *loc = g->loc, *cg = NULL, mmax = 0;
+    Result *R = f->R;
+    const I *crec_ptr = g->crec_ptr, *crec = g->crec, mmax = g->mmax;
+    I *loc = g->loc, *cg = NULL;
     double *cd = NULL;
     dvec xs = {0};
     Work ws = {0};
     int st = OK;
-    for (I cc = g->lo; cc < g->hi; cc++) if (crec_ptr[cc + 1] - crec_ptr[cc] > mmax) mmax = crec_ptr[cc + 1] - crec_ptr[cc];
     cg = malloc((3 * mmax + 1) * sizeof(I));
     cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
     if (!cg || !cd) { st = NO_MEMORY; goto done; }
-    for (I cc = g->lo; cc < g->hi && st == OK; cc++) {
+    for (I c_lo; st == OK && (c_lo = atomic_fetch_add(&g->next, CHUNK)) < g->C;)
+    for (I cc = c_lo; cc < c_lo + CHUNK && cc < g->C && st == OK; cc++) {
         I r0 = crec_ptr[cc], m = crec_ptr[cc + 1] - r0;
         if (!m || g->cdone[cc]) continue;
+        if (f->who) atomic_store(&g->took2, 1);
+        I *co = g->cell_out + 5 * cc, e_before = R->n_extra, t_before = R->tcell.n;
         double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
         Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
         double uv[6], org[3];
@@ -907,67 +940,101 @@ static void fill_cells(Range *g) {
         }
         for (I i = 0; i < m; i++) loc[c2.g[i]] = -1;
         if (s2 != OK) st = s2;
+        co[0] = f->who; co[1] = e_before; co[2] = R->n_extra; co[3] = t_before; co[4] = R->tcell.n;
     }
 done:
     free(cg); free(cd); free(xs.a); free(ws.buf);
-    g->st = st;
+    f->st = st;
 }
 
 #ifdef STARCUT_THREADS
-static void *fill_thread(void *p) { fill_cells((Range *)p); return NULL; }
+static double wall(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
 
 static void *worker_loop(void *p) {
     Worker *w = (Worker *)p;
-    pthread_mutex_lock(&w->mu);
     for (;;) {
-        while (!w->has_job && !w->quit) pthread_cond_wait(&w->go, &w->mu);
-        if (w->quit) break;
-        w->has_job = 0;
-        pthread_mutex_unlock(&w->mu);
-        fill_cells((Range *)w->job);
+        int s;
         pthread_mutex_lock(&w->mu);
-        w->done = 1;
+        while (((s = atomic_load(&w->state)) == W_IDLE || s == W_DONE) && !w->quit) pthread_cond_wait(&w->go, &w->mu);
+        pthread_mutex_unlock(&w->mu);
+        if (w->quit) break;
+        double t0 = wall();
+        for (long i = 1; (s = atomic_load(&w->state)) == W_PINGED; i++) {  /* the range is on its way */
+#if defined(__x86_64__) || defined(__i386__)
+            __builtin_ia32_pause();
+#endif
+            if (!(i & 1023) && wall() - t0 > SPIN_S) break;
+        }
+        if (s == W_PINGED) {
+            pthread_mutex_lock(&w->mu);
+            while ((s = atomic_load(&w->state)) == W_PINGED && !w->quit) pthread_cond_wait(&w->go, &w->mu);
+            pthread_mutex_unlock(&w->mu);
+        }
+        int job = W_JOB;
+        if (s != W_JOB || !atomic_compare_exchange_strong(&w->state, &job, W_RUNNING))
+            continue;  /* not pinged for cells after all, or the cells were all done before it came */
+        fill_cells((Filler *)w->job);
+        pthread_mutex_lock(&w->mu);
+        atomic_store(&w->state, W_DONE);
         pthread_cond_signal(&w->fin);
+        pthread_mutex_unlock(&w->mu);
     }
-    pthread_mutex_unlock(&w->mu);
     return NULL;
 }
 
-/* Hand g to the pool's thread (started if it is not up in this process); 0 if it cannot be. */
-static int worker_start(Worker *w, Range *g) {
-    if (!w->up || w->pid != getpid()) {
-        w->up = 0;
-        if (pthread_mutex_init(&w->mu, NULL) || pthread_cond_init(&w->go, NULL) || pthread_cond_init(&w->fin, NULL))
-            return 0;
-        w->has_job = w->done = w->quit = 0;
-        if (pthread_create(&w->th, NULL, worker_loop, w) != 0) return 0;
-        w->up = 1; w->pid = getpid();
-    }
+/* The pool's thread, started if it is not up in this process; 0 if it cannot be. */
+static int worker_up(Worker *w) {
+    if (w->up && w->pid == getpid()) return 1;
+    w->up = 0;
+    if (pthread_mutex_init(&w->mu, NULL) || pthread_cond_init(&w->go, NULL) || pthread_cond_init(&w->fin, NULL))
+        return 0;
+    w->quit = 0;
+    atomic_store(&w->state, W_IDLE);
+    if (pthread_create(&w->th, NULL, worker_loop, w) != 0) return 0;
+    w->up = 1; w->pid = getpid();
+    return 1;
+}
+
+static void worker_set(Worker *w, int from, int to) {  /* from < 0: any */
     pthread_mutex_lock(&w->mu);
-    w->job = g; w->done = 0; w->has_job = 1;
-    pthread_cond_signal(&w->go);
+    if (from < 0 || atomic_load(&w->state) == from) { atomic_store(&w->state, to); pthread_cond_signal(&w->go); }
+    pthread_mutex_unlock(&w->mu);
+}
+
+/* At a level's start: whether it follows the last closely enough for two threads; if so, and the
+ * last took two, wake the thread now (it will likely be wanted). */
+static int worker_ping(Worker *w, int threads) {
+    int recent = threads > 1 && wall() - w->last_end < RECENT_S;
+    if (recent && w->two_last && worker_up(w)) worker_set(w, W_IDLE, W_PINGED);
+    return recent;
+}
+
+/* At a level's end: a ping that got no cells is taken back; the time noted. */
+static void worker_unping(Worker *w) {
+    if (w->up && w->pid == getpid()) worker_set(w, W_PINGED, W_IDLE);
+    w->last_end = wall();
+}
+
+/* Hand f to the pool's thread; 0 if it cannot be. */
+static int worker_start(Worker *w, Filler *f) {
+    if (!worker_up(w)) return 0;
+    w->job = f;
+    worker_set(w, -1, W_JOB);
+    return 1;
+}
+
+/* After this thread's cells: take the job back if the other has not started it (it will not
+ * touch the cells), else wait until it is done.  1 if it ran. */
+static int worker_wait(Worker *w) {
+    int job = W_JOB;
+    pthread_mutex_lock(&w->mu);
+    if (atomic_compare_exchange_strong(&w->state, &job, W_IDLE)) { pthread_mutex_unlock(&w->mu); return 0; }
+    while (atomic_load(&w->state) != W_DONE) pthread_cond_wait(&w->fin, &w->mu);
+    atomic_store(&w->state, W_IDLE);
     pthread_mutex_unlock(&w->mu);
     return 1;
 }
 
-static void worker_wait(Worker *w) {
-    pthread_mutex_lock(&w->mu);
-    while (!w->done) pthread_cond_wait(&w->fin, &w->mu);
-    pthread_mutex_unlock(&w->mu);
-}
-
-/* W's fill corners and triangles after R's, in that order (as one thread would have made them):
- * W numbers its corners from the points' count, R from its own corners' end. */
-static int merge(Result *R, const Result *W) {
-    I np = R->n_points, off = R->n_extra, nw = W->verts.n - 3 * np;
-    if (!GROW(&R->verts, nw) || !GROW(&R->tri, W->tri.n) || !GROW(&R->tcell, W->tcell.n)) return NO_MEMORY;
-    memcpy(R->verts.a + R->verts.n, W->verts.a + 3 * np, nw * sizeof(double));
-    R->verts.n += nw; R->n_extra += W->n_extra;
-    for (I i = 0; i < W->tri.n; i++) { I v = W->tri.a[i]; R->tri.a[R->tri.n++] = v >= np ? v + off : v; }
-    memcpy(R->tcell.a + R->tcell.n, W->tcell.a, W->tcell.n * sizeof(I));
-    R->tcell.n += W->tcell.n;
-    return OK;
-}
 #endif
 
 /* Triangles: a convex cell's cycle fanned from its first corner; a non-convex cell's section fanned
@@ -1012,44 +1079,46 @@ static int fill_sections(Level *L) {
     }
     MARK(T_FANS);
     for (I r = 0; r < 2 * ns; r++) loc[r] = -1;
-    /* the rest by arrangement or slabs; with two threads, split where half the work (~ m^2 a cell) is done */
-    Range g[2] = {{L, R, 0, C, crec_ptr, crec, cdone, loc, OK}, {L, NULL, C, C, crec_ptr, crec, cdone, loc, OK}};
-    double work = 0, half = 0;
-    for (I cc = 0; cc < C; cc++) if (!cdone[cc]) { double mm = (double)(crec_ptr[cc + 1] - crec_ptr[cc]); work += mm * mm; }
+    /* the rest by arrangement or slabs, cell by cell in order; with two threads, each takes the next
+     * cells as it goes (a level with little such work stays on one: PARALLEL_WORK, ~ m^2 a cell) */
+    if (!GROW(&R->cell_out, 5 * C)) { st = NO_MEMORY; goto done; }
+    R->cell_out.n = 5 * C;
+    Range g = {.L = L, .C = C, .crec_ptr = crec_ptr, .crec = crec, .cdone = cdone, .loc = loc,
+               .cell_out = R->cell_out.a};
+    double work = 0;
+    for (I cc = 0; cc < C; cc++) {
+        I mc = crec_ptr[cc + 1] - crec_ptr[cc];
+        g.cell_out[5 * cc] = -1;
+        if (mc > g.mmax) g.mmax = mc;
+        if (!cdone[cc]) work += (double)mc * (double)mc;
+    }
+    atomic_store(&g.next, 0);
+    atomic_store(&g.took2, 0);
+    Filler f0 = {&g, R, 0, OK};
+    R->pre_extra = R->n_extra; R->pre_tri = R->tcell.n;
 #ifdef STARCUT_THREADS
-    Result own = {0}, *W = L->spare ? result_reset(L->spare) : &own;
-    pthread_t th;
-    int two = L->threads > 1 && work >= PARALLEL_WORK;
+    Worker *wk = (Worker *)L->worker;  /* (NULL without a pool: one thread) */
+    Result *W = L->spare;
+    Filler f1 = {&g, W, 1, OK};
+    int two = wk && W && L->threads > 1 && L->recent && work >= PARALLEL_WORK;
     if (two) {
-        for (I cc = 0; cc < C; cc++) {
-            double mm = cdone[cc] ? 0 : (double)(crec_ptr[cc + 1] - crec_ptr[cc]);
-            if ((half += mm * mm) >= 0.5 * work) { g[0].hi = g[1].lo = cc + 1; break; }
-        }
+        result_reset(W);
         W->n_points = R->n_points;
         if (!GROW(&W->verts, 3 * R->n_points)) two = 0;  /* the points, for the other thread to read */
-        else { memcpy(W->verts.a, R->verts.a, 3 * R->n_points * sizeof(double)); W->verts.n = 3 * R->n_points; g[1].R = W; }
-        Worker *wk = (Worker *)L->worker;
-        if (two && !(wk ? worker_start(wk, &g[1]) : pthread_create(&th, NULL, fill_thread, &g[1]) == 0)) two = 0;
-        if (!two) g[0].hi = C;
+        else { memcpy(W->verts.a, R->verts.a, 3 * R->n_points * sizeof(double)); W->verts.n = 3 * R->n_points; }
+        if (two && !worker_start(wk, &f1)) two = 0;
     }
-    L->used = 1 + two;
-    fill_cells(&g[0]);
-    if (two) {
-        if (L->worker) worker_wait((Worker *)L->worker);
-        else pthread_join(th, NULL);
-        if (g[0].st == OK && g[1].st == OK) {
-            if (W == &own) g[0].st = merge(R, W);
-            else { R->more = W; R->more_off = R->n_extra; R->n_extra += W->n_extra; }  /* joined in starcut_take */
-        }
-        else if (g[1].st != OK) g[0].st = g[1].st;
-    }
-    result_free_arrays(&own);
+    fill_cells(&f0);
+    int ran = two && worker_wait(wk);
+    if (wk) wk->two_last = two;
+    if (ran && f1.st != OK && f0.st == OK) f0.st = f1.st;
+    if (ran && atomic_load(&g.took2)) { R->more = W; R->n_extra += W->n_extra; }  /* joined in starcut_take */
+    L->used = 1 + (ran && atomic_load(&g.took2));
 #else
-    (void)half;
+    fill_cells(&f0);
     L->used = 1;
-    fill_cells(&g[0]);
 #endif
-    st = g[0].st;
+    st = f0.st;
 done:
     free(crec_ptr); free(crec); free(pstart_c); free(cI); free(loc); free(fill); free(cdone);
     return st;
@@ -1082,6 +1151,7 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     L.spare = P ? &P->R[1] : NULL;
 #ifdef STARCUT_THREADS
     L.worker = P ? &P->w : NULL;
+    if (P) L.recent = worker_ping(&P->w, threads);
 #endif
     MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
@@ -1091,6 +1161,9 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     if (st == OK) st = chain_cycles(&L);
     MARK(T_CYCLES);
     if (st == OK) st = fill_sections(&L);
+#ifdef STARCUT_THREADS
+    if (P) worker_unping(&P->w);
+#endif
     level_free(&L);
     *status = st;
     if (st != OK) { result_free(L.R); return NULL; }
@@ -1104,18 +1177,29 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
 /* Copy a result into the caller's arrays (sized by its counts) and free it (a pool's: keep its room). */
 void starcut_take(void *p, double *verts, I *edges, I *flat, I *offsets, I *cells, I *tri, I *tcell) {
     Result *R = (Result *)p, *M = R->more;
-    memcpy(verts, R->verts.a, (size_t)R->verts.n * sizeof(double));
-    if (M) memcpy(verts + R->verts.n, M->verts.a + 3 * M->n_points, (size_t)(M->verts.n - 3 * M->n_points) * sizeof(double));
     memcpy(edges, R->edges.a, (size_t)R->edges.n * sizeof(I));
     memcpy(flat, R->flat.a, (size_t)R->flat.n * sizeof(I));
     memcpy(offsets, R->offsets.a, (size_t)R->offsets.n * sizeof(I));
     memcpy(cells, R->cells.a, (size_t)R->cells.n * sizeof(I));
-    memcpy(tri, R->tri.a, (size_t)R->tri.n * sizeof(I));
-    memcpy(tcell, R->tcell.a, (size_t)R->tcell.n * sizeof(I));
-    if (M) {  /* as `merge` would have joined them */
-        I np = M->n_points, off = R->more_off, *o = tri + R->tri.n;
-        for (I i = 0; i < M->tri.n; i++) { I v = M->tri.a[i]; o[i] = v >= np ? v + off : v; }
-        memcpy(tcell + R->tcell.n, M->tcell.a, (size_t)M->tcell.n * sizeof(I));
+    if (!M) {  /* one thread: already in cell order */
+        memcpy(verts, R->verts.a, (size_t)R->verts.n * sizeof(double));
+        memcpy(tri, R->tri.a, (size_t)R->tri.n * sizeof(I));
+        memcpy(tcell, R->tcell.a, (size_t)R->tcell.n * sizeof(I));
+    } else {  /* what came before the cells' own fills, then cell by cell, its corners renumbered */
+        I np = R->n_points, ne = R->pre_extra, nt = R->pre_tri, C = R->cell_out.n / 5;
+        memcpy(verts, R->verts.a, (size_t)(3 * (np + ne)) * sizeof(double));
+        memcpy(tri, R->tri.a, (size_t)(3 * nt) * sizeof(I));
+        memcpy(tcell, R->tcell.a, (size_t)nt * sizeof(I));
+        for (I cc = 0; cc < C; cc++) {
+            const I *co = R->cell_out.a + 5 * cc;
+            if (co[0] < 0) continue;
+            const Result *S = co[0] ? M : R;
+            I e0 = co[1], e1 = co[2], t0 = co[3], t1 = co[4], shift = (np + ne) - (np + e0);
+            memcpy(verts + 3 * (np + ne), S->verts.a + 3 * (np + e0), (size_t)(3 * (e1 - e0)) * sizeof(double));
+            for (I i = 3 * t0; i < 3 * t1; i++) { I v = S->tri.a[i]; tri[3 * nt + i - 3 * t0] = v >= np ? v + shift : v; }
+            memcpy(tcell + nt, S->tcell.a + t0, (size_t)(t1 - t0) * sizeof(I));
+            ne += e1 - e0; nt += t1 - t0;
+        }
     }
     result_free(R);
 }
