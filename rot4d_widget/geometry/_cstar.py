@@ -9,8 +9,8 @@ compiler); where there is none, `available` is False and every level goes to num
 slices, slower).  A library built from another version of ``_starcut.c`` than the one beside it is
 not used (a warning says to reinstall).  ``ROT4D_NO_C=1`` in the environment turns it off (for
 comparing the two).  Where the machine has two or more cores, a level with many crossing sections
-has half of their fills done by a second thread (the same slice); ``ROT4D_C_THREADS=1`` keeps it to
-one.
+that follows the last level of the same polytope closely (`BATCH_GAP`: a stack, a batch) has some
+of their fills done by a second thread (the same slice); ``ROT4D_C_THREADS=1`` keeps it to one.
 """
 
 from __future__ import annotations
@@ -53,9 +53,9 @@ def _load(here: pathlib.Path | None = None):
     P, N, D = ctypes.c_void_p, ctypes.c_int64, ctypes.c_double
     lib.starcut.restype = P
     #    V  x  c0 tol E  ea eb F  S  fe_face fe_edge fv_vert fv_next basis m  f_cells rho mate C  convex normals
-    #    slabs_only threads pool out...
+    #    slabs_only threads batch_gap pool out...
     lib.starcut.argtypes = [N, P, D, D, N, P, P, N, N, P, P, P, P, P, P, P, P, P, N, P, P, ctypes.c_int, ctypes.c_int,
-                            P, P, P, P]
+                            D, P, P, P, P]
     lib.starcut_pool_new.restype = P
     lib.starcut_pool_new.argtypes = []
     lib.starcut_pool_free.restype = None
@@ -70,6 +70,9 @@ _lib = _load()
 available = _lib is not None
 #: threads a level may use: 2 on a machine with two or more cores, unless ROT4D_C_THREADS=1
 THREADS = 1 if os.environ.get("ROT4D_C_THREADS") == "1" or (os.cpu_count() or 1) < 2 else 2
+#: a level takes two threads only if it follows the last of the same polytope within this many
+#: seconds (levels in a batch); a key's steps, further apart, stay on one (see _starcut.c)
+BATCH_GAP = 0.001
 
 
 def _ptr(a: np.ndarray) -> int:
@@ -112,12 +115,13 @@ class CTables:
 
 
 def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float, slabs_only: bool = False,
-        threads: int | None = None):
+        threads: int | None = None, batch_gap: float | None = None):
     """The level ``c0`` of the unit vertices ``x`` (V, 4) turned by ``m``: (vertices (n, 3), edges,
     polygon corners, offsets, polygon cells, triangles, triangle cells, volume, n_fill), or None
     when the C code declines it (the numpy slicer then does it).  ``slabs_only``: the slab fill
     takes every section the arrangement fill would (so tests reach it with crossing segments);
-    ``threads`` (1 or 2, default `THREADS`): the same slice either way."""
+    ``threads`` (1 or 2, default `THREADS`), ``batch_gap`` (s, default `BATCH_GAP`): the same
+    slice either way."""
     x = np.ascontiguousarray(x, dtype=np.float64)
     m = np.ascontiguousarray(m, dtype=np.float64)
     counts = np.zeros(7, dtype=np.int64)
@@ -125,16 +129,18 @@ def cut(ct: CTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float, slabs_
     status = ctypes.c_int()
     pooled = ct.pool_lock.acquire(blocking=False)  # another thread on the same tables: fresh memory
     try:
-        return _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, ct.pool if pooled else None)
+        return _level(ct, x, m, c0, tol, slabs_only, threads, batch_gap, counts, vol, status,
+                      ct.pool if pooled else None)
     finally:
         if pooled:
             ct.pool_lock.release()
 
 
-def _level(ct, x, m, c0, tol, slabs_only, threads, counts, vol, status, pool):
+def _level(ct, x, m, c0, tol, slabs_only, threads, batch_gap, counts, vol, status, pool):
     threads = THREADS if threads is None else int(threads)
+    batch_gap = BATCH_GAP if batch_gap is None else float(batch_gap)
     res = _lib.starcut(len(x), _ptr(x), c0, tol, ct.E, *ct.edge_ptrs, ct.F, ct.S, *ct.face_ptrs, _ptr(m),
-                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, int(slabs_only), threads, pool, _ptr(counts),
+                       *ct.cell_ptrs, ct.C, *ct.conv_ptrs, int(slabs_only), threads, batch_gap, pool, _ptr(counts),
                        ctypes.addressof(vol), ctypes.addressof(status))
     if not res:
         return None

@@ -117,10 +117,10 @@ static void result_free(Result *r) {
  * done is not waited for (W_JOB taken back).  `pid`: a forked child has no such thread. */
 enum { W_IDLE, W_PINGED, W_JOB, W_RUNNING, W_DONE };
 #define SPIN_S 0.002
-/* Two threads only for a level that follows the last within RECENT_S (a batch: a stack of levels,
- * a benchmark): between levels further apart (a key's steps) the second processor goes to sleep,
- * and waking it costs more than it saves (docs/meshes.md: one 2-processor virtual machine). */
-#define RECENT_S 0.001
+/* Two threads only for a level that follows the last within `batch_gap` seconds (starcut's
+ * argument, _cstar.BATCH_GAP: a batch, a stack of levels, a benchmark): between levels further
+ * apart (a key's steps) the second processor goes to sleep, and waking it can cost more than it
+ * saves (docs/meshes.md, benchmarks/star_threads.py). */
 typedef struct {
     pthread_t th;
     pthread_mutex_t mu;
@@ -1003,8 +1003,8 @@ static void worker_set(Worker *w, int from, int to) {  /* from < 0: any */
 
 /* At a level's start: whether it follows the last closely enough for two threads; if so, and the
  * last took two, wake the thread now (it will likely be wanted). */
-static int worker_ping(Worker *w, int threads) {
-    int recent = threads > 1 && wall() - w->last_end < RECENT_S;
+static int worker_ping(Worker *w, int threads, double batch_gap) {
+    int recent = threads > 1 && wall() - w->last_end < batch_gap;
     if (recent && w->two_last && worker_up(w)) worker_set(w, W_IDLE, W_PINGED);
     return recent;
 }
@@ -1131,7 +1131,8 @@ done:
  * sides (faces ascending); face_basis (F, 2, 4); m (4, 4) the rotation; face_cells (F, 2),
  * face_rho (F, 2); slot_mate (2S,); cell_convex (C,) bytes; cell_normals (C, 4); slabs_only: no
  * arrangement fill (every section it would take goes to the slabs: for tests); threads: 2 lets a
- * second thread fill half the crossing sections (the same result as 1); pool: a `starcut_pool_new`
+ * second thread fill some of the crossing sections (the same result as 1) when the level follows the
+ * pool's last within batch_gap seconds; pool: a `starcut_pool_new`
  * (its memory reused; the result is the pool's until starcut_take), or NULL.  counts (out):
  * points, extra corners, segments, polygon corners, polygons, triangles, threads the fills took;
  * volume, status (out).
@@ -1139,8 +1140,8 @@ done:
 void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, const I *eb, I F, I S,
               const I *fe_face, const I *fe_edge, const I *fv_vert, const I *fv_next, const double *face_basis,
               const double *mrot, const I *face_cells, const double *face_rho, const I *slot_mate, I C,
-              const unsigned char *cell_convex, const double *cell_normals, int slabs_only, int threads, void *pool,
-              I *counts, double *volume, int *status) {
+              const unsigned char *cell_convex, const double *cell_normals, int slabs_only, int threads, double batch_gap,
+              void *pool, I *counts, double *volume, int *status) {
     Level L = {.V = V, .E = E, .F = F, .S = S, .C = C, .x = x, .face_basis = face_basis, .mrot = mrot,
                .face_rho = face_rho, .cell_normals = cell_normals, .ea = ea, .eb = eb, .fe_face = fe_face,
                .fe_edge = fe_edge, .fv_vert = fv_vert, .fv_next = fv_next, .face_cells = face_cells,
@@ -1151,7 +1152,7 @@ void *starcut(I V, const double *x, double c0, double tol, I E, const I *ea, con
     L.spare = P ? &P->R[1] : NULL;
 #ifdef STARCUT_THREADS
     L.worker = P ? &P->w : NULL;
-    if (P) L.recent = worker_ping(&P->w, threads);
+    if (P) L.recent = worker_ping(&P->w, threads, batch_gap);
 #endif
     MARK_START;
     int st = L.R ? cut_edges(&L) : NO_MEMORY;
