@@ -252,7 +252,8 @@ def test_two_threads_give_the_slice_one_thread_gives(slabs_only):
             used.append(st.c.threads_used)
         for two in runs:
             _same(one, two)
-        assert 2 in used  # (it did take some: this level is over the threshold)
+        if (os.cpu_count() or 1) >= 2:  # (one processor: the second thread may never run in time)
+            assert 2 in used  # (it did take some: this level is over the threshold)
         time.sleep(0.01)  # a level on its own (a key's next step): one thread
         _same(one, _cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2))
         assert st.c.threads_used == 1
