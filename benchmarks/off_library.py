@@ -240,6 +240,18 @@ def _fill_area(s, normals) -> np.ndarray:
     return np.bincount(c, weights=a, minlength=len(normals))
 
 
+def _polygons(s) -> collections.Counter:
+    """A slice's polygons as (cell, cycle) from its least corner, each cycle either way round."""
+    out = collections.Counter()
+    flat, off = np.asarray(s.polygon_indices).tolist(), np.asarray(s.polygon_offsets).tolist()
+    for i, c in enumerate(np.asarray(s.cell_ids).tolist()):
+        cyc = flat[off[i]:off[i + 1]]
+        k = cyc.index(min(cyc))
+        fwd = cyc[k:] + cyc[:k]
+        out[(c, min(tuple(fwd), tuple(fwd[:1] + fwd[1:][::-1])))] += 1
+    return out
+
+
 def against_numpy(p: Polytope, s, m: np.ndarray, c0: float) -> list[str] | None:
     """What differs between slice ``s`` (compiled level) and the numpy slicer's of the same level; None
     where there is nothing to compare (no star faces or cells, or no compiled level built)."""
@@ -261,6 +273,8 @@ def against_numpy(p: Polytope, s, m: np.ndarray, c0: float) -> list[str] | None:
     if (s.volume is None) != (ref.volume is None) or (
             s.volume is not None and abs(s.volume - ref.volume) > 1e-9 * max(1.0, abs(ref.volume))):
         out.append(f"c0={c0:.4g}: compiled volume {s.volume!r}, numpy {ref.volume!r}")
+    if _polygons(s) != _polygons(ref):  # (either way round: a cycle of no area has no right one)
+        out.append(f"c0={c0:.4g}: compiled and numpy polygons differ")
     if s.dim == 3 and ref.dim == 3:
         normals = t.cell_normals @ m[:3].T
         a, b = _fill_area(s, normals), _fill_area(ref, normals)

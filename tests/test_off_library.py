@@ -1,6 +1,6 @@
 """Files of two public 4OFF libraries load and slice right (issue 22).
 
-Every file in tests/data/off_library (README.md there: 35 of Pardesco/4d-polytope-viewer and 11
+Every file in tests/data/off_library (README.md there: 36 of Pardesco/4d-polytope-viewer and 11
 of 1-PT-AxH-RV-0/PolytopeViewer, both MIT: convex uniform, the ten regular star polychora,
 non-convex uniform ones with star faces, non-convex and hemi cells, the great duoantiprism; the
 second library's coordinates written with 3-4 digits) is read with `Polytope.from_off` as a user
@@ -82,7 +82,7 @@ def counts_line(path) -> tuple[int, int, int, int]:
 
 def test_the_libraries_are_here():
     assert {d: len([f for f in FILES if f.parent.name == d]) for d in ("pardesco", "polytopeviewer")} == {
-        "pardesco": 35, "polytopeviewer": 11}
+        "pardesco": 36, "polytopeviewer": 11}
     for d in ("pardesco", "polytopeviewer"):
         assert (DATA / d / "LICENSE").read_text().startswith("MIT License")
     assert set(PENDING) | set(NO_VOLUME) <= {name(f) for f in FILES}

@@ -731,6 +731,7 @@ static int chain_cycles(Level *L) {
     Result *R = L->R;
     const I ns = L->ns, n_end = 4 * ns, *seg_pt = L->seg_pt;
     I *at = malloc((L->S + 1) * sizeof(I));
+    ivec ends = {0};  /* a tie's orbit's ends and its reverse's */
     unsigned char *visited = calloc(n_end + 1, 1);
     L->partner = malloc((n_end + 1) * sizeof(I)); L->rec_cell = malloc((2 * ns + 1) * sizeof(I));
     if (!at || !visited || !L->partner || !L->rec_cell) { st = NO_MEMORY; goto done; }
@@ -765,18 +766,31 @@ static int chain_cycles(Level *L) {
         } while (q != q0);
         int keep = score > 0;
         if (score == 0 && rev != q0) {
-            double area = 0.0;
+            /* the orbit's signed area against its reverse's, each summed over its ends in ascending
+             * order (as the numpy slicer sums them): exactly one of the two is kept, even where the
+             * area is zero to rounding (a bowtie's two halves) and the two sums differ in sign by it */
+            if (!GROW(&ends, 2 * len)) { st = NO_MEMORY; goto done; }
+            I *fe = ends.a, *re = ends.a + len, n = 0;
             q = q0;
-            do {
-                I q1 = partner[q] ^ 1;
-                double a[3], b[3], ab[3];
-                I ia = seg_pt[2 * (q >> 2) + (q & 1)], ib = seg_pt[2 * (q1 >> 2) + (q1 & 1)];
-                for (int k = 0; k < 3; k++) { a[k] = PTS[3 * ia + k] - c[k] - A[k]; b[k] = PTS[3 * ib + k] - c[k] - A[k]; }
-                cross3(a, b, ab);
-                area += N[0] * ab[0] + N[1] * ab[1] + N[2] * ab[2];
-                q = q1;
-            } while (q != q0);
-            keep = area > 0 || (area == 0 && q0 < rev);
+            do { fe[n] = q; re[n] = q ^ 1; n++; q = partner[q] ^ 1; } while (q != q0);
+            double area[2] = {0.0, 0.0};
+            for (int w = 0; w < 2; w++) {
+                I *o = w ? re : fe;
+                for (I i = 1; i < n; i++) {  /* (insertion sort: a tie's orbit is short) */
+                    I v = o[i], j = i - 1;
+                    while (j >= 0 && o[j] > v) { o[j + 1] = o[j]; j--; }
+                    o[j + 1] = v;
+                }
+                for (I i = 0; i < n; i++) {
+                    I qa = o[i], qb = partner[qa] ^ 1;
+                    double a[3], b[3], ab[3];
+                    I ia = seg_pt[2 * (qa >> 2) + (qa & 1)], ib = seg_pt[2 * (qb >> 2) + (qb & 1)];
+                    for (int k = 0; k < 3; k++) { a[k] = PTS[3 * ia + k] - c[k] - A[k]; b[k] = PTS[3 * ib + k] - c[k] - A[k]; }
+                    cross3(a, b, ab);
+                    area[w] += N[0] * ab[0] + N[1] * ab[1] + N[2] * ab[2];
+                }
+            }
+            keep = area[0] > area[1] || (area[0] == area[1] && q0 < rev);
         }
         if (!keep || rev == q0) continue;  /* (rev == q0: an orbit that is its own reverse) */
         /* its corners from its least end; repeats dropped, fewer than 3 corners: none */
@@ -794,7 +808,7 @@ static int chain_cycles(Level *L) {
     }
     if (!R->cells.n) st = NO_CROSSING;
 done:
-    free(at); free(visited);
+    free(at); free(visited); free(ends.a);
     return st;
 }
 
