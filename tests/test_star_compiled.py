@@ -247,7 +247,7 @@ def test_two_threads_give_the_slice_one_thread_gives(slabs_only):
         # levels back to back (a batch: two threads; levels further apart stay on one), the second
         # taking cells once it is awake: the same arrays either way
         runs, used = [], []
-        for _ in range(12):
+        for _ in range(30):
             runs.append(_cstar.cut(st.c, x, m, 0.07, t.tol, slabs_only=slabs_only, threads=2))
             used.append(st.c.threads_used)
         for two in runs:
