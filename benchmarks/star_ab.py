@@ -1,17 +1,18 @@
 """Two builds of the compiled star level against each other, in one process, interleaved.
 
 For a change to ``rot4d_widget/geometry/_starcut.c`` whose effect is a few percent (less than this
-machine's drift between runs): builds the file as it is at ``--rev`` (default HEAD) and as it is in
-the working tree (or ``--flags`` against ``--base-flags`` for one source), each into a temporary
-folder with the package's flags (hatch_build.py's, unless given), loads both, and cuts one
-polychoron at ``--steps`` random orientations (benchmarks/star_load.py's, c0 = 0.1) with each in
-turn, ``--rounds`` times; prints each one's median ms per level and their ratio.  Only the C
-call and its copy-out are timed (`_cstar.cut`), not `slice_polytope`'s Python around it.  Both
-builds must have the interface the working tree's `_cstar.py` loads.  Two builds of one source
-differ by a few percent from run to run on this machine (the noise to beat).
+machine's drift between runs): builds the file as it is at ``--rev`` (default HEAD) or in
+``--base-file``, and as it is in the working tree (or ``--flags`` against ``--base-flags`` for one
+source), each into a temporary folder with the package's flags (hatch_build.py's, unless given),
+loads both, and cuts one polychoron at ``--steps`` random orientations (benchmarks/star_load.py's,
+c0 = 0.1) with each in turn, ``--rounds`` times; prints each one's median ms per level and their
+ratio. Only the C call and its copy-out are timed (`_cstar.cut`), not `slice_polytope`'s Python
+around it. Both builds must have the interface the working tree's `_cstar.py` loads. Two builds of
+one source differ by a few percent from run to run on this machine (the noise to beat).
 
     python benchmarks/star_ab.py [--rev HEAD] [--name "great icosahedral 120-cell"] [--rounds 40]
     python benchmarks/star_ab.py --base-flags "-O2" --flags "-O3"       # the working tree's, two ways
+    python benchmarks/star_ab.py --base-file /tmp/_starcut.c               # a saved copy against the working tree
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ def build(source: bytes, folder: pathlib.Path, flags: str):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rev", default="HEAD", help="the git revision of the first build's source")
+    ap.add_argument("--base-file", default=None, help="the first build's source: this file instead of --rev's")
     ap.add_argument("--base-flags", default=None, help="compile the working tree's source twice: these flags first")
     ap.add_argument("--flags", default=FLAGS)
     ap.add_argument("--name", default="great icosahedral 120-cell")
@@ -60,7 +62,9 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=40)
     args = ap.parse_args()
     work = (ROOT / SOURCE).read_bytes()
-    if args.base_flags is None:
+    if args.base_file is not None:
+        sides = [(args.base_file, pathlib.Path(args.base_file).read_bytes(), args.flags), ("working tree", work, args.flags)]
+    elif args.base_flags is None:
         old = subprocess.run(["git", "-C", str(ROOT), "show", f"{args.rev}:{SOURCE}"], check=True,
                              capture_output=True).stdout
         sides = [(f"{args.rev}", old, args.flags), ("working tree", work, args.flags)]

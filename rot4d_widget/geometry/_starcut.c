@@ -367,20 +367,20 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I m = c->m;
     I nxmax = m * (m - 1) / 2 + 1, nsmax = m + 2 * nxmax + 1;
     /* one block for the cell: its crossings, occurrences and pieces at their most */
-    size_t need = (size_t)(3 * nxmax + 4 * (m + 1) + 6 * nxmax + 3 * nsmax) * sizeof(I)
-                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1) + 2 * nsmax) * sizeof(double) + 2 * (size_t)nsmax;
+    size_t need = (size_t)(2 * nxmax + 4 * (m + 1) + 6 * nxmax + 3 * nsmax) * sizeof(I)
+                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1)) * sizeof(double) + 2 * (size_t)nsmax;
     if (ws->cap < need) {
         char *b = realloc(ws->buf, need);
         if (!b) return NO_MEMORY;
         ws->buf = b; ws->cap = need;
     }
     double *xsp = (double *)ws->buf, *xup = xsp + nxmax, *occ_t = xup + nxmax, *ut = occ_t + 2 * nxmax;
-    double *L2 = ut + 2 * nxmax, *hx = L2 + (m + 1), *hy = hx + nsmax;
-    I *xa = (I *)(hy + nsmax), *xb = xa + nxmax, *xid = xb + nxmax;
-    I *k = xid + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
+    double *L2 = ut + 2 * nxmax;
+    I *xa = (I *)(L2 + (m + 1)), *xb = xa + nxmax;
+    I *k = xb + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
     I *occ_x = cnt + (m + 1), *ux = occ_x + 2 * nxmax, *pos = ux + 2 * nxmax;
     I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax;
-    unsigned char *back = (unsigned char *)(fillp + nsmax), *seen = back + nsmax;
+    unsigned char *seen = (unsigned char *)(fillp + nsmax), *up = seen + nsmax;
     const double *restrict X0 = c->X0, *restrict Y0 = c->Y0, *restrict DX = c->dX, *restrict DY = c->dY;
     MARK_START;
     I nx = 0;
@@ -496,75 +496,79 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             a = b; q = 1 - (pe & 1);
         }
     }
-    for (I a = 0; a < m; a++)
-        for (I t = 0; t <= k[a]; t++) {
-            I e = base[a] + t;
-            back[e] = ((cnt[a] + t) & 1) == 0;
-            hx[e] = back[e] ? -c->dX[a] : c->dX[a];
-            hy[e] = back[e] ? -c->dY[a] : c->dY[a];
-        }
     MARK(T_ARR_PARITY);
-    /* the next odd half round its face */
+    /* the odd halves (the pieces walked with the odd side on their left): piece t of record a is
+     * walked backwards, p1 to p0, where cnt[a] + t is even (base[a] + t = optr[a] + a + t); each
+     * one's next odd half round its face and that one's tail (where it starts: crossing x becomes
+     * fill corner x0 + x, as the crossings are output below), and up[e] where the heading passes
+     * +u (once round a face).  Every piece is the next of one: every tail is set. */
+    if (!GROW(&R->verts, 3 * nx) || !GROW(&R->tri, 3 * nsub) || !GROW(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
+    const I x0 = R->n_points + R->n_extra;
+    /* at a crossing of a and b, the two pieces of one record end there and turn left onto the
+     * other's, which start there (the turns are left by construction; the parities must differ,
+     * else the rays disagree: not generic), without a branch on which record's */
+    for (I x = 0; x < nx; x++) {
+        const I a = xa[x], b = xb[x], oa = pos[2 * x], ob = pos[2 * x + 1];
+        const double dya = c->dY[a], dyb = c->dY[b];
+        const int bka = ((cnt[a] + oa - optr[a]) & 1) == 0, bkb = ((cnt[b] + ob - optr[b]) & 1) == 0;
+        const int turn = c->dX[a] * dyb - dya * c->dX[b] > 0;
+        bad |= bka == bkb;
+        /* the record whose piece before x is walked forwards (src) ends at x; dst's pieces leave */
+        const I src = bka ? ob + b : oa + a, dst = bka ? oa + a : ob + b;
+        const int tsel = bka ? !turn : turn;
+        const double hs = bka ? dyb : dya, hd = bka ? dya : dyb;
+        nxt[src] = dst + tsel; nxt[src + 1] = dst + !tsel;
+        tail[dst] = tail[dst + 1] = x0 + x;
+        up[src] = (hs < 0) & ((tsel ? hd : -hd) >= 0);
+        up[src + 1] = (-hs < 0) & ((tsel ? -hd : hd) >= 0);
+    }
+    if (bad) { st = NOT_GENERIC; goto done; }
+    /* at a segment's end, onto the piece of the cell's next segment there: that piece's parity
+     * checked, and the turn (left for a convex face) */
     for (I a = 0; a < m; a++) {
-        for (I t = 0; t <= k[a]; t++) {
-            I e = base[a] + t, nx2;
-            int bk = back[e], expect;
-            int at_x = bk ? t > 0 : t < k[a];
-            if (at_x) {
-                I oc = optr[a] + (bk ? t - 1 : t), x = occ_x[oc];
-                I o2 = pos[2 * x] == oc ? pos[2 * x + 1] : pos[2 * x];
-                I b = xa[x] == a ? xb[x] : xa[x];
-                I t2 = o2 - optr[b];
-                int turn = c->dX[a] * c->dY[b] - c->dY[a] * c->dX[b] > 0;
-                nx2 = base[b] + t2 + (turn != bk);
-                expect = turn == bk;
-            } else {
-                I pe = partner[2 * c->g[a] + 1 - bk];
-                I b = loc[pe >> 1];
-                if (b < 0) { st = NOT_GENERIC; goto done; }
-                int start = (pe & 1) == 0;
-                nx2 = start ? base[b] : base[b + 1] - 1;
-                expect = !start;
-            }
-            if (back[nx2] != expect) { st = NOT_GENERIC; goto done; }
+        const I ka = k[a];
+        for (int bk = 0; bk < 2; bk++) {  /* the last piece walked forwards, the first backwards */
+            if (((cnt[a] + (bk ? 0 : ka)) & 1) != (bk ? 0 : 1)) continue;
+            I e = bk ? base[a] : base[a] + ka;
+            I pe = partner[2 * c->g[a] + 1 - bk], b = loc[pe >> 1];
+            if (b < 0) { st = NOT_GENERIC; goto done; }
+            int start = (pe & 1) == 0, expect = !start;
+            I nx2 = start ? base[b] : base[b + 1] - 1;
+            if ((((cnt[b] + nx2 - base[b]) & 1) == 0) != expect) { st = NOT_GENERIC; goto done; }
+            const double hx = bk ? -c->dX[a] : c->dX[a], hy = bk ? -c->dY[a] : c->dY[a];
+            const double hx2 = expect ? -c->dX[b] : c->dX[b], hy2 = expect ? -c->dY[b] : c->dY[b];
+            if (!(hx * hy2 - hy * hx2 > 0)) { st = NOT_GENERIC; goto done; }
+            up[e] = (hy < 0) & (hy2 >= 0);
             nxt[e] = nx2;
+            tail[nx2] = start ? c->p0[b] : c->p1[b];
         }
     }
     MARK(T_ARR_NEXT);
-    /* the crossings become corners; each odd half's tail */
-    if (!GROW(&R->verts, 3 * nx) || !GROW(&R->tri, 3 * nsub) || !GROW(&R->tcell, nsub)) { st = NO_MEMORY; goto done; }
+    /* the crossings become corners */
     for (I x = 0; x < nx; x++) {
         const double *A = R->verts.a + 3 * c->p0[xa[x]], *B = R->verts.a + 3 * c->p1[xa[x]];
         double *o = R->verts.a + R->verts.n;
         for (int q = 0; q < 3; q++) o[q] = A[q] + xsp[x] * (B[q] - A[q]);
         R->verts.n += 3;
-        xid[x] = R->n_points + R->n_extra++;
     }
-    for (I a = 0; a < m; a++)
-        for (I t = 0; t <= k[a]; t++) {
-            I e = base[a] + t;
-            if (!back[e]) tail[e] = t > 0 ? xid[occ_x[optr[a] + t - 1]] : c->p0[a];
-            else tail[e] = t < k[a] ? xid[occ_x[optr[a] + t]] : c->p1[a];
-        }
+    R->n_extra += nx;
     MARK(T_ARR_OUTPUT);
-    /* faces, each from its least piece: convex (every turn left, the heading passing +u once),
+    /* faces, each from its least piece (its turns checked above; the heading must pass +u once),
      * fanned from that piece's tail as it is walked (a face that fails leaves the cell to the slabs) */
     memset(seen, 0, nsub);
     I *tri = R->tri.a + R->tri.n, *tc = R->tcell.a + R->tcell.n, ntri = 0;  /* (room: fewer triangles than pieces) */
     for (I e0 = 0; e0 < nsub; e0++) {
         if (seen[e0]) continue;
-        I e = e0, ups = 0, t0 = tail[e0];
-        do {
+        I e = e0, ups = 0, t0 = tail[e0], te = t0;
+        do {  /* (a triangle written at every piece, kept where neither end is e0: room for it) */
             if (seen[e]) { st = NOT_GENERIC; goto done; }
             seen[e] = 1;
-            I e2 = nxt[e];
-            if (!(hx[e] * hy[e2] - hy[e] * hx[e2] > 0)) { st = NOT_GENERIC; goto done; }
-            ups += hy[e] < 0 && hy[e2] >= 0;
-            if (e != e0 && e2 != e0) {
-                tri[3 * ntri] = t0; tri[3 * ntri + 1] = tail[e]; tri[3 * ntri + 2] = tail[e2];
-                tc[ntri++] = cell;
-            }
-            e = e2;
+            I e2 = nxt[e], te2 = tail[e2];
+            ups += up[e];
+            tri[3 * ntri] = t0; tri[3 * ntri + 1] = te; tri[3 * ntri + 2] = te2;
+            tc[ntri] = cell;
+            ntri += (e != e0) & (e2 != e0);
+            e = e2; te = te2;
         } while (e != e0);
         if (ups != 1) { st = NOT_GENERIC; goto done; }
     }
