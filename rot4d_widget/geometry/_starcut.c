@@ -367,8 +367,8 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I m = c->m;
     I nxmax = m * (m - 1) / 2 + 1, nsmax = m + 2 * nxmax + 1;
     /* one block for the cell: its crossings, occurrences and pieces at their most */
-    size_t need = (size_t)(2 * nxmax + 4 * (m + 1) + 6 * nxmax + 3 * nsmax) * sizeof(I)
-                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1)) * sizeof(double) + 2 * (size_t)nsmax;
+    size_t need = (size_t)(2 * nxmax + 4 * (m + 1) + 6 * nxmax + 4 * nsmax) * sizeof(I)
+                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1)) * sizeof(double) + (size_t)nsmax;
     if (ws->cap < need) {
         char *b = realloc(ws->buf, need);
         if (!b) return NO_MEMORY;
@@ -379,8 +379,8 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I *xa = (I *)(L2 + (m + 1)), *xb = xa + nxmax;
     I *k = xb + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
     I *occ_x = cnt + (m + 1), *ux = occ_x + 2 * nxmax, *pos = ux + 2 * nxmax;
-    I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax;
-    unsigned char *seen = (unsigned char *)(fillp + nsmax), *up = seen + nsmax;
+    I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax, *up = fillp + nsmax;
+    unsigned char *seen = (unsigned char *)(up + nsmax);
     const double *restrict X0 = c->X0, *restrict Y0 = c->Y0, *restrict DX = c->dX, *restrict DY = c->dY;
     MARK_START;
     I nx = 0;
@@ -509,18 +509,26 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
      * else the rays disagree: not generic), without a branch on which record's */
     for (I x = 0; x < nx; x++) {
         const I a = xa[x], b = xb[x], oa = pos[2 * x], ob = pos[2 * x + 1];
-        const double dya = c->dY[a], dyb = c->dY[b];
+        const double dya = DY[a], dyb = DY[b];
         const int bka = ((cnt[a] + oa - optr[a]) & 1) == 0, bkb = ((cnt[b] + ob - optr[b]) & 1) == 0;
-        const int turn = c->dX[a] * dyb - dya * c->dX[b] > 0;
+        const int turn = DX[a] * dyb - dya * DX[b] > 0;
         bad |= bka == bkb;
-        /* the record whose piece before x is walked forwards (src) ends at x; dst's pieces leave */
-        const I src = bka ? ob + b : oa + a, dst = bka ? oa + a : ob + b;
-        const int tsel = bka ? !turn : turn;
-        const double hs = bka ? dyb : dya, hd = bka ? dya : dyb;
-        nxt[src] = dst + tsel; nxt[src + 1] = dst + !tsel;
+        /* the record whose piece before x is walked forwards (src) ends at x; dst's pieces leave
+         * (selected by masks: the compiler would branch on ?:, and bka is random) */
+        const I ea = oa + a, eb = ob + b, flip = (ea ^ eb) & -(I)bka;
+        const I src = ea ^ flip, dst = eb ^ flip;
+        const int tsel = turn ^ bka;
+        /* up: the heading's y goes from < 0 to >= 0; src walked +d_src, src + 1 -d_src; the next
+         * is dst + 1 (+d_dst) where tsel, else dst (-d_dst); -h < 0 is h > 0, -h >= 0 is h <= 0 */
+        const int neg_a = dya < 0, pos_a = dya > 0, ge_a = dya >= 0, le_a = dya <= 0;
+        const int neg_b = dyb < 0, pos_b = dyb > 0, ge_b = dyb >= 0, le_b = dyb <= 0;
+        const int nb = !bka, nt = !tsel;
+        const int hs_neg = (bka & neg_b) | (nb & neg_a), hs_pos = (bka & pos_b) | (nb & pos_a);
+        const int hd_ge = (bka & ge_a) | (nb & ge_b), hd_le = (bka & le_a) | (nb & le_b);
+        nxt[src] = dst + tsel; nxt[src + 1] = dst + nt;
         tail[dst] = tail[dst + 1] = x0 + x;
-        up[src] = (hs < 0) & ((tsel ? hd : -hd) >= 0);
-        up[src + 1] = (-hs < 0) & ((tsel ? -hd : hd) >= 0);
+        up[src] = hs_neg & ((tsel & hd_ge) | (nt & hd_le));
+        up[src + 1] = hs_pos & ((tsel & hd_le) | (nt & hd_ge));
     }
     if (bad) { st = NOT_GENERIC; goto done; }
     /* at a segment's end, onto the piece of the cell's next segment there: that piece's parity
