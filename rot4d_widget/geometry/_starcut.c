@@ -321,6 +321,17 @@ done:
     return st;
 }
 
+/* the index of the lowest set bit of v != 0 */
+static inline I lowest_bit(uint64_t v) {
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctzll(v);
+#else
+    I i = 0;
+    while (!(v & 1)) { v >>= 1; i++; }
+    return i;
+#endif
+}
+
 typedef struct { char *buf; size_t cap; } Work;  /* scratch memory, grown as needed, freed by the caller */
 
 /* Where records a and b of a cell cross, as parameters s along a and u along b (cross(e, d_b) / den
@@ -368,7 +379,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I nxmax = m * (m - 1) / 2 + 1, nsmax = m + 2 * nxmax + 1;
     /* one block for the cell: its crossings, occurrences and pieces at their most */
     size_t need = (size_t)(2 * nxmax + 4 * (m + 1) + 6 * nxmax + 4 * nsmax) * sizeof(I)
-                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1)) * sizeof(double) + (size_t)nsmax;
+                + (size_t)(4 * nxmax + 2 * nxmax + (m + 1)) * sizeof(double) + 8 * (size_t)(nsmax / 64 + 1);
     if (ws->cap < need) {
         char *b = realloc(ws->buf, need);
         if (!b) return NO_MEMORY;
@@ -380,7 +391,7 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     I *k = xb + nxmax, *optr = k + (m + 1), *base = optr + (m + 1), *cnt = base + (m + 1);
     I *occ_x = cnt + (m + 1), *ux = occ_x + 2 * nxmax, *pos = ux + 2 * nxmax;
     I *nxt = pos + 2 * nxmax, *tail = nxt + nsmax, *fillp = tail + nsmax, *up = fillp + nsmax;
-    unsigned char *seen = (unsigned char *)(up + nsmax);
+    uint64_t *seen = (uint64_t *)(up + nsmax);  /* a bit a piece */
     const double *restrict X0 = c->X0, *restrict Y0 = c->Y0, *restrict DX = c->dX, *restrict DY = c->dY;
     MARK_START;
     I nx = 0;
@@ -451,8 +462,29 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     }
     for (I a = 0; a < m; a++) {
         I s0 = optr[a], s1 = optr[a + 1];
-        I rsum = 0, kk = s1 - s0;
-        for (I i = s0; i < s1; i++) {
+        I rsum = 0, kk = s1 - s0, i = s0;
+#ifdef __SSE2__
+        for (; i + 1 < s1; i += 2) {  /* two at a time: each load compared twice */
+            const double ti = ut[i], ti1 = ut[i + 1];
+            const __m128d vt = _mm_set1_pd(ti), vt1 = _mm_set1_pd(ti1);
+            __m128i cnt2 = _mm_setzero_si128(), cnt3 = _mm_setzero_si128();
+            I j = s0;
+            for (; j + 1 < s1; j += 2) {
+                __m128d v = _mm_loadu_pd(ut + j);
+                cnt2 = _mm_add_epi64(cnt2, _mm_castpd_si128(_mm_cmplt_pd(v, vt)));
+                cnt3 = _mm_add_epi64(cnt3, _mm_castpd_si128(_mm_cmplt_pd(v, vt1)));
+            }
+            int64_t c2[2], c3[2];
+            _mm_storeu_si128((__m128i *)c2, cnt2);
+            _mm_storeu_si128((__m128i *)c3, cnt3);
+            I r = -(c2[0] + c2[1]), r1 = -(c3[0] + c3[1]);
+            for (; j < s1; j++) { r += ut[j] < ti; r1 += ut[j] < ti1; }
+            rsum += r + r1; r += s0; r1 += s0;
+            occ_t[r] = ti; occ_x[r] = ux[i] >> 1; pos[ux[i]] = r;
+            occ_t[r1] = ti1; occ_x[r1] = ux[i + 1] >> 1; pos[ux[i + 1]] = r1;
+        }
+#endif
+        for (; i < s1; i++) {
             double ti = ut[i];
             I r = 0, j = s0;
 #ifdef __SSE2__
@@ -563,14 +595,19 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     MARK(T_ARR_OUTPUT);
     /* faces, each from its least piece (its turns checked above; the heading must pass +u once),
      * fanned from that piece's tail as it is walked (a face that fails leaves the cell to the slabs) */
-    memset(seen, 0, nsub);
+    const I nw = (nsub + 63) >> 6;  /* the least piece not seen found a word at a time (a branch a
+                                      * piece on whether it was seen mispredicts often) */
+    memset(seen, 0, nw * sizeof(uint64_t));
+    if (nsub & 63) seen[nw - 1] = ~(uint64_t)0 << (nsub & 63);  /* no pieces there */
     I *tri = R->tri.a + R->tri.n, *tc = R->tcell.a + R->tcell.n, ntri = 0;  /* (room: fewer triangles than pieces) */
-    for (I e0 = 0; e0 < nsub; e0++) {
-        if (seen[e0]) continue;
+    for (I w = 0; w < nw;) {
+        if (!~seen[w]) { w++; continue; }
+        I e0 = (w << 6) + lowest_bit(~seen[w]);
         I e = e0, ups = 0, t0 = tail[e0], te = t0;
         do {  /* (a triangle written at every piece, kept where neither end is e0: room for it) */
-            if (seen[e]) { st = NOT_GENERIC; goto done; }
-            seen[e] = 1;
+            uint64_t bit = (uint64_t)1 << (e & 63);
+            if (seen[e >> 6] & bit) { st = NOT_GENERIC; goto done; }
+            seen[e >> 6] |= bit;
             I e2 = nxt[e], te2 = tail[e2];
             ups += up[e];
             tri[3 * ntri] = t0; tri[3 * ntri + 1] = te; tri[3 * ntri + 2] = te2;
