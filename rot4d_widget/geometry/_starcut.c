@@ -197,7 +197,7 @@ typedef struct {
     I m;            /* records */
     I *g;           /* global record ids */
     I *p0, *p1;     /* their end points (point ids) */
-    double *X0, *Y0, *dX, *dY;
+    double *X0, *Y0, *dX, *dY;  /* (and a zero record after the m: fill_cells) */
     double *X1, *Y1;  /* the far ends as computed from them (X0 + dX may round otherwise) */
 } Cell2D;
 
@@ -394,21 +394,26 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
     uint64_t *seen = (uint64_t *)(up + nsmax);  /* a bit a piece */
     const double *restrict X0 = c->X0, *restrict Y0 = c->Y0, *restrict DX = c->dX, *restrict DY = c->dY;
     MARK_START;
-    I nx = 0;
+    I nx = 0, nn = 0;
+    I *na = occ_x, *nb = ux;  /* pairs near but not inside (nn), for the shared-end check (free until the order stage) */
     for (I a = 0; a < m; a++) L2[a] = DX[a] * DX[a] + DY[a] * DY[a];
+    L2[m] = 0;  /* (as the zero record after the m: see fill_cells) */
     /* every pair: s along a, u along b (starfill's, to the bit: cb / den equals the sign-corrected
      * quotient exactly); a crossing inside both is kept (nx counts it), one at an end must be where
-     * the two share that end (consecutive in a cycle), a parallel pair (den ~ 0) neither */
+     * the two share that end (consecutive in a cycle, checked below), a parallel pair (den ~ 0)
+     * neither.  Kept pairs and near ones are stored at nx, nn and the count moved on by the test
+     * (the next pair overwrites a dropped one): no branch on which */
     for (I a = 0; a + 1 < m; a++) {
-        const double x0 = c->X0[a], y0 = c->Y0[a], dxa = c->dX[a], dya = c->dY[a], lim = PARALLEL * PARALLEL * L2[a];
-        const I pa0 = c->p0[a], pa1 = c->p1[a];
+        const double x0 = X0[a], y0 = Y0[a], dxa = DX[a], dya = DY[a], lim = PARALLEL * PARALLEL * L2[a];
         I b = a + 1;
 #ifdef __SSE2__
-        /* two pairs at a time: the same IEEE operations as the loop below (min/max as its ?:) */
+        /* two pairs at a time: the same IEEE operations as the loop below (min/max as its ?:); an
+         * odd last one beside the zero record (den = 0: not okd, neither kept nor near) */
         const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vdxa = _mm_set1_pd(dxa), vdya = _mm_set1_pd(dya);
         const __m128d vlim = _mm_set1_pd(lim), e_lo = _mm_set1_pd(EPS_ARR), e_hi = _mm_set1_pd(1 - EPS_ARR);
         const __m128d n_lo = _mm_set1_pd(-EPS_ARR), n_hi = _mm_set1_pd(1 + EPS_ARR);
-        for (; b + 1 < m; b += 2) {
+        const __m128i va = _mm_set1_epi64x(a);
+        for (; b < m; b += 2) {
             __m128d ex = _mm_sub_pd(_mm_loadu_pd(X0 + b), vx0), ey = _mm_sub_pd(_mm_loadu_pd(Y0 + b), vy0);
             __m128d dxb = _mm_loadu_pd(DX + b), dyb = _mm_loadu_pd(DY + b);
             __m128d den = _mm_sub_pd(_mm_mul_pd(vdxa, dyb), _mm_mul_pd(vdya, dxb));
@@ -418,15 +423,16 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             __m128d okd = _mm_cmpgt_pd(_mm_mul_pd(den, den), _mm_mul_pd(vlim, _mm_loadu_pd(L2 + b)));
             int in = _mm_movemask_pd(_mm_and_pd(okd, _mm_and_pd(_mm_cmpgt_pd(lo, e_lo), _mm_cmplt_pd(hi, e_hi))));
             int near = _mm_movemask_pd(_mm_and_pd(okd, _mm_and_pd(_mm_cmpgt_pd(lo, n_lo), _mm_cmplt_pd(hi, n_hi)))) & ~in;
-            double s2[2], u2[2];
-            _mm_storeu_pd(s2, sv); _mm_storeu_pd(u2, uv);
-            for (int j = 0; j < 2; j++) {
-                I bj = b + j;
-                if (near >> j & 1)
-                    bad |= !((pa0 == c->p0[bj]) | (pa0 == c->p1[bj]) | (pa1 == c->p0[bj]) | (pa1 == c->p1[bj]));
-                xa[nx] = a; xb[nx] = bj; xsp[nx] = s2[j]; xup[nx] = u2[j];
-                nx += in >> j & 1;
-            }
+            /* pair b at [n], pair b + 1 at [n + (b's kept)]: over b where b was dropped */
+            I i0 = in & 1, j0 = near & 1;
+            _mm_storeu_si128((__m128i *)(xa + nx), va);
+            xb[nx] = b; xb[nx + i0] = b + 1;
+            _mm_storel_pd(xsp + nx, sv); _mm_storeh_pd(xsp + nx + i0, sv);
+            _mm_storel_pd(xup + nx, uv); _mm_storeh_pd(xup + nx + i0, uv);
+            nx += i0 + (in >> 1);
+            _mm_storeu_si128((__m128i *)(na + nn), va);
+            nb[nn] = b; nb[nn + j0] = b + 1;
+            nn += j0 + (near >> 1);
         }
 #endif
         for (; b < m; b++) {
@@ -437,11 +443,15 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
             int okd = den * den > lim * L2[b];
             int in = okd & (lo > EPS_ARR) & (hi < 1 - EPS_ARR);
             int near = okd & (lo > -EPS_ARR) & (hi < 1 + EPS_ARR);
-            int shared = (pa0 == c->p0[b]) | (pa0 == c->p1[b]) | (pa1 == c->p0[b]) | (pa1 == c->p1[b]);
-            bad |= near & !in & !shared;
             xa[nx] = a; xb[nx] = b; xsp[nx] = s; xup[nx] = u;  /* (a slot to spare: nx < nxmax) */
             nx += in;
+            na[nn] = a; nb[nn] = b;
+            nn += near & !in;
         }
+    }
+    for (I i = 0; i < nn; i++) {
+        const I *p0 = c->p0, *p1 = c->p1, a = na[i], b = nb[i];
+        bad |= !((p0[a] == p0[b]) | (p0[a] == p1[b]) | (p1[a] == p0[b]) | (p1[a] == p1[b]));
     }
     MARK(T_ARR_PAIRS);
     COUNT(C_ARR_TRIED);
@@ -965,7 +975,7 @@ static void fill_cells(Filler *f) {
     Work ws = {0};
     int st = OK;
     cg = malloc((3 * mmax + 1) * sizeof(I));
-    cd = malloc((6 * mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
+    cd = malloc(6 * (mmax + 1) * sizeof(double));  /* a cell's plane coordinates (heap: a cell may hold thousands) */
     if (!cg || !cd) { st = NO_MEMORY; goto done; }
     for (I c_lo; st == OK && (c_lo = atomic_fetch_add(&g->next, CHUNK)) < g->C;)
     for (I cc = c_lo; cc < c_lo + CHUNK && cc < g->C && st == OK; cc++) {
@@ -973,7 +983,8 @@ static void fill_cells(Filler *f) {
         if (!m || g->cdone[cc]) continue;
         if (f->who) atomic_store(&g->took2, 1);
         I *co = g->cell_out + 5 * cc, e_before = R->n_extra, t_before = R->tcell.n;
-        double *X0 = cd, *Y0 = cd + mmax, *dX = cd + 2 * mmax, *dY = cd + 3 * mmax, *X1 = cd + 4 * mmax, *Y1 = cd + 5 * mmax;
+        const I ms = mmax + 1;  /* (room for a zero record after the m) */
+        double *X0 = cd, *Y0 = cd + ms, *dX = cd + 2 * ms, *dY = cd + 3 * ms, *X1 = cd + 4 * ms, *Y1 = cd + 5 * ms;
         Cell2D c2 = {m, cg, cg + mmax, cg + 2 * mmax, X0, Y0, dX, dY, X1, Y1};
         double uv[6], org[3];
         const double *pts = R->verts.a;  /* (the points: not moved until this cell adds its corners) */
@@ -992,6 +1003,7 @@ static void fill_cells(Filler *f) {
             dX[i] = X1[i] - X0[i];
             dY[i] = Y1[i] - Y0[i];
         }
+        X0[m] = Y0[m] = dX[m] = dY[m] = 0;  /* the zero record: the arrangement's pair tests read records two at a time */
         I nv0 = R->verts.n, ne0 = R->n_extra, nt0 = R->tri.n, nc0 = R->tcell.n;
         int s2 = L->slabs_only ? NOT_GENERIC : arrangement(&c2, loc, L->partner, cc, R, &ws);
         if (s2 == NOT_GENERIC) {  /* left to the slabs: what the arrangement added is dropped */
