@@ -648,7 +648,7 @@ typedef struct {
     int slabs_only;           /* every non-star-shaped section by slabs (tests of the slab fill) */
     int threads;              /* 2: the crossing sections' fills split between this thread and one more */
     int used;                 /* threads the fills took */
-    Result *spare;            /* the second thread's result (a pool's), or NULL: its own */
+    Result *spare;            /* the second thread's result (a pool's), or NULL: one thread */
     void *worker;             /* the pool's second thread (a Worker), or NULL: one thread */
     int recent;               /* this level follows the last closely (two threads may pay) */
     unsigned char *above;     /* (V,) each vertex above H */
@@ -1175,7 +1175,7 @@ static int fill_sections(Level *L) {
     Worker *wk = (Worker *)L->worker;  /* (NULL without a pool: one thread) */
     Result *W = L->spare;
     Filler f1 = {&g, W, 1, OK};
-    int two = wk && W && L->threads > 1 && L->recent && work >= PARALLEL_WORK;
+    int two = wk && W && L->recent && work >= PARALLEL_WORK;  /* (recent: threads > 1) */
     if (two) {
         result_reset(W);
         W->n_points = R->n_points;
