@@ -63,7 +63,8 @@ def main() -> None:
     args = ap.parse_args()
     work = (ROOT / SOURCE).read_bytes()
     if args.base_file is not None:
-        sides = [(args.base_file, pathlib.Path(args.base_file).read_bytes(), args.flags), ("working tree", work, args.flags)]
+        base = pathlib.Path(args.base_file).read_bytes()
+        sides = [(args.base_file, base, args.flags), ("working tree", work, args.flags)]
     elif args.base_flags is None:
         old = subprocess.run(["git", "-C", str(ROOT), "show", f"{args.rev}:{SOURCE}"], check=True,
                              capture_output=True).stdout
