@@ -564,9 +564,9 @@ static int arrangement(const Cell2D *c, const I *loc, const I *partner, I cell, 
          * is dst + 1 (+d_dst) where tsel, else dst (-d_dst); -h < 0 is h > 0, -h >= 0 is h <= 0 */
         const int neg_a = dya < 0, pos_a = dya > 0, ge_a = dya >= 0, le_a = dya <= 0;
         const int neg_b = dyb < 0, pos_b = dyb > 0, ge_b = dyb >= 0, le_b = dyb <= 0;
-        const int nb = !bka, nt = !tsel;
-        const int hs_neg = (bka & neg_b) | (nb & neg_a), hs_pos = (bka & pos_b) | (nb & pos_a);
-        const int hd_ge = (bka & ge_a) | (nb & ge_b), hd_le = (bka & le_a) | (nb & le_b);
+        const int fa = !bka, nt = !tsel;  /* fa: a's piece before x walked forwards (src is a) */
+        const int hs_neg = (bka & neg_b) | (fa & neg_a), hs_pos = (bka & pos_b) | (fa & pos_a);
+        const int hd_ge = (bka & ge_a) | (fa & ge_b), hd_le = (bka & le_a) | (fa & le_b);
         nxt[src] = dst + tsel; nxt[src + 1] = dst + nt;
         tail[dst] = tail[dst + 1] = x0 + x;
         up[src] = hs_neg & ((tsel & hd_ge) | (nt & hd_le));
