@@ -7,7 +7,6 @@ first shown, under the canvas.
 
 from __future__ import annotations
 
-import html
 import logging
 from collections.abc import Mapping
 
@@ -15,6 +14,7 @@ import ipywidgets as widgets
 from ipyevents import Event
 from ipywidgets.widgets.widget import _instances
 
+from . import markup
 from .keys import page_time
 
 __all__ = ["KeyPad", "PAD_ROWS", "PAD_EVENTS", "close_quietly"]
@@ -86,7 +86,7 @@ class KeyPad:
                 self.events.append(ev)
                 buttons.append(b)
             if buttons:
-                label = widgets.HTML(f"<small>{html.escape(title)}</small>", layout=widgets.Layout(width="4.5em"))
+                label = markup.html_widget(markup.keypad_label_html(title), layout=widgets.Layout(width="4.5em"))
                 rows.append(widgets.HBox([label, *buttons], layout=widgets.Layout(flex_flow="row wrap")))
         box = widgets.VBox(rows, layout=widgets.Layout(margin="0.3em 0 0 0"))
         box.add_class("rot4d-keypad")
