@@ -268,3 +268,15 @@ def test_an_animation_draws_hostile_text_as_written(flame, tmp_path):
     rec = flame.recording
     n = render_animation(rec, source=flame.source, path=tmp_path / "a.gif", progress=False, size=(160, 120))
     assert n >= 2 and (tmp_path / "a.gif").stat().st_size > 0
+
+
+def test_a_recording_s_fields_are_text_when_replayed(make, tmp_path):
+    w = make(HostileSource())
+    w.press("o")
+    w.press("4")
+    path = tmp_path / "keys.json"
+    w.recording.save(path)
+    again = make(HostileSource())
+    again.replay(path)
+    again.press("o")  # the replayed keymap's action, shown as the last step
+    assert_literal(shown_text(again), IMG, SVG)
