@@ -16,6 +16,7 @@ from ..core import look
 from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source
 from . import markup as ro
+from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut
 from .volume_layer import volume_message
 
@@ -64,7 +65,8 @@ def title(source) -> str:
 def checked_slice(source, matrix, c0, coarse, lock):
     """``source.slice`` validated once (`rot4d_widget.sources.protocol.check_slice`): a bad slice (None,
     non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
-    or TypeError naming the source and the member that is wrong, and is never drawn."""
+    or TypeError naming the source and the member that is wrong, and is never drawn; a slice
+    over the update cap raises `rot4d_widget.view.buffers.UpdateTooLarge`."""
     with lock:
         data = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
         n_groups = int(source.n_groups)
@@ -72,6 +74,7 @@ def checked_slice(source, matrix, c0, coarse, lock):
         check_slice(data, n_groups)
     except (TypeError, ValueError) as exc:
         raise BadSlice(f"{title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
+    check_update_size(data, name=title(source))
     return data
 
 

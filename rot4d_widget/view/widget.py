@@ -557,7 +557,7 @@ def _build_children(w, options) -> None:
 
     built = []
     try:
-        w.scene = Scene(capacity=estimate_capacity(w.source), **options)
+        w.scene = Scene(capacity=estimate_capacity(w.source, name=title(w.source)), **options)
         built.append(w.scene)
         w.companion = Companion(w.scene)
         built.append(w.companion)
