@@ -148,10 +148,11 @@ def update_bytes(data) -> int:
     return n
 
 
-def check_update_size(data, more: int = 0, *, name: str = "the source") -> None:
-    """`UpdateTooLarge` when a slice's update (plus ``more`` bytes that travel with it: a volume's
-    atlas) would exceed `MAX_UPDATE_BYTES`; the message says how large and what is allowed."""
-    n = update_bytes(data) + int(more)
+def check_update_size(data, *, volume=None, name: str = "the source") -> None:
+    """`UpdateTooLarge` when a slice's update (with the binary parts of a ``volume`` message that
+    travels with it: atlas, boxes, colour table) would exceed `MAX_UPDATE_BYTES`; the message
+    says how large and what is allowed."""
+    n = update_bytes(data) + sum(v.nbytes for v in (volume or {}).values() if isinstance(v, memoryview))
     if n > MAX_UPDATE_BYTES:
         raise UpdateTooLarge(
             f"{name}'s slice ({len(data.points):,} points, {len(data.segments):,} segments, "

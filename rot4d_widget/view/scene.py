@@ -398,7 +398,7 @@ class Scene:
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
-        bf.check_update_size(data, _payload_bytes(volume))  # before anything is built
+        bf.check_update_size(data, volume=volume)  # before anything is built
         smooth = getattr(data, "normals", None) is not None
         surface = None
         if smooth:  # the triangles go to the surface layer, quantised; the rows carry the rest
@@ -551,13 +551,6 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"
-
-
-def _payload_bytes(message) -> int:
-    """The bytes of the binary parts of a message dict (a volume's atlas, boxes, colour table)."""
-    if not message:
-        return 0
-    return sum(v.nbytes for v in message.values() if isinstance(v, memoryview))
 
 
 def _build_three(scene, antialias, display):
