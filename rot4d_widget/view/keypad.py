@@ -127,9 +127,14 @@ class KeyPad:
             close_quietly(self.box)
 
 
+#: The widgets a widget makes for itself when it is made (its defaults): closed with it.
+OWN_PARTS = ("layout", "style", "shadowMap")  # shadowMap: a pythreejs WebGLRenderer's own
+
+
 def close_quietly(w) -> None:
-    """Close a widget and its own Layout / Style widgets; never raises (close() must not stop halfway)."""
-    subs = [getattr(w, name, None) for name in ("layout", "style")] if isinstance(w, widgets.Widget) else []
+    """Close a widget and the widgets it made for itself (`OWN_PARTS`: its Layout, Style, a renderer's
+    WebGLShadowMap); never raises (close() must not stop halfway)."""
+    subs = [getattr(w, name, None) for name in OWN_PARTS] if isinstance(w, widgets.Widget) else []
     try:
         w.close()
     except Exception:

@@ -65,13 +65,13 @@ import pathlib
 import re
 import uuid
 
-import ipywidgets as widgets
 import numpy as np
 import pythreejs as p3
 from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
+from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
@@ -543,11 +543,7 @@ class Scene:
         except ValueError:
             pass
         for w in self._widgets:  # with the Layout / Style / shadow map each one made for itself
-            subs = [getattr(w, name, None) for name in ("layout", "style", "shadowMap")]
-            w.close()
-            for sub in subs:
-                if isinstance(sub, widgets.Widget):
-                    sub.close()
+            close_quietly(w)
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"
