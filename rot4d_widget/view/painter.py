@@ -147,8 +147,8 @@ class Painter:
         same_cut = rows is not None and key.same_cut(rows)
         # a stack turns each slice about its own centre: never turned as a whole
         turn = key.turn_from(rows) if same_cut and inner_source(w.source) is w.source else None
-        if shown is not None and key.same(shown) and (shown is rows or held):
-            pass  # the view shows this state (turned rows only while keys are held)
+        if shown is not None and key.same(shown) and (shown is rows or held) and not scene.unsent:
+            pass  # the page shows this state (turned rows only while keys are held)
         elif held and turn is not None and (key.coarse or not rows.coarse):
             if scene.turn(turn, **self.projection(key)):
                 sent = scene.update_id

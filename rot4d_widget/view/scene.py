@@ -487,6 +487,9 @@ class Scene:
             raise
         self._unsent = False
 
+    unsent = property(lambda self: self._unsent, doc="A send failed and none succeeded since: the page is "
+                      "behind, so the picture goes again even if unchanged.")
+
     @property
     def counts(self) -> list:
         """Rows each layer draws now: [balls, bars, faces] (the rest of the capacity is skipped)."""
