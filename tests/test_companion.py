@@ -15,13 +15,17 @@ import os
 import pathlib
 import shutil
 import subprocess
+import tempfile
 
 import pytest
 
 import rot4d_widget
+from rot4d_widget.view.bundle import ENTRY, PAGE_DIR, page_module
 from rot4d_widget.view.companion import Companion
 
-JS = pathlib.Path(rot4d_widget.__file__).parent / "view" / "companion.js"
+#: The module the front end receives (the page's modules joined), as a file Node can import.
+JS = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-page-")) / "page.mjs"
+JS.write_text(page_module())
 
 
 pytestmark = pytest.mark.usefixtures("recording_comms")  # tests/conftest.py
@@ -120,11 +124,11 @@ def test_a_failing_callback_does_not_escape(caplog):
 
 
 def test_the_module_ships_inside_the_package():
-    assert JS.is_file()
-    assert JS.parent == pathlib.Path(rot4d_widget.__file__).parent / "view"  # hatch packages the whole folder
+    assert (PAGE_DIR / ENTRY).is_file()
+    assert PAGE_DIR == pathlib.Path(rot4d_widget.__file__).parent / "view" / "page"  # hatch packages the folder
     text = JS.read_text()
     assert "export default" in text
-    assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped file
+    assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped modules, joined
 
 
 # ------------------------------------------------------------------ JavaScript under Node

@@ -96,7 +96,7 @@ def test_names_and_version(dists):
 
 def test_wheel_carries_the_package_its_javascript_and_glsl(wheel_names):
     names = set(wheel_names)
-    assert "rot4d_widget/view/companion.js" in names
+    assert "rot4d_widget/view/page/companion.js" in names and "rot4d_widget/view/page/package.json" in names
     glsl = {n for n in names if n.startswith("rot4d_widget/view/glsl/")}
     assert glsl and glsl == {f for f in _package_files() if f.startswith("rot4d_widget/view/glsl/")}
     # every file of the package, no more and no less (a new module or shader cannot be forgotten)
@@ -183,7 +183,7 @@ def test_sdist_builds_the_wheel_from_what_it_carries(dists):
     with tarfile.open(dists[0]) as t:
         names = {n.split("/", 1)[1] for n in t.getnames() if "/" in n}
     for needed in ("pyproject.toml", "README.md", "LICENSE", "CHANGELOG.md", "PKG-INFO",
-                   "jupyter-config/jupyter_server_config.d/rot4d_widget.json", "rot4d_widget/view/companion.js"):
+                   "jupyter-config/jupyter_server_config.d/rot4d_widget.json", "rot4d_widget/view/page/companion.js"):
         assert needed in names, needed
     assert not [n for n in names if n.startswith(("test-artifacts/", ".ci-venv/", ".venv/", "dist/"))
                 or "__pycache__" in n or n.endswith(".pyc")]

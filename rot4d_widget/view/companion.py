@@ -1,8 +1,9 @@
 """`Companion`: the few lines of front-end JavaScript the widget needs (anywidget).
 
 An invisible widget (display it next to the scene's renderer, e.g. in the
-same box) whose module, ``companion.js``, ships in the package (no build
-step) and does these things in JupyterLab 4 and Notebook 7 alike:
+same box) whose module -- the page's code, ``rot4d_widget/view/page/*.js``, joined by
+`rot4d_widget.view.bundle` (no build step) -- does these things in JupyterLab 4 and
+Notebook 7 alike:
 
 1. **drawn acknowledgement** -- after the page has *rendered* a frame
    containing the latest buffer assignment (not merely on arrival): at the
@@ -73,11 +74,12 @@ from __future__ import annotations
 import base64
 import binascii
 import math
-import pathlib
 
 import anywidget
 from ipywidgets import CallbackDispatcher, Layout
 from traitlets import List, Unicode
+
+from .bundle import page_module
 
 __all__ = ["Companion"]
 
@@ -91,7 +93,7 @@ class Companion(anywidget.AnyWidget):
     arguments.
     """
 
-    _esm = pathlib.Path(__file__).with_name("companion.js")
+    _esm = page_module()
 
     buffer_model_id = Unicode("").tag(sync=True)
     scene_model_id = Unicode("").tag(sync=True)
