@@ -243,6 +243,11 @@ class RotationState:
                                   must="> 0 (or inf)")
 
     @property
+    def reset_point(self) -> tuple:
+        """``(theta0, alpha, c0, matrix)``: the state `reset` returns to (as made, or as restored)."""
+        return self._initial
+
+    @property
     def alpha_step(self) -> float:
         """How much "k"/"j" change alpha: ``theta0 * ALPHA_STEP_FRACTION``."""
         return self._theta0 * ALPHA_STEP_FRACTION
@@ -273,10 +278,13 @@ class RotationState:
                 return False  # refused, not clamped: the opposite key undoes every step made
             self.alpha = new
         elif kind == "c0":
-            new = self._c0 + action.sign * self._c0_step
+            step = self._c0_step
+            new = self._c0 + action.sign * step
             o = self._c0_origin
             if abs(new - o) > self._c0_limit and abs(new - o) >= abs(self._c0 - o):
                 return False
+            if new + step == new or new - step == new:
+                return False  # where the step would no longer move c0: refused (`_check_c0_steps`)
             self.c0 = new
         elif kind == "theta0":
             new = self._theta0 * THETA0_FACTOR if action.sign > 0 else self._theta0 / THETA0_FACTOR

@@ -56,6 +56,8 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
+import { PageKeymap, keyId } from "./keymap.js";
+import { PageState } from "./state.js";
 
 export { decodeSkeleton, projectSkeleton };
 
