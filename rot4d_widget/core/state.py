@@ -242,6 +242,16 @@ class RotationState:
         self._c0_limit = positive(value, "c0_limit", what="a number > 0 (or inf)", finite=False,
                                   must="> 0 (or inf)")
 
+    def snapshot(self) -> tuple:
+        """``(matrix, theta0, alpha, c0)`` now: what `restore_snapshot` sets back exactly."""
+        return (self._matrix, self._theta0, self._alpha, self._c0)
+
+    def restore_snapshot(self, snap: tuple) -> None:
+        """Set the orientation, theta0, alpha and c0 to a `snapshot` of this state, exactly (the
+        matrix object is shared: matrices are never edited)."""
+        self._matrix, self._theta0, self._alpha, self._c0 = snap
+        self._steps.clear()
+
     @property
     def reset_point(self) -> tuple:
         """``(theta0, alpha, c0, matrix)``: the state `reset` returns to (as made, or as restored)."""

@@ -77,7 +77,7 @@ import math
 
 import anywidget
 from ipywidgets import CallbackDispatcher, Layout
-from traitlets import List, Unicode
+from traitlets import Dict, List, Unicode
 
 from .bundle import page_module
 
@@ -105,6 +105,13 @@ class Companion(anywidget.AnyWidget):
     projection_model_ids = List(Unicode()).tag(sync=True)
     #: the projection canvas's CSS class (its key guards and its test hook)
     projection_class = Unicode("").tag(sync=True)
+    #: what the page needs to step its own copy of the state (`pagestate.page_config`): the key
+    #: table, the bounds, the hold delay and tick rate, the kinds it steps
+    config = Dict().tag(sync=True)
+    #: the kernel's state and its id (`pagestate.state_message` under "state", "epoch", "upto": the
+    #: page time in ms up to which it holds the page's steps, None before any; "picture": the id of
+    #: the scene update that shows it, or None): the page adopts it and applies its later steps on top
+    kernel_state = Dict().tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -122,6 +129,7 @@ class Companion(anywidget.AnyWidget):
         self._drawn_handlers = CallbackDispatcher()
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
+        self._clock_handlers = CallbackDispatcher()
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
@@ -138,8 +146,14 @@ class Companion(anywidget.AnyWidget):
         """Call ``callback(update_id)`` when the page has drawn that update."""
         self._drawn_handlers.register_callback(callback, remove=remove)
 
+    def on_clock(self, callback, remove=False):
+        """Call ``callback(t_ms)`` with the page's clock (ms, the key events' timeStamp clock) as the
+        page sends it with the steps it makes while a key is held."""
+        self._clock_handlers.register_callback(callback, remove=remove)
+
     def on_focus_lost(self, callback, remove=False):
-        """Call ``callback(reason)`` (``"blur"`` or ``"hidden"``) when the page loses focus."""
+        """Call ``callback(reason, t_ms)`` (``"blur"`` or ``"hidden"``; the page's time, or None) when
+        the page loses focus."""
         self._focus_handlers.register_callback(callback, remove=remove)
 
     def _handle_message(self, _widget, content, _buffers=None):
@@ -162,8 +176,13 @@ class Companion(anywidget.AnyWidget):
                 error = "the page sent no PNG"
             self._screenshot_handlers(rid, png, None if png is not None else str(error))
         elif event == "focus_lost":
-            reason = content.get("reason")
-            self._focus_handlers(reason if isinstance(reason, str) else "")
+            reason, t = content.get("reason"), content.get("t")
+            ok = isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)
+            self._focus_handlers(reason if isinstance(reason, str) else "", float(t) if ok else None)
+        elif event == "clock":
+            t = content.get("t")
+            if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+                self._clock_handlers(float(t))
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -106,7 +106,7 @@ class KeyPad:
                     return
                 action, inverted = found
                 with w._pump.lock:
-                    if w._closed or key_id in w._repeater.held_keys:
+                    if w._closed or key_id in w._keys.held:
                         return  # a touch's emulated mousedown: one press only
                     w._keys.press(key_id, action, inverted, page_time(event))
             elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):

@@ -56,8 +56,7 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
-import { PageKeymap, keyId } from "./keymap.js";
-import { PageState } from "./state.js";
+import { adoptKernel, attachKeys, turning } from "./turning.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -107,11 +106,50 @@ async function render({ model, el }) {
     cleanups.push(() => clearTimeout(t));
   }
 
-  // 2. focus loss
-  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur" }));
+  // 2. focus loss (with the page's time: held keys are released then on both sides)
+  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur", t: performance.now() }));
   listen(document, "visibilitychange", () => {
-    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden" });
+    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden", t: performance.now() });
   });
+
+  // 8. the page turns: its own copy of the state, stepped by the keys over this widget's canvases
+  // (turning.js); the kernel's state adopted as it arrives
+  const canvasClasses = () => [model.get("canvas_class"), model.get("projection_class")].filter((c) => c);
+  const canvases = () => {
+    const out = [];
+    for (const cls of canvasClasses()) {
+      for (const host of document.getElementsByClassName(cls)) out.push(host);
+    }
+    return out;
+  };
+  turning(model);
+  attachKeys(model, { listen, hovered: () => canvasClasses().some(canvasHovered), canvases });
+  const onKernelState = () => adoptKernel(model);
+  const onConfig = () => turning(model);
+  if (typeof model.on === "function") {
+    model.on("change:kernel_state", onKernelState);
+    model.on("change:config", onConfig);
+    cleanups.push(() => {
+      model.off("change:kernel_state", onKernelState);
+      model.off("change:config", onConfig);
+    });
+  }
+  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
+  const pageHook = () => {
+    const p = turning(model).prediction;
+    if (!p || !p.state) return null;
+    const k = p.kernel || {};
+    return { matrix: Array.from(p.state.matrix), theta0: p.state.theta0, alpha: p.state.alpha, c0: p.state.c0,
+             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held };
+  };
+  const hookPage = () => {
+    for (const host of canvases()) host.rot4dPage = pageHook;
+  };
+  listen(document, "mouseover", hookPage, true);
+  for (const ms of [0, 100, 500, 2000]) {
+    const t = setTimeout(hookPage, ms);
+    cleanups.push(() => clearTimeout(t));
+  }
 
   const cleanup = () => {
     alive = false;
