@@ -27,12 +27,6 @@ by path):
     the points' bounding box); whether each edge also runs one way in one polygon and the other
     way in the other, as the boundary's orientation induces, is reported apart (`unclosed`: with
     star faces the even-odd rule does not promise it);
-  - for a polytope with star faces or non-convex cells, where the compiled level is built: the same
-    slice again by the numpy slicer alone (`rot4d_widget.geometry.starslice` with the polytope's
-    compiled tables switched off), which must give the same points (bit for bit), volume (relative
-    ``1e-9``) and area of fill per cell (the triangles' signed area about the cell's normal, to
-    ``1e-9`` of the largest); the summary counts the levels compared (those the C code cut; it
-    declines a level with a vertex on H, which the numpy slicer then does anyway);
   - for a polytope reported convex: the slice's volume equals the volume of
     ``scipy.spatial.ConvexHull`` of its points (relative ``1e-6``, plus 4 x the slice's area x the
     file's `flatness`: a file written with few digits leaves its faces and cells that far from flat).
@@ -64,9 +58,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry import _cstar, starslice
 from rot4d_widget.geometry.mesh import Polytope
-from rot4d_widget.geometry.slicetables import tables
 from rot4d_widget.geometry.slicing import slice_polytope
 
 #: distance (relative to the circumradius) within which a slice point and an edge crossing agree
@@ -233,56 +225,6 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     return problems
 
 
-def _fill_area(s, normals) -> np.ndarray:
-    v, t, c = np.asarray(s.vertices), np.asarray(s.triangles), np.asarray(s.triangle_cells)
-    n = normals[c] / np.linalg.norm(normals[c], axis=1)[:, None]
-    a = 0.5 * np.einsum("ij,ij->i", np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), n)
-    return np.bincount(c, weights=a, minlength=len(normals))
-
-
-def _polygons(s) -> collections.Counter:
-    """A slice's polygons as (cell, cycle) from its least corner, each cycle either way round."""
-    out = collections.Counter()
-    flat, off = np.asarray(s.polygon_indices).tolist(), np.asarray(s.polygon_offsets).tolist()
-    for i, c in enumerate(np.asarray(s.cell_ids).tolist()):
-        cyc = flat[off[i]:off[i + 1]]
-        k = cyc.index(min(cyc))
-        fwd = cyc[k:] + cyc[:k]
-        out[(c, min(tuple(fwd), tuple(fwd[:1] + fwd[1:][::-1])))] += 1
-    return out
-
-
-def against_numpy(p: Polytope, s, m: np.ndarray, c0: float) -> list[str] | None:
-    """What differs between slice ``s`` (compiled level) and the numpy slicer's of the same level; None
-    where there is nothing to compare (no star faces or cells, or no compiled level built)."""
-    if p.star is None:
-        return None
-    t = tables(p)
-    st = starslice.star_tables(p, t)
-    if st.c is None or _cstar.cut(st.c, t.vertices @ m.T, m, c0 / t.unit, t.tol) is None:
-        return None  # no compiled level, or it declines this level (the numpy slicer did it)
-    keep, st.c = st.c, None
-    try:
-        ref = slice_polytope(p, m, c0)
-    finally:
-        st.c = keep
-    out = []
-    n, nr = len(s.vertices) - s.n_fill, len(ref.vertices) - ref.n_fill
-    if n != nr or not np.array_equal(np.asarray(s.vertices)[:n], np.asarray(ref.vertices)[:nr]):
-        out.append(f"c0={c0:.4g}: compiled and numpy slice points differ")
-    if (s.volume is None) != (ref.volume is None) or (
-            s.volume is not None and abs(s.volume - ref.volume) > 1e-9 * max(1.0, abs(ref.volume))):
-        out.append(f"c0={c0:.4g}: compiled volume {s.volume!r}, numpy {ref.volume!r}")
-    if _polygons(s) != _polygons(ref):  # (either way round: a cycle of no area has no right one)
-        out.append(f"c0={c0:.4g}: compiled and numpy polygons differ")
-    if s.dim == 3 and ref.dim == 3:
-        normals = t.cell_normals @ m[:3].T
-        a, b = _fill_area(s, normals), _fill_area(ref, normals)
-        if np.abs(a - b).max(initial=0) > 1e-9 * max(1.0, float(np.abs(b).max(initial=0))):
-            out.append(f"c0={c0:.4g}: compiled and numpy fill areas differ (worst {np.abs(a - b).max():.3g})")
-    return out
-
-
 def levels(p: Polytope, m: np.ndarray, n: int) -> list[float]:
     """c0 = 0 and ``n`` levels spread over the rotated w range (never exactly at a vertex)."""
     w = p.vertices @ m.T[:, 3]
@@ -350,22 +292,18 @@ def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str
                 problems.append(f"counts: the file has {len(v)} vertices and {len(e)} face edges, the polytope "
                                 f"{len(p.vertices)} and {len(p.edges)}")
             slice_polytope(p, m, 0.0)  # builds the slicing tables (not timed)
-            times, negative, wound, compared = [], [], [], 0
+            times, negative, wound = [], [], []
             for c0 in levels(p, m, nlevels):
                 t1 = time.perf_counter()
                 s = slice_polytope(p, m, c0)
                 times.append((time.perf_counter() - t1) * 1e3)
                 found = check_slice(p, s, v, e, m, c0, flat=flat)
-                diff = against_numpy(p, s, m, c0)
-                if diff is not None:
-                    compared += 1
-                    found += diff
                 problems += [x for x in found if "not wound" not in x]
                 wound += [x for x in found if "not wound" in x]
                 if s.volume is not None and s.volume < 0:
                     negative.append(c0)
             row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative,
-                       wound=wound, compared=compared)
+                       wound=wound)
         except Exception as exc:  # noqa: BLE001 -- a slicer failure is a finding, reported per file
             row.update(slice_ms=None, problems=[f"slice raised {type(exc).__name__}: {exc}"], ok=False, negative=[],
                        wound=[])
@@ -448,9 +386,6 @@ def summary(rows: list[dict]) -> str:
                    f"the same way; not counted as failed: even-odd sections of star faces close up only as a set, "
                    f"and a boundary with no orientation, hemi or not orientable, induces none): "
                    f"{len(wound)}  ({', '.join(wound[:8])}{', ...' if len(wound) > 8 else ''})")
-    compared = [r for r in loaded if r.get("compared")]
-    out.append(f"  compiled level against the numpy slicer: {sum(r['compared'] for r in compared)} levels of "
-               f"{len(compared)} files compared (compiled level {'built' if _cstar.available else 'NOT built'})")
     if loaded:
         out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "
                    f"max {max(r['load_ms'] for r in loaded):.0f}; slice ms median "

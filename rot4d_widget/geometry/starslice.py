@@ -33,10 +33,6 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
   so the slices' volumes integrate over c0 to the 4-volume the divergence theorem gives
   (Cavalieri).
 
-A level with no vertex on H is cut by the same rules in C when the package was built with a C
-compiler (`rot4d_widget.geometry._cstar`, ``_starcut.c``: one pass instead of some 250 array
-steps); this module stays the reference and does every level the C code declines.
-
 Vertices on H are resolved by simulation of simplicity: they count as above H (the slice just
 below c0, as a limit) unless some cell lies in H, when the side whose slice has the larger volume
 is kept (so the cap of a prism at its end level is there).  The crossing points of the edges at
@@ -51,7 +47,6 @@ import weakref
 import numpy as np
 
 from ..core import tolerances as tol_
-from . import _cstar
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
@@ -89,7 +84,6 @@ class _StarTables:
         mate = np.where(size == 2, o[np.minimum(np.arange(len(ks)) + 1 - 2 * pos, len(ks) - 1)], -1)
         self.slot_mate = np.empty(len(ks), dtype=np.intp)
         self.slot_mate[o] = mate
-        self.c = _cstar.CTables(p, t, self) if _cstar.available else None
 
 
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -105,11 +99,6 @@ def star_tables(p, t: _Tables) -> _StarTables:
 def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
     st = star_tables(p, t)
-    if st.c is not None:  # the compiled generic level; None where it declines (a vertex on H, a tie)
-        r = _cstar.cut(st.c, x, m, c0, t.tol)
-        if r is not None:
-            v, edges, flat, offsets, cells, tri, tcell, volume, n_fill = r
-            return Slice(_scaled(t, v), edges, flat, offsets, cells, tri, tcell, _scaled_volume(t, volume), 3, n_fill)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol
     out = None
