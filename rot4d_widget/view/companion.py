@@ -80,6 +80,7 @@ from ipywidgets import CallbackDispatcher, Layout
 from traitlets import Dict, List, Unicode
 
 from .bundle import page_module
+from .transfer import Transfers
 
 __all__ = ["Companion"]
 
@@ -112,6 +113,9 @@ class Companion(anywidget.AnyWidget):
     #: page time in ms up to which it holds the page's steps, None before any; "picture": the id of
     #: the scene update that shows it, or None): the page adopts it and applies its later steps on top
     kernel_state = Dict().tag(sync=True)
+    #: the one-time transfers the kernel offers, name -> key (`transfer.Transfers`): a page that does
+    #: not hold one asks for it
+    page_data = Dict().tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -130,6 +134,7 @@ class Companion(anywidget.AnyWidget):
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
         self._clock_handlers = CallbackDispatcher()
+        self.transfers = Transfers(self)
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
@@ -179,6 +184,10 @@ class Companion(anywidget.AnyWidget):
             reason, t = content.get("reason"), content.get("t")
             ok = isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)
             self._focus_handlers(reason if isinstance(reason, str) else "", float(t) if ok else None)
+        elif event == "want":
+            name, key = content.get("name"), content.get("key")
+            if isinstance(name, str) and isinstance(key, str):
+                self.transfers.want(name, key)
         elif event == "clock":
             t = content.get("t")
             if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):

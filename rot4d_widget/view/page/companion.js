@@ -57,6 +57,7 @@ import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } 
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, turning } from "./turning.js";
+import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -134,6 +135,18 @@ async function render({ model, el }) {
       model.off("change:config", onConfig);
     });
   }
+  // 9. one-time transfers (transfer.js): asked for when offered and not held, put together here
+  const onPageData = () => askForTransfers(model);
+  const onTransfer = (msg, buffers) => receiveChunk(model, msg, buffers && buffers[0]);
+  if (typeof model.on === "function") {
+    model.on("change:page_data", onPageData);
+    model.on("msg:custom", onTransfer);
+    cleanups.push(() => {
+      model.off("change:page_data", onPageData);
+      model.off("msg:custom", onTransfer);
+    });
+  }
+  onPageData();
   // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
   const pageHook = () => {
     const p = turning(model).prediction;
