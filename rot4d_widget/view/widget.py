@@ -245,7 +245,7 @@ class Rot4DWidget(widgets.HBox):
         self._pump = UpdatePump(
             self._painter.send, tick=self._keys.tick, deadline=self._keys.deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
-            name=f"rot4d-ticker-{id(self):x}",
+            name=f"rot4d-ticker-{id(self):x}", tick_rate=repeater.tick_rate,
         )
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
         self._keeper = Keeper(self, state, self._pump.clock)
