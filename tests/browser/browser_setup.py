@@ -167,3 +167,112 @@ class JupyterServer:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
         self.log.close()
+
+
+class DelayProxy:
+    """A TCP proxy on 127.0.0.1 that holds every chunk of bytes for half of ``rtt_ms`` in each
+    direction, keeping their order: the page then sees the kernel as a remote user does (Binder,
+    JupyterHub: 50-300 ms away).  Open the page through ``port``; the server sees the same Host
+    and Origin, so its token and WebSocket checks pass.  ``rtt_ms`` may change between
+    measurements (`set_rtt`).  Runs an asyncio loop in a thread of its own."""
+
+    def __init__(self, target_port: int, rtt_ms: float = 0.0):
+        import asyncio
+        import threading
+
+        self.target_port = target_port
+        self.rtt_ms = float(rtt_ms)
+        self.port = free_port()
+        self._loop = asyncio.new_event_loop()
+        self._ready = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="delay-proxy", daemon=True)
+        self._server = None
+        self._thread.start()
+        if not self._ready.wait(10):
+            raise RuntimeError("the delay proxy did not start")
+
+    def set_rtt(self, rtt_ms: float) -> None:
+        self.rtt_ms = float(rtt_ms)
+
+    def _run(self):
+        import asyncio
+
+        asyncio.set_event_loop(self._loop)
+
+        async def pipe(reader, writer):
+            queue: asyncio.Queue = asyncio.Queue()
+
+            async def read():
+                while True:
+                    data = await reader.read(65536)
+                    await queue.put((time.monotonic() + self.rtt_ms / 2000.0, data))
+                    if not data:
+                        return
+
+            async def write():
+                while True:
+                    due, data = await queue.get()
+                    wait = due - time.monotonic()
+                    if wait > 0:
+                        await asyncio.sleep(wait)
+                    if not data:
+                        writer.close()
+                        return
+                    writer.write(data)
+                    await writer.drain()
+
+            try:
+                await asyncio.gather(read(), write())
+            except (ConnectionError, OSError):
+                writer.close()
+
+        async def handle(client_reader, client_writer):
+            try:
+                server_reader, server_writer = await asyncio.open_connection("127.0.0.1", self.target_port)
+            except OSError:
+                client_writer.close()
+                return
+            for w in (client_writer, server_writer):
+                sock = w.get_extra_info("socket")
+                if sock is not None:
+                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            await asyncio.gather(pipe(client_reader, server_writer), pipe(server_reader, client_writer),
+                                 return_exceptions=True)
+
+        async def start():
+            self._server = await asyncio.start_server(handle, "127.0.0.1", self.port)
+            self._ready.set()
+
+        self._loop.run_until_complete(start())
+        self._loop.run_forever()
+
+    def stop(self) -> None:
+        def close():
+            if self._server is not None:
+                self._server.close()
+            self._loop.stop()
+
+        self._loop.call_soon_threadsafe(close)
+        self._thread.join(timeout=5)
+
+
+class RemoteServer:
+    """A `JupyterServer` seen through a `DelayProxy`: the same server, its URLs on the proxy's port."""
+
+    def __init__(self, server: JupyterServer, rtt_ms: float):
+        self.server = server
+        self.proxy = DelayProxy(server.port, rtt_ms)
+        self.rtt_ms = rtt_ms
+
+    def __getattr__(self, name):
+        return getattr(self.server, name)
+
+    @property
+    def url(self) -> str:
+        return f"http://127.0.0.1:{self.proxy.port}"
+
+    def notebook_url(self, name: str) -> str:
+        return self.server.notebook_url(name).replace(self.server.url, self.url, 1)
+
+    def stop(self) -> None:
+        self.proxy.stop()

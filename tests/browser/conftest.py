@@ -25,6 +25,7 @@ from browser_setup import (  # the building blocks, shared with benchmarks/brows
     INSTALL_HINT,
     ROOT,
     JupyterServer,
+    RemoteServer,
     apt_install_chromium,
     installed_chromium,
     playwright_chromium,
@@ -53,6 +54,18 @@ def jupyter_server(request, tmp_path_factory):
     server.start()
     yield server
     server.stop()
+
+
+#: The round trip of the remote subset (tests marked ``remote``): a kernel on Binder or JupyterHub
+REMOTE_RTT_MS = float(os.environ.get("ROT4D_RTT_MS", "120"))
+
+
+@pytest.fixture(scope="session")
+def remote_server(jupyter_server):
+    """The same server seen through a proxy delaying every byte by half of `REMOTE_RTT_MS` each way."""
+    remote = RemoteServer(jupyter_server, REMOTE_RTT_MS)
+    yield remote
+    remote.stop()
 
 
 @pytest.fixture(scope="session")

@@ -68,6 +68,20 @@ def _settled(jp, var, sel):
 
 @pytest.mark.parametrize("var", ["w", "s"])
 def test_two_keys_held_together_end_equal_on_page_and_kernel_with_no_jump(jupyter_server, page, var):
+    _two_keys(jupyter_server, page, var)
+
+
+@pytest.mark.remote
+@pytest.mark.parametrize("var", ["w", "s"])
+def test_two_keys_held_together_on_a_remote_kernel(remote_server, page, var):
+    """The same through a proxy delaying every byte (a kernel `REMOTE_RTT_MS` away)."""
+    _two_keys(remote_server, page, var)
+    t = time.monotonic()
+    JupyterPage(page, remote_server, "page_turns.ipynb").kernel("pass")
+    assert time.monotonic() - t >= remote_server.rtt_ms / 1000  # the proxy does hold the bytes
+
+
+def _two_keys(jupyter_server, page, var):
     write_notebook(jupyter_server.root / "page_turns.ipynb", CELLS)
     jp = JupyterPage(page, jupyter_server, "page_turns.ipynb").open()
     jp.run_all()
