@@ -55,6 +55,7 @@ class FakeScene:
         self.options = options
         self.canvas = ipywidgets.Box()  # a DOMWidget, as ipyevents requires
         self.canvas._view_count = 0
+        self.canvas_class = "rot4d-canvas-fake"
         self.camera = FakeCamera()
         self.shown = []  # the slices passed to show()
         self.single = []  # their single_rgb

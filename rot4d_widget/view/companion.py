@@ -111,7 +111,8 @@ class Companion(anywidget.AnyWidget):
     config = Dict().tag(sync=True)
     #: the kernel's state and its id (`pagestate.state_message` under "state", "epoch", "upto": the
     #: page time in ms up to which it holds the page's steps, None before any; "picture": the id of
-    #: the scene update that shows it, or None): the page adopts it and applies its later steps on top
+    #: the scene update that shows it, None when the picture shown does, "pending" when one is owed):
+    #: the page adopts it and applies its later steps on top; a screenshot waits until they agree
     kernel_state = Dict().tag(sync=True)
     #: the one-time transfers the kernel offers, name -> key (`transfer.Transfers`): a page that does
     #: not hold one asks for it

@@ -149,6 +149,8 @@ class KeyPath:
         if self.page.advance().changed:
             w._pump.mark_dirty()
             w._sync.state_traits()
+            # the page learns the kernel answers; the picture of this state is owed (the pump sends it)
+            w._painter.send_state("pending", throttle=bool(self.page.held))
 
     def settle(self) -> None:
         """At rest (no key held): bring the readout up to date and the rows into the turned frame,

@@ -48,7 +48,13 @@ STYLE = Markup(
     ".rot4d-cbar-bar{position:relative;height:0.9em;margin:0.15em 0;border:1px solid #888}"
     ".rot4d-cbar-bar i{position:absolute;top:-4px;bottom:-4px;width:0;margin-left:-2px;"
     "border-left:4px solid;box-shadow:0 0 0 1px #fff}"
-    ".rot4d-cbar-ticks{display:flex;justify-content:space-between}</style>"
+    ".rot4d-cbar-ticks{display:flex;justify-content:space-between}"
+    # the page is ahead of the kernel (keys it steps itself): the readout is of an older state
+    ".rot4d-side.rot4d-behind .rot4d-readout table,.rot4d-side.rot4d-behind .rot4d-readout svg{opacity:0.45}"
+    ".rot4d-side.rot4d-behind .rot4d-readout::before{content:'turning: the numbers follow at rest';"
+    "display:block;font-size:85%;color:#666}"
+    ".rot4d-side.rot4d-silent .rot4d-readout::before{content:'the kernel is not answering: keys wait for it';"
+    "display:block;font-size:85%;color:#c8102e}</style>"
 )
 
 #: The colours of the object's axes x, y, z, w in the gizmo.

@@ -26,6 +26,9 @@ __all__ = ["ViewKey", "Painter", "READOUT_PERIOD", "checked_slice", "title"]
 #: While keys repeat, the readout (an HTML relayout on the page) changes at most this often (s);
 #: it is exact again as soon as no key is held.
 READOUT_PERIOD = 0.25
+#: While the page steps its keys, the kernel's state goes to it at most this often (s): the page
+#: needs it to stay exact and to know the kernel answers, not every step.
+STATE_PERIOD = 0.03
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,6 +106,7 @@ class Painter:
         self.note = None  # one line for the readout: what a screenshot did
         self.readout_at = -math.inf  # when the readout was last computed
         self.readout_stale = False  # the readout lags the state (keys were repeating)
+        self.state_at = -math.inf  # when the kernel's state was last sent to the page
 
     # -- slices -----------------------------------------------------------------------------
     def current_slice(self, coarse: bool = False):
@@ -210,6 +214,7 @@ class Painter:
             self.rows_data = data
             self.shown = self.rows_key = key
         self.send_state(picture=sent)  # the state and its id; which picture shows it, if one was sent
+        w._shots.send_owed()  # screenshots asked meanwhile: of this picture
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered
         if not w._keys.held or now - self.readout_at >= READOUT_PERIOD:
@@ -219,19 +224,25 @@ class Painter:
             self.readout_stale = True
         return sent
 
-    def send_state(self, picture=None) -> None:
+    def send_state(self, picture=None, *, throttle: bool = False) -> None:
         """The kernel's state and its id to the page (`Companion.kernel_state`), when they changed;
-        ``picture``: the update id of the scene's picture that shows it."""
+        ``picture``: the update id of the scene's picture that shows it, None when the picture shown
+        does, or "pending" when one is owed (the pump sends it).  ``throttle`` (a step of the
+        page's keys, many a second): not sooner than `STATE_PERIOD` after the last (the next goes)."""
         w = self.w
+        now = w._pump.clock()
+        if throttle and now - self.state_at < STATE_PERIOD:
+            return
         w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
         epoch, upto = w._keys.page.state_id
         msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": state_message(w.state),
                "picture": picture}
         old = w.companion.kernel_state
-        if picture is None and old.get("state") == msg["state"] and old.get("epoch") == epoch \
-                and old.get("upto") == msg["upto"]:
+        if picture is None and old.get("picture") != "pending" and old.get("state") == msg["state"] \
+                and old.get("epoch") == epoch and old.get("upto") == msg["upto"]:
             return  # unchanged: nothing to send (the picture named before still shows it)
         w.companion.kernel_state = msg
+        self.state_at = now
 
     def projection(self, key: ViewKey) -> dict:
         """The projection view's part of the update showing ``key`` (`ProjectionView.message`), as the

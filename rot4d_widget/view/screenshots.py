@@ -32,6 +32,7 @@ class Screenshots:
         self.pending = {}  # request id -> (path, callback, time asked): asked, not answered yet
         self.seq = 0
         self.shot_number = 1  # key p's next file number (rot4d-001.png ...)
+        self.owed = []  # requests to send once the picture of the latest state has left
 
     def ask(self, path, callback, warn=False):
         """Ask every view for a PNG (lock held); the request id, or None when no view is shown."""
@@ -47,7 +48,10 @@ class Screenshots:
         self.seq += 1
         rid = self.seq
         self.pending[rid] = (path, callback, now)
-        w.companion.request_screenshot(rid)
+        if w._pump.dirty or w._keys.held:
+            self.owed.append(rid)  # asked of the page after the picture of the latest state (`send_owed`)
+        else:
+            w.companion.request_screenshot(rid)
         if w.scene.view_count == 0:  # kept, bounded by the timeout and the cap above
             text = "no view is displayed to answer: no screenshot (display the widget first)"
             w._painter.set_note(text)
@@ -57,6 +61,17 @@ class Screenshots:
         shown = "rot4d-NNN.png" if path is KEY_P else path
         w._painter.set_note(f"screenshot asked{' for ' + str(shown) if shown is not None else ''}\u2026")
         return rid
+
+    def send_owed(self) -> None:
+        """After the picture of the latest state left (the pump's send, no key held): the requests
+        asked meanwhile go to the page now, after that picture, so it shows the state they asked
+        of (the page also waits until its own steps and the kernel's state agree)."""
+        w = self.w
+        if self.owed and not w._pump.dirty and not w._keys.held:
+            owed, self.owed = self.owed, []
+            for rid in owed:
+                if rid in self.pending:
+                    w.companion.request_screenshot(rid)
 
     def key_p(self) -> None:
         """Key p: a numbered PNG in the current directory (rot4d-001.png, ...), never overwriting

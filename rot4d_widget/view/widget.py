@@ -586,6 +586,7 @@ def _build_children(w, options) -> None:
             layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
         )
         w._side_box.add_class("rot4d-side")
+        w._side_box.add_class(f"{w.scene.canvas_class}-side")  # the page says here when it is ahead
         built += [w._canvas_box, w._side_box]
     except BaseException:
         for x in reversed(built):

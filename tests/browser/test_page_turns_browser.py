@@ -100,10 +100,20 @@ def _two_keys(jupyter_server, page, var):
     time.sleep(0.3)
     jp.page.keyboard.up("c")
     before = _page(jp, sel)  # the page's state right after the release (its steps all made)
+    # a screenshot asked at once waits until page and kernel agree: the picture of the final state
+    jp.kernel(f"{var}.screenshot('first-{var}.png')")
     assert jp.wait_for(lambda: _settled(jp, var, sel), timeout=60), (_page(jp, sel), _kernel(jp, var))
     after, kernel = _page(jp, sel), _kernel(jp, var)
     np.testing.assert_allclose(after["matrix"], kernel["m"], rtol=0, atol=1e-12)
     assert (after["theta0"], after["alpha"], after["c0"]) == (kernel["theta0"], kernel["alpha"], kernel["c0"])
     np.testing.assert_allclose(before["matrix"], after["matrix"], rtol=0, atol=1e-12)  # no jump at release
+    time.sleep(1.0)
+    jp.kernel(f"{var}.screenshot('second-{var}.png')")
+    shots = [jupyter_server.root / f"{n}-{var}.png" for n in ("first", "second")]
+    assert jp.wait_for(lambda: all(p.exists() and p.stat().st_size for p in shots), timeout=30)
+    from PIL import Image
+
+    a, b = (np.asarray(Image.open(p).convert("RGB"), dtype=int) for p in shots)
+    assert a.shape == b.shape and np.abs(a - b).max() <= 2, "the first screenshot was not of the final state"
     steps = jp.kernel(f"print(sum(1 for e in {var}.recording.events if getattr(e, 'key', 0) is None))")
     assert int(steps.strip()) > 10  # both keys repeated

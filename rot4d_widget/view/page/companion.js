@@ -61,6 +61,9 @@ import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer
 
 export { decodeSkeleton, projectSkeleton };
 
+// A screenshot waits at most this long (ms) for page and kernel to agree on the state shown.
+const SCREENSHOT_WAIT = 5000;
+
 async function render({ model, el }) {
   el.style.display = "none";
   let alive = true;
@@ -135,6 +138,21 @@ async function render({ model, el }) {
       model.off("change:config", onConfig);
     });
   }
+  // the readout is the kernel's: while the page is ahead of it (its own steps, keys held) the side
+  // panel says so; and when the kernel does not answer
+  const sideMark = (p, sh) => {
+    const ahead = !!p && (p.pending > 0 || p.held.length > 0);
+    for (const cls of canvasClasses()) {
+      for (const side of document.getElementsByClassName(cls + "-side")) {
+        side.classList.toggle("rot4d-behind", ahead && !sh.silent);
+        side.classList.toggle("rot4d-silent", !!sh.silent);
+      }
+    }
+  };
+  const shared0 = turning(model);
+  shared0.listeners.add(sideMark);
+  cleanups.push(() => shared0.listeners.delete(sideMark));
+
   // 9. one-time transfers (transfer.js): asked for when offered and not held, put together here
   const onPageData = () => askForTransfers(model);
   const onTransfer = (msg, buffers) => receiveChunk(model, msg, buffers && buffers[0]);
@@ -753,13 +771,34 @@ async function render({ model, el }) {
             send({ event: "screenshot", id, error: String(e) });
           }
         };
-        scene.on("afterRender", grab);
-        const t = setTimeout(grab, 1000);
+        // The picture of the state page and kernel agree on: no key held, no step of the page's
+        // beyond the kernel's state, and the kernel's picture of that state arrived.  Waited for
+        // (at most SCREENSHOT_WAIT), then read at the next render (a frozen view: a second later).
+        const settled = () => {
+          const p = turning(model).prediction;
+          if (p && (p.held.length || p.pending)) return false;
+          const ks = model.get("kernel_state") || {};
+          const seq = buffer.get("_rot4d_seq");
+          return ks.picture !== "pending" && (!Number.isInteger(ks.picture) || seq >= ks.picture);
+        };
+        let waited = 0;
+        const whenSettled = () => {
+          if (done) return;
+          if (!settled() && waited < SCREENSHOT_WAIT) {
+            waited += 50;
+            timers.push(setTimeout(whenSettled, 50));
+            return;
+          }
+          scene.on("afterRender", grab);
+          timers.push(setTimeout(grab, 1000));
+          scene.trigger("rerender", scene, {});
+        };
+        const timers = [];
         cleanups.push(() => {
-          clearTimeout(t);
+          timers.forEach(clearTimeout);
           scene.off("afterRender", grab);
         });
-        scene.trigger("rerender", scene, {});
+        whenSettled();
       };
       model.on("msg:custom", onMessage);
       cleanups.push(() => model.off("msg:custom", onMessage));

@@ -13,6 +13,10 @@ import { Prediction } from "./predict.js";
 
 const MODIFIERS = new Set(["Shift", "Control", "Alt", "Meta", "CapsLock", "AltGraph", "OS", "Fn"]);
 
+// With keys held, no state from the kernel for this long (ms): it is not answering -- the page
+// stops stepping (its keys released there) and says so, until the kernel's state comes again.
+export const KERNEL_SILENT_MS = 3000;
+
 // model -> {prediction, views, frame, listeners}: one per widget (its companion model)
 const shared = new WeakMap();
 
@@ -21,7 +25,8 @@ const shared = new WeakMap();
 export function turning(model) {
   let s = shared.get(model);
   if (!s) {
-    s = { model, prediction: null, configSeen: null, listeners: new Set(), frame: null, lastBeat: -Infinity };
+    s = { model, prediction: null, configSeen: null, listeners: new Set(), frame: null, lastBeat: -Infinity,
+          lastKernel: performance.now(), silent: false };
     shared.set(model, s);
   }
   const config = model.get("config");
@@ -35,7 +40,7 @@ export function turning(model) {
 function changed(s) {
   for (const f of [...s.listeners]) {
     try {
-      f(s.prediction);
+      f(s.prediction, s);
     } catch (e) {
       console.warn("rot4d_widget companion: a prediction listener failed", e);
     }
@@ -47,12 +52,16 @@ function frame(s, now) {
   s.frame = null;
   const p = s.prediction;
   if (!p) return;
+  if (p.held.length && now - s.lastKernel > KERNEL_SILENT_MS) {  // the kernel is not answering
+    p.releaseAll(now);
+    s.silent = true;
+  }
   const moved = p.advance(now);
   if (p.held.length && now - s.lastBeat >= 1) {
     s.lastBeat = now;
     s.model.send({ event: "clock", t: now });
   }
-  if (moved) changed(s);
+  if (moved || s.silent) changed(s);
   if (p.held.length) schedule(s);
 }
 
@@ -68,9 +77,11 @@ export function attachKeys(model, { listen, hovered, canvases }) {
   const onDown = (event) => {
     const s = turning(model);
     const p = s.prediction;
-    if (!p || event.repeat || MODIFIERS.has(event.key) || !hovered()) return;
+    if (!p || event.repeat || MODIFIERS.has(event.key) || !hovered() || s.silent) return;
     const mine = p.ours(event, keyId(event));
-    if (!mine || !p.press(mine.kid, mine.action, mine.inverted, event.timeStamp)) return;
+    if (!mine) return;
+    if (!p.held.length) s.lastKernel = Math.max(s.lastKernel, event.timeStamp);  // silence counts from here
+    if (!p.press(mine.kid, mine.action, mine.inverted, event.timeStamp)) return;
     frame(s, event.timeStamp);
     schedule(s);
   };
@@ -101,6 +112,8 @@ export function attachKeys(model, { listen, hovered, canvases }) {
 // The kernel's state arrived (`kernel_state`): adopted, the page's later steps on top.
 export function adoptKernel(model) {
   const s = turning(model);
+  s.lastKernel = performance.now();
+  s.silent = false;
   if (!s.prediction) return;
   s.prediction.adopt(model.get("kernel_state"));
   s.prediction.advance(performance.now());
