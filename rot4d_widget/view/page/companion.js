@@ -58,6 +58,7 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { PageKeymap, keyId } from "./keymap.js";
 import { PageState } from "./state.js";
+import { decodePolytope, slicePolytope, sliceData } from "./slicer.js";
 
 export { decodeSkeleton, projectSkeleton };
 

@@ -1,0 +1,260 @@
+"""The page cuts polytopes itself, array for array as the kernel does (issue 34).
+
+``page/slicer.js`` gets a polytope as the kernel sends it (`rot4d_widget.view.pagegeometry.
+polytope_message`, its arrays as bytes: base64 here, DataViews in the page) and slices it under
+Node; every array is compared with `slice_polytope`'s: vertices, edges, polygons and their corner
+order, cell ids, fan triangles, volume and dimension.  Unturned, at c0 = 0 and at every distinct
+vertex height, the page's numbers are the kernel's exactly; turned (numpy's BLAS fuses
+multiply-adds, the page does not), the vertices agree within 1e-12 of the circumradius and the
+volumes within 1e-12 relative, and every index array exactly.  The cases reach every row of the
+slicer's case table: faces and cells lying in H, faces inside a non-convex slice (`_faces_in_h`),
+vertices and edges only touching it (`_boundary_only`), H touching in a face, an edge or a
+vertex, missing, a face almost parallel to H (the fallback to exact signs), and polytopes scaled
+by 1e-100 and 1e100 (the power-of-two `unit`).
+"""
+
+from __future__ import annotations
+
+import base64
+import math
+
+import numpy as np
+import pytest
+
+from mesh_shapes import SHAPES, stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
+from page_node import run_page
+from rot4d_widget import Polytope
+from rot4d_widget.core.rotation import random_rotation, simple_rotation
+from rot4d_widget.geometry import section
+from rot4d_widget.geometry.catalogue import polytope
+from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.view.pagegeometry import polytope_message, polytope_message_bytes
+
+SLICE_SCRIPT = """
+import { decodePolytope, slicePolytope } from "page:slicer.js";
+const out = INPUT.map((c) => {
+  const msg = { ...c.msg };
+  for (const k of c.binary) msg[k] = Buffer.from(msg[k], "base64");
+  const p = decodePolytope(msg);
+  return c.cases.map(([m, c0]) => {
+    const s = slicePolytope(p, m, c0);
+    const r = { volume: s.volume, dim: s.dim };
+    for (const k of ["vertices", "edges", "flat", "offsets", "cellIds", "triangles", "triangleCells"]) r[k] = Array.from(s[k]);
+    return r;
+  });
+});
+console.log(JSON.stringify(out));
+"""
+
+# Python's name of each array the page returns
+ARRAYS = {"edges": "edges", "flat": "polygon_indices", "offsets": "polygon_offsets", "cellIds": "cell_ids",
+          "triangles": "triangles", "triangleCells": "triangle_cells"}
+IDENTITY = np.eye(4)
+
+
+def wire(p) -> dict:
+    """`polytope_message` as it reaches Node: binary arrays in base64, named in ``binary``."""
+    msg = polytope_message(p)
+    binary = [k for k, v in msg.items() if isinstance(v, memoryview)]
+    return {"msg": {k: base64.b64encode(bytes(v)).decode() if k in binary else v for k, v in msg.items()},
+            "binary": binary}
+
+
+def cases(p, seed, turns=3):
+    """(matrix, c0) pairs: unturned at 0 and at every distinct vertex height; ``turns`` random
+    orientations each at a random level and at the height of a turned vertex, exactly."""
+    out = [(IDENTITY, 0.0)] + [(IDENTITY, float(h)) for h in np.unique(np.asarray(p.vertices)[:, 3])]
+    rng = np.random.default_rng(seed)
+    for _ in range(turns):
+        m = random_rotation(rng)
+        w = (np.asarray(p.vertices) @ m.T)[:, 3]
+        out += [(m, float(rng.uniform(-1, 1) * p.circumradius)), (m, float(w[rng.integers(len(w))]))]
+    return out
+
+
+class Paths:
+    """What the kernel's slicer did over the cases (spies on its steps): dimensions seen, slices
+    cut again with exact signs, faces lying in H left out of S, slices that dropped vertices or
+    edges inside S."""
+
+    def __init__(self, monkeypatch):
+        self.dims, self.exact_signs, self.faces_inside, self.dropped = set(), 0, 0, 0
+        cut, faces, boundary = section._slice, section._faces_in_h, section._boundary_only
+
+        def spy_cut(t, x, m, c0, tol):
+            self.exact_signs += tol == 0.0
+            return cut(t, x, m, c0, tol)
+
+        def spy_faces(*args):
+            keep, outward = faces(*args)
+            self.faces_inside += int((~keep).sum())
+            return keep, outward
+
+        def spy_boundary(vertices, *rest):
+            out = boundary(vertices, *rest)
+            self.dropped += len(out[0]) < len(vertices) or len(out[1]) < len(rest[0])
+            return out
+
+        monkeypatch.setattr(section, "_slice", spy_cut)
+        monkeypatch.setattr(section, "_faces_in_h", spy_faces)
+        monkeypatch.setattr(section, "_boundary_only", spy_boundary)
+
+
+def compare(groups, paths=None) -> float:
+    """Slice every (polytope, cases) of ``groups`` in Node and in Python and compare them; the
+    worst turned vertex difference relative to the circumradius."""
+    page = run_page(SLICE_SCRIPT, [{**wire(p), "cases": [(np.asarray(m).reshape(-1).tolist(), c0) for m, c0 in cs]}
+                                   for p, cs in groups])
+    worst = 0.0
+    for (p, cs), got in zip(groups, page):
+        for (m, c0), g in zip(cs, got):
+            s = slice_polytope(p, m, c0)
+            where = f"{p.name} at c0 = {c0!r}" + ("" if m is IDENTITY else " (turned)")
+            if paths is not None:
+                paths.dims.add(s.dim)
+            for js, py in ARRAYS.items():
+                assert g[js] == getattr(s, py).reshape(-1).tolist(), f"{where}: {js}"
+            assert g["dim"] == s.dim, where
+            v = np.asarray(g["vertices"], dtype=np.float64).reshape(-1, 3)
+            assert v.shape == s.vertices.shape, where
+            volume = math.inf if g["volume"] is None else g["volume"]  # JSON has no inf
+            if m is IDENTITY:
+                assert np.array_equal(v, s.vertices), where
+                assert volume == s.volume, where
+            else:
+                if len(v):
+                    worst = max(worst, float(np.abs(v - s.vertices).max()) / p.circumradius)
+                assert volume == pytest.approx(s.volume, rel=1e-12, abs=0.0), where
+    assert worst <= 1e-12, worst
+    return worst
+
+
+def test_the_regular_six(monkeypatch):
+    paths = Paths(monkeypatch)
+    names = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
+    eight = polytope("8-cell")
+    on_top = simple_rotation("xw", math.pi / 4)  # a square on top
+    edge_top = simple_rotation("yw", math.atan(1 / math.sqrt(2))) @ on_top  # an edge on top
+    special = [(m, float((np.asarray(eight.vertices) @ m.T)[:, 3].max())) for m in (on_top, edge_top)]
+    special.append((IDENTITY, 1.5))  # misses it
+    compare([(polytope(n), cases(polytope(n), seed)) for seed, n in enumerate(names)] + [(eight, special)], paths)
+    assert paths.dims == {-1, 0, 1, 2, 3}  # missed; touching in a vertex, an edge, a face; solid
+
+
+def test_uniform_polychora():
+    names = ["rectified 5-cell", "truncated tesseract", "runcinated tesseract", "cantellated 24-cell",
+             "snub 24-cell", "grand antiprism", "bitruncated 120-cell", "5-7 duoprism", "icosahedral prism",
+             "12-antiprismatic prism"]
+    compare([(polytope(n), cases(polytope(n), seed)) for seed, n in enumerate(names)])
+
+
+def test_the_omnitruncated_120_cell():
+    p = polytope("omnitruncated 120-cell")
+    compare([(p, cases(p, 7, turns=4))])
+
+
+def test_scaled_by_powers_of_ten():
+    groups = []
+    for scale in (1e-100, 1e100):
+        for name in ("8-cell", "24-cell"):
+            q = polytope(name)
+            p = Polytope(np.asarray(q.vertices) * scale, [f.tolist() for f in q.faces], q.cells, name=f"{name} x {scale}")
+            assert p.unit != 1.0
+            groups.append((p, cases(p, 3)))
+    compare(groups)
+
+
+def _nonconvex():
+    out = [tesseract_union(shape)[0] for shape in ("L", "ring", "tripod", "staircase")]
+    v, f, c, _ = stellated_tesseract_mesh(2.0)  # reflex ridges
+    out.append(Polytope(v, f, c, name="stellated tesseract"))
+    v, f, c, _ = tesseract_union_mesh([(0, 0, 0, 0), (0, 0, 0, 3)], centre=False)  # two pieces apart in w
+    out.append(Polytope(v, f, c, name="two tesseracts"))
+    out += [polytope("grand 600-cell"), polytope("icosahedral 120-cell")]  # convex cells, winding round
+    return out
+
+
+def test_nonconvex_polytopes_with_convex_cells(monkeypatch):
+    paths = Paths(monkeypatch)
+    groups = []
+    for seed, p in enumerate(_nonconvex()):
+        assert p.star is None and not p.convex
+        groups.append((p, cases(p, seed)))
+    compare(groups, paths)
+    assert paths.faces_inside and paths.dropped  # faces inside S, vertices and edges touching it only
+
+
+def test_faces_almost_parallel_to_h_are_cut_with_exact_signs(monkeypatch):
+    """A pentagon tilted by less than the tolerance: its chord has three ends under the tolerance,
+    so the kernel cuts again by exact signs (`_Inconsistent`); the page does the same."""
+    p = polytope("dodecahedral prism")
+    top = float(np.asarray(p.vertices)[:, 3].max())
+    tol = 1e-9 * p.circumradius
+    rng = np.random.default_rng(0)
+    paths = Paths(monkeypatch)
+    found = []
+    for _ in range(200):
+        a = rng.standard_normal(3) * tol * rng.uniform(0.2, 3) / p.circumradius
+        m = simple_rotation("xw", a[0]) @ simple_rotation("yw", a[1]) @ simple_rotation("zw", a[2])
+        c0 = top + float(rng.uniform(-1.5, 1.5)) * tol
+        before = paths.exact_signs
+        slice_polytope(p, m, c0)
+        if paths.exact_signs > before:
+            found.append((m, c0))
+    assert len(found) >= 5
+    compare([(p, found)])
+
+
+def test_slice_data_is_what_the_source_returns():
+    """`sliceData` = `PolytopeSource.slice`: points, segments, triangles, groups, no fill corners,
+    the volume (None where it left float64's range: scaled by 1e150 or 1e-150), convex."""
+    script = """
+    import { decodePolytope, sliceData } from "page:slicer.js";
+    console.log(JSON.stringify(INPUT.map((c) => {
+      const msg = { ...c.msg };
+      for (const k of c.binary) msg[k] = Buffer.from(msg[k], "base64");
+      const d = sliceData(decodePolytope(msg), c.matrix, c.c0);
+      return { points: Array.from(d.points), segments: Array.from(d.segments), triangles: Array.from(d.triangles),
+               groups: Array.from(d.groups), cornerOnly: d.cornerOnly, volume: d.volume, convex: d.convex };
+    })));
+    """
+    eight = polytope("8-cell")
+    big, small = (Polytope(np.asarray(eight.vertices) * s, [f.tolist() for f in eight.faces], eight.cells)
+                  for s in (1e150, 1e-150))
+    runs = [(polytope("24-cell"), 0.0), (polytope("24-cell"), math.sqrt(2)), (tesseract_union("L")[0], 0.25),
+            (big, 0.0), (small, 0.0)]
+    page = run_page(script, [{**wire(p), "matrix": IDENTITY.reshape(-1).tolist(), "c0": c0} for p, c0 in runs])
+    for (p, c0), got in zip(runs, page):
+        d = PolytopeSource(p).slice(IDENTITY, c0)
+        assert got["points"] == d.points.reshape(-1).tolist()
+        for name in ("segments", "triangles", "groups"):
+            assert got[name] == getattr(d, name).reshape(-1).tolist(), name
+        assert got["cornerOnly"] is None and d.corner_only is None
+        assert got["volume"] == d.volume and got["convex"] == d.convex
+    assert page[3]["volume"] is None and page[4]["volume"] is None  # inf; underflowed
+
+
+def test_the_message_and_what_the_page_refuses():
+    """Sent once: the omnitruncated 120-cell's tables are 2.4 MB.  The page refuses a star
+    polytope by name, and a message whose arrays do not fit its counts, naming the array."""
+    assert polytope_message_bytes(polytope_message(polytope("omnitruncated 120-cell"))) < 2.5e6
+    script = """
+    import { decodePolytope, slicePolytope } from "page:slicer.js";
+    const errors = INPUT.map((c) => {
+      const msg = { ...c.msg };
+      for (const k of c.binary) msg[k] = Buffer.from(msg[k], "base64");
+      if (c.cut) msg[c.cut] = msg[c.cut].subarray(4);
+      if (c.bad) msg[c.bad] = Buffer.from(new Int32Array(msg[c.bad].length / 4).fill(1e6).buffer);
+      try { slicePolytope(decodePolytope(msg), Array.from({ length: 16 }, (_, i) => +(i % 5 === 0)), 0); return null; }
+      catch (e) { return e.message; }
+    });
+    console.log(JSON.stringify(errors));
+    """
+    star, five = polytope("great grand stellated 120-cell"), polytope("5-cell")
+    errors = run_page(script, [wire(star), {**wire(five), "cut": "cell_normals"}, {**wire(five), "bad": "face_vidx"},
+                               wire(five)])
+    assert "great grand stellated 120-cell has star faces or non-convex cells" in errors[0]
+    assert "cell_normals has 156 bytes, expected 20 x 8" in errors[1]
+    assert "face_vidx[0] = 1000000 is not in [0, 5)" in errors[2]
+    assert errors[3] is None
