@@ -10,7 +10,8 @@ volumes within 1e-12 relative, and every index array exactly.  The cases reach e
 slicer's case table: faces and cells lying in H, faces inside a non-convex slice (`_faces_in_h`),
 vertices and edges only touching it (`_boundary_only`), H touching in a face, an edge or a
 vertex, missing, a face almost parallel to H (the fallback to exact signs), and polytopes scaled
-by 1e-100 and 1e100 (the power-of-two `unit`).
+by 1e-100 and 1e100 (the power-of-two `unit`).  ``page/rows.js`` builds the scene's row table bit
+for bit as `slice_rows` (the triangles ordered for blending from an eye, convex or not).
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ from rot4d_widget.core.rotation import random_rotation, simple_rotation
 from rot4d_widget.geometry import section
 from rot4d_widget.geometry.catalogue import polytope
 from rot4d_widget.geometry.slicing import slice_polytope
-from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.protocol import PolytopeSource, SliceData
+from rot4d_widget.view.buffers import ball_count, group_palette, pack_rgb, rows_needed, slice_rows
 from rot4d_widget.view.pagegeometry import polytope_message, polytope_message_bytes
 
 SLICE_SCRIPT = """
@@ -258,3 +260,91 @@ def test_the_message_and_what_the_page_refuses():
     assert "cell_normals has 156 bytes, expected 20 x 8" in errors[1]
     assert "face_vidx[0] = 1000000 is not in [0, 5)" in errors[2]
     assert errors[3] is None
+
+
+ROWS_SCRIPT = """
+import { decodePolytope, sliceData } from "page:slicer.js";
+import { sliceRows } from "page:rows.js";
+const typed = (b64, T) => { const u = Buffer.from(b64, "base64"); return new T(u.buffer.slice(u.byteOffset, u.byteOffset + u.byteLength)); };
+console.log(JSON.stringify(INPUT.map((c) => {
+  let data;
+  if (c.polytope) {  // the page's own slice
+    const msg = { ...c.polytope.msg };
+    for (const k of c.polytope.binary) msg[k] = Buffer.from(msg[k], "base64");
+    data = sliceData(decodePolytope(msg), c.matrix, c.c0);
+  } else {  // the kernel's slice, its very bytes
+    data = { points: typed(c.points, Float64Array), segments: typed(c.segments, Int32Array),
+             triangles: typed(c.triangles, Int32Array), groups: typed(c.groups, Int32Array), convex: c.convex,
+             cornerOnly: c.cornerOnly, showPoints: c.showPoints };
+  }
+  const { rows, counts } = sliceRows(data, c.options);
+  return { rows: Buffer.from(rows.buffer).toString("base64"), counts };
+})));
+"""
+
+
+def _b64(a, dtype) -> str:
+    return base64.b64encode(np.ascontiguousarray(a, dtype=dtype).tobytes()).decode()
+
+
+def _rows_case(data, *, scale, n_groups=None, capacity=None, eye=None, single_rgb=None):
+    """(what Node gets, slice_rows's table): the slice's arrays as bytes, the options as the page
+    takes them (colours packed, as `pack_rgb` packs them)."""
+    palette = None if n_groups is None else group_palette(n_groups)
+    want = slice_rows(data, scale=scale, group_rgb=palette, capacity=capacity, eye=eye, single_rgb=single_rgb)
+    corner = getattr(data, "corner_only", None)
+    case = {"points": _b64(data.points, "<f8"), "segments": _b64(data.segments, "<i4"),
+            "triangles": _b64(data.triangles, "<i4"), "groups": _b64(data.groups, "<i4"), "convex": bool(data.convex),
+            "cornerOnly": None if corner is None else corner.tolist(), "showPoints": bool(data.show_points),
+            "options": {"scale": scale, "capacity": capacity, "eye": None if eye is None else list(eye),
+                        "palette": None if palette is None else pack_rgb(palette).tolist(),
+                        "singleRgb": None if single_rgb is None else float(pack_rgb([single_rgb])[0])}}
+    return case, want, data
+
+
+def _check_rows(cases):
+    """Each case's rows from Node equal ``slice_rows``'s bit for bit (signed zeros too), and its
+    counts are the balls, bars and triangles of the slice."""
+    page = run_page(ROWS_SCRIPT, [c for c, _, _ in cases])
+    for i, ((_, want, data), got) in enumerate(zip(cases, page)):
+        rows = np.frombuffer(base64.b64decode(got["rows"]), dtype="<f4")
+        assert rows.shape == (want.size,), f"case {i}: {rows.size // 20} rows, expected {len(want)}"
+        bad = np.flatnonzero(rows.view("<u4") != want.reshape(-1).view(np.uint32))
+        assert not len(bad), f"case {i}: {len(bad)} floats differ, the first in row {bad[0] // 20}, column {bad[0] % 20}"
+        assert got["counts"] == [ball_count(data), len(data.segments), len(data.triangles)]
+
+
+def test_rows_bit_for_bit():
+    """Convex slices (away-facing triangles first) and non-convex ones (farthest first) seen from
+    an eye, one colour for all, spare capacity, fill corners without balls, no balls at all."""
+    rng = np.random.default_rng(5)
+    cases = []
+    for name, c0 in (("24-cell", 0.3), ("omnitruncated 120-cell", 2.0), ("grand 600-cell", 0.1)):
+        src = PolytopeSource(name)
+        data = src.slice(random_rotation(rng), c0)
+        direction = rng.standard_normal(3)
+        eye = tuple(5.0 * direction / np.linalg.norm(direction))  # outside the slice, drawn 1.7 across
+        cases.append(_rows_case(data, scale=1.7 / src.size, n_groups=src.n_groups, eye=eye,
+                                capacity=rows_needed(data) + 5))
+    src = PolytopeSource(tesseract_union("L")[0])
+    data = src.slice(random_rotation(rng), 0.1)
+    cases.append(_rows_case(data, scale=0.4, n_groups=src.n_groups, eye=(0.5, -2.0, 3.0)))
+    cases.append(_rows_case(data, scale=0.4, single_rgb=(0.2, 0.6, 1.0)))
+    fill = SliceData.build(rng.standard_normal((6, 3)), [[0, 1], [1, 2]], [[0, 1, 2], [3, 4, 5], [0, 2, 5]], [0, 1, 0],
+                           corner_only=[False, False, True, False, True, False])
+    cases.append(_rows_case(fill, scale=2.0, n_groups=2, eye=(1.0, 1.0, 1.0)))
+    bare = SliceData.build(rng.standard_normal((4, 3)), [[0, 1]], [[0, 1, 2]], [0], show_points=False)
+    cases.append(_rows_case(bare, scale=1.0, n_groups=1))
+    _check_rows(cases)
+
+
+def test_rows_of_the_pages_own_slice_are_the_kernels():
+    """Unturned, the page's slice and rows are the kernel's: the whole path, bit for bit."""
+    cases = []
+    for p, c0, eye in ((polytope("24-cell"), 0.0, [0.3, -2.0, 5.0]), (tesseract_union("L")[0], 0.25, [2.0, 1.0, -4.0]),
+                       (polytope("120-cell"), 1.0, [-3.0, 0.5, 0.5])):
+        src = PolytopeSource(p)
+        case, want, data = _rows_case(src.slice(IDENTITY, c0), scale=1.3, n_groups=src.n_groups, eye=eye)
+        cases.append(({"polytope": wire(p), "matrix": IDENTITY.reshape(-1).tolist(), "c0": c0,
+                       "options": case["options"]}, want, data))
+    _check_rows(cases)

@@ -59,6 +59,7 @@ import { modelId, dataOf, getModel } from "./models.js";
 import { PageKeymap, keyId } from "./keymap.js";
 import { PageState } from "./state.js";
 import { decodePolytope, slicePolytope, sliceData } from "./slicer.js";
+import { sliceRows } from "./rows.js";
 
 export { decodeSkeleton, projectSkeleton };
 
