@@ -24,11 +24,12 @@ import pytest
 
 from mesh_shapes import SHAPES, stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
 from page_node import run_page
+from test_slicing import check_against_halfspaces, check_closed_ccw_surface
 from rot4d_widget import Polytope
 from rot4d_widget.core.rotation import random_rotation, simple_rotation
 from rot4d_widget.geometry import section
 from rot4d_widget.geometry.catalogue import polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing import Slice, slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 from rot4d_widget.view.buffers import ball_count, group_palette, pack_rgb, rows_needed, slice_rows
 from rot4d_widget.view.pagegeometry import polytope_message, polytope_message_bytes
@@ -53,6 +54,7 @@ console.log(JSON.stringify(out));
 ARRAYS = {"edges": "edges", "flat": "polygon_indices", "offsets": "polygon_offsets", "cellIds": "cell_ids",
           "triangles": "triangles", "triangleCells": "triangle_cells"}
 IDENTITY = np.eye(4)
+NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 
 
 def wire(p) -> dict:
@@ -103,9 +105,9 @@ class Paths:
         monkeypatch.setattr(section, "_boundary_only", spy_boundary)
 
 
-def compare(groups, paths=None) -> float:
-    """Slice every (polytope, cases) of ``groups`` in Node and in Python and compare them; the
-    worst turned vertex difference relative to the circumradius."""
+def compare(groups, paths=None) -> list:
+    """Slice every (polytope, cases) of ``groups`` in Node and in Python and compare them (turned
+    vertices within 1e-12 of the circumradius); the page's slices, per group and case."""
     page = run_page(SLICE_SCRIPT, [{**wire(p), "cases": [(np.asarray(m).reshape(-1).tolist(), c0) for m, c0 in cs]}
                                    for p, cs in groups])
     worst = 0.0
@@ -129,19 +131,44 @@ def compare(groups, paths=None) -> float:
                     worst = max(worst, float(np.abs(v - s.vertices).max()) / p.circumradius)
                 assert volume == pytest.approx(s.volume, rel=1e-12, abs=0.0), where
     assert worst <= 1e-12, worst
-    return worst
+    return page
 
 
 def test_the_regular_six(monkeypatch):
     paths = Paths(monkeypatch)
-    names = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
     eight = polytope("8-cell")
     on_top = simple_rotation("xw", math.pi / 4)  # a square on top
     edge_top = simple_rotation("yw", math.atan(1 / math.sqrt(2))) @ on_top  # an edge on top
     special = [(m, float((np.asarray(eight.vertices) @ m.T)[:, 3].max())) for m in (on_top, edge_top)]
     special.append((IDENTITY, 1.5))  # misses it
-    compare([(polytope(n), cases(polytope(n), seed)) for seed, n in enumerate(names)] + [(eight, special)], paths)
+    compare([(polytope(n), cases(polytope(n), seed)) for seed, n in enumerate(NAMES)] + [(eight, special)], paths)
     assert paths.dims == {-1, 0, 1, 2, 3}  # missed; touching in a vertex, an edge, a face; solid
+
+
+def test_vertex_heights_of_turned_polytopes():
+    """test_slicing's vertex-height property on the page's slices: 20 random orientations of each
+    regular polytope, cut exactly at the height of one of its turned vertices, give a closed,
+    outward surface holding that vertex once, of the volume the half-spaces give."""
+    rng = np.random.default_rng(11)
+    groups = []
+    for name in NAMES:
+        p, hits = polytope(name), []
+        for _ in range(20):
+            m = random_rotation(rng)
+            k = int(rng.integers(len(p.vertices)))
+            hits.append((m, float((np.asarray(p.vertices) @ m.T)[k, 3]), k))
+        groups.append((p, hits))
+    page = compare([(p, [(m, c0) for m, c0, _ in hits]) for p, hits in groups])
+    for (p, hits), got in zip(groups, page):
+        for (m, c0, k), g in zip(hits, got):
+            s = Slice(np.reshape(g["vertices"], (-1, 3)), np.reshape(g["edges"], (-1, 2)), np.asarray(g["flat"]),
+                      np.asarray(g["offsets"]), np.asarray(g["cellIds"]), np.reshape(g["triangles"], (-1, 3)),
+                      np.asarray(g["triangleCells"]), g["volume"], g["dim"])
+            if s.dim == 3:
+                check_closed_ccw_surface(s)
+                x = (np.asarray(p.vertices) @ m.T)[k, :3]
+                assert np.sum(np.linalg.norm(s.vertices - x, axis=1) < 1e-9) == 1
+            check_against_halfspaces(p.name, m, c0, s)
 
 
 def test_uniform_polychora():
