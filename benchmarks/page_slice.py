@@ -106,7 +106,8 @@ def main() -> None:
         table.append((p, _python(p, cases, args.repeats, scale, palette)))
     page = run_page(SCRIPT, {"runs": runs, "repeats": args.repeats, "eye": EYE})
     print(f"ms per slice, median of {args.repeats} passes over {args.slices} slices (first pass in brackets)")
-    print(f"{'polytope':<24} {'message':>9} {'page slice':>16} {'page rows':>14} {'kernel slice':>13} {'kernel rows':>12}")
+    print(f"{'polytope':<24} {'message':>9} {'page slice':>16} {'page rows':>14} {'kernel slice':>13} "
+          f"{'kernel rows':>12}")
     for (p, (py_slice, py_rows)), got in zip(table, page):
         mb = polytope_message_bytes(polytope_message(p)) / 1e6
         js_slice, js_rows = got["slice"], got["rows"]

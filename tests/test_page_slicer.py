@@ -21,10 +21,10 @@ import math
 
 import numpy as np
 import pytest
-
-from mesh_shapes import SHAPES, stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
+from mesh_shapes import stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
 from page_node import run_page
 from test_slicing import check_against_halfspaces, check_closed_ccw_surface
+
 from rot4d_widget import Polytope
 from rot4d_widget.core.rotation import random_rotation, simple_rotation
 from rot4d_widget.geometry import section
@@ -43,7 +43,9 @@ const out = INPUT.map((c) => {
   return c.cases.map(([m, c0]) => {
     const s = slicePolytope(p, m, c0);
     const r = { volume: s.volume, dim: s.dim };
-    for (const k of ["vertices", "edges", "flat", "offsets", "cellIds", "triangles", "triangleCells"]) r[k] = Array.from(s[k]);
+    for (const k of ["vertices", "edges", "flat", "offsets", "cellIds", "triangles", "triangleCells"]) {
+      r[k] = Array.from(s[k]);
+    }
     return r;
   });
 });
@@ -188,7 +190,8 @@ def test_scaled_by_powers_of_ten():
     for scale in (1e-100, 1e100):
         for name in ("8-cell", "24-cell"):
             q = polytope(name)
-            p = Polytope(np.asarray(q.vertices) * scale, [f.tolist() for f in q.faces], q.cells, name=f"{name} x {scale}")
+            p = Polytope(np.asarray(q.vertices) * scale, [f.tolist() for f in q.faces], q.cells,
+                         name=f"{name} x {scale}")
             assert p.unit != 1.0
             groups.append((p, cases(p, 3)))
     compare(groups)
@@ -292,7 +295,10 @@ def test_the_message_and_what_the_page_refuses():
 ROWS_SCRIPT = """
 import { decodePolytope, sliceData } from "page:slicer.js";
 import { sliceRows } from "page:rows.js";
-const typed = (b64, T) => { const u = Buffer.from(b64, "base64"); return new T(u.buffer.slice(u.byteOffset, u.byteOffset + u.byteLength)); };
+const typed = (b64, T) => {
+  const u = Buffer.from(b64, "base64");
+  return new T(u.buffer.slice(u.byteOffset, u.byteOffset + u.byteLength));
+};
 console.log(JSON.stringify(INPUT.map((c) => {
   let data;
   if (c.polytope) {  // the page's own slice
@@ -337,7 +343,7 @@ def _check_rows(cases):
         rows = np.frombuffer(base64.b64decode(got["rows"]), dtype="<f4")
         assert rows.shape == (want.size,), f"case {i}: {rows.size // 20} rows, expected {len(want)}"
         bad = np.flatnonzero(rows.view("<u4") != want.reshape(-1).view(np.uint32))
-        assert not len(bad), f"case {i}: {len(bad)} floats differ, the first in row {bad[0] // 20}, column {bad[0] % 20}"
+        assert not len(bad), f"case {i}: {len(bad)} floats differ, the first in row {bad[0] // 20} column {bad[0] % 20}"
         assert got["counts"] == [ball_count(data), len(data.segments), len(data.triangles)]
 
 

@@ -57,7 +57,8 @@ export function sliceRows(data, { scale = 1.0, palette = null, capacity = null, 
   for (let i = 0; i < nt; i++) {
     const packed = singleRgb !== null ? singleRgb : palette && palette[groups[i]];
     if (packed === undefined || packed === null) {
-      throw new Error(`Expected \`palette\` to have a colour for group ${groups[i]}, got ${palette ? palette.length : 0} colours`);
+      const have = palette ? palette.length : 0;
+      throw new Error(`Expected \`palette\` to have a colour for group ${groups[i]}, got ${have} colours`);
     }
     colour[i] = packed;
   }

@@ -35,7 +35,8 @@ function typed(bytes, T, length, name) {
   else if (ArrayBuffer.isView(bytes)) u8 = new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   else throw new Error(`polytope message: ${name} is not binary (${typeof bytes})`);
   if (u8.byteLength !== length * T.BYTES_PER_ELEMENT) {
-    throw new Error(`polytope message: ${name} has ${u8.byteLength} bytes, expected ${length} x ${T.BYTES_PER_ELEMENT}`);
+    const want = `${length} x ${T.BYTES_PER_ELEMENT}`;
+    throw new Error(`polytope message: ${name} has ${u8.byteLength} bytes, expected ${want}`);
   }
   const out = new T(length);
   new Uint8Array(out.buffer).set(u8);
@@ -45,7 +46,9 @@ function typed(bytes, T, length, name) {
 function indices(msg, name, length, bound) {
   const a = typed(msg[name], Int32Array, length, name);
   for (let i = 0; i < a.length; i++) {
-    if (!(a[i] >= 0 && a[i] < bound)) throw new Error(`polytope message: ${name}[${i}] = ${a[i]} is not in [0, ${bound})`);
+    if (!(a[i] >= 0 && a[i] < bound)) {
+      throw new Error(`polytope message: ${name}[${i}] = ${a[i]} is not in [0, ${bound})`);
+    }
   }
   return a;
 }
@@ -93,7 +96,8 @@ export function decodePolytope(msg) {
 }
 
 // Row j of the 4-vector a[i..i+3] turned by the row-major `m` (vertices @ m.T), summed k = 0..3.
-const turned = (m, j, a, i) => m[4 * j] * a[i] + m[4 * j + 1] * a[i + 1] + m[4 * j + 2] * a[i + 2] + m[4 * j + 3] * a[i + 3];
+const turned = (m, j, a, i) =>
+  m[4 * j] * a[i] + m[4 * j + 1] * a[i + 1] + m[4 * j + 2] * a[i + 2] + m[4 * j + 3] * a[i + 3];
 
 // slicetables._inplane_axes of one normal: u = n x (e_x, or e_y near e_x), v = n x u, not unit.
 function inplaneAxes(nx, ny, nz) {
@@ -113,7 +117,7 @@ class Inconsistent extends Error {}
 //   2 / 1 / 0 when H touches a face / edge / vertex; -1 empty) -- geometry.slicetables.Slice.
 export function slicePolytope(p, matrix16, c0) {
   if (p.star) {
-    throw new Error(`${p.name} has star faces or non-convex cells: the page does not cut it (the kernel's slices only)`);
+    throw new Error(`${p.name} has star faces or non-convex cells: the page does not cut it (the kernel does)`);
   }
   if (!matrix16 || matrix16.length !== 16) throw new Error("Expected `matrix16` to be 16 numbers (4 x 4, row by row)");
   const m = Float64Array.from(matrix16);
@@ -138,16 +142,18 @@ function sliceLevel(p, x, m, c0) {
   return cut(p, x, m, c0 + p.nudge, p.tol);
 }
 
-// section._slice: one level with one tolerance, step by step.
+// section._slice: one level with one tolerance, step by step.  (Python skips the crossing
+// edges, chords and cells when no vertex lies on each side of H; here the loops find none.)
 function cut(p, x, m, c0, tol) {
   const { side, h, onIdx, crossing } = classify(p, x, c0, tol);
   const cOn = cellsInH(p, side, onIdx);
-  const { vertices, crossE, edgeSv, vertSv } = points(p, x, h, side, onIdx, crossing);
-  const edges = sliceEdges(p, side, crossing, crossE, edgeSv, vertSv);
+  const { vertices, crossE, edgeSv, vertSv } = points(p, x, h, side, onIdx);
+  const edges = sliceEdges(p, side, crossE, edgeSv, vertSv);
   const faceIds = facesLyingInH(p, side, onIdx);
-  const solid = crossing || (onIdx.length > 0 && cOn.includes(1));  // or no polygon comes out (pieces apart)
+  const solid = crossing || (onIdx.length > 0 && cOn.includes(1));
   if (!solid) return touching(p, vertices, edges, onIdx, faceIds);
-  const polys = polygons(p, x, m, side, crossing, crossE, edgeSv, vertSv, faceIds, cOn);
+  const polys = polygons(p, x, m, side, crossE, edgeSv, vertSv, faceIds, cOn);
+  // no cell crosses H and no face in H bounds a solid part (a polytope's pieces may lie apart)
   if (!polys.ids.length) return touching(p, vertices, edges, onIdx, faceIds);
   const { flat, offsets } = cornerOrder(vertices, polys);
   // the 4-D cell of each polygon: a face's cell lying in H if one is, else its lower-numbered cell
@@ -209,12 +215,12 @@ function facesLyingInH(p, side, onIdx) {
 // The slice's vertices (3 per point): each crossing edge's point a + s (b - a), s = ha / (ha - hb),
 // in edge order, then the vertices on H; with each crossing edge's (`edgeSv`) and each on-H
 // vertex's (`vertSv`) index among them.
-function points(p, x, h, side, onIdx, crossing) {
+function points(p, x, h, side, onIdx) {
   const { E, edges } = p;
   const crossE = new Uint8Array(E);
   const edgeSv = new Int32Array(E).fill(-1);
   let nE = 0;
-  for (let e = 0; crossing && e < E; e++) {
+  for (let e = 0; e < E; e++) {
     if (side[edges[2 * e]] * side[edges[2 * e + 1]] === -1) {
       crossE[e] = 1;
       edgeSv[e] = nE++;
@@ -238,10 +244,10 @@ function points(p, x, h, side, onIdx, crossing) {
 // The slice's edges (pairs): each crossing face's chord -- its crossing sides' points, then its
 // corners on H -- face by face, then the polytope's edges lying in H.  A face whose chord has an
 // odd number of ends is `Inconsistent`.
-function sliceEdges(p, side, crossing, crossE, edgeSv, vertSv) {
+function sliceEdges(p, side, crossE, edgeSv, vertSv) {
   const { facePtr, faceVidx, faceEidx, edges } = p;
   const out = [];
-  for (let f = 0; crossing && f < p.F; f++) {
+  for (let f = 0; f < p.F; f++) {
     const ends = [];
     let fPos = false, fNeg = false;
     for (let k = facePtr[f]; k < facePtr[f + 1]; k++) {
@@ -249,7 +255,9 @@ function sliceEdges(p, side, crossing, crossE, edgeSv, vertSv) {
       fPos = fPos || side[faceVidx[k]] === 1;
       fNeg = fNeg || side[faceVidx[k]] === -1;
     }
-    for (let k = facePtr[f]; fPos && fNeg && k < facePtr[f + 1]; k++) if (side[faceVidx[k]] === 0) ends.push(vertSv[faceVidx[k]]);
+    if (fPos && fNeg) {
+      for (let k = facePtr[f]; k < facePtr[f + 1]; k++) if (side[faceVidx[k]] === 0) ends.push(vertSv[faceVidx[k]]);
+    }
     if (ends.length % 2) throw new Inconsistent();
     out.push(...ends);
   }
@@ -263,10 +271,10 @@ function sliceEdges(p, side, crossing, crossE, edgeSv, vertSv) {
 // The polygons of a solid slice, by id: each cell crossing H (id = cell; corners: its crossing
 // edges' points, then its vertices on H), then each face lying in H that bounds the slice (id =
 // C + face; corners: its own, in cycle order), each with its outward normal within H.
-function polygons(p, x, m, side, crossing, crossE, edgeSv, vertSv, faceIds, cOn) {
+function polygons(p, x, m, side, crossE, edgeSv, vertSv, faceIds, cOn) {
   const { C, facePtr, faceVidx, cellVptr, cellVidx, cellEptr, cellEidx } = p;
   const out = { ids: [], corners: [], normals: [] };
-  for (let c = 0; crossing && c < C; c++) {
+  for (let c = 0; c < C; c++) {
     const corners = [];
     for (let k = cellEptr[c]; k < cellEptr[c + 1]; k++) if (crossE[cellEidx[k]]) corners.push(edgeSv[cellEidx[k]]);
     let cPos = false, cNeg = false;
@@ -274,7 +282,11 @@ function polygons(p, x, m, side, crossing, crossE, edgeSv, vertSv, faceIds, cOn)
       cPos = cPos || side[cellVidx[k]] === 1;
       cNeg = cNeg || side[cellVidx[k]] === -1;
     }
-    for (let k = cellVptr[c]; cPos && cNeg && k < cellVptr[c + 1]; k++) if (side[cellVidx[k]] === 0) corners.push(vertSv[cellVidx[k]]);
+    if (cPos && cNeg) {
+      for (let k = cellVptr[c]; k < cellVptr[c + 1]; k++) {
+        if (side[cellVidx[k]] === 0) corners.push(vertSv[cellVidx[k]]);
+      }
+    }
     if (!corners.length) continue;
     out.ids.push(c);
     out.corners.push(corners);
@@ -315,7 +327,9 @@ function cornerOrder(vertices, polys) {
     });
     const [u0, u1, u2, v0, v1, v2] = inplaneAxes(...polys.normals[r]);
     const key = corners.map((sv) => {
-      const d0 = vertices[3 * sv] - centre[0], d1 = vertices[3 * sv + 1] - centre[1], d2 = vertices[3 * sv + 2] - centre[2];
+      const d0 = vertices[3 * sv] - centre[0];
+      const d1 = vertices[3 * sv + 1] - centre[1];
+      const d2 = vertices[3 * sv + 2] - centre[2];
       return r * TWO_PI_PLUS + Math.atan2(dot3(d0, d1, d2, v0, v1, v2), dot3(d0, d1, d2, u0, u1, u2));
     });
     const order = corners.map((_, i) => i).sort((i, j) => key[i] - key[j] || i - j);
@@ -433,7 +447,10 @@ function boundaryOnly(s) {
     }
   }
   const side = [];
-  for (let e = 0; e < edges.length; e += 2) side.push(sides.has(Math.min(edges[e], edges[e + 1]) * n + Math.max(edges[e], edges[e + 1])));
+  for (let e = 0; e < edges.length; e += 2) {
+    const a = edges[e], b = edges[e + 1];
+    side.push(sides.has(Math.min(a, b) * n + Math.max(a, b)));
+  }
   if (used.every(Boolean) && side.every(Boolean)) return s;
   const renumber = new Int32Array(n);  // cumsum(used) - 1
   let next = 0;
