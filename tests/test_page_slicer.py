@@ -267,6 +267,36 @@ def test_slice_data_is_what_the_source_returns():
     assert page[3]["volume"] is None and page[4]["volume"] is None  # inf; underflowed
 
 
+def test_the_message_decodes_from_any_view_of_its_bytes():
+    """As anywidget delivers buffers (DataViews, here at an odd offset into a larger buffer), as
+    bare ArrayBuffers, or as Node Buffers: one decoding, the same slice."""
+    script = """
+    import { decodePolytope, slicePolytope } from "page:slicer.js";
+    const forms = {
+      buffer: (b) => b,
+      arraybuffer: (b) => b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength),
+      dataview: (b) => {
+        const big = new Uint8Array(b.byteLength + 3);
+        big.set(b, 1);
+        return new DataView(big.buffer, 1, b.byteLength);
+      },
+    };
+    const out = {};
+    for (const [name, form] of Object.entries(forms)) {
+      const msg = { ...INPUT.msg };
+      for (const k of INPUT.binary) msg[k] = form(Buffer.from(msg[k], "base64"));
+      const s = slicePolytope(decodePolytope(msg), INPUT.matrix, 0.1);
+      out[name] = [Array.from(s.vertices), Array.from(s.flat), s.volume];
+    }
+    console.log(JSON.stringify(out));
+    """
+    p = polytope("24-cell")
+    m = random_rotation(np.random.default_rng(2))
+    out = run_page(script, {**wire(p), "matrix": m.reshape(-1).tolist()})
+    assert out["buffer"] == out["arraybuffer"] == out["dataview"]
+    assert out["buffer"][1] == slice_polytope(p, m, 0.1).polygon_indices.tolist()
+
+
 def test_the_message_and_what_the_page_refuses():
     """Sent once: the omnitruncated 120-cell's tables are 2.4 MB.  The page refuses a star
     polytope by name, and a message whose arrays do not fit its counts, naming the array."""
