@@ -301,6 +301,11 @@ def test_the_message_and_what_the_page_refuses():
     """Sent once: the omnitruncated 120-cell's tables are 2.4 MB.  The page refuses a star
     polytope by name, and a message whose arrays do not fit its counts, naming the array."""
     assert polytope_message_bytes(polytope_message(polytope("omnitruncated 120-cell"))) < 2.5e6
+    p = polytope("24-cell")
+    msg, inc = polytope_message(p), p.incidence
+    for name in ("face_ptr", "face_vidx", "face_eidx", "cell_vptr", "cell_vidx", "cell_eptr", "cell_eidx"):
+        assert np.array_equal(np.frombuffer(msg[name], "<i4"), getattr(inc, name)), name
+    assert np.array_equal(np.frombuffer(msg["vertices"], "<f8").reshape(-1, 4), p.unit_vertices)
     script = """
     import { decodePolytope, slicePolytope } from "page:slicer.js";
     const errors = INPUT.map((c) => {
