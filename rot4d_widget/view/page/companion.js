@@ -58,6 +58,8 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
+import { decodePolytope, slicePolytope, sliceData } from "./slicer.js";
+import { sliceRows } from "./rows.js";
 
 export { decodeSkeleton, projectSkeleton };
 
