@@ -1,6 +1,6 @@
 // The page's own polytope slicer: the slice w = c0 of a turned polytope whose cells are convex,
 // array for array as rot4d_widget.geometry.slicing.slice_polytope computes it (section.py:
-// slice_level, _slice, _touching, _faces_in_h, _boundary_only; slicetables.py: _fan,
+// slice_level, _slice, _touching, _faces_in_h; slicetables.py: _fan,
 // _inplane_axes, _scaled, _scaled_volume), so the page can draw the slice of the state it
 // predicts without waiting for the kernel.
 //
@@ -165,7 +165,7 @@ function cut(p, x, m, c0, tol) {
   const { triangles, triangleCells } = fan(flat, offsets, cellIds);
   const slice = { vertices, edges, flat, offsets, cellIds, triangles, triangleCells,
                   volume: volumeOf(vertices, triangles), dim: 3 };
-  return scaled(p, onIdx.length ? boundaryOnly(slice) : slice);
+  return scaled(p, slice);
 }
 
 // Each vertex above (side 1), below (-1) or on H (0) within `tol`; its height h = w - c0.
@@ -430,42 +430,6 @@ function facesInH(p, x, m, faceIds, fn, cOn) {
     outward.push(filled[1]);
   });
   return { keep, outward };
-}
-
-// section._boundary_only: drop the vertices on H and edges in H that no polygon uses (inside S,
-// or where P touches H away from S); a convex polytope's slice keeps them all (same arrays).
-function boundaryOnly(s) {
-  const { vertices, edges, flat, offsets, triangles } = s;
-  const n = vertices.length / 3;
-  const used = new Uint8Array(n);
-  for (const v of flat) used[v] = 1;
-  const sides = new Set();
-  for (let r = 0; r + 1 < offsets.length; r++) {
-    for (let k = offsets[r]; k < offsets[r + 1]; k++) {
-      const a = flat[k], b = flat[k + 1 < offsets[r + 1] ? k + 1 : offsets[r]];
-      sides.add(Math.min(a, b) * n + Math.max(a, b));
-    }
-  }
-  const side = [];
-  for (let e = 0; e < edges.length; e += 2) {
-    const a = edges[e], b = edges[e + 1];
-    side.push(sides.has(Math.min(a, b) * n + Math.max(a, b)));
-  }
-  if (used.every(Boolean) && side.every(Boolean)) return s;
-  const renumber = new Int32Array(n);  // cumsum(used) - 1
-  let next = 0;
-  const kept = [];
-  for (let i = 0; i < n; i++) {
-    if (used[i]) {
-      kept.push(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]);
-      next++;
-    }
-    renumber[i] = next - 1;
-  }
-  const keptEdges = [];
-  side.forEach((k, i) => { if (k) keptEdges.push(renumber[edges[2 * i]], renumber[edges[2 * i + 1]]); });
-  return { ...s, vertices: Float64Array.from(kept), edges: Int32Array.from(keptEdges),
-           flat: flat.map((v) => renumber[v]), triangles: triangles.map((v) => renumber[v]) };
 }
 
 // What rot4d_widget.sources.protocol.PolytopeSource.slice returns for the page's state: points,
