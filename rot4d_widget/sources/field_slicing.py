@@ -165,9 +165,11 @@ def _slice_offset(field, m, d, levels, res, *, coarse, box=None) -> tuple:
     """One `FieldSlice` per level of ``levels`` (a tuple of floats) at the offset ``d`` (slice units)
     after the validated rotation ``m``, sampled at ``res`` along the longest side; of
     ``field.coarse()`` with ``coarse``.  ``box``: the box's cut there, when known (the coarse copy
-    has the field's box)."""
+    has the field's box).  A full step of a chunked field reads only the chunks its samples touch:
+    its cap scale comes from this cut's samples until the coarse copy is ready (`Field4D.cap_scale`),
+    never from a coarse copy built for it."""
     src = field.coarse() if coarse else field
-    s = _sample(src, m, d, res, box=box)
+    s = _sample(src, m, d, res, first_cut=not coarse, box=box)
     if s is None:
         return tuple(_empty_slice(lv, 0.0) for lv in levels)
     return tuple(_surface(s, lv, field.inside, field.caps) for lv in levels)

@@ -139,7 +139,8 @@ class FieldStatistics:
         """K for one step's samples ``s``: the field's (`statistics`), or, for a chunked or lazy array
         whose coarse copy is not ready, the 95th percentile of |grad f| within the first cut's
         samples (kept until the coarse copy is ready, so the pictures agree) -- with ``first_cut``
-        (`Field4D.slice`; `slice_field` builds the coarse copy) or once K was taken so."""
+        (every full step: `Field4D.slice`, `slice_field`) or once K was taken so.  A full step
+        therefore never builds the coarse copy (which reads every chunk)."""
         f = self._field
         if ((first_cut or self._k_first is not None) and self._stats is None
                 and f.kind not in ("numpy", "function") and not f.coarse_ready):

@@ -330,6 +330,14 @@ class Field4D(FieldLevels):
         ``"actual_range"``, ``"valid_range"`` or ``"valid_min/valid_max"``."""
         return self._stat.range_info()[1]
 
+    @property
+    def known_range(self) -> tuple:
+        """`data_range` as far as it is known without reading every chunk: the same, except for a
+        chunked or lazy array whose coarse copy is not ready, whose range is then the first cut's
+        (the chunks read so far; the cut at rest is read when nothing was).  What a full step's
+        grid (`sample_field`) reports, so that it never triggers a full read."""
+        return self._stat.range_info(first_cut=True)[0]
+
     def _statistics(self):
         """((min, max), K): `data_range` and a typical |grad f| (level units per slice unit)."""
         return self._stat.statistics()
