@@ -35,6 +35,8 @@ class CoarseCopy:
         self._field = field
         self._counted = counted
         self.copy = None
+        #: the whole array in memory once the background read made it (else None)
+        self.loaded = None
         self._lock = threading.Lock()
         self._thread = None  # the background build (`prepare`)
         self.error = None

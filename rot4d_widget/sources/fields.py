@@ -90,7 +90,7 @@ from .field_input import (  # noqa: F401,E402  (export reads them)
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
 from .field_levels import FieldLevels
 from .field_readout import _describe, _order_text, _readout
-from .field_slicing import _box_slice, _sample, _sample_raw, _slice_offset
+from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
@@ -211,6 +211,8 @@ class Field4D(FieldLevels):
         self.coarse_resolution = max(24, self.resolution // 2) if coarse_resolution is None else coarse_resolution
         self.chunk_cache_bytes = int(chunk_cache_bytes)
         self._reader = None
+        #: the last cut sampled from chunked data (`rot4d_widget.sources.field_slicing.LastCut`)
+        self.last_cut = LastCut()
         self._levels = None if levels is None else _as_levels(levels)
         self.inside = inside
         self.caps = caps
@@ -405,6 +407,16 @@ class Field4D(FieldLevels):
                  "unit": _sealed(self._unit.copy())}
         return FieldSliceData.assemble(slices, box, readout, frame)
 
+    def outline(self, matrix, c0) -> "FieldSliceData":
+        """The slice's bars without its surface: the cut of the data's box at w = ``c0`` after
+        ``matrix``, read from nothing (the source protocol's ``outline``: what the widget sizes its
+        buffers and ball radius from, so that building a view reads no chunk but its first cut's)."""
+        m = as_rotation_matrix(matrix)
+        d = self.offset(c0)
+        frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
+                 "unit": _sealed(self._unit.copy())}
+        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), _box_slice(self, m, d), (), frame)
+
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
 
@@ -453,6 +465,12 @@ class Field4D(FieldLevels):
         return self._dims
 
     @property
+    def resident(self):
+        """The values as a numpy array in memory, in the array's own axis order -- given so, or read
+        whole in the background (`prepare`) -- else None (steps then read chunks)."""
+        return self._values if self._kind == "numpy" else self._coarse_copy.loaded
+
+    @property
     def reader(self):
         """The chunk reader of a chunked or lazy array once a step read from it, else None."""
         return self._reader
@@ -461,8 +479,9 @@ class Field4D(FieldLevels):
         """(N,) float64: quadrilinear values at the (N, 4) array-index coordinates ``idx`` (clamped
         into the array) where ``inside``, 0 elsewhere; a chunked or lazy array is read chunk by chunk
         (its chunk reader and cache), never assembled."""
-        if self._kind == "numpy":
-            return _resample_points(self._values, idx, inside)
+        resident = self.resident
+        if resident is not None:
+            return _resample_points(resident, idx, inside)
         if self._reader is None:
             self._reader = _ChunkReader(self._values, self.chunk_cache_bytes)
         return _chunked_values(self._reader, idx, inside, _SORT_PASSES)

@@ -54,6 +54,10 @@ that comes from these optional members, never from its class (`inner_source`,
 ``coarse_steps`` (optional)
     True when ``slice(matrix, c0, coarse=True)`` gives a cheaper slice for held
     keys (a field's coarse copy); by default read from ``slice``'s signature.
+``outline(matrix, c0)`` (optional)
+    A slice with the balls and bars ``slice`` gives and no surface, made without reading
+    the source's data (a field's: the cut of its data box): what the widget sizes its buffers
+    and its default ball radius from (`outline_of`; default: ``slice`` itself).
 ``sample(matrix, c0, resolution=None, *, coarse=False)`` (optional)
     The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
     spacing, units, data range): what the volume and maximum-intensity renderings
@@ -99,6 +103,7 @@ __all__ = [
     "settings_of",
     "apply_setting",
     "takes_coarse",
+    "outline_of",
 ]
 
 
@@ -271,6 +276,13 @@ def takes_coarse(source) -> bool:
         return "coarse" in inspect.signature(source.slice).parameters
     except (TypeError, ValueError):
         return False
+
+
+def outline_of(source, matrix, c0):
+    """``source.outline(matrix, c0)`` (the slice's balls and bars, no surface, nothing read), or
+    ``source.slice(matrix, c0)`` for a source without one."""
+    outline = getattr(source, "outline", None)
+    return source.slice(matrix, c0) if outline is None else outline(matrix, c0)
 
 
 def data_w_text(source, w: float, matrix=None) -> str:

@@ -45,6 +45,7 @@ import numpy as np
 
 from ..core.look import as_rgb, cell_palette, group_palette
 from ..core.rotation import random_rotation
+from ..sources.protocol import outline_of
 
 __all__ = [
     "ROW_FLOATS",
@@ -127,12 +128,13 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
 
     Central slices are usually the largest; the estimate includes `HEADROOM`.
     It is a starting size, not a bound: the scene grows the table safely if a
-    larger slice ever comes.
+    larger slice ever comes.  Each orientation is the source's outline
+    (`rot4d_widget.sources.protocol.outline_of`: a field's box cut, its data not read).
     """
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):
-        most = max(most, rows_needed(source.slice(random_rotation(rng), 0.0)))
+        most = max(most, rows_needed(outline_of(source, random_rotation(rng), 0.0)))
     return capacity_for(most)
 
 

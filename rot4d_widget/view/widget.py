@@ -632,10 +632,11 @@ def _fit_c0_range(state, source) -> None:
 
 
 def _default_ball_radius(source, scale, state) -> float:
-    """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment."""
+    """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment
+    (of its outline, `outline_of`: a field's box cut, nothing read)."""
     edge = getattr(source, "edge_length", None)
     if edge is None:
-        data = checked_slice(source, state.matrix, state.c0, False, threading.RLock())
+        data = checked_slice(source, state.matrix, state.c0, False, threading.RLock(), outline=True)
         seg = np.asarray(data.segments)
         if len(seg):
             p = np.asarray(data.points, dtype=np.float64)
