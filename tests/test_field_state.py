@@ -313,7 +313,7 @@ def test_the_data_range_comes_from_metadata_without_a_read(attrs, encoding, want
 
 def test_the_data_range_of_a_lazy_field_without_metadata_is_the_coarse_copy_s_and_says_so():
     da = _lazy_dataarray(_values(), {})
-    field = Field4D.from_xarray(da, w="time")
+    field = Field4D.from_xarray(da, w="time", memory_budget=0)  # bigger than its budget: never read whole
     rng = field.data_range
     assert READS["n"] > 0 and rng == field.coarse().data_range
     assert field.data_range_source == "coarse copy"
@@ -332,9 +332,11 @@ def test_an_array_in_memory_has_the_range_of_all_its_samples_not_the_coarse_copy
     level = dict(field.slice(M, 0.0).readout)["level"]
     assert level.endswith("of 0 \u2026 0.53"), level
     dask = pytest.importorskip("dask.array")
-    lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")
+    lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx", memory_budget=0)  # never read whole
     assert lazy.data_range == field.coarse().data_range and lazy.data_range_source == "coarse copy"
     assert dict(lazy.slice(M, 0.0).readout)["level"].endswith("(coarse copy)")
+    fits = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")  # read whole in the coarse copy's pass
+    assert fits.data_range == (0.0, 0.53) and fits.data_range_source == "data" and fits.resident is not None
 
 
 def test_a_plain_zarr_array_s_own_attributes_give_the_range_without_a_read():

@@ -286,7 +286,7 @@ def test_numpy_dask_xarray_zarr_give_the_same_surface_and_read_few_chunks():
     counting = CountingArray(tzyx)
     coords = {"t": np.linspace(0, 1, 32), "z": np.linspace(-1, 1, 22), "y": np.linspace(-1, 1, 20),
               "x": np.linspace(-1, 1, 24)}
-    kw = dict(extent=ext, w_per_unit=0.5)
+    kw = dict(extent=ext, w_per_unit=0.5, memory_budget=0)  # big data: never read whole (chunks are counted)
     fields = {
         "numpy": Field4D(a, axes="xyzw", **kw),
         "numpy wzyx": Field4D(tzyx, axes="wzyx", **kw),

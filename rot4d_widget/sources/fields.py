@@ -31,13 +31,15 @@ coordinates about the box's centre, with w divided by ``w_per_unit`` (how
 much data-w one unit of space is): a data point q is drawn at
 ``matrix @ (q - centre)`` with its w so scaled.
 
-Chunked data (dask, zarr, anything with ``chunks``): a full-resolution step
-reads only the chunks the hyperplane comes within one sample of (the whole
-4-D bounding block is never read), into a zero-filled buffer whose untouched
-pages are never committed; recently read chunks are kept up to
+Chunked data (dask, zarr, anything with ``chunks``) and lazily read files: a
+full-resolution step reads only the chunks its samples' cells touch (the whole
+4-D bounding block is never read); recently read chunks are kept up to
 ``chunk_cache_bytes``.  ``field.coarse()`` is an in-memory copy with at most
 `COARSE_SAMPLES` nodes per axis over the same box (built once, the only time
-every chunk is read) for the held-key steps and for the data range.
+every chunk is read) for the held-key steps and for the data range.  Data that
+fit ``memory_budget`` (`MEMORY_BUDGET`, 1 GiB) are read whole in that same pass
+(`prepare`: in the background, with a progress bar; the widget starts it), after
+which steps run on the array in memory (`resident`).
 
 Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
@@ -54,15 +56,17 @@ itself becomes inf (or 0); `Field4D.slice` then gives the widget no volume.
 
 from __future__ import annotations
 
+import math
 import numbers
 
 import numpy as np
 
 from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
+from ..core.validate import int_in_range
 from ..geometry.polytopes import check_scale
 from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
-from .coarse import COARSE_SAMPLES, CoarseCopy
+from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
 from .field_checks import (
     _AXES,
     BYTES_PER_SAMPLE,
@@ -95,7 +99,7 @@ from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
-           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
 
 _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
                _resample_affine, _sample_raw, _surface)
@@ -147,7 +151,7 @@ class Field4D(FieldLevels):
     levels : float or sequence of floats, optional
         Iso levels (default: one, midway between the min and max of `data_range`: for a chunked
         array, of the first slice's chunks until `coarse` is ready -- the first picture never
-        reads the whole array; `prepare_coarse` builds the copy in the background).
+        reads the whole array; `prepare` builds the copy in the background).
     inside : "above" or "below"
         Which side of each level the surface encloses: ``"above"`` {f >= level} (a density,
         a phase field), ``"below"`` {f <= level} (a signed distance, negative inside: the ball,
@@ -160,12 +164,17 @@ class Field4D(FieldLevels):
     chunk_cache_bytes : int
         Recently read chunks of a chunked array kept in memory (default 128 MiB: with the
         rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
+    memory_budget : int
+        Bytes a chunked or lazy array may take in memory (float32 kept, other types as
+        float64) to be read whole when the coarse copy is made (`prepare`, `coarse`); default
+        `MEMORY_BUDGET` (1 GiB); 0: never.  Bigger data keep the coarse copy and read, for a full
+        step, only the chunks its samples touch.
     """
 
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, space_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
-                 _coords=None, _function=None, _copy_of=None):
+                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None):
         self._function = _function
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
@@ -210,6 +219,7 @@ class Field4D(FieldLevels):
         self.resolution = resolution
         self.coarse_resolution = max(24, self.resolution // 2) if coarse_resolution is None else coarse_resolution
         self.chunk_cache_bytes = int(chunk_cache_bytes)
+        self.memory_budget = memory_budget
         self._reader = None
         #: the last cut sampled from chunked data (`rot4d_widget.sources.field_slicing.LastCut`)
         self.last_cut = LastCut()
@@ -465,6 +475,26 @@ class Field4D(FieldLevels):
         return self._dims
 
     @property
+    def memory_budget(self) -> int:
+        """Bytes a chunked or lazy array may take in memory to be read whole (settable; 0: never)."""
+        return self._memory_budget
+
+    @memory_budget.setter
+    def memory_budget(self, value) -> None:
+        self._memory_budget = int_in_range(value, "memory_budget", 0)
+
+    @property
+    def fits_in_memory(self) -> bool:
+        """True when the values are in memory, or would take at most `memory_budget` bytes there
+        (float32 kept, other types as float64): the background read then reads them whole."""
+        if self.resident is not None:
+            return True
+        if self._kind == "function":
+            return False
+        itemsize = 4 if np.dtype(self._values.dtype) == np.float32 else 8
+        return math.prod(int(n) for n in self._values.shape) * itemsize <= self._memory_budget
+
+    @property
     def resident(self):
         """The values as a numpy array in memory, in the array's own axis order -- given so, or read
         whole in the background (`prepare`) -- else None (steps then read chunks)."""
@@ -486,6 +516,12 @@ class Field4D(FieldLevels):
             self._reader = _ChunkReader(self._values, self.chunk_cache_bytes)
         return _chunked_values(self._reader, idx, inside, _SORT_PASSES)
 
+    def drop_chunk_cache(self) -> None:
+        """Forget the chunks kept from earlier steps (`chunk_cache_bytes`): once the array is read
+        whole, steps no longer read chunks."""
+        if self._reader is not None:
+            self._reader.clear_cache()
+
     # -- coarse copy -------------------------------------------------------------
     def coarse(self) -> "Field4D":
         """An in-memory copy with at most `COARSE_SAMPLES` nodes per axis over the same box
@@ -493,13 +529,14 @@ class Field4D(FieldLevels):
 
         The field itself when it already is that small and in memory, or a function.  A chunked or
         lazy array is read chunk by chunk (each downsampled into the copy and dropped: memory is the
-        copy plus a few chunks).  Blocks until the copy is built: when `prepare_coarse` started it
-        in the background, waits for that build."""
+        copy plus a few chunks; one that `fits_in_memory` is kept whole as well, `resident`).  An
+        array in memory is resampled in blocks of 16 samples a side: the same numbers.  Blocks until
+        the copy is built: when `prepare` started it in the background, waits for that read."""
         return self._coarse_copy.get()
 
     @property
     def coarse_ready(self) -> bool:
-        """True once the coarse copy is built (`coarse`, or the background build of `prepare_coarse`)."""
+        """True once the coarse copy is built (`coarse`, or the background read of `prepare`)."""
         return self._coarse_copy.ready
 
     @property
@@ -512,17 +549,22 @@ class Field4D(FieldLevels):
         """What made the background build of the coarse copy fail (None so far)."""
         return self._coarse_copy.error
 
-    def prepare_coarse(self, progress: bool = True) -> None:
-        """Start building the coarse copy (`coarse`) on a daemon thread and return at once.
+    def prepare(self, progress: bool = True):
+        """Start the background read on a daemon thread and return at once (the source protocol's
+        ``prepare``; a live `Rot4DWidget` calls it when shown): one pass over the array, chunk by chunk,
+        building the coarse copy (`coarse`) and, when the field `fits_in_memory`, reading the whole
+        array into memory (`resident`; steps then run as on data given in memory).  Memory: the copy
+        plus a few chunks, and the array when it is read whole.
 
-        The build reads the array chunk by chunk (memory: the copy plus a few chunks), counting
-        chunks on a progress bar (`rot4d_widget.view.progress`, shown after a second: a widget in a
-        kernel, a line on a terminal) when ``progress`` is true; `coarse_progress` holds
-        (chunks done, chunks in all).  Until `coarse_ready`, held keys meanwhile slice at full
-        resolution (``slice(..., coarse=True)`` returns the full-resolution slice and says so), the
-        data range and default level come from the chunks read so far ("first cut"); `coarse`
-        waits for the build.  Does nothing when the copy is built or being built."""
-        self._coarse_copy.prepare(progress)
+        Returns the `rot4d_widget.core.progress.Progress` counting chunks (the one already running when
+        the read was started before), or None when there is nothing to read.  ``progress``: a bar
+        shown after a second -- in a kernel a widget in this cell's output, on a terminal a line;
+        a `Rot4DWidget` passes False and shows the returned progress in its own bar, in the page.
+        `coarse_progress` holds (chunks done, chunks in all).  Until `coarse_ready`, held keys
+        slice the full data at the coarse resolution (``slice(..., coarse=True)`` says so in its
+        readout) and the data range and default level come from the chunks read so far ("first
+        cut"); `coarse` waits for the read."""
+        return self._coarse_copy.prepare(progress)
 
     def __repr__(self) -> str:
         if self._kind == "function":

@@ -52,9 +52,9 @@ from ipyevents import Event
 from ..core import look
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
-from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
+from ..sources.protocol import as_source, inner_source, prepare_in_background, takes_coarse, w_frame
 from ..sources.tomography import ARRANGEMENTS
-from . import progress as _progress  # noqa: F401 - registers the kernel's progress bar with the core
+from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
 from . import readout as ro
 from . import traits as t
 from .buffers import estimate_capacity
@@ -162,6 +162,8 @@ class Rot4DWidget(widgets.HBox):
     stats : counters of the update pump (updates, acks, timeouts)
     readout, help_panel : ipywidgets.HTML
     errors : ipywidgets.Output -- exceptions raised by key handling
+    progress_bar : `rot4d_widget.view.progress.ViewBar` -- under the canvas, shown while the source
+        is read in the background (`prepare_source`)
     """
 
     theta0 = t.Angle(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
@@ -421,6 +423,17 @@ class Rot4DWidget(widgets.HBox):
         (then the module the file names is imported) or the source is passed in."""
         return Keeper.from_state(cls, path, source, allow_code=allow_code, **kwargs)
 
+    def prepare_source(self):
+        """Start the source's background work (`rot4d_widget.sources.protocol.prepare_in_background`:
+        a field's read into memory, or its coarse copy) and show its progress on the widget's own
+        bar, under the canvas, until it is over; a live widget does this when it is made.  Returns
+        the `rot4d_widget.core.progress.Progress`, or None when there is nothing to do."""
+        self._check_open()
+        counter = prepare_in_background(inner_source(self.source), progress=False)
+        if counter is not None:
+            counter.attach(self.progress_bar)
+        return counter
+
     def release_keys(self, page_time=None) -> None:
         """Release every held key (what mouseleave and focus loss do); ``page_time``: the page's
         time of the event in seconds, if known (each key's steps are then corrected to it)."""
@@ -515,12 +528,12 @@ def _wire(w, keypad) -> None:
 
     # The initial picture is part of the models' state: not "in flight".
     w._pump.send_now(expect_ack=False)
-    # A big field's coarse copy (for held keys) is built in the background from now on, with
-    # a progress bar; its first picture above read only the chunks the cut touches.  Only with
-    # the ticker running (a live widget): scripts and tests stay deterministic.
-    prepare = getattr(inner_source(w.source), "prepare_coarse", None)
-    if prepare is not None and w._pump.autotick:
-        prepare(progress=True)
+    # A field is read in the background from now on (the whole of it into memory when it fits its
+    # budget, else its coarse copy for held keys), counted on the widget's own bar under the
+    # canvas; its first picture above read only the chunks the cut touches.  Only with the
+    # ticker running (a live widget): scripts and tests stay deterministic (`prepare_source`).
+    if w._pump.autotick:
+        w.prepare_source()
 
 
 def _unwire(w) -> None:
@@ -542,6 +555,9 @@ def _close_children(w) -> None:
     before the canvas does."""
     w._keypad.close()
     w._projection.close()
+    bar = getattr(w, "progress_bar", None)
+    if bar is not None:
+        bar.close_widgets()
     for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
         x = getattr(w, name, None)
         if x is not None:
@@ -575,8 +591,11 @@ def _build_children(w, options) -> None:
             ignore_modifier_key_events=True,
         )
         built.append(w.events)
+        w.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
+        built.append(w.progress_bar.box)
         # the canvas keeps its size; the side panel wraps below it when narrow
-        w._canvas_box = widgets.VBox([w.scene.canvas, w.companion], layout=widgets.Layout(flex="0 0 auto"))
+        w._canvas_box = widgets.VBox([w.scene.canvas, w.progress_bar.box, w.companion],
+                                     layout=widgets.Layout(flex="0 0 auto"))
         w._side_box = widgets.VBox(
             [w.readout, w.help_panel, w.errors],
             layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
