@@ -164,9 +164,16 @@ def test_a_dataset_is_refused_naming_its_variables():
     xr = pytest.importorskip("xarray")
     ds = dataset(xr)
     ds["S"] = ds["T"] * 2
-    for call in (lambda: Field4D.from_xarray(ds, w="time"), lambda: Field4D(ds, axes="wzyx")):
-        with pytest.raises(TypeError, match=r"Dataset with data variables 'T', 'S'; pick one: ds\['T'\]"):
-            call()
+    with pytest.raises(ValueError, match=r"Dataset has data variables 'T', 'S'; name one: "
+                                         r"Field4D.from_xarray\(ds, 'T', w='time'\)"):
+        Field4D.from_xarray(ds, w="time")
+    with pytest.raises(ValueError, match=r"no data variable 'U'; it has 'T', 'S'"):
+        Field4D.from_xarray(ds, "U", w="time")
+    with pytest.raises(TypeError, match=r"Dataset with data variables 'T', 'S'; use Field4D.from_xarray\(ds, 'T'"):
+        Field4D(ds, axes="wzyx")
+    with pytest.raises(TypeError, match=r"`variable` \('T'\) names a data variable of an xarray.Dataset"):
+        Field4D.from_xarray(ds["T"], "T", w="time")
+    assert Field4D.from_xarray(ds, "S", w="time").name == "S"
     with pytest.raises(TypeError, match=r"from_xarray\(da, w='time'\)"):
         Field4D(ds["T"], axes="wzyx")
 

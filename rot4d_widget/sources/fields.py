@@ -227,8 +227,11 @@ class Field4D(FieldLevels):
         self.inside = inside
         self.caps = caps
         #: Where the values come from, for a state file to reopen them (`Field4D.open`; `from_xarray`
-        #: when xarray's encoding names the file): a JSON-able dict, or None (not reopenable)
+        #: of a Dataset, or of a DataArray when xarray's encoding names the file): a JSON-able dict, or
+        #: None (not reopenable)
         self.origin = None
+        #: Why `from_xarray` found no origin (said when a state file is saved), or None
+        self.origin_missing = None
 
     # -- constructors ---------------------------------------------------------
     @classmethod
@@ -244,8 +247,18 @@ class Field4D(FieldLevels):
                    _function=f, **kwargs)
 
     @classmethod
-    def from_xarray(cls, da, *, x=None, y=None, z=None, w=None, w_per_unit=None, **kwargs) -> "Field4D":
-        """A field from a 4-D ``xarray.DataArray`` (dims by name; extents from coordinates).
+    def from_xarray(cls, data, variable=None, *, x=None, y=None, z=None, w=None, w_per_unit=None,
+                    **kwargs) -> "Field4D":
+        """A field from a 4-D ``xarray.DataArray``, or from ``variable`` of an ``xarray.Dataset``
+        (dims by name; extents from coordinates).
+
+        ``Field4D.from_xarray(xarray.open_dataset("run.nc"), "T", w="time")`` (or ``open_zarr``):
+        the Dataset knows the file it was opened from, whatever the engine, so the field
+        remembers it (``origin``) and a state file reopens it (`Rot4DWidget.from_state(path)`);
+        ``variable`` may be omitted when the Dataset has one data variable.  A DataArray
+        (``ds["T"]``) remembers its file only when xarray's encoding names it (the netCDF4 and
+        h5netcdf engines); neither remembers a selection made after opening (use `open`'s
+        ``isel=`` / ``sel=``): saving such a field warns that it cannot be rebuilt, and says why.
 
         Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one
         left over is w (``("time", "z", "y", "x")``); otherwise name them with
@@ -255,11 +268,13 @@ class Field4D(FieldLevels):
         value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
         mean w spacing over the mean spatial spacing (voxels are cubes).
         """
-        values, args, dims, meta_range, origin, long_name = _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs)
+        values, args, dims, meta_range, (origin, why), long_name = _xarray_arguments(
+            data, variable, x, y, z, w, w_per_unit, kwargs)
         field = cls(values, **args, **kwargs)
         field._dims, field.long_name = dims, long_name
         field._stat.meta_range = meta_range
         field.origin = origin
+        field.origin_missing = why
         return field
 
     @classmethod
@@ -284,6 +299,7 @@ class Field4D(FieldLevels):
         da, record = _open_dataarray(path, variable, engine, chunks, isel, sel, load)
         field = cls.from_xarray(da, x=x, y=y, z=z, w=w, **kwargs)
         field.origin = {**record, "kwargs": dict(zip(field.axes, field._dims)), "load": bool(load)}
+        field.origin_missing = None
         return field
 
     # -- geometry and resolution ------------------------------------------------
