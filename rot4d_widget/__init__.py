@@ -80,7 +80,7 @@ _MOVED = {
     "companion": "view.companion",
     "pump": "view.pump",
     "keyhold": "view.keyhold",
-    "readout": "view.readout",
+    "readout": "view.markup",
     "progress": "core.progress",
 }
 

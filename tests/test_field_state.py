@@ -16,6 +16,7 @@ chunked data, and then the readout says so.
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import warnings
@@ -380,6 +381,39 @@ def test_the_data_range_comes_from_metadata_without_a_read(attrs, encoding, want
     assert READS["n"] == 0
     rows = dict(field.slice(M, 0.0).readout)  # a slice reads, and names the range's source
     assert READS["n"] > 0 and rows["level"].endswith(f"({where})")
+
+
+@pytest.mark.parametrize("attrs, dtype", [
+    ({"valid_min": -1e308, "valid_max": 1e308}, "f8"),  # a step of 1/50 of the span overflowed: o made it inf
+    ({"valid_range": np.array([-1e307, 1e307])}, "f4"),  # beyond what float32 data hold
+    ({"actual_range": [1.0, 1.0]}, "f8"),  # o / i had nowhere to go, and said nothing
+])
+def test_metadata_that_is_no_range_to_step_through_is_ignored_and_the_keys_move_the_level(attrs, dtype, make):
+    """Issue 33, item 4: each case failed before (the level became inf, or stayed put)."""
+    da = _lazy_dataarray(_values().astype(dtype), attrs)
+    field = Field4D.from_xarray(da, w="time")
+    assert field.data_range_source not in ("actual_range", "valid_range", "valid_min/valid_max")
+    lo, hi = field.data_range
+    assert math.isfinite(lo) and math.isfinite(hi) and lo < hi
+    w = make(field)
+    before = field.levels
+    for _ in range(3):
+        w.press("o")
+    assert all(math.isfinite(v) for v in field.levels) and field.levels[0] > before[0]
+    for _ in range(3):
+        w.press("i")
+    assert field.levels == pytest.approx(before)
+    assert w.errors.outputs == ()
+
+
+def test_a_level_step_never_overflows_on_data_that_reach_the_float_limits():
+    a = np.zeros((NT, 6, 6, 6))
+    a[0, 0, 0, 0], a[-1, -1, -1, -1] = -1e308, 1e308
+    field = Field4D(a, axes="wzyx")
+    assert math.isfinite(field.level_step) and field.level_step > 0
+    for _ in range(60):
+        field.step_levels(1)
+    assert all(math.isfinite(v) for v in field.levels)
 
 
 def test_the_data_range_of_a_lazy_field_without_metadata_is_the_coarse_copy_s_and_says_so():

@@ -297,11 +297,13 @@ def test_a_source_failing_in_construction_leaves_no_models():
     assert _models() == before
 
 
-def test_create_and_close_leaves_no_models():
-    Rot4DWidget(_autotick=False).close()  # warm-up (module-level widgets)
+@pytest.mark.parametrize("options", [{"keypad": True}, {"projection": True}])
+def test_create_and_close_leaves_no_models(options):
+    """With ``projection=True`` 20 cycles left 20 models before (its renderer's own WebGLShadowMap)."""
+    Rot4DWidget(_autotick=False, **options).close()  # warm-up (module-level widgets)
     before = _models()
-    for _ in range(5):
-        Rot4DWidget(_autotick=False, keypad=True).close()
+    for _ in range(20):
+        Rot4DWidget(_autotick=False, **options).close()
     assert _models() == before
 
 

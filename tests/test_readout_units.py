@@ -10,7 +10,7 @@ import re
 import pytest
 
 from rot4d_widget.sources.fields import Field4D
-from rot4d_widget.view.readout import number_text
+from rot4d_widget.core.look import number_text
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

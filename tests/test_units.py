@@ -10,7 +10,7 @@ import pytest
 
 from rot4d_widget.view.keyhold import KeyRepeater
 from rot4d_widget.view.pump import PAGE_BUDGET, UpdatePump
-from rot4d_widget import readout as ro
+from rot4d_widget.view import markup as ro
 from rot4d_widget.core.rotation import simple_rotation
 
 

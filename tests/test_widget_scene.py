@@ -454,3 +454,46 @@ def test_held_keys_that_move_w_send_new_rows(make, clock, recording_comms):
     msgs = buffer_messages(w, recording_comms[n0:])
     assert msgs and all("array" in d["state"] and "_rot4d_turn" not in d["state"] for d, _ in msgs)
     assert not w.scene.turned
+
+
+def _page_copy(log, bid, name):
+    """The value of buffer trait ``name`` the page holds: the last message that carried it."""
+    value = None
+    for cid, data, _, _ in log:
+        if cid == bid and isinstance(data, dict) and name in data.get("state", {}):
+            value = data["state"][name]
+    return value
+
+
+@pytest.mark.parametrize("there, back", [("l", "h"), ("2", "Shift+2")])
+def test_a_failed_send_then_a_step_back_to_the_picture_shown_leaves_the_page_in_step(
+        make, clock, recording_comms, monkeypatch, there, back):
+    """Issue 33, item 6 (the soak): a send that failed, then a step back to the state the page
+    shows (a late keyup taking steps back), left the kernel's copy of the buffer holding the
+    unsent picture while nothing was owed, so a view opened later drew it (painter.send's
+    no-change branch ignored the scene's unsent part)."""
+    w = make("24-cell")
+    w.state.c0_step = 0.015625  # out and back is exact
+    bid = w.scene.buffer_model_id
+    comm = ipywidget_module._instances[bid].comm
+    drawn(w)
+
+    def fail(*args, **kwargs):
+        raise ConnectionError("injected: the comm is down")
+
+    real = comm.send
+    monkeypatch.setattr(comm, "send", fail)
+    shift = back.startswith("Shift+")
+    key = back.removeprefix("Shift+")
+    down(w, there, t=10.0)  # its picture (or turn) fails to leave
+    monkeypatch.setattr(comm, "send", real)
+    down(w, key, shift=shift, t=10.02)  # while the first is held: back to the state the page shows
+    up(w, there, t=10.04)
+    up(w, key, shift=shift, t=10.06)
+    drawn(w)
+    run_ticker(w, clock, clock.t + 1.0)
+    assert not w.scene.unsent
+    for name in ("_rot4d_seq", "_rot4d_turn", "_rot4d_counts"):  # as the page holds them (if ever sent)
+        page = _page_copy(recording_comms, bid, name)
+        assert page is None or page == getattr(w.scene._buffer, name), name
+    assert _page_copy(recording_comms, bid, "_rot4d_seq") == w.scene.update_id

@@ -117,3 +117,44 @@ def test_key_p_saves_numbered_pngs_next_to_the_notebook(make, recording_comms, t
     assert (tmp_path / "rot4d-001.png").read_bytes() == b"taken before"  # never overwritten
     assert (tmp_path / "rot4d-002.png").read_bytes() == png == (tmp_path / "rot4d-003.png").read_bytes()
     assert "saved rot4d-003.png" in w.readout.value
+
+
+class FailingSend(Exception):
+    """A comm send that fails (the kernel lost its connection for a moment)."""
+
+
+def test_an_answer_whose_note_cannot_be_sent_never_raises_into_the_companion(make, monkeypatch):
+    """Issue 33, item 6 (the soak): the note's readout send raised out of the companion's handler."""
+    w = make()
+    front_end_view_count(w, 1)
+    rid = w.screenshot()
+
+    def fail(*args, **kwargs):
+        raise FailingSend("the comm is down")
+
+    monkeypatch.setattr(w.readout.comm, "send", fail)
+    _answer(w, rid, png=_data_url(_png()))  # must not raise
+    assert w.last_screenshot is not None
+    assert "the comm is down" in str(w.errors.outputs)
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="no FIFOs on this platform")
+def test_a_fifo_at_the_target_name_is_refused_without_waiting(make, tmp_path):
+    """Issue 33, item 7: opening a FIFO for writing waits for a reader -- under the pump's lock."""
+    import os
+    import threading
+
+    fifo = tmp_path / "view.png"
+    os.mkfifo(fifo)
+    w = make()
+    front_end_view_count(w, 1)
+    rid = w.screenshot(fifo)
+    done = threading.Event()
+
+    def answer():
+        _answer(w, rid, png=_data_url(_png()))
+        done.set()
+
+    threading.Thread(target=answer, daemon=True).start()
+    assert done.wait(30), "the answer waited on the FIFO"
+    assert "screenshot not saved" in w.readout.value and "not a regular file" in w.readout.value

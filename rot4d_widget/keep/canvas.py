@@ -1,4 +1,5 @@
-"""The animation frame canvas: one reused figure, and text drawn from kept glyph bitmaps.
+"""The figures pictures are drawn in: text as written, and the animation frame canvas (one reused
+figure, text drawn from kept glyph bitmaps).
 
 Part of `rot4d_widget.keep.figures` (`_FrameCanvas`, `render_state(..., _canvas=)`).
 """
@@ -9,6 +10,21 @@ import math
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.text import Text
+
+
+class LiteralTextFigure(Figure):
+    """A matplotlib ``Figure`` whose text is drawn as written.  Names, units and labels come from
+    data and state files: "$\\bad$" must not be parsed as mathtext (it raises) and no text goes
+    to LaTeX (``text.usetex``, which reads files).  Every text is made literal as the figure
+    draws, so text added after the figure was made is covered too (PNG, SVG, PDF, frames)."""
+
+    def draw(self, renderer):
+        for text in self.findobj(Text):
+            text.set_parse_math(False)
+            text.set_usetex(False)
+        return super().draw(renderer)
+
 
 _TEXT_CACHE_SIZE = 512  # rendered lines of text an animation's canvas keeps
 
@@ -181,7 +197,7 @@ class _FrameCanvas:
         high above it and a strip ``right`` wide beside it (a field's colour bar)."""
         key = (width, height, top, dpi, tuple(background), right)
         if self.fig is None or key != self.key:
-            self.fig = Figure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
+            self.fig = LiteralTextFigure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
             self.ax = self.fig.add_axes([0, 0, width / (width + right), height / (height + top)])
             self.ax.set_axis_off()
             self.ax.set_facecolor(background)

@@ -18,6 +18,7 @@ from ..core.look import REFERENCE_RADIUS
 from ..core.state import RotationState
 from ..geometry.polytopes import Polytope, pentachoron
 from ..geometry.slicing import slice_polytope
+from .canvas import LiteralTextFigure
 from .drawing import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0, TITLE_HEIGHT, _as_polytope, _count, _real, _save, draw_slice
 
 
@@ -31,7 +32,7 @@ def _grid_figure(n_panels: int, ncols: int, panel_size: float, dpi: float, title
     nrows = -(-n_panels // ncols)
     top = TITLE_HEIGHT if title else 0.0
     width, height = ncols * panel_size, nrows * panel_size + top
-    fig = Figure(figsize=(width, height), dpi=dpi, facecolor=look.BACKGROUND)
+    fig = LiteralTextFigure(figsize=(width, height), dpi=dpi, facecolor=look.BACKGROUND)
     axes = []
     for k in range(nrows * ncols):
         r, c = divmod(k, ncols)

@@ -23,6 +23,7 @@ from ..geometry.slicing import Slice
 from ..sources.field_labels import box_labels
 from ..sources.protocol import apply_setting, as_source, inner_source, settings_of
 from ..sources.tomography import StackSource
+from .canvas import LiteralTextFigure
 from .drawing import (
     _REFERENCE_EDGE,
     _Z_BASE,
@@ -173,7 +174,7 @@ def render_tomography(
     top = TITLE_HEIGHT if title else 0.0
     right = colorbar_width(height) if colorbar and (field or volume) else 0.0
     if _canvas is None:
-        fig = Figure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
+        fig = LiteralTextFigure(figsize=(width + right, height + top), dpi=dpi, facecolor=background)
         # the camera's frame; the title above it, the colour bar right of it
         ax = fig.add_axes([0, 0, width / (width + right), height / (height + top)])
         ax.set_axis_off()

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import warnings
 
 import numpy as np
 
@@ -115,18 +116,22 @@ def _zarr_attrs(values) -> dict:
         return {}
 
 
-def _metadata_range(attrs, encoding):
+def _metadata_range(attrs, encoding, dtype=None):
     """(lo, hi, where) of a variable from its attributes, read without touching its data, or None.
 
     ``actual_range`` (CF: the data's own min and max, in unpacked units) first, else
     ``valid_range`` or ``valid_min`` and ``valid_max`` (CF: the bounds of valid values, in packed
     units: unpacked here by the ``scale_factor`` / ``add_offset`` xarray moved into the encoding
-    when it decoded the data).  A pair that is not finite and ordered is ignored."""
+    when it decoded the data).  A pair is a range the level keys can step through only when it is
+    finite with lo < hi and a finite span: ``[1, 1]`` (o / i would have nowhere to go) and
+    ``[-1e308, 1e308]`` (a step of 1/50 of the span overflows) are ignored, as is a pair beyond
+    what the data's floating ``dtype`` holds (``valid_max = 1e307`` for float32 data): the range
+    then comes from the data."""
     attrs = attrs or {}
     encoding = encoding or {}
     packed = "scale_factor" in attrs or "add_offset" in attrs  # not decoded: the data are still packed
     pair = None if packed else _attr_numbers(attrs.get("actual_range"), 2)
-    if pair is not None and pair[0] <= pair[1]:
+    if pair is not None and _steppable(pair, dtype):
         return pair[0], pair[1], "actual_range"
     pair, where = _attr_numbers(attrs.get("valid_range"), 2), "valid_range"
     if pair is None:
@@ -140,7 +145,18 @@ def _metadata_range(attrs, encoding):
         if scale is None or offset is None:
             return None
         pair = tuple(sorted((pair[0] * scale[0] + offset[0], pair[1] * scale[0] + offset[0])))
-    return (pair[0], pair[1], where) if pair[0] <= pair[1] else None
+    return (pair[0], pair[1], where) if _steppable(pair, dtype) else None
+
+
+def _steppable(pair, dtype=None) -> bool:
+    """A metadata (lo, hi) the field can use as its data range: finite, lo < hi, a finite span, and
+    within what a floating ``dtype`` holds."""
+    lo, hi = (float(v) for v in pair)
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi and math.isfinite(hi - lo)):
+        return False
+    if dtype is not None and np.issubdtype(np.dtype(dtype), np.floating):
+        return max(abs(lo), abs(hi)) <= float(np.finfo(dtype).max)
+    return True
 
 
 def _encoding_origin(da, chosen):
@@ -171,9 +187,7 @@ def _dataset_origin(ds, variable, da, chosen):
     (None, why not).  The file is opened again (metadata and coordinates only) to tell the whole
     variable from a selection made after opening (``ds.isel(...)``: its shape or coordinates differ),
     which a state file would reopen whole: refused, naming `Field4D.open`'s ``isel=`` / ``sel=``."""
-    import warnings
-
-    import xarray  # from_xarray was given a Dataset: xarray is there
+    import xarray  # optional: from_xarray was given a Dataset, so it is installed
 
     src = (getattr(ds, "encoding", None) or {}).get("source")
     if not isinstance(src, str) or not os.path.exists(src):
@@ -373,7 +387,7 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
             f"Expected at least 2 samples along every dim (a surface needs a cell to cross), got "
             f"{', '.join(few)}; dims {dict((d, int(da.sizes[d])) for d in dims)}. A single time step is a "
             f"3-D field, not a 4-D one: select a range, e.g. da.isel({chosen['w']}=slice(0, 2))")
-    meta_range = _metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None))
+    meta_range = _metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None), getattr(da, "dtype", None))
     if ds is not None:
         origin = _dataset_origin(ds, variable, da, chosen)
     else:

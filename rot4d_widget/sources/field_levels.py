@@ -59,8 +59,8 @@ class FieldLevels:
         lo, hi = self.data_range
         if not (math.isfinite(lo) and math.isfinite(hi)):
             return 0.02
-        span = hi - lo
-        return span / 50 if span > 0 else max(abs(hi), 1.0) / 50
+        span = hi / 50 - lo / 50  # not (hi - lo) / 50: data reaching +-1e308 would overflow to inf
+        return span if span > 0 else max(abs(hi), 1.0) / 50
 
     def step_levels(self, sign: int):
         """Move every level by ``sign * level_step``; returns the levels, or False (no change) when
@@ -69,6 +69,8 @@ class FieldLevels:
         step = self.level_step
         lo, hi = self.data_range
         new = tuple(v + (1 if sign > 0 else -1) * step for v in self.levels)
+        if not all(math.isfinite(v) for v in new):
+            return False  # a level never becomes inf, however it was set
         if math.isfinite(lo) and math.isfinite(hi):
             def outside(v):  # how far beyond the widened range (0 inside)
                 return max(lo - step - v, v - hi - step, 0.0)
@@ -76,8 +78,6 @@ class FieldLevels:
             # a level set outside by hand may still step back towards the range
             if any(outside(v) > 0 and outside(v) >= outside(u) for u, v in zip(self.levels, new)):
                 return False
-        elif not all(math.isfinite(v) for v in new):
-            return False
         self._levels = new
         return self._levels
 

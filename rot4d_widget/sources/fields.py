@@ -209,7 +209,7 @@ class Field4D(FieldLevels):
         self._centre.flags.writeable = False
         #: (lo, hi, where) from the data's metadata (`from_xarray`: actual_range, valid_min/valid_max;
         #: a zarr array's own attributes likewise)
-        meta = _metadata_range(_zarr_attrs(self._values), None) if self._kind == "zarr" else None
+        meta = _metadata_range(_zarr_attrs(self._values), None, self._values.dtype) if self._kind == "zarr" else None
         self._stat = FieldStatistics(self, meta)
         self._coarse_copy = CoarseCopy(self, self._stat.counted)
         if _copy_of is not None:  # a coarse copy is its own, and its infinities are the field's to report

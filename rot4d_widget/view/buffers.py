@@ -45,7 +45,7 @@ import numpy as np
 
 from ..core.look import as_rgb, cell_palette, group_palette
 from ..core.rotation import random_rotation
-from ..sources.protocol import outline_of
+from ..sources.protocol import BadSlice, outline_of
 
 __all__ = [
     "ROW_FLOATS",
@@ -66,6 +66,10 @@ __all__ = [
     "surface_arrays",
     "surface_message",
     "without_triangles",
+    "MAX_UPDATE_BYTES",
+    "UpdateTooLarge",
+    "update_bytes",
+    "check_update_size",
 ]
 
 #: float32 values per row, and bytes per row
@@ -82,6 +86,14 @@ COLUMNS = {
     "tri_c": (16, 3),
     "tri_rgb": (19, 1),
 }
+
+#: One update message carries at most this many bytes (32 MiB).  The largest legitimate ones,
+#: measured by ``python benchmarks/update_size.py`` (docs/performance.md), are about 2.2 MB (12
+#: slices of a 64^4 field ray-cast) and 1.6 MB (the great icosahedral 120-cell's 12,000 faces; a
+#: 64^4 field's three surfaces): the cap leaves room for a field sampled at 128 a side, 8 times
+#: the bytes, while a slice of millions of points -- 240 MB for 3 M points, which freezes a
+#: browser tab for seconds -- is refused before its rows are built.
+MAX_UPDATE_BYTES = 32 * 2**20
 
 #: capacities are multiples of this many rows
 ROW_QUANTUM = 16
@@ -123,18 +135,49 @@ def capacity_for(rows: int, headroom: float = HEADROOM, quantum: int = ROW_QUANT
     return max(quantum, -(-want // quantum) * quantum)
 
 
-def estimate_capacity(source, samples: int = 6, seed: int = 0) -> int:
+class UpdateTooLarge(BadSlice):
+    """A slice whose update would exceed `MAX_UPDATE_BYTES`: refused before its rows are built."""
+
+
+def update_bytes(data) -> int:
+    """The bytes a slice's update carries (rows at `ROW_BYTES`, a smooth surface's 12 per point and
+    12 per triangle), before any is built: what `check_update_size` holds to the cap."""
+    n = rows_needed(data) * ROW_BYTES
+    if getattr(data, "normals", None) is not None:
+        n += 12 * (len(data.points) + len(data.triangles))
+    return n
+
+
+def check_update_size(data, *, volume=None, name: str = "the source") -> None:
+    """`UpdateTooLarge` when a slice's update (with the binary parts of a ``volume`` message that
+    travels with it: atlas, boxes, colour table) would exceed `MAX_UPDATE_BYTES`; the message
+    says how large and what is allowed."""
+    n = update_bytes(data) + sum(v.nbytes for v in (volume or {}).values() if isinstance(v, memoryview))
+    if n > MAX_UPDATE_BYTES:
+        raise UpdateTooLarge(
+            f"{name}'s slice ({len(data.points):,} points, {len(data.segments):,} segments, "
+            f"{len(data.triangles):,} triangles) would be a {n / 2**20:,.0f} MiB update; one update "
+            f"carries at most {MAX_UPDATE_BYTES / 2**20:.0f} MiB (rot4d_widget.view.buffers.MAX_UPDATE_BYTES, "
+            f"about {MAX_UPDATE_BYTES // ROW_BYTES:,} balls, bars or triangles): slice fewer points "
+            "(a coarser sampling, fewer slices)")
+
+
+def estimate_capacity(source, samples: int = 6, seed: int = 0, *, name: str = "the source") -> int:
     """Capacity for a source's central slices, from ``samples`` fixed-seed random orientations.
 
     Central slices are usually the largest; the estimate includes `HEADROOM`.
     It is a starting size, not a bound: the scene grows the table safely if a
     larger slice ever comes.  Each orientation is the source's outline
-    (`rot4d_widget.sources.protocol.outline_of`: a field's box cut, its data not read).
+    (`rot4d_widget.sources.protocol.outline_of`: a field's box cut, its data not read; any other
+    source's slice).  An outline over the update cap raises `UpdateTooLarge` at once (the other
+    samples are not taken).
     """
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):
-        most = max(most, rows_needed(outline_of(source, random_rotation(rng), 0.0)))
+        data = outline_of(source, random_rotation(rng), 0.0)
+        check_update_size(data, name=name)
+        most = max(most, rows_needed(data))
     return capacity_for(most)
 
 

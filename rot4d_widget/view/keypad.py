@@ -7,7 +7,6 @@ first shown, under the canvas.
 
 from __future__ import annotations
 
-import html
 import logging
 from collections.abc import Mapping
 
@@ -15,6 +14,7 @@ import ipywidgets as widgets
 from ipyevents import Event
 from ipywidgets.widgets.widget import _instances
 
+from . import markup
 from .keys import page_time
 
 __all__ = ["KeyPad", "PAD_ROWS", "PAD_EVENTS", "close_quietly"]
@@ -86,7 +86,7 @@ class KeyPad:
                 self.events.append(ev)
                 buttons.append(b)
             if buttons:
-                label = widgets.HTML(f"<small>{html.escape(title)}</small>", layout=widgets.Layout(width="4.5em"))
+                label = markup.html_widget(markup.keypad_label_html(title), layout=widgets.Layout(width="4.5em"))
                 rows.append(widgets.HBox([label, *buttons], layout=widgets.Layout(flex_flow="row wrap")))
         box = widgets.VBox(rows, layout=widgets.Layout(margin="0.3em 0 0 0"))
         box.add_class("rot4d-keypad")
@@ -127,9 +127,14 @@ class KeyPad:
             close_quietly(self.box)
 
 
+#: The widgets a widget makes for itself when it is made (its defaults): closed with it.
+OWN_PARTS = ("layout", "style", "shadowMap")  # shadowMap: a pythreejs WebGLRenderer's own
+
+
 def close_quietly(w) -> None:
-    """Close a widget and its own Layout / Style widgets; never raises (close() must not stop halfway)."""
-    subs = [getattr(w, name, None) for name in ("layout", "style")] if isinstance(w, widgets.Widget) else []
+    """Close a widget and the widgets it made for itself (`OWN_PARTS`: its Layout, Style, a renderer's
+    WebGLShadowMap); never raises (close() must not stop halfway)."""
+    subs = [getattr(w, name, None) for name in OWN_PARTS] if isinstance(w, widgets.Widget) else []
     try:
         w.close()
     except Exception:

@@ -14,7 +14,7 @@ import math
 from collections.abc import Mapping
 
 from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
-from .readout import help_html
+from . import markup
 
 __all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
 
@@ -163,7 +163,8 @@ class KeyPath:
             keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
         w._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
         w.state.keymap = keymap
-        w.help_panel.value = help_html(help_groups(keymap), w._repeater.hold_delay, w._repeater.tick_rate)
+        markup.show(w.help_panel, markup.help_html(help_groups(keymap), w._repeater.hold_delay,
+                                                   w._repeater.tick_rate))
 
     # -- steps -----------------------------------------------------------------------------
     def tick(self, now: float) -> None:

@@ -7,7 +7,6 @@ in step.  `ViewKey` says which state a picture shows.
 
 from __future__ import annotations
 
-import html
 import math
 from dataclasses import dataclass
 
@@ -16,7 +15,8 @@ import numpy as np
 from ..core import look
 from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source, outline_of
-from . import readout as ro
+from . import markup as ro
+from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut
 from .volume_layer import volume_message
 
@@ -65,7 +65,8 @@ def title(source) -> str:
 def checked_slice(source, matrix, c0, coarse, lock, *, outline: bool = False):
     """``source.slice`` validated once (`rot4d_widget.sources.protocol.check_slice`): a bad slice (None,
     non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
-    or TypeError naming the source and the member that is wrong, and is never drawn.
+    or TypeError naming the source and the member that is wrong, and is never drawn; a slice
+    over the update cap raises `rot4d_widget.view.buffers.UpdateTooLarge`.
     ``outline``: the source's outline instead (`outline_of`: balls and bars, no data read)."""
     with lock:
         if outline:
@@ -77,6 +78,7 @@ def checked_slice(source, matrix, c0, coarse, lock, *, outline: bool = False):
         check_slice(data, n_groups)
     except (TypeError, ValueError) as exc:
         raise BadSlice(f"{title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
+    check_update_size(data, name=title(source))
     return data
 
 
@@ -149,8 +151,8 @@ class Painter:
         same_cut = rows is not None and key.same_cut(rows)
         # a stack turns each slice about its own centre: never turned as a whole
         turn = key.turn_from(rows) if same_cut and inner_source(w.source) is w.source else None
-        if shown is not None and key.same(shown) and (shown is rows or held):
-            pass  # the view shows this state (turned rows only while keys are held)
+        if shown is not None and key.same(shown) and (shown is rows or held) and not scene.unsent:
+            pass  # the page shows this state (turned rows only while keys are held)
         elif held and turn is not None and (key.coarse or not rows.coarse):
             if scene.turn(turn, **self.projection(key)):
                 sent = scene.update_id
@@ -213,7 +215,7 @@ class Painter:
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered
         if not len(w._repeater) or now - self.readout_at >= READOUT_PERIOD:
-            w.readout.value = self.readout_html()
+            ro.show(w.readout, self.readout_html())
             self.readout_at, self.readout_stale = now, False
         else:
             self.readout_stale = True
@@ -239,9 +241,9 @@ class Painter:
     # -- the readout ------------------------------------------------------------------------
     def set_note(self, text: str) -> None:
         self.note = text
-        self.w.readout.value = self.readout_html()
+        ro.show(self.w.readout, self.readout_html())
 
-    def readout_html(self) -> str:
+    def readout_html(self) -> ro.Markup:
         w = self.w
         st, source = w.state, w.source
         # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
@@ -250,7 +252,7 @@ class Painter:
         if label is None:
             last = "\u2014"
         else:
-            last = html.escape(label) + (f" \u00d7{count}" if count > 1 else "")
+            last = label + (f" \u00d7{count}" if count > 1 else "")
         w_range = getattr(source, "w_range", None)
         lo, hi = w_range(st.matrix) if w_range is not None else (-source.size, source.size)
         rows = [
@@ -260,13 +262,10 @@ class Painter:
             ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None))),
             ("last", last),
         ]
-        rows += [(k, html.escape(str(v))) for k, v in getattr(data, "readout", ())]
+        rows += [(k, str(v)) for k, v in getattr(data, "readout", ())]
         colors, labels = self.colours()
         if labels is not None and w.color_by == "group":  # the legend: what each colour is
-            rows.append(("colours", " ".join(
-                f"<span style='display:inline-block;width:0.9em;height:0.9em;vertical-align:middle;"
-                f"background:#{''.join(f'{round(255 * c):02x}' for c in rgb)}'></span>&nbsp;{html.escape(t)}"
-                for t, rgb in zip(labels, colors))))
+            rows.append(("colours", ro.legend_html(labels, colors)))
         bar = self.colourbar(colors if labels is not None and inner_source(source) is source else None)
         if bar:
             rows.append(("colour", bar))
@@ -274,14 +273,14 @@ class Painter:
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
         if self.note:
-            rows.append(("picture", html.escape(self.note)))
+            rows.append(("picture", self.note))
         views = w._projection.readout_row()  # which view is which, with the projection shown
         if views is not None:
             rows.insert(0, views)
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
 
-    def colourbar(self, level_rgb=None) -> str:
-        """The colour bar of a field's values (`readout.colourbar_html`): ``cmap`` over ``clim`` (or
+    def colourbar(self, level_rgb=None) -> ro.Markup | str:
+        """The colour bar of a field's values (`markup.colourbar_html`): ``cmap`` over ``clim`` (or
         the data's range), its name (xarray's ``long_name`` when the field keeps it) and units, a
         mark per iso level in its surface's colour (``level_rgb``; black when the surfaces are
         coloured otherwise: a stack by w, one colour).  A ray-cast picture's bar spans the limits
@@ -298,7 +297,7 @@ class Painter:
         else:
             lo, hi = w.clim if w.clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            return "no colour scale (the data's range is " + html.escape(f"{lo:.4g} \u2026 {hi:.4g})")
+            return f"no colour scale (the data's range is {lo:.4g} \u2026 {hi:.4g})"
         if level_rgb is None or w.color_by != "group":
             level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
         label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"

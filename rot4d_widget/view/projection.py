@@ -45,13 +45,13 @@ nothing in the projection (the caption says so).
 
 from __future__ import annotations
 
-import html
 import uuid
 
 import numpy as np
 
 from ..core import look
 from ..sources.protocol import inner_source, w_frame
+from . import markup
 from .keypad import close_quietly
 from .traits import Checked
 
@@ -295,7 +295,7 @@ class ProjectionView:
         self.events = Event(source=self.renderer, watched_events=list(KEY_EVENTS), prevent_default_action=True,
                             ignore_modifier_key_events=True)
         self.events.on_dom_event(w._handle_event)
-        self.caption = widgets.HTML(self._caption_html())
+        self.caption = markup.html_widget(self._caption_html())
         self.box = widgets.VBox([self.caption, self.renderer], layout=widgets.Layout(flex="0 0 auto"))
         self._widgets = [self.events, self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
                          self._lines, self._points, self._edge_geometry, self._edge_material,
@@ -306,14 +306,9 @@ class ProjectionView:
             w.companion.projection_model_ids = [self._lines.model_id, self._points.model_id, self._scene.model_id]
             w.companion.projection_class = self.canvas_class
 
-    def _caption_html(self) -> str:
-        d = EYE_DISTANCE
-        text = (f"<b>projection</b>: the whole object, perspective from w = {d:g}&times;size; edges "
-                "<span style='color:#3b4cc0'>blue below</span> / <span style='color:#b40426'>red above</span> "
-                "w = c0, <span style='color:#e07b00'>balls</span>: where w = c0 cuts (the slice)")
-        if skeleton(self.w.source) is None:
-            text += " &mdash; " + html.escape("this source has no edges or box to project")
-        return f"<div style='font-size:0.85em;max-width:36em'>{text}</div>"
+    def _caption_html(self) -> markup.Markup:
+        note = "this source has no edges or box to project" if skeleton(self.w.source) is None else None
+        return markup.projection_caption_html(EYE_DISTANCE, note)
 
     # -- showing --------------------------------------------------------------------------
     def changed(self, change=None) -> None:
@@ -349,7 +344,7 @@ class ProjectionView:
         if self._skeleton_key is None or any(a is not b and a != b for a, b in zip(key, self._skeleton_key)):
             out["skeleton"] = skeleton_message(w.source, w._scale)
             self._skeleton_key = key
-            self.caption.value = self._caption_html()
+            markup.show(self.caption, self._caption_html())
         self.shown_key = (matrix, c0, version)
         return out
 
@@ -368,7 +363,7 @@ class ProjectionView:
         """``(label, html)`` for the readout saying which view is which, or None when off."""
         if not self.on:
             return None
-        return ("views", "left: the slice w = c0 &middot; right: the whole object projected (balls: the slice)")
+        return ("views", markup.views_html())
 
     def close(self) -> None:
         if self.events is not None:

@@ -65,13 +65,13 @@ import pathlib
 import re
 import uuid
 
-import ipywidgets as widgets
 import numpy as np
 import pythreejs as p3
 from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
+from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
@@ -398,6 +398,7 @@ class Scene:
         """
         if self._closed:
             raise RuntimeError("this Scene is closed")
+        bf.check_update_size(data, volume=volume)  # before anything is built
         smooth = getattr(data, "normals", None) is not None
         surface = None
         if smooth:  # the triangles go to the surface layer, quantised; the rows carry the rest
@@ -486,6 +487,9 @@ class Scene:
             raise
         self._unsent = False
 
+    unsent = property(lambda self: self._unsent, doc="A send failed and none succeeded since: the page is "
+                      "behind, so the picture goes again even if unchanged.")
+
     @property
     def counts(self) -> list:
         """Rows each layer draws now: [balls, bars, faces] (the rest of the capacity is skipped)."""
@@ -542,11 +546,7 @@ class Scene:
         except ValueError:
             pass
         for w in self._widgets:  # with the Layout / Style / shadow map each one made for itself
-            subs = [getattr(w, name, None) for name in ("layout", "style", "shadowMap")]
-            w.close()
-            for sub in subs:
-                if isinstance(sub, widgets.Widget):
-                    sub.close()
+            close_quietly(w)
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"

@@ -10,6 +10,7 @@ never through a link.
 from __future__ import annotations
 
 import os
+import stat
 import warnings
 
 __all__ = ["Screenshots", "SCREENSHOT_TIMEOUT", "MAX_PENDING_SCREENSHOTS", "png_size_text"]
@@ -63,46 +64,68 @@ class Screenshots:
         self.ask(KEY_P, None)
 
     def answer(self, rid, png, error) -> None:
-        """A view answered request ``rid`` (the first answer counts; later views' are dropped)."""
+        """A view answered request ``rid`` (the first answer counts; later views' are dropped).
+        Never raises (it runs in the companion's message handler): a note that cannot be shown
+        (its send failed) or a callback's error goes to the widget's errors area.  The file is
+        written with the pump's lock free (a slow disk never holds up keys)."""
         w = self.w
-        with w._pump.lock:
-            asked = self.pending.pop(rid, None)
-            if asked is None or w._closed:
-                return
-            path, callback, _ = asked
-            note = w._painter.set_note
-            if png is None:
-                note(f"screenshot failed: {error}")
-                return
-            w.last_screenshot = png
-            where = "kept as last_screenshot"
-            if path is not None:
-                try:
-                    if path is KEY_P:
-                        path, self.shot_number = write_numbered_png(png, self.shot_number)
-                    else:
-                        path = write_png(path, png)
-                except OSError as exc:
-                    note(f"screenshot not saved: {exc}")
+        try:
+            with w._pump.lock:
+                asked = self.pending.pop(rid, None)
+                if asked is None or w._closed:
                     return
-                where = f"saved {path}"
-            note(f"{where} ({png_size_text(png)})")
-        if callback is not None:
+                if png is not None:
+                    w.last_screenshot = png
+            path, callback, _ = asked
+            note = self._saved(path, png, error)
+            with w._pump.lock:
+                if not w._closed:
+                    w._painter.set_note(note)
+        except Exception as exc:
+            w._report_error(exc)
+            return
+        if callback is not None and png is not None:
             try:
                 callback(png)
             except Exception as exc:  # shown like any callback error, never lost
                 w._report_error(exc)
 
+    def _saved(self, path, png, error) -> str:
+        """Write the answer where it was asked to go; the readout's note on what became of it."""
+        if png is None:
+            return f"screenshot failed: {error}"
+        if path is None:
+            return f"kept as last_screenshot ({png_size_text(png)})"
+        try:
+            if path is KEY_P:
+                path, self.shot_number = write_numbered_png(png, self.shot_number)
+            else:
+                path = write_png(path, png)
+        except OSError as exc:
+            return f"screenshot not saved: {exc}"
+        return f"saved {path} ({png_size_text(png)})"
 
-_PNG_FLAGS = os.O_WRONLY | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_BINARY", 0)
+
+#: O_NONBLOCK: opening a FIFO for writing with no reader fails at once (ENXIO) instead of waiting
+_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
+_PNG_FLAGS = os.O_WRONLY | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_BINARY", 0) | _NONBLOCK
 
 
 def write_png(path, png: bytes) -> str:
-    """Write ``png`` to ``path`` (replacing a file) but never through a link at that name."""
+    """Write ``png`` to ``path`` (replacing a regular file), never through a link at that name and
+    never into anything but a regular file (a FIFO, a device: OSError, without waiting)."""
     name = os.fspath(path)
     if os.path.islink(name):
         raise OSError(f"{name} is a link: a screenshot is never written through one")
-    with os.fdopen(os.open(name, _PNG_FLAGS | os.O_TRUNC, 0o666), "wb") as f:
+    if os.path.exists(name) and not os.path.isfile(name):
+        raise OSError(f"{name} is not a regular file: a screenshot is written only into one")
+    fd = os.open(name, _PNG_FLAGS, 0o666)
+    with os.fdopen(fd, "wb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # it became something else since
+            raise OSError(f"{name} is not a regular file: a screenshot is written only into one")
+        if _NONBLOCK:
+            os.set_blocking(fd, True)
+        f.truncate(0)
         f.write(png)
     return name
 

@@ -19,7 +19,7 @@ The widget holds the traits and the public API and wires small units together:
 * `rot4d_widget.view.stacking.Stacking` -- a single view made parallel slices at run time;
 * `rot4d_widget.view.keypad.KeyPad`, `rot4d_widget.view.screenshots.Screenshots`,
   `rot4d_widget.view.keeping.Keeper` (render, export, state files, recordings);
-* `rot4d_widget.view.readout` -- the readout and help HTML;
+* `rot4d_widget.view.markup` -- every piece of HTML shown (readout, help), from escaped text;
 * `rot4d_widget.view.scene.Scene` -- everything pythreejs.
 
 Rotation stops on keyup, on mouseleave, and when the companion reports that
@@ -54,8 +54,8 @@ from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
 from ..sources.protocol import as_source, inner_source, prepare_in_background, takes_coarse, w_frame
 from ..sources.tomography import ARRANGEMENTS
+from . import markup
 from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
-from . import readout as ro
 from . import traits as t
 from .buffers import estimate_capacity
 from .companion import Companion
@@ -573,13 +573,13 @@ def _build_children(w, options) -> None:
 
     built = []
     try:
-        w.scene = Scene(capacity=estimate_capacity(w.source), **options)
+        w.scene = Scene(capacity=estimate_capacity(w.source, name=title(w.source)), **options)
         built.append(w.scene)
         w.companion = Companion(w.scene)
         built.append(w.companion)
-        w.readout = widgets.HTML()
-        w.help_panel = widgets.HTML(
-            ro.help_html(help_groups(w.state.keymap), w._repeater.hold_delay, w._repeater.tick_rate),
+        w.readout = markup.html_widget()
+        w.help_panel = markup.html_widget(
+            markup.help_html(help_groups(w.state.keymap), w._repeater.hold_delay, w._repeater.tick_rate),
             layout=widgets.Layout(display="none"),
         )
         w.errors = w._error_area.output = widgets.Output()
