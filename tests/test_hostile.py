@@ -24,7 +24,7 @@ from rot4d_widget.view.keyhold import steps_for
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP
 from rot4d_widget.core.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
 from rot4d_widget.sources.tomography import SPACING_MAX, SPACING_MIN
-from test_widget import down, run_ticker, up, xw_steps
+from test_widget import deliver, down, run_ticker, up, xw_steps
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
@@ -458,3 +458,76 @@ def test_a_keyup_80_s_late_takes_back_every_step_with_one_observer_call(make, cl
 
     drawn(w)  # the page drew what is in flight: the readout catches up
     assert "<td>last</td><td>R_xw</td>" in w.readout.value  # one step, not "R_xw ×2400"
+
+
+# ------------------------------------------------------- issue 33, item 7: small ones (each failed before)
+def test_a_page_timestamp_past_float_range_is_no_page_time_not_an_error(make):
+    w = make()
+    deliver(w, {"type": "keydown", "key": "4", "code": "Digit4", "repeat": False, "timeStamp": 10**400,
+                "shiftKey": False, "altKey": False, "ctrlKey": False, "metaKey": False})
+    deliver(w, {"type": "keyup", "key": "4", "code": "Digit4", "repeat": False, "timeStamp": 10**400,
+                "shiftKey": False, "altKey": False, "ctrlKey": False, "metaKey": False})
+    assert w.errors.outputs == ()  # an OverflowError was shown under the readout
+    assert xw_steps(w) == 1
+
+
+def test_a_second_keydown_without_repeat_during_a_tap_is_a_repeat_not_a_step(make):
+    w = make()
+    down(w, "4", t=1.0)
+    down(w, "4", t=1.03)  # no keyup between, no repeat flag (some browsers and OSes)
+    up(w, "4", t=1.05)
+    assert xw_steps(w) == 1  # it made 2
+
+
+def test_a_state_file_whose_c0_its_step_cannot_move_is_refused(make, tmp_path):
+    import json
+
+    from rot4d_widget.keep.export import load_state
+
+    w = make()
+    path = tmp_path / "view.json"
+    w.save_state(path)
+    d = json.loads(path.read_text())
+    d["state"]["c0"] = 1e308  # h could never step back from there
+    path.write_text(json.dumps(d))
+    with pytest.raises(ValueError, match=r"Expected `c0` where its step .* moves it .*got 1e\+308"):
+        load_state(path)
+    with pytest.raises(ValueError, match="could never bring it back"):
+        w.state.c0 = 1e308
+    w.state.c0 = 1e6  # far outside, but the keys step it back
+    assert w.press("h") and w.state.c0 < 1e6
+
+
+@pytest.mark.parametrize("what", ["state", "recording"])
+def test_a_deeply_nested_json_file_is_a_value_error(tmp_path, what):
+    from rot4d_widget.keep.export import load_state
+    from rot4d_widget.keep.recording import Recording
+
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)  # RecursionError before
+    with pytest.raises(ValueError, match="nested deeper than 64 levels"):
+        (load_state if what == "state" else Recording.load)(path)
+    path.write_text('{"format": "rot4d_widget state", "a": ' + "[" * 70 + "]" * 70 + "}")
+    with pytest.raises(ValueError, match="nested deeper"):
+        (load_state if what == "state" else Recording.load)(path)
+
+
+def test_an_object_scaled_to_the_coordinate_bound_is_in_and_one_past_it_says_by_how_much():
+    from rot4d_widget import Polytope, polytope
+
+    p = polytope("5-cell")
+    v = p.vertices / np.abs(p.vertices).max()
+    top = np.nextafter(1e150, np.inf)  # 1e150 as a scaling rounds to
+    Polytope(v * top, p.faces, p.cells)  # refused before: "is 1e+150; expected 1e-150 to 1e+150"
+    with pytest.raises(ValueError, match=r"is 1\.01e\+150; expected 1e-150 to 1e\+150"):
+        Polytope(v * 1.01e150, p.faces, p.cells)
+
+
+def test_float_indices_in_a_user_slice_are_refused():
+    with pytest.raises(ValueError, match="`segments` to be integer indices, got an array of float64"):
+        SliceData.build(np.eye(3), segments=[[0.0, 1.7]])  # 1.7 pointed at point 1 before
+    with pytest.raises(ValueError, match="`triangles` to be integer indices"):
+        SliceData.build(np.eye(3), triangles=[[0.0, 1.0, 2.0]])
+    with pytest.raises(ValueError, match="`groups` to be integer indices"):
+        SliceData.build(np.eye(3), triangles=[[0, 1, 2]], groups=[0.5])
+    assert SliceData.build(np.eye(3), segments=np.zeros((0, 2))).segments.shape == (0, 2)  # empty: any dtype

@@ -60,6 +60,7 @@ class FakeScene:
         self.single = []  # their single_rgb
         self.turns = []  # the 3-D turns passed to turn()
         self.closed = False
+        self.unsent = False  # as Scene.unsent: no send of the fake ever fails
         self.display = {k: options[k] for k in ("ball_radius", "bar_radius", "face_opacity", "background",
                                                  "show_balls", "show_bars", "show_faces")}
         self._view_cbs, self._eye_cbs = [], []

@@ -95,6 +95,15 @@ def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
                          f"in [-pi, pi] radians")
 
 
+def _check_c0_steps(c0: float, step: float) -> None:
+    """ValueError when a step of ``step`` cannot move ``c0`` (c0 + step == c0 or c0 - step == c0): a
+    c0 of 1e308 from a state file could then never be stepped back by h / l.  c0 may lie outside
+    the keys' range (set by hand, stepped back), but only where the keys move it."""
+    if c0 + step == c0 or c0 - step == c0:
+        raise ValueError(f"Expected `c0` where its step {step:.6g} moves it (|c0| below about "
+                         f"{step * 2.0 ** 52:.3g}), got {c0!r}: the l / h keys could never bring it back")
+
+
 def check_theta0(value) -> float:
     """A step angle theta0 as a float in (0, `THETA0_MAX`] radians; else TypeError/ValueError naming
     what is allowed.  The check of `RotationState.theta0` and the view's `Angle` trait.
@@ -144,7 +153,7 @@ class RotationState:
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else real(alpha, "alpha")
         _check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
         self._c0 = real(c0, "c0")
-        self.c0_step = c0_step
+        self.c0_step = c0_step  # checks that the step can move c0 (`_check_c0_steps`)
         self.c0_limit = c0_limit
         self.c0_origin = c0_origin
         self._matrix = sealed(np.eye(4) if matrix is None else as_rotation_matrix(matrix))
@@ -199,7 +208,9 @@ class RotationState:
 
     @c0.setter
     def c0(self, value) -> None:
-        self._c0 = real(value, "c0")
+        value = real(value, "c0")
+        _check_c0_steps(value, self._c0_step)
+        self._c0 = value
 
     @property
     def c0_step(self) -> float:
@@ -207,7 +218,9 @@ class RotationState:
 
     @c0_step.setter
     def c0_step(self, value) -> None:
-        self._c0_step = positive(value, "c0_step")
+        value = positive(value, "c0_step")
+        _check_c0_steps(self._c0, value)
+        self._c0_step = value
 
     @property
     def c0_limit(self) -> float:

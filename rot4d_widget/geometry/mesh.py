@@ -47,10 +47,14 @@ COORDINATE_RANGE = (1e-150, 1e150)
 
 
 def check_scale(scale: float, what: str) -> None:
-    """ValueError unless ``COORDINATE_RANGE[0] <= scale <= COORDINATE_RANGE[1]`` (``what`` names it)."""
+    """ValueError unless ``COORDINATE_RANGE[0] <= scale <= COORDINATE_RANGE[1]`` (``what`` names it), the
+    bounds taken with a relative slack of 1e-9: an object scaled by 1e150 whose largest coordinate
+    rounds to 1.0000000000000002e150 is in (its squares stay far from float64's limits)."""
     lo, hi = COORDINATE_RANGE
-    if not lo <= scale <= hi:
-        raise ValueError(f"{what} is {scale:.3g}; expected {lo:g} to {hi:g} "
+    if not lo * (1 - 1e-9) <= scale <= hi * (1 + 1e-9):
+        shown = f"{scale:.3g}"  # with every digit where three would look like a bound (1.0000000000000002e+150)
+        shown = repr(float(scale)) if float(shown) in (lo, hi) else shown
+        raise ValueError(f"{what} is {shown}; expected {lo:g} to {hi:g} "
                          f"(rot4d_widget.geometry.polytopes.COORDINATE_RANGE: "
                          f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
                          f"other units)")

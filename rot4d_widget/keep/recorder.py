@@ -55,6 +55,7 @@ from ..core.rotation import as_rotation_matrix
 from ..core.state import RotationState, action_from_data, action_to_data
 from ..sources.protocol import apply_setting, inner_source, settings_of, w_frame
 from ..sources.tomography import ARRANGEMENTS, StackSource
+from .jsonfile import read_json
 from .rebuild import _jsonable
 
 RECORDING_FORMAT = "rot4d_widget recording"
@@ -469,12 +470,7 @@ class Recording:
     @classmethod
     def load(cls, path) -> "Recording":
         """Read a recording `save` wrote; ``ValueError`` naming what is wrong otherwise."""
-        try:
-            with open(os.fspath(path), encoding="utf-8") as fh:
-                d = json.load(fh)
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{os.fspath(path)!r} is not a rot4d_widget recording: not JSON ({exc})") from None
-        return cls.from_dict(d)
+        return cls.from_dict(read_json(path, "rot4d_widget recording"))
 
     # -- replay ----------------------------------------------------------------------------
     def replay(self, state: RotationState | None = None, source=None, *, restart: bool = True,

@@ -41,6 +41,7 @@ from typing import Mapping, NamedTuple
 from .. import __version__
 from ..core.state import RotationState
 from ..sources.protocol import as_source
+from .jsonfile import read_json
 from .rebuild import (
     CodeNotAllowed,
     SourceNotRebuildable,
@@ -212,13 +213,7 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
         raise TypeError("Expected `source` or `function`, not both (the source already has its function)")
     allow_code = bool(allow_code)
     path = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8") as fh:
-            doc = json.load(fh)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path!r} is not a rot4d_widget state file: not JSON ({exc})") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"{path!r} is not a rot4d_widget state file: not UTF-8 text") from None
+    doc = read_json(path, "rot4d_widget state file")
     if not isinstance(doc, dict) or doc.get("format") != STATE_FILE_FORMAT:
         raise ValueError(f"{path!r} is not a rot4d_widget state file (no \"format\": \"{STATE_FILE_FORMAT}\")")
     version = doc.get("version")

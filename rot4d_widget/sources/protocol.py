@@ -146,6 +146,10 @@ class SourceAction:
 
 
 def _readonly(a, dtype, shape_tail, name):
+    if np.issubdtype(dtype, np.integer):  # indices: never cast from floats (0.7 would point at 0)
+        given = np.asarray(a)
+        if given.size and given.dtype.kind not in "iu":
+            raise ValueError(f"Expected `{name}` to be integer indices, got an array of {given.dtype}")
     arr = np.array(a, dtype=dtype, copy=True)
     if arr.ndim != 1 + len(shape_tail) or tuple(arr.shape[1:]) != shape_tail:
         want = "(n" + "".join(f", {s}" for s in shape_tail) + ")"
@@ -205,10 +209,9 @@ class SliceData:
         p = _readonly(np.zeros((0, 3)) if points is None else points, np.float64, (3,), "points")
         s = _readonly(np.zeros((0, 2)) if segments is None else segments, np.intp, (2,), "segments")
         t = _readonly(np.zeros((0, 3)) if triangles is None else triangles, np.intp, (3,), "triangles")
-        g = np.zeros(len(t), dtype=np.intp) if groups is None else np.array(groups, dtype=np.intp, copy=True)
+        g = _readonly(np.zeros(len(t), dtype=np.intp) if groups is None else groups, np.intp, (), "groups")
         if g.shape != (len(t),):
             raise ValueError(f"Expected `groups` to have shape ({len(t)},), one per triangle, got {g.shape}")
-        g.flags.writeable = False
         normals = kwargs.pop("normals", None)
         if normals is not None:
             normals = _readonly(normals, np.float64, (3,), "normals")

@@ -56,7 +56,7 @@ def _finite_or_none(t):
         return None
     try:
         t = float(t)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return None
     return t if math.isfinite(t) else None
 

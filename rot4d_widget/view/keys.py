@@ -60,9 +60,10 @@ class KeyPath:
             return
         action, inverted = found
         with w._pump.lock:
-            if w._closed:
+            if w._closed or w._repeater.held(kid) is not None:
+                # a keydown of a key held (no keyup between: a browser or an OS that repeats
+                # without the repeat flag) is a repeat: the ticker repeats, it is not a new press
                 return
-            w._repeater.release(kid)
             self.press(kid, action, inverted, page_time(event))
 
     def press(self, kid, action: Action, inverted: bool, when=None) -> None:
@@ -246,9 +247,13 @@ def _opposite(action: Action, inverted: bool):
 def page_time(event) -> float | None:
     """The page's time of an ipyevents event in seconds (its ``timeStamp``, ms), or None."""
     t = event.get("timeStamp") if isinstance(event, Mapping) else None
-    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+    if isinstance(t, bool) or not isinstance(t, (int, float)):
         return None
-    return float(t) / 1000.0
+    try:
+        t = float(t)  # an int past float's range (10**400) is no page time either
+    except OverflowError:
+        return None
+    return t / 1000.0 if math.isfinite(t) else None
 
 
 def key_id(event: Mapping):
