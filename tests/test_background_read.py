@@ -162,7 +162,7 @@ def test_a_widget_shows_the_read_on_its_own_bar_while_it_runs(make, monkeypatch)
     w = make(field)
     assert not w.progress_bar.visible and w.progress_bar.box in w._canvas_box.children
     arr.pause = 0.1  # 40 chunks: 4 s
-    w.prepare_source()
+    w.progress_bar.follow(field)  # what a live widget does when it is made
     t0 = time.monotonic()
     seen = None
     while time.monotonic() - t0 < 20 and not field.coarse_ready:
@@ -177,4 +177,4 @@ def test_a_widget_shows_the_read_on_its_own_bar_while_it_runs(make, monkeypatch)
     while w.progress_bar.visible and time.monotonic() - t0 < 10:
         time.sleep(0.02)
     assert not w.progress_bar.visible and field.resident is not None
-    assert w.prepare_source() is None  # nothing left to read: no bar
+    assert w.progress_bar.follow(field) is None  # nothing left to read: no bar

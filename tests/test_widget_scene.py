@@ -77,7 +77,7 @@ def scaled_points(w, data=None):
 def test_layout_holds_canvas_companion_readout_help_and_errors(make):
     w = make()
     canvas, side = w.children
-    assert canvas.children == (w.scene.canvas, w.companion)
+    assert canvas.children == (w.scene.canvas, w.progress_bar.box, w.companion)  # the bar hidden until a read
     assert side.children == (w.readout, w.help_panel, w.errors)
     assert w.events.source is w.scene.canvas
     assert w.companion.canvas_class == w.scene.canvas_class

@@ -90,9 +90,7 @@ def sample_field(field, matrix, c0, resolution: int = 64, *, coarse: bool = Fals
     an array (order 1, no prefilter), a function evaluated exactly at the nodes.  Of chunked data,
     only the chunks the samples touch are read.
     """
-    from .fields import Field4D  # the container imports this module: its class is looked up at call time
-
-    if not isinstance(field, Field4D):
+    if not all(hasattr(field, a) for a in ("half_widths", "offset", "coarse")):  # plain members: nothing is read
         raise TypeError(f"Expected `field` to be a Field4D, got {type(field).__name__}")
     d = field.offset(c0)
     m = as_rotation_matrix(matrix)

@@ -40,7 +40,7 @@ def _import_numba():
     if _numba is None:
         with _kernel_lock:
             if _numba is None:
-                try:
+                try:  # numba's import (~0.2 s) waits for the first step, not the package's import
                     import numba
                 except ImportError:  # pragma: no cover - numba is optional: scipy stands in without it
                     _numba = False

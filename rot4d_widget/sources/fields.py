@@ -56,14 +56,12 @@ itself becomes inf (or 0); `Field4D.slice` then gives the widget no volume.
 
 from __future__ import annotations
 
-import math
 import numbers
 
 import numpy as np
 
 from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
-from ..core.validate import int_in_range
 from ..geometry.polytopes import check_scale
 from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
 from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
@@ -93,6 +91,7 @@ from .field_input import (  # noqa: F401,E402  (export reads them)
 )
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
 from .field_levels import FieldLevels
+from .field_memory import FieldMemory
 from .field_readout import _describe, _order_text, _readout
 from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
@@ -109,7 +108,7 @@ _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINT
 _SORT_PASSES = True
 
 
-class Field4D(FieldLevels):
+class Field4D(FieldLevels, FieldMemory):
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
 
     Parameters
@@ -249,24 +248,19 @@ class Field4D(FieldLevels):
     @classmethod
     def from_xarray(cls, data, variable=None, *, x=None, y=None, z=None, w=None, w_per_unit=None,
                     **kwargs) -> "Field4D":
-        """A field from a 4-D ``xarray.DataArray``, or from ``variable`` of an ``xarray.Dataset``
-        (dims by name; extents from coordinates).
+        """A field from a 4-D ``xarray.DataArray``, or ``variable`` of an ``xarray.Dataset`` (dims by
+        name; extents from coordinates).  ``from_xarray(xarray.open_dataset("run.nc"), "T", w="time")``
+        (or ``open_zarr``): the Dataset knows its file whatever the engine, so a state file reopens
+        the field (``origin``); ``variable`` may be omitted when there is one.  A DataArray names its
+        file only with the netCDF4 and h5netcdf engines, and a selection made after opening is not
+        kept (`open` keeps ``isel=`` / ``sel=``): saving such a field warns, saying why.
 
-        ``Field4D.from_xarray(xarray.open_dataset("run.nc"), "T", w="time")`` (or ``open_zarr``):
-        the Dataset knows the file it was opened from, whatever the engine, so the field
-        remembers it (``origin``) and a state file reopens it (`Rot4DWidget.from_state(path)`);
-        ``variable`` may be omitted when the Dataset has one data variable.  A DataArray
-        (``ds["T"]``) remembers its file only when xarray's encoding names it (the netCDF4 and
-        h5netcdf engines); neither remembers a selection made after opening (use `open`'s
-        ``isel=`` / ``sel=``): saving such a field warns that it cannot be rebuilt, and says why.
-
-        Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one
-        left over is w (``("time", "z", "y", "x")``); otherwise name them with
-        ``x=, y=, z=, w=``.  Coordinates may be unevenly spaced (each maps to a
-        fractional index) and decreasing (read reversed, lazily); not monotonic
-        -> ValueError.  datetime64 coordinates become seconds since their first
-        value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
-        mean w spacing over the mean spatial spacing (voxels are cubes).
+        Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one left over is w
+        (``("time", "z", "y", "x")``); otherwise name them with ``x=, y=, z=, w=``.  Coordinates may
+        be unevenly spaced (each maps to a fractional index) and decreasing (read reversed, lazily);
+        not monotonic -> ValueError.  datetime64 coordinates become seconds since their first value.
+        A dask-backed array stays lazy.  ``w_per_unit`` defaults to the mean w spacing over the mean
+        spatial spacing (voxels are cubes).
         """
         values, args, dims, meta_range, (origin, why), long_name = _xarray_arguments(
             data, variable, x, y, z, w, w_per_unit, kwargs)
@@ -491,32 +485,6 @@ class Field4D(FieldLevels):
         return self._dims
 
     @property
-    def memory_budget(self) -> int:
-        """Bytes a chunked or lazy array may take in memory to be read whole (settable; 0: never)."""
-        return self._memory_budget
-
-    @memory_budget.setter
-    def memory_budget(self, value) -> None:
-        self._memory_budget = int_in_range(value, "memory_budget", 0)
-
-    @property
-    def fits_in_memory(self) -> bool:
-        """True when the values are in memory, or would take at most `memory_budget` bytes there
-        (float32 kept, other types as float64): the background read then reads them whole."""
-        if self.resident is not None:
-            return True
-        if self._kind == "function":
-            return False
-        itemsize = 4 if np.dtype(self._values.dtype) == np.float32 else 8
-        return math.prod(int(n) for n in self._values.shape) * itemsize <= self._memory_budget
-
-    @property
-    def resident(self):
-        """The values as a numpy array in memory, in the array's own axis order -- given so, or read
-        whole in the background (`prepare`) -- else None (steps then read chunks)."""
-        return self._values if self._kind == "numpy" else self._coarse_copy.loaded
-
-    @property
     def reader(self):
         """The chunk reader of a chunked or lazy array once a step read from it, else None."""
         return self._reader
@@ -531,56 +499,6 @@ class Field4D(FieldLevels):
         if self._reader is None:
             self._reader = _ChunkReader(self._values, self.chunk_cache_bytes)
         return _chunked_values(self._reader, idx, inside, _SORT_PASSES)
-
-    def drop_chunk_cache(self) -> None:
-        """Forget the chunks kept from earlier steps (`chunk_cache_bytes`): once the array is read
-        whole, steps no longer read chunks."""
-        if self._reader is not None:
-            self._reader.clear_cache()
-
-    # -- coarse copy -------------------------------------------------------------
-    def coarse(self) -> "Field4D":
-        """An in-memory copy with at most `COARSE_SAMPLES` nodes per axis over the same box
-        (linear resampling onto evenly spaced fractional indices), built once.
-
-        The field itself when it already is that small and in memory, or a function.  A chunked or
-        lazy array is read chunk by chunk (each downsampled into the copy and dropped: memory is the
-        copy plus a few chunks; one that `fits_in_memory` is kept whole as well, `resident`).  An
-        array in memory is resampled in blocks of 16 samples a side: the same numbers.  Blocks until
-        the copy is built: when `prepare` started it in the background, waits for that read."""
-        return self._coarse_copy.get()
-
-    @property
-    def coarse_ready(self) -> bool:
-        """True once the coarse copy is built (`coarse`, or the background read of `prepare`)."""
-        return self._coarse_copy.ready
-
-    @property
-    def coarse_progress(self):
-        """(chunks done, chunks in all) of the coarse copy's build, once it started (else None)."""
-        return self._coarse_copy.progress
-
-    @property
-    def _coarse_error(self):
-        """What made the background build of the coarse copy fail (None so far)."""
-        return self._coarse_copy.error
-
-    def prepare(self, progress: bool = True):
-        """Start the background read on a daemon thread and return at once (the source protocol's
-        ``prepare``; a live `Rot4DWidget` calls it when shown): one pass over the array, chunk by chunk,
-        building the coarse copy (`coarse`) and, when the field `fits_in_memory`, reading the whole
-        array into memory (`resident`; steps then run as on data given in memory).  Memory: the copy
-        plus a few chunks, and the array when it is read whole.
-
-        Returns the `rot4d_widget.core.progress.Progress` counting chunks (the one already running when
-        the read was started before), or None when there is nothing to read.  ``progress``: a bar
-        shown after a second -- in a kernel a widget in this cell's output, on a terminal a line;
-        a `Rot4DWidget` passes False and shows the returned progress in its own bar, in the page.
-        `coarse_progress` holds (chunks done, chunks in all).  Until `coarse_ready`, held keys
-        slice the full data at the coarse resolution (``slice(..., coarse=True)`` says so in its
-        readout) and the data range and default level come from the chunks read so far ("first
-        cut"); `coarse` waits for the read."""
-        return self._coarse_copy.prepare(progress)
 
     def __repr__(self) -> str:
         if self._kind == "function":

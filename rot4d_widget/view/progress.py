@@ -14,6 +14,8 @@ import ipywidgets
 from IPython.display import display
 
 from ..core.progress import register_widget_bar
+from ..sources.protocol import prepare_in_background
+from .keypad import close_quietly
 
 __all__ = ["WidgetBar", "ViewBar"]
 
@@ -52,6 +54,16 @@ class ViewBar:
     def visible(self) -> bool:
         return self.box.layout.display != "none"
 
+    def follow(self, source):
+        """Start ``source``'s background work (`rot4d_widget.sources.protocol.prepare_in_background`: a
+        field's read into memory, or its coarse copy) and show its progress here until it is over; a
+        live widget does this for its source when it is made.  Returns the
+        `rot4d_widget.core.progress.Progress`, or None when there is nothing to do."""
+        counter = prepare_in_background(source, progress=False)
+        if counter is not None:
+            counter.attach(self)
+        return counter
+
     def show(self, description: str, count: int, total: int, text: str) -> None:
         with self.bar.hold_sync():
             self.bar.max = max(int(total), 1)
@@ -62,10 +74,15 @@ class ViewBar:
     def close(self, done: bool) -> None:
         self.box.layout.display = "none"
 
+    @property
+    def widgets(self) -> tuple:
+        """The ipywidgets it is made of (each closed with its own layout and style: `close_widgets`)."""
+        return self.box, self.bar, self.label
+
     def close_widgets(self) -> None:
-        """Close the ipywidgets (the widget closing)."""
-        for w in (self.box, self.bar, self.label):
-            w.close()
+        """Close the ipywidgets, their layouts and styles too (the widget closing); never raises."""
+        for w in self.widgets:
+            close_quietly(w)
 
 
 register_widget_bar(WidgetBar)

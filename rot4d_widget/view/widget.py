@@ -52,7 +52,7 @@ from ipyevents import Event
 from ..core import look
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
-from ..sources.protocol import as_source, inner_source, prepare_in_background, takes_coarse, w_frame
+from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
 from ..sources.tomography import ARRANGEMENTS
 from . import markup
 from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
@@ -163,7 +163,7 @@ class Rot4DWidget(widgets.HBox):
     readout, help_panel : ipywidgets.HTML
     errors : ipywidgets.Output -- exceptions raised by key handling
     progress_bar : `rot4d_widget.view.progress.ViewBar` -- under the canvas, shown while the source
-        is read in the background (`prepare_source`)
+        is read in the background (its ``follow``)
     """
 
     theta0 = t.Angle(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
@@ -423,17 +423,6 @@ class Rot4DWidget(widgets.HBox):
         (then the module the file names is imported) or the source is passed in."""
         return Keeper.from_state(cls, path, source, allow_code=allow_code, **kwargs)
 
-    def prepare_source(self):
-        """Start the source's background work (`rot4d_widget.sources.protocol.prepare_in_background`:
-        a field's read into memory, or its coarse copy) and show its progress on the widget's own
-        bar, under the canvas, until it is over; a live widget does this when it is made.  Returns
-        the `rot4d_widget.core.progress.Progress`, or None when there is nothing to do."""
-        self._check_open()
-        counter = prepare_in_background(inner_source(self.source), progress=False)
-        if counter is not None:
-            counter.attach(self.progress_bar)
-        return counter
-
     def release_keys(self, page_time=None) -> None:
         """Release every held key (what mouseleave and focus loss do); ``page_time``: the page's
         time of the event in seconds, if known (each key's steps are then corrected to it)."""
@@ -531,9 +520,9 @@ def _wire(w, keypad) -> None:
     # A field is read in the background from now on (the whole of it into memory when it fits its
     # budget, else its coarse copy for held keys), counted on the widget's own bar under the
     # canvas; its first picture above read only the chunks the cut touches.  Only with the
-    # ticker running (a live widget): scripts and tests stay deterministic (`prepare_source`).
+    # ticker running (a live widget): scripts and tests stay deterministic.
     if w._pump.autotick:
-        w.prepare_source()
+        w.progress_bar.follow(inner_source(w.source))
 
 
 def _unwire(w) -> None:
@@ -592,7 +581,7 @@ def _build_children(w, options) -> None:
         )
         built.append(w.events)
         w.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
-        built.append(w.progress_bar.box)
+        built += w.progress_bar.widgets
         # the canvas keeps its size; the side panel wraps below it when narrow
         w._canvas_box = widgets.VBox([w.scene.canvas, w.progress_bar.box, w.companion],
                                      layout=widgets.Layout(flex="0 0 auto"))
