@@ -4,7 +4,7 @@
 copy, and -- when the array fits ``memory_budget`` -- the whole array, after which steps run on
 it in memory (`Field4D.resident`) and read nothing.  Bigger data keep the coarse copy only.  The
 pass is counted by a `Progress`: the kernel's bar goes to the caller's cell (made there, hidden
-until due) and a widget shows it on its own bar under the canvas while it runs.
+until due) and a widget shows it on its own bar, above its readout, while it runs.
 """
 
 from __future__ import annotations
@@ -160,7 +160,7 @@ def test_a_widget_shows_the_read_on_its_own_bar_while_it_runs(make, monkeypatch)
     monkeypatch.setattr(coarse, "CHUNK_BATCH", 4)  # the read counts every 4 chunks
     arr, field = _field()
     w = make(field)
-    assert not w.progress_bar.visible and w.progress_bar.box in w._canvas_box.children
+    assert not w.progress_bar.visible and w.progress_bar.box in w._side_box.children
     arr.pause = 0.1  # 40 chunks: 4 s
     w.progress_bar.follow(field)  # what a live widget does when it is made
     t0 = time.monotonic()

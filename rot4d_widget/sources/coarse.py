@@ -218,9 +218,9 @@ class CoarseCopy:
                 del x
                 done += 1
                 self.progress = (done, total)
-                if counter is not None:
-                    counter.update(1)
             del got
+            if counter is not None:  # once a batch: the count a bar shows is never a batch behind
+                counter.update(len(part))
         if not coarse:
             return None
         if report:

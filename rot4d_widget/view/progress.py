@@ -3,7 +3,7 @@
 `rot4d_widget.core.progress` counts and decides when to show; this module draws.  `WidgetBar` is
 the bar a kernel shows in the cell's output (an ipywidgets ``IntProgress`` and a label "12/33,
 4 s"), registered with the core on import (`rot4d_widget.core.progress.register_widget_bar`);
-`ViewBar` is the bar a `Rot4DWidget` carries under its canvas for its source's background work
+`ViewBar` is the bar a `Rot4DWidget` carries above its readout for its source's background work
 (a field's read into memory, its coarse copy), attached to that work's `Progress`: the page shows
 it while the work runs, whatever cell is running meanwhile, and hides it when the work is over.
 """
@@ -40,14 +40,14 @@ class WidgetBar:
 
 
 class ViewBar:
-    """A widget's own progress bar (``box``: an ``IntProgress`` and a label, CSS class
+    """A widget's own progress bar (``box``: a label over an ``IntProgress``, CSS class
     ``rot4d-progress``), hidden but while a `Progress` it is attached to is showing: the label
     says what is being done ("reading T into memory") and how far ("12/33, 4 s")."""
 
     def __init__(self):
-        self.bar = ipywidgets.IntProgress(value=0, min=0, max=1, layout=ipywidgets.Layout(width="12em"))
+        self.bar = ipywidgets.IntProgress(value=0, min=0, max=1, layout=ipywidgets.Layout(width="100%"))
         self.label = ipywidgets.Label()
-        self.box = ipywidgets.HBox([self.bar, self.label], layout=ipywidgets.Layout(display="none"))
+        self.box = ipywidgets.VBox([self.label, self.bar], layout=ipywidgets.Layout(display="none"))
         self.box.add_class("rot4d-progress")
 
     @property

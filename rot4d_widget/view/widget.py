@@ -162,7 +162,7 @@ class Rot4DWidget(widgets.HBox):
     stats : counters of the update pump (updates, acks, timeouts)
     readout, help_panel : ipywidgets.HTML
     errors : ipywidgets.Output -- exceptions raised by key handling
-    progress_bar : `rot4d_widget.view.progress.ViewBar` -- under the canvas, shown while the source
+    progress_bar : `rot4d_widget.view.progress.ViewBar` -- above the readout, shown while the source
         is read in the background (its ``follow``)
     """
 
@@ -583,10 +583,9 @@ def _build_children(w, options) -> None:
         w.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
         built += w.progress_bar.widgets
         # the canvas keeps its size; the side panel wraps below it when narrow
-        w._canvas_box = widgets.VBox([w.scene.canvas, w.progress_bar.box, w.companion],
-                                     layout=widgets.Layout(flex="0 0 auto"))
+        w._canvas_box = widgets.VBox([w.scene.canvas, w.companion], layout=widgets.Layout(flex="0 0 auto"))
         w._side_box = widgets.VBox(
-            [w.readout, w.help_panel, w.errors],
+            [w.progress_bar.box, w.readout, w.help_panel, w.errors],
             layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
         )
         w._side_box.add_class("rot4d-side")
