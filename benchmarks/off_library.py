@@ -10,12 +10,16 @@ by path):
   (counted).
 * **slice**: one fixed random rotation (``--seed``), cut at c0 = 0 and at ``--levels`` more
   levels spread over the rotated w range (``slice_polytope`` with a single c0 each; the time is
-  the median over the levels, the slicing tables built by a first, untimed cut).
+  the median over the levels, the slicing tables built by a first, untimed cut).  With
+  ``--vertex-heights [K]`` (issue 33) instead: c0 exactly at every distinct vertex height unturned
+  (the identity matrix), and at every vertex's height after the fixed rotation, or at K of them
+  drawn with the seed where a file has more (the rows' problems start "unturned" or "turned").
 * **check**, independently of the slicer (numpy on the file's vertices, faces and cells, read
   here from the file with its own few lines of parsing):
   - the slice's points are the edges' crossings of the hyperplane: every crossing (and every
     vertex lying in it) is within ``1e-7 * circumradius`` of a slice point and every slice point
-    is within that of a crossing;
+    is within that of a crossing; every edge lying in the hyperplane (both ends within ``1e-9 *
+    circumradius``) is an edge of the slice between those ends' points;
   - every slice point is finite (it lies in the hyperplane by construction: it is given in the
     hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
     failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
@@ -27,17 +31,11 @@ by path):
     the points' bounding box); whether each edge also runs one way in one polygon and the other
     way in the other, as the boundary's orientation induces, is reported apart (`unclosed`: with
     star faces the even-odd rule does not promise it);
-  - for a polytope with star faces or non-convex cells, where the compiled level is built: the same
-    slice again by the numpy slicer alone (`rot4d_widget.geometry.starslice` with the polytope's
-    compiled tables switched off), which must give the same points (bit for bit), volume (relative
-    ``1e-9``) and area of fill per cell (the triangles' signed area about the cell's normal, to
-    ``1e-9`` of the largest); the summary counts the levels compared (those the C code cut; it
-    declines a level with a vertex on H, which the numpy slicer then does anyway);
   - for a polytope reported convex: the slice's volume equals the volume of
     ``scipy.spatial.ConvexHull`` of its points (relative ``1e-6``, plus 4 x the slice's area x the
     file's `flatness`: a file written with few digits leaves its faces and cells that far from flat).
 
-    python benchmarks/off_library.py DIR [--numbers 1-132] [--levels 3] [--seed 0]
+    python benchmarks/off_library.py DIR [--numbers 1-132] [--levels 3 | --vertex-heights [K]] [--seed 0]
         [--max-bytes N] [--timeout S] [--json out.json] [--quiet]
 
 ``--numbers A-B`` takes only files whose name starts with a number in A..B (the Bowers numbers of
@@ -64,9 +62,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, cKDTree
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry import _cstar, starslice
 from rot4d_widget.geometry.mesh import Polytope
-from rot4d_widget.geometry.slicetables import tables
 from rot4d_widget.geometry.slicing import slice_polytope
 
 #: distance (relative to the circumradius) within which a slice point and an edge crossing agree
@@ -156,6 +152,14 @@ def crossings(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: fl
     return np.concatenate([x[a, :3] + t * (x[b, :3] - x[a, :3]), x[on, :3]])
 
 
+def in_hyperplane(v: np.ndarray, e: np.ndarray, m: np.ndarray, c0: float, on_tol: float) -> np.ndarray:
+    """(k, 2, 3) the ends of the edges ``e`` lying in w = c0 (both ends within ``on_tol``): edges of P ∩ H."""
+    x = v @ m.T
+    on = np.abs(x[:, 3] - c0) <= on_tol
+    both = on[e[:, 0]] & on[e[:, 1]]
+    return x[e[both]][..., :3]
+
+
 def unclosed(s) -> tuple[str, str] | None:
     """What keeps the slice's polygons from closing up, as (kind, text), or None: every directed edge of their
     cycles must come as often as its reverse (each segment of a face's chord bounds the sections
@@ -205,14 +209,22 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
         if len(want) != len(pts):
             problems.append(f"c0={c0:.4g}: {len(pts)} slice points but {len(want)} edge crossings")
         return problems
-    d1 = cKDTree(pts).query(want)[0]
+    tree = cKDTree(pts)
+    d1 = tree.query(want)[0]
     d2 = cKDTree(want).query(pts)[0]
     if d1.max() > tol:
-        problems.append(f"c0={c0:.4g}: {int(np.sum(d1 > tol))} of {len(want)} edge crossings are no slice point "
-                        f"(worst {d1.max() / scale:.2g} x R)")
+        problems.append(f"c0={c0:.4g}: {int(np.sum(d1 > tol))} of {len(want)} edge crossings (and vertices on H) "
+                        f"are no slice point (worst {d1.max() / scale:.2g} x R)")
     if d2.max() > tol:
         problems.append(f"c0={c0:.4g}: {int(np.sum(d2 > tol))} of {len(pts)} slice points are no edge crossing "
                         f"(worst {d2.max() / scale:.2g} x R)")
+    flat_edges = in_hyperplane(v, e, m, c0, 1e-9 * scale)
+    if len(flat_edges):  # every edge lying in H is an edge of the slice, between its two ends' points
+        ends = tree.query(flat_edges.reshape(-1, 3))[1].reshape(-1, 2)
+        have = {frozenset(k) for k in np.asarray(s.edges).tolist()}
+        lost = sum(frozenset(k) not in have for k in ends.tolist())
+        if lost:
+            problems.append(f"c0={c0:.4g}: {lost} of the {len(flat_edges)} edges lying in H are no slice edge")
     if p.volume_defined:
         if s.volume is None or not np.isfinite(s.volume):
             problems.append(f"c0={c0:.4g}: volume {s.volume}")
@@ -233,62 +245,36 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     return problems
 
 
-def _fill_area(s, normals) -> np.ndarray:
-    v, t, c = np.asarray(s.vertices), np.asarray(s.triangles), np.asarray(s.triangle_cells)
-    n = normals[c] / np.linalg.norm(normals[c], axis=1)[:, None]
-    a = 0.5 * np.einsum("ij,ij->i", np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), n)
-    return np.bincount(c, weights=a, minlength=len(normals))
-
-
-def _polygons(s) -> collections.Counter:
-    """A slice's polygons as (cell, cycle) from its least corner, each cycle either way round."""
-    out = collections.Counter()
-    flat, off = np.asarray(s.polygon_indices).tolist(), np.asarray(s.polygon_offsets).tolist()
-    for i, c in enumerate(np.asarray(s.cell_ids).tolist()):
-        cyc = flat[off[i]:off[i + 1]]
-        k = cyc.index(min(cyc))
-        fwd = cyc[k:] + cyc[:k]
-        out[(c, min(tuple(fwd), tuple(fwd[:1] + fwd[1:][::-1])))] += 1
-    return out
-
-
-def against_numpy(p: Polytope, s, m: np.ndarray, c0: float) -> list[str] | None:
-    """What differs between slice ``s`` (compiled level) and the numpy slicer's of the same level; None
-    where there is nothing to compare (no star faces or cells, or no compiled level built)."""
-    if p.star is None:
-        return None
-    t = tables(p)
-    st = starslice.star_tables(p, t)
-    if st.c is None or _cstar.cut(st.c, t.vertices @ m.T, m, c0 / t.unit, t.tol) is None:
-        return None  # no compiled level, or it declines this level (the numpy slicer did it)
-    keep, st.c = st.c, None
-    try:
-        ref = slice_polytope(p, m, c0)
-    finally:
-        st.c = keep
-    out = []
-    n, nr = len(s.vertices) - s.n_fill, len(ref.vertices) - ref.n_fill
-    if n != nr or not np.array_equal(np.asarray(s.vertices)[:n], np.asarray(ref.vertices)[:nr]):
-        out.append(f"c0={c0:.4g}: compiled and numpy slice points differ")
-    if (s.volume is None) != (ref.volume is None) or (
-            s.volume is not None and abs(s.volume - ref.volume) > 1e-9 * max(1.0, abs(ref.volume))):
-        out.append(f"c0={c0:.4g}: compiled volume {s.volume!r}, numpy {ref.volume!r}")
-    if _polygons(s) != _polygons(ref):  # (either way round: a cycle of no area has no right one)
-        out.append(f"c0={c0:.4g}: compiled and numpy polygons differ")
-    if s.dim == 3 and ref.dim == 3:
-        normals = t.cell_normals @ m[:3].T
-        a, b = _fill_area(s, normals), _fill_area(ref, normals)
-        if np.abs(a - b).max(initial=0) > 1e-9 * max(1.0, float(np.abs(b).max(initial=0))):
-            out.append(f"c0={c0:.4g}: compiled and numpy fill areas differ (worst {np.abs(a - b).max():.3g})")
-    return out
-
-
 def levels(p: Polytope, m: np.ndarray, n: int) -> list[float]:
     """c0 = 0 and ``n`` levels spread over the rotated w range (never exactly at a vertex)."""
     w = p.vertices @ m.T[:, 3]
     lo, hi = float(w.min()), float(w.max())
     fr = 0.1 + 0.8 * (np.arange(n) + 0.37) / n  # off the middle: a centrally symmetric one has 0 there
     return [0.0] + [lo + f * (hi - lo) for f in fr]
+
+
+def vertex_heights(p: Polytope, m: np.ndarray, k: int | None = None, seed: int = 0) -> list[float]:
+    """The distinct heights w of ``p``'s vertices turned by ``m`` (one of each cluster within 1e-9 x the
+    circumradius; c0 there puts those vertices exactly on H), or ``k`` of them drawn with ``seed``."""
+    w = np.sort((p.vertices @ m.T)[:, 3])
+    first = np.ones(len(w), dtype=bool)
+    first[1:] = np.diff(w) > 1e-9 * float(np.max(np.linalg.norm(p.vertices, axis=1)))
+    w = w[first]
+    if k is not None and k < len(w):
+        w = np.sort(np.random.default_rng(seed).choice(w, k, replace=False))
+    return [float(c) for c in w]
+
+
+def cuts(p: Polytope, m: np.ndarray, nlevels: int, at_vertices: int | None,
+         seed: int) -> list[tuple[str, np.ndarray, float]]:
+    """(label, matrix, c0) of every slice to check: `levels` after the rotation ``m``; or, with
+    ``at_vertices`` (0: every one), c0 at every distinct vertex height unturned (the identity) and at
+    every vertex's height after ``m``, or ``at_vertices`` of them drawn with ``seed`` when there are more."""
+    if at_vertices is None:
+        return [("", m, c0) for c0 in levels(p, m, nlevels)]
+    eye = np.eye(4)
+    return ([("unturned, ", eye, c0) for c0 in vertex_heights(p, eye)]
+            + [("turned, ", m, c0) for c0 in vertex_heights(p, m, at_vertices or None, seed)])
 
 
 class _TimeUp(Exception):
@@ -325,7 +311,8 @@ def load(path, tries: int = 3) -> tuple[Polytope, str, int]:
                 used.append(float(hint.group(1)))
 
 
-def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str | None = None) -> dict:
+def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str | None = None,
+             at_vertices: int | None = None, seed: int = 0) -> dict:
     row = {"file": name or path.name, "bytes": path.stat().st_size}
     if timeout:
         signal.signal(signal.SIGALRM, _alarm)
@@ -350,25 +337,24 @@ def run_file(path, m: np.ndarray, nlevels: int, timeout: float | None, name: str
                 problems.append(f"counts: the file has {len(v)} vertices and {len(e)} face edges, the polytope "
                                 f"{len(p.vertices)} and {len(p.edges)}")
             slice_polytope(p, m, 0.0)  # builds the slicing tables (not timed)
-            times, negative, wound, compared = [], [], [], 0
-            for c0 in levels(p, m, nlevels):
+            times, negative, wound, failed = [], [], [], 0
+            todo = cuts(p, m, nlevels, at_vertices, seed)
+            for label, mm, c0 in todo:
                 t1 = time.perf_counter()
-                s = slice_polytope(p, m, c0)
+                s = slice_polytope(p, mm, c0)
                 times.append((time.perf_counter() - t1) * 1e3)
-                found = check_slice(p, s, v, e, m, c0, flat=flat)
-                diff = against_numpy(p, s, m, c0)
-                if diff is not None:
-                    compared += 1
-                    found += diff
-                problems += [x for x in found if "not wound" not in x]
+                found = [label + x for x in check_slice(p, s, v, e, mm, c0, flat=flat)]
+                bad = [x for x in found if "not wound" not in x]
+                problems += bad
+                failed += bool(bad)
                 wound += [x for x in found if "not wound" in x]
                 if s.volume is not None and s.volume < 0:
                     negative.append(c0)
             row.update(slice_ms=statistics.median(times), problems=problems, ok=not problems, negative=negative,
-                       wound=wound, compared=compared)
+                       wound=wound, levels=len(todo), failed_levels=failed)
         except Exception as exc:  # noqa: BLE001 -- a slicer failure is a finding, reported per file
             row.update(slice_ms=None, problems=[f"slice raised {type(exc).__name__}: {exc}"], ok=False, negative=[],
-                       wound=[])
+                       wound=[], levels=0, failed_levels=0)
         return row
     finally:
         if timeout:
@@ -396,7 +382,8 @@ def row_text(r: dict) -> str:
     if not r["loaded"]:
         return (f"{r['file'][-40:]:40} {'':>6} {'':>6} {'':>6} {'':>5} {'':>6} {'':>6} {'':>12} "
                 f"{r['load_ms']:8.0f} {'':>8}  REFUSED: {r['error'][:150]}")
-    res = "ok" if r["ok"] else "CHECK FAILED: " + "; ".join(r["problems"])[:200]
+    res = "ok" if r["ok"] else (f"CHECK FAILED at {r['failed_levels']} of {r['levels']} levels: "
+                                + "; ".join(r["problems"])[:200])
     if r["wound"]:
         res += f" (sections not wound as the boundary at {len(r['wound'])} of the levels)"
     if r["negative"]:
@@ -426,6 +413,9 @@ def summary(rows: list[dict]) -> str:
            f"{sum(not r['convex'] and not r['self_intersecting'] for r in loaded)}; "
            f"{sum(r['warnings'] > 0 for r in loaded)} read with a warning (edge count); "
            f"{sum(bool(r['negative']) for r in loaded)} with a negative (winding-weighted) slice volume somewhere"]
+    unturned = sum(any(x.startswith("unturned") for x in r["problems"]) for r in loaded)
+    out.append(f"  {sum(r['levels'] for r in loaded)} levels cut, {sum(r['failed_levels'] for r in loaded)} with a "
+               f"check failed" + (f" (files failing unturned: {unturned})" if unturned else ""))
     novol = collections.Counter(r["no_volume"] for r in loaded if r.get("no_volume"))
     for why, k in sorted(novol.items()):
         names = [r["file"] for r in loaded if r.get("no_volume") == why]
@@ -448,9 +438,6 @@ def summary(rows: list[dict]) -> str:
                    f"the same way; not counted as failed: even-odd sections of star faces close up only as a set, "
                    f"and a boundary with no orientation, hemi or not orientable, induces none): "
                    f"{len(wound)}  ({', '.join(wound[:8])}{', ...' if len(wound) > 8 else ''})")
-    compared = [r for r in loaded if r.get("compared")]
-    out.append(f"  compiled level against the numpy slicer: {sum(r['compared'] for r in compared)} levels of "
-               f"{len(compared)} files compared (compiled level {'built' if _cstar.available else 'NOT built'})")
     if loaded:
         out.append(f"  load ms median {statistics.median(r['load_ms'] for r in loaded):.0f}, "
                    f"max {max(r['load_ms'] for r in loaded):.0f}; slice ms median "
@@ -464,6 +451,9 @@ def main(argv=None) -> int:
     ap.add_argument("--numbers", help="only files whose name starts with a number in A-B")
     ap.add_argument("--levels", type=int, default=3, help="levels besides c0 = 0 (default 3)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the fixed rotation")
+    ap.add_argument("--vertex-heights", type=int, nargs="?", const=0, default=None, metavar="K",
+                    help="instead of --levels: c0 at every distinct vertex height unturned, and at every vertex's "
+                         "height after the fixed rotation (or K of them, drawn with the seed, where there are more)")
     ap.add_argument("--max-bytes", type=int, help="skip files larger than this")
     ap.add_argument("--timeout", type=float, help="seconds per file (load and slices) before it counts as refused")
     ap.add_argument("--json", help="write the rows here")
@@ -478,7 +468,8 @@ def main(argv=None) -> int:
     if not args.quiet:
         print(HEADER, flush=True)
     for f in files:
-        r = run_file(f, m, args.levels, args.timeout, name=str(f.relative_to(args.directory)))
+        r = run_file(f, m, args.levels, args.timeout, name=str(f.relative_to(args.directory)),
+                     at_vertices=args.vertex_heights, seed=args.seed)
         rows.append(r)
         if not args.quiet:
             print(row_text(r), flush=True)

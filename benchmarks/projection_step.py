@@ -41,6 +41,7 @@ from scipy.stats import special_ortho_group
 
 from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.view import projection as pj
+from rot4d_widget.view.bundle import page_module
 from rot4d_widget.view.widget import Rot4DWidget
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
@@ -98,15 +99,16 @@ console.log(JSON.stringify(times));
 
 
 def page_times(w, states):
-    """ms of companion.js's projectSkeleton for the skeleton of ``w``'s source and each state, under
+    """ms of the page's projectSkeleton for the skeleton of ``w``'s source and each state, under
     Node, ``[first pass, second pass]`` (None without Node)."""
     node = shutil.which("node") or shutil.which("nodejs")
     if node is None:
         return None
     sk = pj.skeleton_message(w.source, w._scale)
     sk.update({k: base64.b64encode(bytes(sk[k])).decode() for k in ("vertices", "edges")})
-    js = pathlib.Path(pj.__file__).with_name("companion.js")
     with tempfile.TemporaryDirectory() as tmp:
+        js = pathlib.Path(tmp) / "page.mjs"
+        js.write_text(page_module())
         driver = pathlib.Path(tmp) / "driver.mjs"
         driver.write_text(NODE_DRIVER)
         proc = subprocess.run([node, str(driver), str(js)], capture_output=True, text=True, timeout=300,
@@ -164,7 +166,7 @@ def main(argv=None):
         print(f"{r['name']:<11} {off[0]:>8.3f} {off[1]:>8.3f} {off[2]:>7.1f} {on[0]:>8.3f} {on[1]:>8.3f} "
               f"{on[2]:>7.1f} {r['ratio']:>7.2f}")
     if all(r["page"] is not None for r in rows):
-        print("\nthe page's share: companion.js projectSkeleton under Node, the same rotations, second pass"
+        print("\nthe page's share: the page's projectSkeleton under Node, the same rotations, second pass"
               " (first pass: before V8 optimises)")
         print(f"{'source':<11} {'page ms':>8} {'page p90':>8} {'1st pass':>8}")
         for r in rows:

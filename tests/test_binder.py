@@ -152,7 +152,7 @@ def test_the_venv_runs_the_installed_wheel_not_the_source_tree(binder_venv):
     assert version == b.wheel.name.split("-")[1]
     assert '"editable": true' not in (direct_url or "") and b.wheel.name in (direct_url or ""), direct_url
     pkg = Path(where).parent
-    assert (pkg / "view" / "companion.js").is_file() and list((pkg / "view" / "glsl").glob("*.vert"))
+    assert (pkg / "view" / "page" / "companion.js").is_file() and list((pkg / "view" / "glsl").glob("*.vert"))
     assert (b.venv / "etc" / "jupyter" / "jupyter_server_config.d" / "rot4d_widget.json").is_file()
 
 

@@ -15,13 +15,17 @@ import os
 import pathlib
 import shutil
 import subprocess
+import tempfile
 
 import pytest
 
 import rot4d_widget
+from rot4d_widget.view.bundle import ENTRY, PAGE_DIR, page_module
 from rot4d_widget.view.companion import Companion
 
-JS = pathlib.Path(rot4d_widget.__file__).parent / "view" / "companion.js"
+#: The module the front end receives (the page's modules joined), as a file Node can import.
+JS = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-page-")) / "page.mjs"
+JS.write_text(page_module())
 
 
 pytestmark = pytest.mark.usefixtures("recording_comms")  # tests/conftest.py
@@ -84,10 +88,11 @@ def test_on_drawn_and_on_focus_lost_dispatch_and_can_be_removed():
     c = Companion(FakeScene())
     drawn, lost = [], []
     c.on_drawn(drawn.append)
-    c.on_focus_lost(lost.append)
+    c.on_focus_lost(lambda reason, t: lost.append((reason, t)))
     from_page(c, {"event": "drawn", "seq": 7})
     from_page(c, {"event": "focus_lost", "reason": "hidden"})
-    assert drawn == [7] and lost == ["hidden"]
+    from_page(c, {"event": "focus_lost", "reason": "blur", "t": 1234.5})  # the page's time, issue 34
+    assert drawn == [7] and lost == [("hidden", None), ("blur", 1234.5)]
     c.on_drawn(drawn.append, remove=True)
     from_page(c, {"event": "drawn", "seq": 8})
     assert drawn == [7]
@@ -120,11 +125,11 @@ def test_a_failing_callback_does_not_escape(caplog):
 
 
 def test_the_module_ships_inside_the_package():
-    assert JS.is_file()
-    assert JS.parent == pathlib.Path(rot4d_widget.__file__).parent / "view"  # hatch packages the whole folder
+    assert (PAGE_DIR / ENTRY).is_file()
+    assert PAGE_DIR == pathlib.Path(rot4d_widget.__file__).parent / "view" / "page"  # hatch packages the folder
     text = JS.read_text()
     assert "export default" in text
-    assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped file
+    assert Companion(FakeScene())._esm == text  # what the front end receives is the shipped modules, joined
 
 
 # ------------------------------------------------------------------ JavaScript under Node
@@ -160,6 +165,7 @@ globalThis.window = target();
 globalThis.document = Object.assign(target(), {
   visibilityState: "visible",
   querySelector: (sel) => (hovered && sel === "." + CLS + ":hover" ? {} : null),
+  getElementsByClassName: () => [],
 });
 globalThis.CSS = { escape: (s) => s };
 let raf = [];
@@ -393,7 +399,8 @@ def test_js_the_page_does_not_send_the_row_buffer_back(js_run):
 
 
 def test_js_shortcut_guard_prevents_only_while_hovered(js_run):
-    assert js_run["capture"] == [[True], [True], [True]]  # capture phase on window
+    # capture phase on window: the shortcut guard (every key event) and the page's own steps (issue 34)
+    assert js_run["capture"] == [[True, True], [True, True], [True]]
     assert js_run["notHovered"] is False
     assert js_run["hovered"] == [True, True, True]
     assert js_run["ctrl"] is False and js_run["meta"] is False
@@ -457,7 +464,10 @@ def test_js_retries_get_model_until_the_model_is_registered(js_run):
 
 
 def test_js_focus_loss(js_run):
-    assert js_run["focus"] == [{"event": "focus_lost", "reason": "blur"}, {"event": "focus_lost", "reason": "hidden"}]
+    # with the page's time (issue 34): the kernel releases held keys then, as the page does
+    assert [{k: v for k, v in m.items() if k != "t"} for m in js_run["focus"]] == [
+        {"event": "focus_lost", "reason": "blur"}, {"event": "focus_lost", "reason": "hidden"}]
+    assert all(isinstance(m["t"], (int, float)) for m in js_run["focus"])
 
 
 def test_js_cleanup_removes_every_listener(js_run):

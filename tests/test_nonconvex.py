@@ -92,11 +92,16 @@ def pieces_components(shape, m, c0):
     return connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(len(cut), len(cut))), directed=False)[0]
 
 
-def check_closed(s, manifold=True):
+def check_closed(s, manifold=True, lying_in_h=None):
     """Every directed triangle edge once and its reverse once; every edge in exactly two polygons.
 
     ``manifold=False`` (two solids touching along an edge in H): every directed edge as often
-    as its reverse, every edge in an even number of polygons (a closed surface, pinched)."""
+    as its reverse, every edge in an even number of polygons (a closed surface, pinched).
+
+    The slice's vertices are the polygons' corners and its edges their sides, but for the parts of
+    P lying in H that bound no polygon (where P touches H away from the solid, issue 33):
+    ``lying_in_h`` (k, 3), P's vertices on H (None: there are none), then also holds every vertex
+    no polygon uses, and the ends of every edge that is no polygon's side."""
     directed = Counter()
     for a, b, c in s.triangles.tolist():
         for e in ((a, b), (b, c), (c, a)):
@@ -111,9 +116,15 @@ def check_closed(s, manifold=True):
         assert set(directed.values()) == {1} and set(sides.values()) == {2}
     else:
         assert all(n % 2 == 0 for n in sides.values())
-    assert set(sides) == {frozenset(e) for e in s.edges.tolist()}
-    assert len(s.edges) == len(sides)
-    assert set(np.unique(s.polygon_indices).tolist()) == set(range(len(s.vertices)))
+    edges = {frozenset(e) for e in s.edges.tolist()}
+    used = set(np.unique(s.polygon_indices).tolist())
+    assert set(sides) <= edges and len(s.edges) == len(edges) and used <= set(range(len(s.vertices)))
+    alone = {k for e in edges - set(sides) for k in e} | (set(range(len(s.vertices))) - used)
+    if lying_in_h is None:
+        assert not alone
+    elif alone:
+        k = sorted(alone)
+        assert np.abs(s.vertices[k][:, None, :] - lying_in_h[None, :, :]).max(axis=2).min(axis=1).max() < 1e-9
 
 
 def signed_volume(s):
@@ -210,7 +221,7 @@ def test_slices_exactly_at_vertex_heights(shape, seed, which):
     s = slice_polytope(p, m, c0)
     assert s.volume == pytest.approx(pieces_volume(shape, m, c0), rel=1e-9, abs=1e-12)
     if s.dim == 3:
-        check_closed(s)
+        check_closed(s, lying_in_h=(p.vertices @ m.T)[np.abs(h - c0) <= 1e-9 * p.circumradius, :3])
         assert signed_volume(s) == pytest.approx(s.volume, rel=1e-9)
 
 
@@ -384,7 +395,8 @@ def test_levels_through_whole_faces_and_cells(shape, direction, which, spin):
     assert s.volume == pytest.approx(expected, rel=1e-9, abs=1e-12)
     if expected > 0:
         assert s.dim == 3
-        check_closed(s, manifold=False)  # H may hold a reflex edge: two solids touching along it
+        check_closed(s, manifold=False,  # H may hold a reflex edge: two solids touching along it
+                     lying_in_h=(p.vertices @ m.T)[np.abs(h - c0) <= 1e-9 * p.circumradius, :3])
         assert signed_volume(s) == pytest.approx(s.volume, rel=1e-9)
         check_outward(shape, m, c0, s)
     else:

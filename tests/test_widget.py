@@ -126,6 +126,9 @@ class FakeCompanion(ipywidgets.DOMWidget):
         self.scene = scene
         self._drawn = CallbackDispatcher()
         self._focus = CallbackDispatcher()
+        self._clock = CallbackDispatcher()
+        self.config = {}  # as `Companion`: what the page steps its state by, and the kernel's state
+        self.kernel_state = {}
         self.last_draw_time = None  # as `Companion`: the page's time for the last update it drew
 
     def on_drawn(self, callback, remove=False):
@@ -133,6 +136,13 @@ class FakeCompanion(ipywidgets.DOMWidget):
 
     def on_focus_lost(self, callback, remove=False):
         self._focus.register_callback(callback, remove=remove)
+
+    def on_clock(self, callback, remove=False):
+        self._clock.register_callback(callback, remove=remove)
+
+    def clock(self, t_ms):
+        """The page says its clock has reached ``t_ms`` (as it does with each step it makes)."""
+        self._clock(t_ms)
 
     def on_screenshot(self, callback, remove=False):
         pass  # screenshots: tests/test_widget_screenshot.py, with the real companion

@@ -106,3 +106,19 @@ def test_hiding_the_pad_releases_its_buttons_and_bad_events_are_harmless(make):
     w._keypad.handle("2", False, None)
     w._keypad.handle("2", False, {"type": "wheel"})
     assert w.errors.outputs == ()
+
+
+def test_hiding_the_pad_releases_its_buttons_even_when_the_layout_s_send_fails(make, monkeypatch):
+    """The soak (issue 33, seed 1): a pad button held while the pad was hidden during a comm failure
+    stayed held for ever (the layout's send raised before the release)."""
+    w = make("5-cell", keypad=True)
+    pad(w, "z", "mousedown", shift=True)
+    assert w.held_keys == ("pad:z+shift",)
+
+    def fail(*args, **kwargs):
+        raise ConnectionError("injected: the comm is down")
+
+    monkeypatch.setattr(w._keypad.box.layout.comm, "send", fail)
+    with pytest.raises(ConnectionError):
+        w.keypad = False
+    assert w.held_keys == ()

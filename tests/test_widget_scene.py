@@ -88,7 +88,7 @@ def test_layout_holds_canvas_companion_readout_help_and_errors(make):
 
 
 @pytest.mark.parametrize("name", POLYTOPE_NAMES)
-def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recording_comms, name):
+def test_one_update_is_one_new_float32_array_a_readout_and_a_state_message(make, recording_comms, name):
     w = make(name)
     rng = np.random.default_rng(7)
     before_ids = set(ipywidget_module._instances)
@@ -105,7 +105,8 @@ def test_one_update_is_one_new_float32_array_and_one_readout_message(make, recor
         assert w.stats.updates == updates + 1
         msgs = recording_comms[n0:]
         by_widget = Counter(cid for cid, *_ in msgs)
-        assert by_widget == {w.scene.buffer_model_id: 1, w.readout.model_id: 1}, by_widget
+        # the picture, the readout, and the kernel's state with its id naming the picture (issue 34)
+        assert by_widget == {w.scene.buffer_model_id: 1, w.readout.model_id: 1, w.companion.model_id: 1}, by_widget
         total = sum(n for _, _, n, _ in msgs)
         assert total <= 64 * 1024
         (data, nbytes), = buffer_messages(w, msgs)
@@ -274,7 +275,8 @@ def test_parameter_keys_change_the_readout_only(make, recording_comms):
     n0 = len(recording_comms)
     down(w, "j")
     up(w, "j")
-    assert [cid for cid, *_ in recording_comms[n0:]] == [w.readout.model_id]
+    # the kernel's new state goes to the page (issue 34), then the readout: no picture
+    assert [cid for cid, *_ in recording_comms[n0:]] == [w.companion.model_id, w.readout.model_id]
     assert not w.in_flight  # no picture sent, so no acknowledgement to wait for
     down(w, "l")
     up(w, "l")

@@ -242,6 +242,21 @@ class RotationState:
         self._c0_limit = positive(value, "c0_limit", what="a number > 0 (or inf)", finite=False,
                                   must="> 0 (or inf)")
 
+    def snapshot(self) -> tuple:
+        """``(matrix, theta0, alpha, c0)`` now: what `restore_snapshot` sets back exactly."""
+        return (self._matrix, self._theta0, self._alpha, self._c0)
+
+    def restore_snapshot(self, snap: tuple) -> None:
+        """Set the orientation, theta0, alpha and c0 to a `snapshot` of this state, exactly (the
+        matrix object is shared: matrices are never edited)."""
+        self._matrix, self._theta0, self._alpha, self._c0 = snap
+        self._steps.clear()
+
+    @property
+    def reset_point(self) -> tuple:
+        """``(theta0, alpha, c0, matrix)``: the state `reset` returns to (as made, or as restored)."""
+        return self._initial
+
     @property
     def alpha_step(self) -> float:
         """How much "k"/"j" change alpha: ``theta0 * ALPHA_STEP_FRACTION``."""
@@ -273,10 +288,13 @@ class RotationState:
                 return False  # refused, not clamped: the opposite key undoes every step made
             self.alpha = new
         elif kind == "c0":
-            new = self._c0 + action.sign * self._c0_step
+            step = self._c0_step
+            new = self._c0 + action.sign * step
             o = self._c0_origin
             if abs(new - o) > self._c0_limit and abs(new - o) >= abs(self._c0 - o):
                 return False
+            if new + step == new or new - step == new:
+                return False  # where the step would no longer move c0: refused (`_check_c0_steps`)
             self.c0 = new
         elif kind == "theta0":
             new = self._theta0 * THETA0_FACTOR if action.sign > 0 else self._theta0 / THETA0_FACTOR

@@ -2,8 +2,7 @@
 
 See `rot4d_widget.geometry.slicing` for the case table and what replaced convexity;
 `slice_level` is the entry (with its fallbacks for near-degenerate classifications), `_slice` the
-vectorised steps, `_faces_in_h` the rule for 2-faces lying in H, `_boundary_only` what a solid
-slice of a non-convex polytope keeps.
+vectorised steps, `_faces_in_h` the rule for 2-faces lying in H.
 """
 
 from __future__ import annotations
@@ -168,8 +167,6 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
             + A[:, 2] * (B[:, 0] * D[:, 1] - B[:, 1] * D[:, 0])
         ).sum()
     ) / 6.0
-    if len(on_idx):
-        vertices, edges, flat, triangles = _boundary_only(vertices, edges, flat, offsets, triangles)
     return Slice(_scaled(t, vertices), edges, flat, offsets, cell_ids, triangles, triangle_cells,
                  _scaled_volume(t, volume), 3)
 
@@ -225,21 +222,3 @@ def _faces_in_h(t: _Tables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, 
     plus, minus = filled
     return plus != minus, minus
 
-
-def _boundary_only(vertices, edges, flat, offsets, triangles):
-    """Drop the on-H vertices and in-H edges that no polygon uses (a solid slice of a non-convex
-    polytope is given by its boundary: a face inside S, or P touching H away from S, adds none).
-
-    A convex polytope's solid slice uses them all: then nothing changes (same arrays)."""
-    n = len(vertices)
-    used = np.zeros(n, dtype=bool)
-    used[flat] = True
-    nxt = np.arange(1, len(flat) + 1)
-    nxt[offsets[1:] - 1] = offsets[:-1]
-    sides = np.minimum(flat, flat[nxt]) * n + np.maximum(flat, flat[nxt])
-    ekey = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
-    side = np.isin(ekey, sides)
-    if used.all() and side.all():
-        return vertices, edges, flat, triangles
-    new = np.cumsum(used) - 1
-    return vertices[used], new[edges[side]], new[flat], new[triangles]

@@ -36,9 +36,13 @@ replaced it:
   have pieces above and below and none crossing: S is then empty (or only
   touches), decided by whether any polygon comes out.
 * In a solid slice every vertex on H and every edge in H was on S's boundary.
-  Now a solid slice is given by its boundary alone: vertices on H and edges in
-  H that no polygon uses (inside S, or where P touches H away from S) are
-  dropped (`_boundary_only`; for a convex polytope nothing is dropped).
+  It is still a vertex (an edge) of the slice, as the table says, but may be
+  on no polygon: where P touches H away from the solid part (a vertex whose
+  cells all lie on one side, a face of P lying in H that bounds nothing), or
+  inside it.  The slice is P ∩ H whole, its solid part given by the polygons;
+  for a convex polytope every one is on a polygon.  (Issue 11 dropped those
+  no polygon used; issue 33 keeps them: a user cutting at a vertex's height
+  sees that vertex.)
 * H touching P: the dimension is 2 if a face lies in H, else 1 if an edge
   does, else 0 (a convex polytope touches in one face, edge or vertex).
 
@@ -100,7 +104,7 @@ from ._ragged import _owner
 from .catalogue import polytope as _get_polytope
 from .mesh import Polytope
 from .multislice import _NoCrossing, _nonzero2, _slice_generic, _slice_many
-from .section import _TWO_PI_PLUS, _boundary_only, _faces_in_h, _slice, _touching
+from .section import _TWO_PI_PLUS, _faces_in_h, _slice, _touching
 from .section import slice_level as _slice_level
 from .slicetables import _TABLES, Slice, _fan, _Inconsistent, _inplane_axes, _padded, _scaled, _scaled_volume, _Tables
 from .slicetables import tables as _tables
@@ -113,7 +117,7 @@ __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
 TOLERANCE = tol_.ON_HYPERPLANE
 
 #: the private names this module had before it was split, still importable from it
-_MOVED = (_owner, Polytope, _NoCrossing, _nonzero2, _slice_generic, _TWO_PI_PLUS, _boundary_only, _faces_in_h,
+_MOVED = (_owner, Polytope, _NoCrossing, _nonzero2, _slice_generic, _TWO_PI_PLUS, _faces_in_h,
           _slice, _touching, _TABLES, _fan, _Inconsistent, _inplane_axes, _padded, _scaled, _scaled_volume, _Tables)
 
 

@@ -33,15 +33,17 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
   so the slices' volumes integrate over c0 to the 4-volume the divergence theorem gives
   (Cavalieri).
 
-A level with no vertex on H is cut by the same rules in C when the package was built with a C
-compiler (`rot4d_widget.geometry._cstar`, ``_starcut.c``: one pass instead of some 250 array
-steps); this module stays the reference and does every level the C code declines.
-
-Vertices on H are resolved by simulation of simplicity: they count as above H (the slice just
-below c0, as a limit) unless some cell lies in H, when the side whose slice has the larger volume
-is kept (so the cap of a prism at its end level is there).  The crossing points of the edges at
-such a vertex are that vertex, kept once; stretches of no length are dropped from the segments
-and polygons.  Per level: no Python loop over geometry (per-polytope tables built once).
+Vertices on H are resolved by simulation of simplicity: for the segments, polygons, fill and
+volume they count as above H (the slice just below c0, as a limit) unless some cell lies in H,
+when the side whose slice has the larger volume is kept (so the cap of a prism at its end level
+is there).  The crossing points of the edges at such a vertex are that vertex, kept once;
+stretches of no length are dropped from the segments and polygons.  The limit alone is not P ∩ H:
+it has no point at a vertex on H whose neighbours all lie on the side it is counted on (a vertex
+whose edges all rise, as many do at once unturned), nor the edges lying in H.  So, as in the
+convex-cell slicer's case table (`rot4d_widget.geometry.slicing`), every vertex on H is a vertex
+of the slice and every edge lying in H an edge of it, on a polygon or not (issue 33: a user who
+cuts at a vertex's height sees that vertex).  Per level: no Python loop over geometry
+(per-polytope tables built once).
 """
 
 from __future__ import annotations
@@ -51,7 +53,6 @@ import weakref
 import numpy as np
 
 from ..core import tolerances as tol_
-from . import _cstar
 from ._ragged import _ptr
 from .section import _touching
 from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
@@ -89,7 +90,6 @@ class _StarTables:
         mate = np.where(size == 2, o[np.minimum(np.arange(len(ks)) + 1 - 2 * pos, len(ks) - 1)], -1)
         self.slot_mate = np.empty(len(ks), dtype=np.intp)
         self.slot_mate[o] = mate
-        self.c = _cstar.CTables(p, t, self) if _cstar.available else None
 
 
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -105,11 +105,6 @@ def star_tables(p, t: _Tables) -> _StarTables:
 def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
     st = star_tables(p, t)
-    if st.c is not None:  # the compiled generic level; None where it declines (a vertex on H, a tie)
-        r = _cstar.cut(st.c, x, m, c0, t.tol)
-        if r is not None:
-            v, edges, flat, offsets, cells, tri, tcell, volume, n_fill = r
-            return Slice(_scaled(t, v), edges, flat, offsets, cells, tri, tcell, _scaled_volume(t, volume), 3, n_fill)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol
     out = None
@@ -154,21 +149,22 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     dpdc = dx / (x[b, 3] - x[a, 3])[:, None]  # how a crossing moves with the level (ties on H)
     cid = np.full(len(t.ea), -1, dtype=np.intp)
     cid[ce] = np.arange(len(ce))
-    # one slice vertex per crossing point, the crossings at a vertex on H merged into it
-    at_v = np.where(on[a], a, np.where(on[b], b, -1))
+    # one slice vertex per crossing point, then every vertex on H (a vertex of S, whether or not an
+    # edge crosses at it: one whose neighbours are all on the side it is counted on has none), in
+    # vertex order; the crossings at a vertex on H merged into it.  No sort
+    on_idx = np.flatnonzero(on)
     vid = np.arange(len(ce))
-    if on.any():  # no sort: vertices on H numbered in vertex order after the other crossings
+    vnum = None
+    if len(on_idx):
+        at_v = np.where(on[a], a, np.where(on[b], b, -1))
         own = at_v < 0
         vid = np.cumsum(own) - 1
-        mark = np.zeros(len(h), dtype=bool)
-        mark[at_v[~own]] = True
-        vnum = np.cumsum(mark) - 1 + int(own.sum())
+        vnum = np.full(len(h), -1, dtype=np.intp)
+        vnum[on_idx] = int(own.sum()) + np.arange(len(on_idx))
         vid[~own] = vnum[at_v[~own]]
-        first = np.empty(int(vid.max()) + 1, dtype=np.intp)
-        first[vid] = np.arange(len(ce))
+        vertices = np.concatenate([pts[own], x[on_idx, :3]])
     else:
-        first = vid
-    vertices = pts[first]
+        vertices = pts
 
     # each crossing face's points along its line w = c0, sorted; paired even-odd
     ks = np.flatnonzero(cross[t.fe_edge])
@@ -373,7 +369,9 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     all_v = np.concatenate([vertices, extra]) if len(extra) else vertices
     ev = vid[seg]
     ev = ev[ev[:, 0] != ev[:, 1]]
-    if on.any() and len(ev):  # chords along an edge lying in H come from each of its faces: once
+    if vnum is not None:  # every edge lying in H is an edge of S; a chord along one (from each of its faces): once
+        e_on = on[t.ea] & on[t.eb]
+        ev = np.concatenate([ev, np.stack([vnum[t.ea[e_on]], vnum[t.eb[e_on]]], axis=1)])
         lo_hi = np.sort(ev, axis=1)
         ev = lo_hi[np.unique(lo_hi[:, 0] * len(vertices) + lo_hi[:, 1], return_index=True)[1]]
     edges = ev if len(ev) else t.empty_i2

@@ -594,6 +594,10 @@ class Recorder:
         with self._lock:
             self._start(state, source_settings, view_settings)
 
+    def since_start(self, clock_time: float) -> float:
+        """A time of the recorder's ``clock`` as the recording's ``t`` (seconds since it started)."""
+        return max(0.0, clock_time - self._t0)
+
     def _stamp(self, t):
         return max(0.0, self._clock() - self._t0) if t is None else _time(t)
 

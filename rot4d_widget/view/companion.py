@@ -1,8 +1,9 @@
 """`Companion`: the few lines of front-end JavaScript the widget needs (anywidget).
 
 An invisible widget (display it next to the scene's renderer, e.g. in the
-same box) whose module, ``companion.js``, ships in the package (no build
-step) and does these things in JupyterLab 4 and Notebook 7 alike:
+same box) whose module -- the page's code, ``rot4d_widget/view/page/*.js``, joined by
+`rot4d_widget.view.bundle` (no build step) -- does these things in JupyterLab 4 and
+Notebook 7 alike:
 
 1. **drawn acknowledgement** -- after the page has *rendered* a frame
    containing the latest buffer assignment (not merely on arrival): at the
@@ -73,11 +74,13 @@ from __future__ import annotations
 import base64
 import binascii
 import math
-import pathlib
 
 import anywidget
 from ipywidgets import CallbackDispatcher, Layout
-from traitlets import List, Unicode
+from traitlets import Dict, List, Unicode
+
+from .bundle import page_module
+from .transfer import Transfers
 
 __all__ = ["Companion"]
 
@@ -91,7 +94,7 @@ class Companion(anywidget.AnyWidget):
     arguments.
     """
 
-    _esm = pathlib.Path(__file__).with_name("companion.js")
+    _esm = page_module()
 
     buffer_model_id = Unicode("").tag(sync=True)
     scene_model_id = Unicode("").tag(sync=True)
@@ -103,6 +106,16 @@ class Companion(anywidget.AnyWidget):
     projection_model_ids = List(Unicode()).tag(sync=True)
     #: the projection canvas's CSS class (its key guards and its test hook)
     projection_class = Unicode("").tag(sync=True)
+    #: what the page needs to step its own copy of the state (`pagestate.page_config`): the key
+    #: table, the bounds, the hold delay and tick rate, the kinds it steps
+    config = Dict().tag(sync=True)
+    #: the kernel's state and its id (`pagestate.state_message` under "state", "epoch", "upto": the
+    #: page time in ms up to which it holds the page's steps, None before any; "picture": the id of
+    #: the scene update that shows it, or None): the page adopts it and applies its later steps on top
+    kernel_state = Dict().tag(sync=True)
+    #: the one-time transfers the kernel offers, name -> key (`transfer.Transfers`): a page that does
+    #: not hold one asks for it
+    page_data = Dict().tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -120,6 +133,8 @@ class Companion(anywidget.AnyWidget):
         self._drawn_handlers = CallbackDispatcher()
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
+        self._clock_handlers = CallbackDispatcher()
+        self.transfers = Transfers(self)
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
@@ -136,8 +151,14 @@ class Companion(anywidget.AnyWidget):
         """Call ``callback(update_id)`` when the page has drawn that update."""
         self._drawn_handlers.register_callback(callback, remove=remove)
 
+    def on_clock(self, callback, remove=False):
+        """Call ``callback(t_ms)`` with the page's clock (ms, the key events' timeStamp clock) as the
+        page sends it with the steps it makes while a key is held."""
+        self._clock_handlers.register_callback(callback, remove=remove)
+
     def on_focus_lost(self, callback, remove=False):
-        """Call ``callback(reason)`` (``"blur"`` or ``"hidden"``) when the page loses focus."""
+        """Call ``callback(reason, t_ms)`` (``"blur"`` or ``"hidden"``; the page's time, or None) when
+        the page loses focus."""
         self._focus_handlers.register_callback(callback, remove=remove)
 
     def _handle_message(self, _widget, content, _buffers=None):
@@ -160,8 +181,17 @@ class Companion(anywidget.AnyWidget):
                 error = "the page sent no PNG"
             self._screenshot_handlers(rid, png, None if png is not None else str(error))
         elif event == "focus_lost":
-            reason = content.get("reason")
-            self._focus_handlers(reason if isinstance(reason, str) else "")
+            reason, t = content.get("reason"), content.get("t")
+            ok = isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)
+            self._focus_handlers(reason if isinstance(reason, str) else "", float(t) if ok else None)
+        elif event == "want":
+            name, key = content.get("name"), content.get("key")
+            if isinstance(name, str) and isinstance(key, str):
+                self.transfers.want(name, key)
+        elif event == "clock":
+            t = content.get("t")
+            if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+                self._clock_handlers(float(t))
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

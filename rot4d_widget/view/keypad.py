@@ -47,9 +47,9 @@ class KeyPad:
             self.box = self.build()
             w._canvas_box.children = (*w._canvas_box.children, self.box)
         if self.box is not None:
-            self.box.layout.display = None if visible else "none"
-            if not visible:
+            if not visible:  # first: hiding must release them even if the layout's send fails
                 w.release_keys()
+            self.box.layout.display = None if visible else "none"
 
     def build(self):
         """Rows of buttons, one per bound action in `PAD_ROWS`; each button's presses feed the
@@ -106,7 +106,7 @@ class KeyPad:
                     return
                 action, inverted = found
                 with w._pump.lock:
-                    if w._closed or key_id in w._repeater.held_keys:
+                    if w._closed or key_id in w._keys.held:
                         return  # a touch's emulated mousedown: one press only
                     w._keys.press(key_id, action, inverted, page_time(event))
             elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):

@@ -1,10 +1,13 @@
-"""The key path: an ipyevents dict (or a key pad button) -> keymap -> one step -> the pump.
+"""The key path: an ipyevents dict (or a key pad button) -> keymap -> steps -> the pump.
 
-`KeyPath` handles the canvas's key events, presses and releases held keys (the
-`rot4d_widget.view.keyhold.KeyRepeater` says when they repeat), applies one step of an action
-(the state's, the source's own, a screenshot, or the first added slice that makes the view a
-stack), records it and marks the picture dirty.  It never raises into the event loop: errors
-go to the widget's ``errors`` area.
+`KeyPath` handles the canvas's key events.  The state's own keys pressed in the page (with the
+page's timestamp) take the page's schedule: `rot4d_widget.view.pagesteps.PageSteps` applies
+exactly the steps the page makes, in the page's order, as far as the kernel has heard the page's
+clock (the page predicts them; the kernel decides).  Every other key -- a source's own, the
+view's, the stack's, a key from code or without a page time -- is the kernel's: one step now,
+repeats while held by `rot4d_widget.view.keyhold.KeyRepeater`, corrected to the page's
+timestamps at release.  A step is recorded and marks the picture dirty.  Nothing here raises into
+the event loop: errors go to the widget's ``errors`` area.
 """
 
 from __future__ import annotations
@@ -15,6 +18,8 @@ from collections.abc import Mapping
 
 from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
 from . import markup
+from .pagestate import page_config
+from .pagesteps import HEARTBEAT_STALE, PREDICTED_KINDS
 
 __all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
 
@@ -25,9 +30,13 @@ class KeyPath:
 
     def __init__(self, widget):
         self.w = widget
-        self.last_label = None  # the readout's "last" row: the last step and how many times
-        self.last_count = 0
         self.was_displayed = False  # a view of the canvas was counted once
+
+    @property
+    def held(self) -> tuple:
+        """Every key held now: the page's (`PageSteps`) and the kernel's (the repeater)."""
+        w = self.w
+        return w._page_steps.held + w._repeater.held_keys
 
     # -- events ----------------------------------------------------------------------------
     def handle_event(self, event) -> None:
@@ -60,9 +69,9 @@ class KeyPath:
             return
         action, inverted = found
         with w._pump.lock:
-            if w._closed or w._repeater.held(kid) is not None:
+            if w._closed or w._repeater.held(kid) is not None or w._page_steps.held_key(kid) is not None:
                 # a keydown of a key held (no keyup between: a browser or an OS that repeats
-                # without the repeat flag) is a repeat: the ticker repeats, it is not a new press
+                # without the repeat flag) is a repeat, not a new press
                 return
             self.press(kid, action, inverted, page_time(event))
 
@@ -75,6 +84,12 @@ class KeyPath:
         if action.kind == "help":
             w.help_visible = not w.help_visible
             return
+        if action.kind in PREDICTED_KINDS and when is not None:  # the page's schedule
+            w._page_steps.press(kid, action, inverted, 1000.0 * when, action.kind in REPEATING_KINDS)
+            self.advance()
+            w._pump.flush()
+            return
+        self.advance()  # the page's steps so far come before this one
         now = w._pump.clock()
         changed = self.step(action, inverted)
         if action.kind in REPEATING_KINDS or (action.kind == "custom" and w._custom[action.name][1]):
@@ -86,6 +101,8 @@ class KeyPath:
         its steps corrected to what the page says the hold was; at rest, settle."""
         w = self.w
         with w._pump.lock:
+            if w._page_steps.release(kid, None if when is None else 1000.0 * when):
+                self.advance()
             held = w._repeater.held(kid)
             correction = w._repeater.release(kid, when)
             if held is not None:
@@ -96,15 +113,41 @@ class KeyPath:
         """Every held key up (mouseleave, focus lost, no view left)."""
         w = self.w
         with w._pump.lock:
+            if w._page_steps.release_all(None if when is None else 1000.0 * when):
+                self.advance()
             for action, inverted, correction in w._repeater.release_all(when):
                 self.correct(action, inverted, correction)
             self.settle()
+
+    def heartbeat(self, t_ms) -> None:
+        """Companion: the page's clock has reached ``t_ms`` (it sends it with each step it makes).
+        Never raises."""
+        w = self.w
+        try:
+            if isinstance(t_ms, bool) or not isinstance(t_ms, (int, float)) or not math.isfinite(t_ms):
+                return
+            with w._pump.lock:
+                if w._closed:
+                    return
+                w._page_steps.heartbeat(float(t_ms))
+                self.advance()
+                w._pump.flush()
+        except Exception as exc:
+            w._report_error(exc)
+
+    def advance(self) -> None:
+        """The page's steps heard of and not applied yet (lock held): applied, recorded, the picture
+        dirty and the traits synced once."""
+        w = self.w
+        if w._page_steps.advance().changed:
+            w._pump.mark_dirty()
+            w._sync.state_traits()
 
     def settle(self) -> None:
         """At rest (no key held): bring the readout up to date and the rows into the turned frame,
         and send a picture still owed (one whose send failed)."""
         w = self.w
-        if w._closed or len(w._repeater):
+        if w._closed or self.held:
             return
         if w._painter.readout_stale or not w._painter.settled:
             w._pump.mark_dirty()
@@ -121,8 +164,9 @@ class KeyPath:
             opposite = _opposite(action, inverted)
             undone = sum(self.apply_step(*opposite) for _ in range(-correction))
             if undone:
-                if self.last_label == action.label(inverted):
-                    self.last_count = max(self.last_count - undone, 1)
+                last = w._last
+                if last.label == action.label(inverted):
+                    last.count = max(last.count - undone, 1)
                 self.after_steps(action)
         clock = w._pump.clock
         start = clock()
@@ -131,10 +175,12 @@ class KeyPath:
                 break
             self.step(action, inverted)
 
-    def focus_lost(self, *args, **kwargs) -> None:
-        """Companion: the page or window lost focus (no keyup will come): every key up."""
+    def focus_lost(self, reason=None, t_ms=None) -> None:
+        """Companion: the page or window lost focus at page time ``t_ms`` (None: not said); no keyup
+        will come: every key up then."""
         try:
-            self.w.release_keys()
+            ok = isinstance(t_ms, (int, float)) and not isinstance(t_ms, bool) and math.isfinite(t_ms)
+            self.w.release_keys(t_ms / 1000.0 if ok else None)
         except Exception as exc:
             self.w._report_error(exc)
 
@@ -166,6 +212,14 @@ class KeyPath:
         w.state.keymap = keymap
         markup.show(w.help_panel, markup.help_html(help_groups(keymap), w._repeater.hold_delay,
                                                    w._repeater.tick_rate))
+        self.send_config()
+
+    def send_config(self) -> None:
+        """The key table and rules the page steps its copy of the state by (`pagestate.page_config`)."""
+        w = self.w
+        rep = w._repeater
+        w.companion.config = page_config(w.state.keymap, hold_delay=rep.hold_delay, tick_rate=rep.tick_rate,
+                                         max_lag=rep.max_steps * rep.period, predicted=PREDICTED_KINDS)
 
     # -- steps -----------------------------------------------------------------------------
     def tick(self, now: float) -> None:
@@ -174,6 +228,9 @@ class KeyPath:
         w = self.w
         rep = w._repeater
         clock = w._pump.clock
+        if w._page_steps.held:  # the page silent for a while: its steps by the kernel's estimate
+            w._page_steps.tick()
+            self.advance()
         for kid, action, inverted in rep.due_keys(now):
             if self.step(action, inverted):
                 rep.note_applied(kid)
@@ -183,15 +240,21 @@ class KeyPath:
         if after - now > rep.period:
             rep.drop_missed(after)
 
+    def deadline(self):
+        """When `tick` next wants to run: the repeater's next tick, or with a key of the page held,
+        when the page will have been silent too long (`HEARTBEAT_STALE`)."""
+        w = self.w
+        d = w._repeater.next_deadline()
+        if w._page_steps.held:
+            soon = w._pump.clock() + HEARTBEAT_STALE
+            d = soon if d is None else min(d, soon)
+        return d
+
     def step(self, action: Action, inverted: bool) -> bool:
-        """One step of ``action``: applied, recorded, counted in the readout, traits synced."""
+        """One step of ``action`` (the kernel's): applied, recorded, counted in the readout, traits synced."""
         changed = self.apply_step(action, inverted)
         if changed:
-            label = action.label(inverted)
-            if label == self.last_label:
-                self.last_count += 1
-            else:
-                self.last_label, self.last_count = label, 1
+            self.w._last.note(action.label(inverted))
             self.after_steps(action)
         return changed
 

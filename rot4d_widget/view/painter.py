@@ -18,6 +18,7 @@ from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source,
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut
+from .pagestate import state_message
 from .volume_layer import volume_message
 
 __all__ = ["ViewKey", "Painter", "READOUT_PERIOD", "checked_slice", "title"]
@@ -141,7 +142,7 @@ class Painter:
         """
         w = self.w
         st, scene = w.state, w.scene
-        held = bool(len(w._repeater))
+        held = bool(w._keys.held)
         coarse = held and self.coarse_ok
         shown, rows = self.shown, self.rows_key
         cast = w.rendering != "surface" and can_sample(w.source)  # ray-cast from the cut on grids
@@ -212,14 +213,29 @@ class Painter:
                 self.labelled = bool(labels)
             self.rows_data = data
             self.shown = self.rows_key = key
+        self.send_state(picture=sent)  # the state and its id; which picture shows it, if one was sent
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered
-        if not len(w._repeater) or now - self.readout_at >= READOUT_PERIOD:
+        if not w._keys.held or now - self.readout_at >= READOUT_PERIOD:
             ro.show(w.readout, self.readout_html())
             self.readout_at, self.readout_stale = now, False
         else:
             self.readout_stale = True
         return sent
+
+    def send_state(self, picture=None) -> None:
+        """The kernel's state and its id to the page (`Companion.kernel_state`), when they changed;
+        ``picture``: the update id of the scene's picture that shows it."""
+        w = self.w
+        w._page_steps.sync_external()  # a change from the kernel since the last step: a new epoch
+        epoch, upto = w._page_steps.state_id
+        msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": state_message(w.state),
+               "picture": picture}
+        old = w.companion.kernel_state
+        if picture is None and old.get("state") == msg["state"] and old.get("epoch") == epoch \
+                and old.get("upto") == msg["upto"]:
+            return  # unchanged: nothing to send (the picture named before still shows it)
+        w.companion.kernel_state = msg
 
     def projection(self, key: ViewKey) -> dict:
         """The projection view's part of the update showing ``key`` (`ProjectionView.message`), as the
@@ -248,7 +264,7 @@ class Painter:
         st, source = w.state, w.source
         # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
         data = self.rows_data if self.rows_data is not None else self.current_slice()
-        label, count = w._keys.last_label, w._keys.last_count
+        label, count = w._last.label, w._last.count
         if label is None:
             last = "\u2014"
         else:

@@ -65,6 +65,7 @@ from .keeping import Keeper
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keypad import KeyPad, close_quietly
 from .keys import KeyPath, help_groups, source_actions
+from .pagesteps import LastStep, PageSteps
 from .painter import READOUT_PERIOD, Painter, checked_slice, title
 from .projection import ProjectionFlag, ProjectionView
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
@@ -245,13 +246,17 @@ class Rot4DWidget(widgets.HBox):
         self._keypad = KeyPad(self)
         self._renderings, self._projection = Renderings(self), ProjectionView(self)
         self._pump = UpdatePump(
-            self._painter.send, tick=self._keys.tick, deadline=repeater.next_deadline, clock=_clock,
+            self._painter.send, tick=self._keys.tick, deadline=self._keys.deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
             name=f"rot4d-ticker-{id(self):x}",
         )
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
         self._keeper = Keeper(self, state, self._pump.clock)
         self._recorder = self._keeper.recorder
+        # the page's keys: its steps by its clock, applied here as it makes them (`pagesteps`)
+        self._last = LastStep()
+        self._page_steps = PageSteps(state, self._recorder, self._last, hold_delay=repeater.hold_delay,
+                                     tick_rate=repeater.tick_rate, clock=self._pump.clock)
 
         # -- widgets ------------------------------------------------------------
         _build_children(self, dict(
@@ -288,7 +293,7 @@ class Rot4DWidget(widgets.HBox):
     @property
     def held_keys(self) -> tuple:
         """The keys (browser ``code``s) held now, in the order pressed."""
-        return self._repeater.held_keys
+        return self._keys.held
 
     hold_delay = property(lambda self: self._repeater.hold_delay, doc="Seconds before a held key repeats.")
     tick_rate = property(lambda self: self._repeater.tick_rate, doc="Repeats per second while a key is held.")
@@ -501,10 +506,12 @@ def _wire(w, keypad) -> None:
     """Connect the parts and send the initial picture (the last step of construction)."""
     w._sync.state_traits()
     w._sync.source_traits()
+    w._keys.send_config()
 
     w.events.on_dom_event(w._handle_event)
     w.companion.on_drawn(w._handle_drawn)
     w.companion.on_focus_lost(w._keys.focus_lost)
+    w.companion.on_clock(w._keys.heartbeat)
     w.companion.on_screenshot(w._shots.answer)
     w.scene.on_view_count(w._keys.view_count)
     w.scene.on_eye_moved(w._painter.eye_moved)
@@ -533,6 +540,7 @@ def _unwire(w) -> None:
     if companion is not None:
         companion.on_drawn(w._handle_drawn, remove=True)
         companion.on_focus_lost(w._keys.focus_lost, remove=True)
+        companion.on_clock(w._keys.heartbeat, remove=True)
         companion.on_screenshot(w._shots.answer, remove=True)
     if scene is not None:
         scene.on_view_count(w._keys.view_count, remove=True)

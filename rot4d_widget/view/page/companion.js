@@ -51,230 +51,15 @@
 // All listeners are removed when the view is removed (and each layer gets its instanced
 // geometry back).
 
-const GUARD_TAG = "rot4d-leave-guard";
+import { GUARD_TAG, defineLeaveGuard, canvasHovered } from "./guards.js";
+import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
+import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
+import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
+import { modelId, dataOf, getModel } from "./models.js";
+import { adoptKernel, attachKeys, turning } from "./turning.js";
+import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 
-// Defined once per page (this module may be evaluated several times).
-function defineLeaveGuard() {
-  if (typeof customElements === "undefined" || customElements.get(GUARD_TAG)) return;
-  customElements.define(
-    GUARD_TAG,
-    class extends HTMLElement {
-      connectedCallback() {
-        this.style.display = "none";
-        this._host = this.parentElement; // the canvas element (ipyevents' source view)
-      }
-      disconnectedCallback() {
-        const host = this._host;
-        // only when the canvas itself left the document (not if just this guard was removed)
-        if (host && !host.isConnected) host.dispatchEvent(new MouseEvent("mouseleave"));
-      }
-    }
-  );
-}
-
-// three.js re-uploads an attribute only when its `version` exceeds the one it uploaded last.
-// pythreejs resets `version` to its model's (small) value when it re-syncs an attribute from the
-// kernel, so counting up from there can stay below what the GPU holds and the upload is
-// skipped: the old, shorter buffer is drawn with the new index count ("glDrawElements:
-// Insufficient buffer size", no surface).  The surface's versions come from one counter that
-// starts far above any pythreejs value and only rises.
-let surfaceVersion = 2 ** 30;
-const nextSurfaceVersion = () => ++surfaceVersion;
-
-// The unit cube's 12 triangles, counter-clockwise seen from outside (a volume box's template).
-const CUBE = [0,0,0,0,1,1,0,1,0,0,0,0,0,0,1,0,1,1,1,0,0,1,1,0,1,1,1,1,0,0,1,1,1,1,0,1,0,0,0,1,0,0,1,0,1,0,0,0,1,0,1,0,0,1,
-  0,1,0,1,1,1,1,1,0,0,1,0,0,1,1,1,1,1,0,0,0,1,1,0,1,0,0,0,0,0,0,1,0,1,1,0,0,0,1,1,0,1,1,1,1,0,0,1,1,1,1,0,1,1];
-
-// A texture of the same class and settings as ``t`` (a THREE.DataTexture), holding a 1 x 1 image.
-function likeTexture(t) {
-  const T = t.constructor;
-  const data = new Uint8Array(4);
-  const c = new T(data, 1, 1, t.format, t.type, t.mapping, t.wrapS, t.wrapT, t.magFilter, t.minFilter);
-  c.generateMipmaps = false;
-  c.flipY = false;
-  c.unpackAlignment = 1;
-  return c;
-}
-
-// 6. Plain geometries drawn in place of the instanced ones, shared by every companion view
-// of one scene (keyed by the layer's three.js instanced geometry).
-const expansions = new WeakMap();
-// 7. The projection's geometries, shared by every companion view of one widget (keyed by the
-// projection's edges mesh, a three.js object).
-const projections = new WeakMap();
-
-// THREE.BufferGeometry without importing three.js: the instanced geometry's parent class.
-function plainGeometryClass(inst) {
-  const parent = inst && Object.getPrototypeOf(inst.constructor.prototype);
-  const C = parent && parent.constructor;
-  return typeof C === "function" && C !== Object && !C.prototype.isInstancedBufferGeometry ? C : null;
-}
-
-// The layer's template (`position`, V vertices) and the row columns its attributes read;
-// null if the geometry is not one this module knows how to expand.
-function layerLayout(inst) {
-  const attrs = inst && inst.attributes;
-  const tmpl = attrs && attrs.position;
-  if (!tmpl || !tmpl.array || tmpl.itemSize !== 3 || !plainGeometryClass(inst)) return null;
-  const columns = [];
-  for (const [name, a] of Object.entries(attrs)) {
-    if (name === "position") continue;
-    if (!a || !a.isInterleavedBufferAttribute || !Number.isInteger(a.offset) || !Number.isInteger(a.itemSize)) return null;
-    columns.push({ name, offset: a.offset, size: a.itemSize });
-  }
-  return columns.length ? { template: tmpl.array, Attribute: tmpl.constructor, columns } : null;
-}
-
-// A plain geometry for `capacity` rows of the layer: the template repeated per row and one
-// attribute per column (Float32, filled by fillExpansion).
-function buildGeometry(inst, layout, capacity) {
-  const Geometry = plainGeometryClass(inst);
-  const geometry = new Geometry();
-  const add = (name, attr) => (geometry.addAttribute ? geometry.addAttribute(name, attr) : geometry.setAttribute(name, attr));
-  const V = layout.template.length / 3;
-  const position = new Float32Array(capacity * V * 3);
-  for (let i = 0; i < capacity; i++) position.set(layout.template, i * V * 3);
-  add("position", new layout.Attribute(position, 3));
-  const columns = layout.columns.map((c) => {
-    const attr = new layout.Attribute(new Float32Array(capacity * V * c.size), c.size);
-    add(c.name, attr);
-    return { ...c, attr };
-  });
-  geometry.setDrawRange(0, 0);
-  return { geometry, columns, capacity, rows: null };
-}
-
-function makeExpansion(inst, layout, capacity) {
-  const V = layout.template.length / 3;
-  return { inst, layout, V, version: null, count: -1, users: 0, ...buildGeometry(inst, layout, capacity) };
-}
-
-// Copy rows [0, count) of the interleaved `rows` (stride floats per row) into the expansion.
-function fillExpansion(e, rows, stride, count) {
-  const n = Math.max(0, Math.min(count, e.capacity, Math.floor(rows.length / stride)));
-  const V = e.V;
-  for (const c of e.columns) {
-    const dst = c.attr.array;
-    const size = c.size;
-    for (let i = 0; i < n; i++) {
-      const src = i * stride + c.offset;
-      for (let k = 0, o = i * V * size; k < V; k++, o += size) {
-        for (let j = 0; j < size; j++) dst[o + j] = rows[src + j];
-      }
-    }
-    if (n > 0) c.attr.needsUpdate = true;
-  }
-  e.geometry.setDrawRange(0, n * V);
-  return n;
-}
-
-// 7. The projection (rot4d_widget/view/projection.py): the skeleton as the kernel sends it once
-// per source (`skeleton_message`), decoded; null if there is none or it is malformed.
-const bytesAs = (dv, T) =>
-  dv && dv.byteLength !== undefined ? new T(dv.buffer.slice(dv.byteOffset, dv.byteOffset + dv.byteLength)) : new T(0);
-
-export function decodeSkeleton(sk) {
-  const V = sk && Number.isInteger(sk.n_vertices) ? sk.n_vertices : 0;
-  const E = sk && Number.isInteger(sk.n_edges) ? sk.n_edges : 0;
-  if (!V) return null;
-  const vertices = bytesAs(sk.vertices, Float64Array);
-  const edges = bytesAs(sk.edges, Uint32Array);
-  if (vertices.length !== 4 * V || edges.length !== 2 * E || edges.some((i) => i >= V)) return null;
-  const rgb = (x) => (Array.isArray(x) && x.length === 3 ? x.map(Number) : [0.5, 0.5, 0.5]);
-  return { V, E, vertices, edges, d: Number(sk.distance), size: Number(sk.size), scale: Number(sk.scale),
-           below: rgb(sk.below), on: rgb(sk.on), above: rgb(sk.above) };
-}
-
-// What the projection draws for the state `st` (`state_message`: matrix row by row, offsets,
-// middle), exactly as projection.projection_arrays computes it: the vertices rotated
-// (v @ matrix.T) and seen from (0, 0, 0, d), xyz * d / (d - w) * scale; their colours on the
-// diverging map of w about the middle hyperplane; the edges' crossings of every hyperplane,
-// offset by offset then edge by edge (an edge whose ends straddle or touch it: a + t (b - a);
-// edges lying in a hyperplane: their first ends, then their second ends), projected alike.
-// Float32 arrays: positions (3V), rgb (3V), points (3m); index (2E) is the skeleton's own.
-export function projectSkeleton(s, st) {
-  const m = st && st.matrix;
-  const offsets = st && Array.isArray(st.offsets) ? st.offsets.map(Number) : [];
-  if (!s || !Array.isArray(m) || m.length !== 16) return null;
-  const { V, vertices: v, edges: e, d, size, scale } = s;
-  const r = new Float64Array(4 * V);
-  let wmax = 0;
-  for (let i = 0; i < V; i++) {
-    const x = v[4 * i], y = v[4 * i + 1], z = v[4 * i + 2], w = v[4 * i + 3];
-    for (let a = 0; a < 4; a++) r[4 * i + a] = m[4 * a] * x + m[4 * a + 1] * y + m[4 * a + 2] * z + m[4 * a + 3] * w;
-    wmax = Math.max(wmax, Math.abs(r[4 * i + 3]));
-  }
-  const positions = new Float32Array(3 * V);
-  const rgb = new Float32Array(3 * V);
-  const middle = Number(st.middle);
-  for (let i = 0; i < V; i++) {
-    const w = r[4 * i + 3];
-    const f = d / (d - w);
-    const t = Math.min(1, Math.max(-1, (w - middle) / size));
-    for (let j = 0; j < 3; j++) {
-      positions[3 * i + j] = r[4 * i + j] * f * scale;
-      rgb[3 * i + j] = s.on[j] + Math.max(t, 0) * (s.above[j] - s.on[j]) + Math.min(t, 0) * (s.on[j] - s.below[j]);
-    }
-  }
-  const tol = 1e-12 * Math.max(1, wmax);
-  const pts = [];
-  const put = (x, y, z, w) => {
-    const f = d / (d - w);
-    pts.push(x * f * scale, y * f * scale, z * f * scale);
-  };
-  const flat = [];
-  for (const o of offsets) {
-    for (let j = 0; j < e.length; j += 2) {
-      const a = 4 * e[j], b = 4 * e[j + 1];
-      const wa = r[a + 3], wb = r[b + 3];
-      const lo = Math.min(wa, wb), hi = Math.max(wa, wb);
-      if (hi - lo <= tol) {
-        if (Math.abs(lo - o) <= tol) flat.push(a, b);
-        continue;
-      }
-      if (lo <= o + tol && hi >= o - tol) {
-        const t = Math.min(1, Math.max(0, (o - wa) / (wb - wa)));
-        put(r[a] + t * (r[b] - r[a]), r[a + 1] + t * (r[b + 1] - r[a + 1]), r[a + 2] + t * (r[b + 2] - r[a + 2]), o);
-      }
-    }
-  }
-  for (let k = 0; k < 2; k++) {
-    for (let i = k; i < flat.length; i += 2) put(r[flat[i]], r[flat[i] + 1], r[flat[i] + 2], r[flat[i] + 3]);
-  }
-  return { positions, rgb, index: e, points: new Float32Array(pts) };
-}
-
-function modelId(ref) {
-  return typeof ref === "string" && ref.startsWith("IPY_MODEL_") ? ref.slice(10) : ref;
-}
-
-function canvasHovered(cls) {
-  if (!cls) return false;
-  try {
-    return document.querySelector("." + CSS.escape(cls) + ":hover") !== null;
-  } catch (e) {
-    return false;
-  }
-}
-
-// The typed array three.js gets for a data-union value (an ndarray's `.data`).
-function dataOf(value) {
-  return value && value.data !== undefined ? value.data : value;
-}
-
-// widget_manager.get_model rejects while a model is not registered yet (e.g.
-// while a reloaded page restores widgets from the kernel): retry, 50 ms first,
-// then up to 1 s apart, for about a minute, while this view lives.
-async function getModel(manager, id, isAlive) {
-  for (let i = 0, wait = 50; ; i++, wait = Math.min(2 * wait, 1000)) {
-    try {
-      return await manager.get_model(id);
-    } catch (e) {
-      if (i >= 65 || !isAlive()) throw e;
-      await new Promise((resolve) => setTimeout(resolve, wait));
-    }
-  }
-}
+export { decodeSkeleton, projectSkeleton };
 
 async function render({ model, el }) {
   el.style.display = "none";
@@ -322,11 +107,62 @@ async function render({ model, el }) {
     cleanups.push(() => clearTimeout(t));
   }
 
-  // 2. focus loss
-  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur" }));
+  // 2. focus loss (with the page's time: held keys are released then on both sides)
+  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur", t: performance.now() }));
   listen(document, "visibilitychange", () => {
-    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden" });
+    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden", t: performance.now() });
   });
+
+  // 8. the page turns: its own copy of the state, stepped by the keys over this widget's canvases
+  // (turning.js); the kernel's state adopted as it arrives
+  const canvasClasses = () => [model.get("canvas_class"), model.get("projection_class")].filter((c) => c);
+  const canvases = () => {
+    const out = [];
+    for (const cls of canvasClasses()) {
+      for (const host of document.getElementsByClassName(cls)) out.push(host);
+    }
+    return out;
+  };
+  turning(model);
+  attachKeys(model, { listen, hovered: () => canvasClasses().some(canvasHovered), canvases });
+  const onKernelState = () => adoptKernel(model);
+  const onConfig = () => turning(model);
+  if (typeof model.on === "function") {
+    model.on("change:kernel_state", onKernelState);
+    model.on("change:config", onConfig);
+    cleanups.push(() => {
+      model.off("change:kernel_state", onKernelState);
+      model.off("change:config", onConfig);
+    });
+  }
+  // 9. one-time transfers (transfer.js): asked for when offered and not held, put together here
+  const onPageData = () => askForTransfers(model);
+  const onTransfer = (msg, buffers) => receiveChunk(model, msg, buffers && buffers[0]);
+  if (typeof model.on === "function") {
+    model.on("change:page_data", onPageData);
+    model.on("msg:custom", onTransfer);
+    cleanups.push(() => {
+      model.off("change:page_data", onPageData);
+      model.off("msg:custom", onTransfer);
+    });
+  }
+  onPageData();
+  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
+  const pageHook = () => {
+    const p = turning(model).prediction;
+    if (!p || !p.state) return null;
+    const k = p.kernel || {};
+    return { matrix: Array.from(p.state.matrix), theta0: p.state.theta0, alpha: p.state.alpha, c0: p.state.c0,
+             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held };
+  };
+  const hookPage = () => {
+    for (const host of canvases()) host.rot4dPage = pageHook;
+  };
+  listen(document, "mouseover", hookPage, true);
+  for (const ms of [0, 100, 500, 2000]) {
+    const t = setTimeout(hookPage, ms);
+    cleanups.push(() => clearTimeout(t));
+  }
 
   const cleanup = () => {
     alive = false;

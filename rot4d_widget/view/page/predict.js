@@ -1,0 +1,86 @@
+// The page's prediction: the kernel's latest state (adopted whole, with its id) and the page's
+// own steps after it.  The kernel's state for id (epoch, upto) holds every page step due at or
+// before page time `upto`; the page applies its steps after `upto` on top -- client-side
+// prediction with server reconciliation.  Steps already applied are kept while they are still
+// what the keys make; otherwise the state is rebuilt from the kernel's (a late keyup).
+
+import { KeyLog } from "./keys.js";
+import { PageKeymap } from "./keymap.js";
+import { PageState } from "./state.js";
+
+export class Prediction {
+  // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null
+  constructor(config, kernel) {
+    this.config = config;
+    this.keymap = new PageKeymap(config.keymap, config.shift_kinds);
+    this.predicted = new Set(config.predicted_kinds || []);
+    this.repeating = new Set(config.repeating_kinds || []);
+    this.log = new KeyLog(config.hold_delay, config.tick_rate);
+    this.kernel = null;
+    this.state = null;
+    this.applied = [];
+    this.lastLabel = null;
+    if (kernel) this.adopt(kernel);
+  }
+
+  // The kernel's state for its id: the page's steps up to `upto` are in it.
+  adopt(kernel) {
+    if (!kernel || !kernel.state) return;
+    this.kernel = kernel;
+    this.log.checkpoint(kernel.upto === null ? -Infinity : kernel.upto);
+    this.base = new PageState(kernel.state, this.config.bounds);
+    this.state = this.base.copy();
+    this.applied = [];
+  }
+
+  // A key event the page steps itself: {action, inverted, kid} or null (not ours: the kernel's).
+  ours(event, kid) {
+    const found = this.keymap.lookup(event);
+    if (!found || !kid || !this.predicted.has(found.action.kind)) return null;
+    return { ...found, kid };
+  }
+
+  press(kid, action, inverted, t) {
+    return this.log.press(kid, action, inverted, t, this.repeating.has(action.kind));
+  }
+
+  release(kid, t) {
+    return this.log.release(kid, t);
+  }
+
+  releaseAll(t) {
+    return this.log.releaseAll(t);
+  }
+
+  get held() {
+    return this.log.held;
+  }
+
+  // Apply the steps due by page time `now`; true if the predicted state changed.
+  advance(now) {
+    if (!this.base) return false;
+    const steps = this.log.steps(now);
+    const done = this.applied;
+    let same = done.length <= steps.length;
+    for (let i = 0; same && i < done.length; i++) {
+      same = done[i].t === steps[i].t && done[i].order === steps[i].order;
+    }
+    let todo = steps.slice(done.length);
+    if (!same) {
+      this.state = this.base.copy();
+      this.applied = [];
+      todo = steps;
+    }
+    let changed = !same;
+    for (const s of todo) {
+      changed = this.state.apply(s.action, s.inverted) || changed;
+      this.applied.push(s);
+    }
+    return changed;
+  }
+
+  // Steps the page has made that the kernel's state does not hold yet.
+  get pending() {
+    return this.applied.length;
+  }
+}

@@ -1,0 +1,108 @@
+// The page turns (issue 34): the page steps its own copy of the state as keys are pressed and
+// held over the view, by the same key table, bounds and schedule as the kernel, tells the kernel
+// how far its clock has gone (a heartbeat with each frame that makes a step: the kernel applies
+// exactly the page's steps as far as it has heard), and adopts the kernel's state and id as they
+// arrive, its own later steps on top.  One prediction per widget, shared by all its views.
+//
+// The page steps only when ipyevents would forward the event: the pointer over the view (or the
+// projection's canvas), not the browser's auto-repeat, not a modifier alone, no Ctrl/Alt/Meta;
+// keys release on keyup, when the pointer leaves and when the page loses focus.
+
+import { keyId } from "./keymap.js";
+import { Prediction } from "./predict.js";
+
+const MODIFIERS = new Set(["Shift", "Control", "Alt", "Meta", "CapsLock", "AltGraph", "OS", "Fn"]);
+
+// model -> {prediction, views, frame, listeners}: one per widget (its companion model)
+const shared = new WeakMap();
+
+// The widget's prediction (made on first use, remade when the key table changes), and a way to
+// be told when the predicted state changes: `subscribe(f)` -> unsubscribe.
+export function turning(model) {
+  let s = shared.get(model);
+  if (!s) {
+    s = { model, prediction: null, configSeen: null, listeners: new Set(), frame: null, lastBeat: -Infinity };
+    shared.set(model, s);
+  }
+  const config = model.get("config");
+  if (config && config.keymap && s.configSeen !== config) {
+    s.configSeen = config;
+    s.prediction = new Prediction(config, model.get("kernel_state"));
+  }
+  return s;
+}
+
+function changed(s) {
+  for (const f of [...s.listeners]) {
+    try {
+      f(s.prediction);
+    } catch (e) {
+      console.warn("rot4d_widget companion: a prediction listener failed", e);
+    }
+  }
+}
+
+// Step to `now`, tell the kernel, wake again while a key is held.
+function frame(s, now) {
+  s.frame = null;
+  const p = s.prediction;
+  if (!p) return;
+  const moved = p.advance(now);
+  if (p.held.length && now - s.lastBeat >= 1) {
+    s.lastBeat = now;
+    s.model.send({ event: "clock", t: now });
+  }
+  if (moved) changed(s);
+  if (p.held.length) schedule(s);
+}
+
+function schedule(s) {
+  if (s.frame === null && typeof requestAnimationFrame === "function") {
+    s.frame = requestAnimationFrame(() => frame(s, performance.now()));
+  }
+}
+
+// The key listeners of one view (capture phase on `window`, like the shortcut guard); `hovered()`
+// says whether the pointer is over a canvas of this widget.  Returns the cleanup.
+export function attachKeys(model, { listen, hovered, canvases }) {
+  const onDown = (event) => {
+    const s = turning(model);
+    const p = s.prediction;
+    if (!p || event.repeat || MODIFIERS.has(event.key) || !hovered()) return;
+    const mine = p.ours(event, keyId(event));
+    if (!mine || !p.press(mine.kid, mine.action, mine.inverted, event.timeStamp)) return;
+    frame(s, event.timeStamp);
+    schedule(s);
+  };
+  const onUp = (event) => {
+    const s = turning(model);
+    const p = s.prediction;
+    if (!p || !p.release(keyId(event), event.timeStamp)) return;
+    frame(s, event.timeStamp);
+  };
+  const releaseAll = (t) => {
+    const s = turning(model);
+    if (s.prediction && s.prediction.releaseAll(t).length) frame(s, t);
+  };
+  listen(window, "keydown", onDown, true);
+  listen(window, "keyup", onUp, true);
+  listen(window, "blur", () => releaseAll(performance.now()));
+  listen(document, "visibilitychange", () => {
+    if (document.visibilityState === "hidden") releaseAll(performance.now());
+  });
+  // ipyevents forwards the canvas's mouseleave (its timeStamp) and the kernel releases then
+  listen(document, "mouseout", (event) => {
+    for (const c of canvases()) {
+      if (event.target === c && !(event.relatedTarget && c.contains(event.relatedTarget))) releaseAll(event.timeStamp);
+    }
+  }, true);
+}
+
+// The kernel's state arrived (`kernel_state`): adopted, the page's later steps on top.
+export function adoptKernel(model) {
+  const s = turning(model);
+  if (!s.prediction) return;
+  s.prediction.adopt(model.get("kernel_state"));
+  s.prediction.advance(performance.now());
+  changed(s);
+}

@@ -1,0 +1,95 @@
+"""The page steps its own copy of the state and the kernel ends where the page is (issue 34),
+in JupyterLab 4 and Notebook 7.
+
+Keys held over the view step the page's copy at once (its test hook on the canvas element,
+``rot4dPage()``); the kernel applies exactly those steps, in the page's order, by the page's
+timestamps and heartbeats.  Two keys held together -- on a kernel made slow on purpose (a
+source whose slice sleeps, and a heartbeat handler held up) -- end equal on both sides, and the
+page's state does not jump at the release: the state the page shows after every key is up is
+the one it showed on the last frame before (it adopts the kernel's, which is the same).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from jupyter_page import JupyterPage, write_notebook
+from test_widget_browser import _canvas, _hover
+
+pytestmark = pytest.mark.browser
+
+CELLS = [
+    '''\
+import time
+import numpy as np
+from rot4d_widget import Rot4DWidget, polytope
+
+
+class Slow:
+    """The 24-cell, sliced slowly (a loaded kernel): every picture takes 0.4 s."""
+
+    def __init__(self):
+        from rot4d_widget.sources.protocol import PolytopeSource
+        self._inner = PolytopeSource(polytope("24-cell"))
+        self.size, self.n_groups, self.name = self._inner.size, self._inner.n_groups, "slow 24-cell"
+
+    def slice(self, matrix, c0):
+        time.sleep(0.4)
+        return self._inner.slice(matrix, c0)
+
+    def describe(self):
+        return {"kind": "slow"}
+
+
+w = Rot4DWidget("24-cell", width=360, height=300)
+w''',
+    "s = Rot4DWidget(Slow(), width=360, height=300)\ns",
+]
+
+
+def _page(jp, sel):
+    return jp.page.evaluate(f"() => document.querySelector({sel.rsplit(' canvas', 1)[0]!r}).rot4dPage()")
+
+
+def _kernel(jp, var):
+    return jp.kernel_json(f"dict(m={var}.state.matrix.reshape(-1).tolist(), theta0={var}.state.theta0, "
+                          f"alpha={var}.state.alpha, c0={var}.state.c0, sid=list({var}._page_steps.state_id), "
+                          f"held=list({var}.held_keys))")
+
+
+def _settled(jp, var, sel):
+    k = _kernel(jp, var)
+    p = _page(jp, sel)
+    return not k["held"] and p and not p["held"] and p["pending"] == 0 and p["upto"] == k["sid"][1]
+
+
+@pytest.mark.parametrize("var", ["w", "s"])
+def test_two_keys_held_together_end_equal_on_page_and_kernel_with_no_jump(jupyter_server, page, var):
+    write_notebook(jupyter_server.root / "page_turns.ipynb", CELLS)
+    jp = JupyterPage(page, jupyter_server, "page_turns.ipynb").open()
+    jp.run_all()
+    sel = _canvas(jp, var)
+    jp.page.locator(sel).scroll_into_view_if_needed()
+    _hover(jp, sel)
+    start = _page(jp, sel)
+    assert start is not None, "the page has no copy of the state"
+    jp.page.keyboard.down("4")
+    time.sleep(0.6)
+    moved = _page(jp, sel)
+    assert moved["matrix"] != start["matrix"]  # the page stepped at once, whatever the kernel does
+    jp.page.keyboard.down("c")
+    time.sleep(0.5)
+    jp.page.keyboard.up("4")
+    time.sleep(0.3)
+    jp.page.keyboard.up("c")
+    before = _page(jp, sel)  # the page's state right after the release (its steps all made)
+    assert jp.wait_for(lambda: _settled(jp, var, sel), timeout=60), (_page(jp, sel), _kernel(jp, var))
+    after, kernel = _page(jp, sel), _kernel(jp, var)
+    np.testing.assert_allclose(after["matrix"], kernel["m"], rtol=0, atol=1e-12)
+    assert (after["theta0"], after["alpha"], after["c0"]) == (kernel["theta0"], kernel["alpha"], kernel["c0"])
+    np.testing.assert_allclose(before["matrix"], after["matrix"], rtol=0, atol=1e-12)  # no jump at release
+    steps = jp.kernel(f"print(sum(1 for e in {var}.recording.events if getattr(e, 'key', 0) is None))")
+    assert int(steps.strip()) > 10  # both keys repeated
