@@ -116,7 +116,7 @@ def test_a_keyup_stamped_before_steps_heard_of_rebuilds_them(make, clock):
 
 def test_the_state_id_names_the_page_time_and_a_change_from_the_kernel_starts_an_epoch(make, clock):
     w = make("24-cell")
-    steps = w._page_steps
+    steps = w._keys.page
     down(w, "4", t=1.0)
     heartbeat(w, 1100.0)
     assert steps.state_id == (0, 1100.0)

@@ -120,6 +120,24 @@ def test_a_slow_page_gets_fewer_in_flight_but_never_fewer_than_two():
     assert one.acknowledge(1, draw_time=1.0) is False and one.limit == 1  # a bound of one stays one
 
 
+@pytest.mark.parametrize("rtt, want", [(0.0, 3), (0.05, 3), (0.12, 4), (0.3, 9), (2.0, 12)])
+def test_a_page_far_away_gets_a_round_trip_of_updates_in_flight(rtt, want):
+    """Issue 34: for a source the page cannot cut, a kernel 120 ms away keeps the page drawing every
+    tick with ceil(0.12 x 30) = 4 in flight (three waited a round trip per three ticks); capped."""
+    t = [0.0]
+    page = Page()
+    pump = make_pump(page, lambda: t[0], ack_timeout=5.0, max_in_flight=3, tick_rate=30.0)
+    for _ in range(8):  # each update acknowledged a round trip (plus the page's 10 ms) after it left
+        page.changes += 1
+        pump.mark_dirty()
+        pump.flush()
+        t[0] += rtt + 0.01
+        pump.acknowledge(page.sent[-1][0], draw_time=0.01)
+    assert pump.round_trip == pytest.approx(rtt, abs=1e-9)
+    assert pump.limit == want
+    assert make_pump(Page(), lambda: 0.0, max_in_flight=3).limit == 3  # no tick rate: the fixed bound
+
+
 def test_without_an_ack_the_oldest_is_given_up_after_the_timeout():
     t = [0.0]
     page = Page()

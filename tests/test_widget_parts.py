@@ -178,7 +178,7 @@ def test_the_key_path_steps_records_and_settles(make):
     w = make("5-cell")
     keys = w._keys
     keys.handle_event({"type": "keydown", "key": "4", "code": "Digit4", "timeStamp": 1000.0})
-    assert keys.last_label is not None and keys.last_count == 1 and w.held_keys == ("Digit4",)
+    assert keys.last.label is not None and keys.last.count == 1 and w.held_keys == ("Digit4",)
     keys.handle_event({"type": "keyup", "key": "4", "code": "Digit4", "timeStamp": 1010.0})
     assert w.held_keys == () and w._painter.settled
     assert len(w.recording.events) == 1

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
 from . import markup
 from .pagestate import page_config
-from .pagesteps import HEARTBEAT_STALE, PREDICTED_KINDS
+from .pagesteps import HEARTBEAT_STALE, PREDICTED_KINDS, LastStep, PageSteps
 
 __all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
 
@@ -31,12 +31,19 @@ class KeyPath:
     def __init__(self, widget):
         self.w = widget
         self.was_displayed = False  # a view of the canvas was counted once
+        self.last = LastStep()  # the readout's "last" row
+        self.page = None  # the page's keys (`PageSteps`), once the recorder and clock exist
+
+    def use_page_steps(self, recorder, clock) -> None:
+        """Take the page's keys by their timestamps from now on (`PageSteps`)."""
+        rep = self.w._repeater
+        self.page = PageSteps(self.w.state, recorder, self.last, hold_delay=rep.hold_delay,
+                              tick_rate=rep.tick_rate, clock=clock)
 
     @property
     def held(self) -> tuple:
         """Every key held now: the page's (`PageSteps`) and the kernel's (the repeater)."""
-        w = self.w
-        return w._page_steps.held + w._repeater.held_keys
+        return self.page.held + self.w._repeater.held_keys
 
     # -- events ----------------------------------------------------------------------------
     def handle_event(self, event) -> None:
@@ -69,7 +76,7 @@ class KeyPath:
             return
         action, inverted = found
         with w._pump.lock:
-            if w._closed or w._repeater.held(kid) is not None or w._page_steps.held_key(kid) is not None:
+            if w._closed or w._repeater.held(kid) is not None or self.page.held_key(kid) is not None:
                 # a keydown of a key held (no keyup between: a browser or an OS that repeats
                 # without the repeat flag) is a repeat, not a new press
                 return
@@ -85,7 +92,7 @@ class KeyPath:
             w.help_visible = not w.help_visible
             return
         if action.kind in PREDICTED_KINDS and when is not None:  # the page's schedule
-            w._page_steps.press(kid, action, inverted, 1000.0 * when, action.kind in REPEATING_KINDS)
+            self.page.press(kid, action, inverted, 1000.0 * when, action.kind in REPEATING_KINDS)
             self.advance()
             w._pump.flush()
             return
@@ -101,7 +108,7 @@ class KeyPath:
         its steps corrected to what the page says the hold was; at rest, settle."""
         w = self.w
         with w._pump.lock:
-            if w._page_steps.release(kid, None if when is None else 1000.0 * when):
+            if self.page.release(kid, None if when is None else 1000.0 * when):
                 self.advance()
             held = w._repeater.held(kid)
             correction = w._repeater.release(kid, when)
@@ -113,7 +120,7 @@ class KeyPath:
         """Every held key up (mouseleave, focus lost, no view left)."""
         w = self.w
         with w._pump.lock:
-            if w._page_steps.release_all(None if when is None else 1000.0 * when):
+            if self.page.release_all(None if when is None else 1000.0 * when):
                 self.advance()
             for action, inverted, correction in w._repeater.release_all(when):
                 self.correct(action, inverted, correction)
@@ -129,7 +136,7 @@ class KeyPath:
             with w._pump.lock:
                 if w._closed:
                     return
-                w._page_steps.heartbeat(float(t_ms))
+                self.page.heartbeat(float(t_ms))
                 self.advance()
                 w._pump.flush()
         except Exception as exc:
@@ -139,7 +146,7 @@ class KeyPath:
         """The page's steps heard of and not applied yet (lock held): applied, recorded, the picture
         dirty and the traits synced once."""
         w = self.w
-        if w._page_steps.advance().changed:
+        if self.page.advance().changed:
             w._pump.mark_dirty()
             w._sync.state_traits()
 
@@ -164,7 +171,7 @@ class KeyPath:
             opposite = _opposite(action, inverted)
             undone = sum(self.apply_step(*opposite) for _ in range(-correction))
             if undone:
-                last = w._last
+                last = self.last
                 if last.label == action.label(inverted):
                     last.count = max(last.count - undone, 1)
                 self.after_steps(action)
@@ -228,8 +235,8 @@ class KeyPath:
         w = self.w
         rep = w._repeater
         clock = w._pump.clock
-        if w._page_steps.held:  # the page silent for a while: its steps by the kernel's estimate
-            w._page_steps.tick()
+        if self.page.held:  # the page silent for a while: its steps by the kernel's estimate
+            self.page.tick()
             self.advance()
         for kid, action, inverted in rep.due_keys(now):
             if self.step(action, inverted):
@@ -245,7 +252,7 @@ class KeyPath:
         when the page will have been silent too long (`HEARTBEAT_STALE`)."""
         w = self.w
         d = w._repeater.next_deadline()
-        if w._page_steps.held:
+        if self.page.held:
             soon = w._pump.clock() + HEARTBEAT_STALE
             d = soon if d is None else min(d, soon)
         return d
@@ -254,7 +261,7 @@ class KeyPath:
         """One step of ``action`` (the kernel's): applied, recorded, counted in the readout, traits synced."""
         changed = self.apply_step(action, inverted)
         if changed:
-            self.w._last.note(action.label(inverted))
+            self.last.note(action.label(inverted))
             self.after_steps(action)
         return changed
 

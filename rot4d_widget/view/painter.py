@@ -227,8 +227,8 @@ class Painter:
         """The kernel's state and its id to the page (`Companion.kernel_state`), when they changed;
         ``picture``: the update id of the scene's picture that shows it."""
         w = self.w
-        w._page_steps.sync_external()  # a change from the kernel since the last step: a new epoch
-        epoch, upto = w._page_steps.state_id
+        w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
+        epoch, upto = w._keys.page.state_id
         msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": state_message(w.state),
                "picture": picture}
         old = w.companion.kernel_state
@@ -264,7 +264,7 @@ class Painter:
         st, source = w.state, w.source
         # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
         data = self.rows_data if self.rows_data is not None else self.current_slice()
-        label, count = w._last.label, w._last.count
+        label, count = w._keys.last.label, w._keys.last.count
         if label is None:
             last = "\u2014"
         else:

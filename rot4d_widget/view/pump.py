@@ -15,6 +15,12 @@ one (the page acknowledges only the newest of several arriving before a frame).
 With several views the first acknowledgement counts; stale and unknown ones
 are ignored.
 
+**A page far away gets more in flight**: with the widget's tick rate, the bound is what leaves in
+one round trip, ``ceil(round_trip * tick_rate)`` (at most `MAX_IN_FLIGHT_CAP`), the round trip being
+the median time from sending to the acknowledgement less the page's own time in it: a kernel
+120 ms away then keeps a page that cannot predict the picture (a field, a user's source) drawing a
+new one every tick instead of waiting a round trip per three.
+
 **A slow page gets fewer in flight** (never fewer than two, which keep it busy while the next
 update travels): the page says with each acknowledgement how long it took from the update's
 arrival to the acknowledgement (``draw_time``), and while the recent median of that times
@@ -71,7 +77,8 @@ import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_ACK_TIMEOUT", "MAX_IN_FLIGHT", "PAGE_BUDGET"]
+__all__ = ["UpdatePump", "PumpStats", "ACK_TIMEOUT", "MAX_ACK_TIMEOUT", "MAX_IN_FLIGHT", "PAGE_BUDGET",
+           "MAX_IN_FLIGHT_CAP"]
 
 ACK_TIMEOUT = 0.5
 #: The adaptive acknowledgement timeout never exceeds this (s).
@@ -82,8 +89,15 @@ MIN_WAIT = 0.001
 MAX_IN_FLIGHT = 3
 #: The page's time for what is in flight, at most (s): a slow page gets fewer updates in flight.
 PAGE_BUDGET = 0.25
+#: However far the page, at most this many updates in flight (a 400 ms round trip at 30 Hz).
+MAX_IN_FLIGHT_CAP = 12
 #: Recent acknowledgement times the adaptive timeout (and the page's times the bound) look at.
 _ACK_WINDOW = 8
+
+
+def _lower_median(values) -> float:
+    times = sorted(values)
+    return times[(len(times) - 1) // 2]
 
 
 def _complete(gen, result):
@@ -134,13 +148,16 @@ class UpdatePump:
     ack_timeout : float
         Seconds to wait for an acknowledgement at least (see the module docs).
     max_in_flight : int >= 1
+        The bound near the page; far from it, ``ceil(round trip x tick_rate)`` (`limit`).
+    tick_rate : float, optional
+        The widget's ticks per second (held keys), for `limit`.
     autotick : bool
         Run the daemon thread when there is something to wait for.
     on_error : callable (exception) -> None
     """
 
     def __init__(self, send, *, tick=None, deadline=None, clock=None, ack_timeout=ACK_TIMEOUT,
-                 max_in_flight=MAX_IN_FLIGHT, autotick=True, on_error=None, name="rot4d-ticker"):
+                 max_in_flight=MAX_IN_FLIGHT, autotick=True, on_error=None, name="rot4d-ticker", tick_rate=None):
         self._send = send
         self._tick = tick
         self._deadline = deadline
@@ -149,6 +166,7 @@ class UpdatePump:
         if isinstance(max_in_flight, bool) or not isinstance(max_in_flight, int) or max_in_flight < 1:
             raise ValueError(f"Expected `max_in_flight` to be an int >= 1, got {max_in_flight!r}")
         self.max_in_flight = max_in_flight
+        self.tick_rate = tick_rate  # Hz: with the round trip, how many updates may be in flight
         self.autotick = bool(autotick)
         self._on_error = on_error
         self._name = name
@@ -175,15 +193,28 @@ class UpdatePump:
         return len(self._flight)
 
     @property
+    def round_trip(self) -> float | None:
+        """The page's recent round trip (s): the median send -> acknowledgement time less the median
+        time the page itself took (arrival -> acknowledgement); None before any is known."""
+        if not self._ack_times or not self._draw_times:
+            return None
+        return max(0.0, _lower_median(self._ack_times) - _lower_median(self._draw_times))
+
+    @property
     def limit(self) -> int:
-        """Updates allowed in flight now: ``max_in_flight``, or as many as the page draws in
-        `PAGE_BUDGET` by its recent median ``draw_time`` (at least two; module docs)."""
+        """Updates allowed in flight now: ``max_in_flight``, or for a page far away as many as leave in
+        one round trip at the tick rate (``ceil(round_trip * tick_rate)``, at most `MAX_IN_FLIGHT_CAP`:
+        a remote kernel keeps the page drawing every tick); fewer for a slow page, as many as it
+        draws in `PAGE_BUDGET` by its recent median ``draw_time`` (at least two; module docs)."""
+        want = self.max_in_flight
+        rtt = self.round_trip
+        if rtt is not None and self.tick_rate and self.max_in_flight > 2:
+            want = max(want, min(MAX_IN_FLIGHT_CAP, math.ceil(rtt * self.tick_rate)))
         if not self._draw_times or self.max_in_flight <= 2:
-            return self.max_in_flight
-        times = sorted(self._draw_times)
-        t = times[(len(times) - 1) // 2]
-        fits = int(PAGE_BUDGET / t) if t > 0 else self.max_in_flight
-        return max(2, min(self.max_in_flight, fits))
+            return want
+        t = _lower_median(self._draw_times)
+        fits = int(PAGE_BUDGET / t) if t > 0 else want
+        return max(2, min(want, fits))
 
     @property
     def timeout(self) -> float:

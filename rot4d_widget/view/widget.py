@@ -65,7 +65,6 @@ from .keeping import Keeper
 from .keyhold import HOLD_DELAY, TICK_RATE, KeyRepeater, positive_seconds
 from .keypad import KeyPad, close_quietly
 from .keys import KeyPath, help_groups, source_actions
-from .pagesteps import LastStep, PageSteps
 from .painter import READOUT_PERIOD, Painter, checked_slice, title
 from .projection import ProjectionFlag, ProjectionView
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
@@ -248,15 +247,12 @@ class Rot4DWidget(widgets.HBox):
         self._pump = UpdatePump(
             self._painter.send, tick=self._keys.tick, deadline=self._keys.deadline, clock=_clock,
             ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
-            name=f"rot4d-ticker-{id(self):x}",
+            name=f"rot4d-ticker-{id(self):x}", tick_rate=repeater.tick_rate,
         )
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
         self._keeper = Keeper(self, state, self._pump.clock)
         self._recorder = self._keeper.recorder
-        # the page's keys: its steps by its clock, applied here as it makes them (`pagesteps`)
-        self._last = LastStep()
-        self._page_steps = PageSteps(state, self._recorder, self._last, hold_delay=repeater.hold_delay,
-                                     tick_rate=repeater.tick_rate, clock=self._pump.clock)
+        self._keys.use_page_steps(self._recorder, self._pump.clock)  # the page's keys (`pagesteps`)
 
         # -- widgets ------------------------------------------------------------
         _build_children(self, dict(

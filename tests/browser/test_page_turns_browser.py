@@ -56,7 +56,7 @@ def _page(jp, sel):
 
 def _kernel(jp, var):
     return jp.kernel_json(f"dict(m={var}.state.matrix.reshape(-1).tolist(), theta0={var}.state.theta0, "
-                          f"alpha={var}.state.alpha, c0={var}.state.c0, sid=list({var}._page_steps.state_id), "
+                          f"alpha={var}.state.alpha, c0={var}.state.c0, sid=list({var}._keys.page.state_id), "
                           f"held=list({var}.held_keys))")
 
 
