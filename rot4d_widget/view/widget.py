@@ -162,8 +162,7 @@ class Rot4DWidget(widgets.HBox):
     stats : counters of the update pump (updates, acks, timeouts)
     readout, help_panel : ipywidgets.HTML
     errors : ipywidgets.Output -- exceptions raised by key handling
-    progress_bar : `rot4d_widget.view.progress.ViewBar` -- above the readout, shown while the source
-        is read in the background (its ``follow``)
+    progress_bar : `rot4d_widget.view.progress.ViewBar` -- shown while the source is read (``follow``)
     """
 
     theta0 = t.Angle(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
@@ -521,8 +520,8 @@ def _wire(w, keypad) -> None:
     # The initial picture is part of the models' state: not "in flight".
     w._pump.send_now(expect_ack=False)
     # A field is read in the background from now on (the whole of it into memory when it fits its
-    # budget, else its coarse copy for held keys), counted on the widget's own bar under the
-    # canvas; its first picture above read only the chunks the cut touches.  Only with the
+    # budget, else its coarse copy for held keys), counted on the widget's own bar above the
+    # readout; its first picture above read only the chunks the cut touches.  Only with the
     # ticker running (a live widget): scripts and tests stay deterministic.
     if w._pump.autotick:
         w.progress_bar.follow(inner_source(w.source))
