@@ -114,6 +114,8 @@ def test_what_fits_is_counted_in_the_type_the_step_uses():
         Field4D(a32, axes="wzyx", memory_budget="1 GB")
     assert Field4D(_values(), axes="wzyx").fits_in_memory  # in memory already
     assert Field4D.from_function(lambda x, y, z, w: x, [(-1, 1)] * 4).prepare() is None
+    small = Field4D(_values(), axes="wzyx")  # in memory and no bigger than a coarse copy: its own
+    assert small.prepare() is None and small.coarse() is small
 
 
 def test_an_array_in_memory_gets_its_coarse_copy_in_the_background_with_the_same_numbers():

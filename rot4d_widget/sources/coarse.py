@@ -95,8 +95,8 @@ class CoarseCopy:
             if self.copy is not None and not load:
                 return None
             f = self._field
-            if f.kind == "function":
-                self.copy = f
+            if f.kind == "function" or (f.kind == "numpy" and max(f.values.shape) <= COARSE_SAMPLES):
+                self.copy = f  # its own coarse copy: nothing to read
                 return None
             total = _count(_reader(f.values, load))
             if load and self.copy is None:  # then the copy, from memory, in blocks
