@@ -26,7 +26,7 @@ The store is opened through a thin wrapper that counts the chunk objects zarr fe
 1. open: time, chunks fetched (0 expected);
 2. first picture: a full-resolution step of the fresh field (no levels given): time, chunks
    fetched of the store's total -- only those the hyperplane touches, never a full read;
-3. background build alone: ``prepare_coarse(progress=False)`` (a daemon thread reading every
+3. background build alone: ``prepare(progress=False)`` (a daemon thread reading every
    chunk once, chunk by chunk) and nothing else until ``coarse_ready``: the build time, and the
    resident set's peak rise over the build's start, against the bound: the coarse copy (its
    float64 accumulator plus the float32 result) plus the chunks of one read batch plus 4 more;
@@ -34,7 +34,7 @@ The store is opened through a thin wrapper that counts the chunk objects zarr fe
    (the coarse copy only, no chunk read);
 5. at rest: a full-resolution step at each of 3 orientations, chunk cache cleared first;
 6. held keys during the build: a fresh field (opened again), its first picture, then
-   ``prepare_coarse`` and held-key steps (``slice(..., coarse=True)``) back to back until the
+   ``prepare`` and held-key steps (``slice(..., coarse=True)``) back to back until the
    copy is ready -- from the full data meanwhile, at the resolution the readout names (quoted in
    the row) -- then ``--steps`` more.
 
@@ -64,6 +64,9 @@ import numpy as np
 PAGE = os.sysconf("SC_PAGE_SIZE")
 MB = 2**20
 LAYOUT = "rot4d field store v2"  # the first line of the COMPLETE marker
+#: The fields' memory budget: 0, the store is never read whole (the big-store path this measures,
+#: whatever --size; a store within the default budget would be read into memory by the background read)
+BUDGET = 0
 
 
 def rss() -> int:
@@ -185,12 +188,12 @@ def open_field(how: str, path: pathlib.Path, n: int):
         import xarray
 
         ds = xarray.open_zarr(st)  # chunks: the store's own (dask); consolidated metadata
-        field = Field4D.from_xarray(ds["f"])
+        field = Field4D.from_xarray(ds["f"], memory_budget=BUDGET)
     else:
         import zarr
 
         z = zarr.open_array(store=st, path="f", mode="r")
-        field = Field4D(z, axes="xyzw", extent=[(-1.0, 1.0)] * 4)  # no levels: the default one from the first cut
+        field = Field4D(z, axes="xyzw", extent=[(-1.0, 1.0)] * 4, memory_budget=BUDGET)  # no levels: from the first cut
     return field, st.counts
 
 
@@ -244,7 +247,7 @@ def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chu
     start = mem.reset()
     fetch.start()
     t0 = time.perf_counter()
-    field.prepare_coarse(progress=False)
+    field.prepare(progress=False)
     t_return = time.perf_counter() - t0
     while not field.coarse_ready:
         if field._coarse_error is not None:
@@ -260,7 +263,7 @@ def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chu
     bound = acc_bytes + copy_bytes + (batch + 4) * chunk_mb * MB
     rise = peak - start
     ok = rise <= bound
-    rows.append((how, f"background build alone: prepare_coarse() returned in {1000 * t_return:.1f} ms; "
+    rows.append((how, f"background build alone: prepare() returned in {1000 * t_return:.1f} ms; "
                       f"coarse copy {tuple(coarse.values.shape)} ready (every chunk once, chunk by chunk)",
                  f"{t_build:.1f} s", peak, rise, fetched_text(f_build, n_chunks)))
     notes.append(f"{how}: build rise {rise / MB:.0f} MB over its start ({start / MB:.0f} MB) vs the bound "
@@ -307,7 +310,7 @@ def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chu
     start = mem.reset()
     fetch.start()
     t0 = time.perf_counter()
-    field.prepare_coarse(progress=False)
+    field.prepare(progress=False)
     m = m0
     during, said = [], set()
     while not field.coarse_ready:

@@ -1,6 +1,6 @@
 """Big stores: a fresh chunked field's first picture reads only the chunks its hyperplane touches
 (the range and default level from them, "first cut"); the coarse copy is built in the background
-(`prepare_coarse`), chunk by chunk, and held keys meanwhile slice at full resolution."""
+(`prepare`), chunk by chunk, and held keys meanwhile slice at full resolution."""
 
 import threading
 
@@ -36,9 +36,10 @@ def _values():
     return (1.0 - r2 - 0.5 * w * w).astype(np.float64)
 
 
-def _field():
+def _field(memory_budget=0):
+    """A store bigger than its memory budget (0: never read whole), unless one is given."""
     arr = Counted(_values(), (CW, CS, CS, CS))
-    return arr, Field4D(arr, axes="wzyx", extent=[(-1.0, 1.0)] * 4)
+    return arr, Field4D(arr, axes="wzyx", extent=[(-1.0, 1.0)] * 4, memory_budget=memory_budget)
 
 
 def _touched_at_rest():
@@ -76,7 +77,7 @@ def test_the_background_build_returns_at_once_and_held_keys_slice_at_full_resolu
     field.slice(np.eye(4), 0.0)
     gate = threading.Event()
     arr.gate = gate  # the build waits here until released
-    field.prepare_coarse(progress=False)
+    field.prepare(progress=False)
     assert not field.coarse_ready
     held = field.slice(np.eye(4), 0.1, coarse=True)  # reads through the gate too: release it first
     gate.set()
@@ -106,7 +107,7 @@ def test_held_keys_during_the_build_do_not_wait_for_it():
 
     arr.__class__ = Slow
     try:
-        field.prepare_coarse(progress=False)
+        field.prepare(progress=False)
         held = field.slice(np.eye(4), 0.05, coarse=True)
         assert not field.coarse_ready
         assert "coarse copy is being built" in dict(held.readout)["resolution"]
@@ -123,3 +124,25 @@ def test_a_dask_field_s_first_picture_reads_the_touched_chunks_only():
                     extent=[(-1.0, 1.0)] * 4)
     field.slice(np.eye(4), 0.0)
     assert arr.reads <= _touched_at_rest() and not field.coarse_ready
+
+
+@pytest.mark.parametrize("how", ["zarr-like", "dask"])
+def test_a_widget_s_first_picture_reads_only_the_chunks_of_its_cut(make, how):
+    """Building the view reads the chunks of its first cut and no others (issue 35: a 2 GB store
+    took 10-16 s to its first picture): its buffers and ball radius come from the cut of the box
+    (the source's outline), and the first cut that sets the default level is the first picture's,
+    read once."""
+    if how == "dask":
+        da = pytest.importorskip("dask.array")
+        arr = Counted(_values(), None)
+        field = Field4D(da.from_array(arr, chunks=(CW, CS, CS, CS), asarray=False), axes="wzyx",
+                        extent=[(-1.0, 1.0)] * 4)
+    else:
+        arr, field = _field()
+    w = make(field)
+    assert arr.reads <= _touched_at_rest(), f"building the view read {arr.reads} chunks"
+    assert not field.coarse_ready and field.data_range_source == "first cut"
+    assert len(w.slice.triangles) > 100
+    before = arr.reads
+    w.press("l")  # a step at rest reads only the new cut's chunks: here, the same ones (cached)
+    assert arr.reads - before <= _touched_at_rest()

@@ -215,6 +215,77 @@ def test_a_zarr_field_from_xarray_says_to_use_field4d_open(data, tmp_path):
         save_state(tmp_path / "view.json", _state(), field)
 
 
+#: The README's xarray route (issue 35): the Dataset as xarray opened it, and the variable's name.
+XARRAY_OPENINGS = {
+    "netcdf scipy lazy": lambda d: xr.open_dataset(d / "run.nc", engine="scipy"),
+    "netcdf xarray's engine": lambda d: xr.open_dataset(d / "run.nc"),  # scipy here: netCDF4 is not a dependency
+    "netcdf chunked": lambda d: xr.open_dataset(d / "run.nc", engine="scipy", chunks={}),
+    "netcdf loaded": lambda d: xr.open_dataset(d / "run.nc", engine="scipy").load(),
+    "zarr open_zarr": lambda d: xr.open_zarr(d / "run.zarr"),
+    "zarr open_zarr lazy": lambda d: xr.open_zarr(d / "run.zarr", chunks=None),
+}
+
+
+@pytest.mark.parametrize("how", list(XARRAY_OPENINGS))
+def test_the_readme_xarray_route_is_reopened_by_a_state_file_alone(data, tmp_path, how):
+    """`Field4D.from_xarray(xarray.open_dataset(path), "T", w="time")` -- any engine, the scipy one
+    xarray picks when netCDF4 is absent included -- or `open_zarr`: saved without a warning and
+    rebuilt from the state file alone, the same field, lazy staying lazy.  Before, a Dataset was
+    refused and `ds["T"]` from these engines kept no path (saving warned, loading gave no source)."""
+    if "zarr" in how and not _has("zarr"):
+        pytest.skip("zarr is not installed")
+    if "chunked" in how or how == "zarr open_zarr":
+        pytest.importorskip("dask")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", category=RuntimeWarning)  # zarr: no consolidated metadata
+        ds = XARRAY_OPENINGS[how](data)
+    field = _tune(Field4D.from_xarray(ds, "T", w="time"))
+    assert field.origin is not None and field.origin["variable"] == "T"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", category=SourceNotRebuildable)
+        save_state(tmp_path / "view.json", _state(), field)
+        state, back, _ = load_state(tmp_path / "view.json")
+    _assert_same_field(back, field)
+    assert type(back.values) is type(field.values)  # lazy stays lazy, chunked chunked, loaded in memory
+    doc = json.loads((tmp_path / "view.json").read_text())
+    assert doc["source"]["rebuild"] is True and os.path.exists(doc["source"]["origin"]["path"])
+    ds.close()
+
+
+def test_the_widget_from_state_alone_reopens_a_field_from_the_readme_xarray_route(data, tmp_path, make):
+    from rot4d_widget import Rot4DWidget
+
+    ds = xr.open_dataset(data / "run.nc", engine="scipy")
+    w = make(Field4D.from_xarray(ds, "T", w="time"), levels=[0.4])
+    w.press("4")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", category=SourceNotRebuildable)
+        w.save_state(tmp_path / "view.json")
+        w2 = Rot4DWidget.from_state(tmp_path / "view.json", _autotick=False)
+    try:
+        np.testing.assert_array_equal(w2.state.matrix, w.state.matrix)
+        np.testing.assert_array_equal(w2.slice.points, w.slice.points)
+    finally:
+        w2.close()
+
+
+def test_what_the_xarray_route_cannot_keep_is_said_when_saving(data, tmp_path):
+    """A DataArray from the scipy engine names no file, and a selection made on the Dataset after
+    opening would reopen as the whole variable: both are saved with a warning that says why and
+    what keeps them (the Dataset and a name; `Field4D.open` with isel= / sel=)."""
+    ds = xr.open_dataset(data / "run.nc", engine="scipy")
+    da_field = Field4D.from_xarray(ds["T"], w="time")
+    with pytest.warns(SourceNotRebuildable, match=r"DataArray does not say which file.*scipy.*"
+                                                  r"Field4D.from_xarray\(ds, 'T', w=...\)"):
+        save_state(tmp_path / "a.json", _state(), da_field)
+    part = Field4D.from_xarray(ds.isel(time=slice(2, 10)), "T", w="time")
+    assert part.origin is None
+    with pytest.warns(SourceNotRebuildable, match=r"a selection of 'T' in .*run.nc.*Field4D.open\(path, 'T', isel="):
+        save_state(tmp_path / "b.json", _state(), part)
+    mem = Field4D.from_xarray(_dataset(), "T", w="time")  # made in memory: no file
+    assert mem.origin is None and "no encoding['source']" in mem.describe()["rebuild"]
+
+
 def test_a_version_1_state_file_still_loads(data, tmp_path):
     """A file as the code before version 2 wrote it (open_field's origin, no inside/caps)."""
     field = Field4D.open(data / "run.nc", "T", w="time", engine="scipy", levels=(0.35,))
@@ -347,7 +418,7 @@ def test_a_level_step_never_overflows_on_data_that_reach_the_float_limits():
 
 def test_the_data_range_of_a_lazy_field_without_metadata_is_the_coarse_copy_s_and_says_so():
     da = _lazy_dataarray(_values(), {})
-    field = Field4D.from_xarray(da, w="time")
+    field = Field4D.from_xarray(da, w="time", memory_budget=0)  # bigger than its budget: never read whole
     rng = field.data_range
     assert READS["n"] > 0 and rng == field.coarse().data_range
     assert field.data_range_source == "coarse copy"
@@ -366,9 +437,11 @@ def test_an_array_in_memory_has_the_range_of_all_its_samples_not_the_coarse_copy
     level = dict(field.slice(M, 0.0).readout)["level"]
     assert level.endswith("of 0 \u2026 0.53"), level
     dask = pytest.importorskip("dask.array")
-    lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")
+    lazy = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx", memory_budget=0)  # never read whole
     assert lazy.data_range == field.coarse().data_range and lazy.data_range_source == "coarse copy"
     assert dict(lazy.slice(M, 0.0).readout)["level"].endswith("(coarse copy)")
+    fits = Field4D(dask.from_array(a, chunks=(8, 6, 6, 6)), axes="wzyx")  # read whole in the coarse copy's pass
+    assert fits.data_range == (0.0, 0.53) and fits.data_range_source == "data" and fits.resident is not None
 
 
 def test_a_plain_zarr_array_s_own_attributes_give_the_range_without_a_read():

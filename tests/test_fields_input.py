@@ -96,10 +96,11 @@ def test_the_readme_xarray_line_works_however_the_file_is_opened(files, how):
     field = Field4D.from_xarray(ds["T"], w="time")
     assert field.axes == "wzyx" and field.shape == (8, 8, 8, NT) and field.units == "K"
     ref = Field4D(tzyx_array(), axes="wzyx", extent=field.extent, w_per_unit=field.w_per_unit)
-    # in memory: the whole array's range; chunked or lazy: the coarse copy's, and said so
-    loaded = how.endswith("load")
-    assert field.data_range_source == ("data" if loaded else "coarse copy")
-    assert field.data_range == pytest.approx(ref.data_range if loaded else ref.coarse().data_range)
+    # in memory, or chunked or lazy and within the memory budget (read whole with the coarse copy,
+    # which the range asks for): the whole array's range
+    assert field.data_range_source == "data" and field.resident is not None
+    assert field.data_range == pytest.approx(ref.data_range)
+    np.testing.assert_array_equal(field.resident, tzyx_array())
     level = 0.25
     rng = np.random.default_rng(3)
     origin, per = field.w_frame
@@ -163,9 +164,16 @@ def test_a_dataset_is_refused_naming_its_variables():
     xr = pytest.importorskip("xarray")
     ds = dataset(xr)
     ds["S"] = ds["T"] * 2
-    for call in (lambda: Field4D.from_xarray(ds, w="time"), lambda: Field4D(ds, axes="wzyx")):
-        with pytest.raises(TypeError, match=r"Dataset with data variables 'T', 'S'; pick one: ds\['T'\]"):
-            call()
+    with pytest.raises(ValueError, match=r"Dataset has data variables 'T', 'S'; name one: "
+                                         r"Field4D.from_xarray\(ds, 'T', w='time'\)"):
+        Field4D.from_xarray(ds, w="time")
+    with pytest.raises(ValueError, match=r"no data variable 'U'; it has 'T', 'S'"):
+        Field4D.from_xarray(ds, "U", w="time")
+    with pytest.raises(TypeError, match=r"Dataset with data variables 'T', 'S'; use Field4D.from_xarray\(ds, 'T'"):
+        Field4D(ds, axes="wzyx")
+    with pytest.raises(TypeError, match=r"`variable` \('T'\) names a data variable of an xarray.Dataset"):
+        Field4D.from_xarray(ds["T"], "T", w="time")
+    assert Field4D.from_xarray(ds, "S", w="time").name == "S"
     with pytest.raises(TypeError, match=r"from_xarray\(da, w='time'\)"):
         Field4D(ds["T"], axes="wzyx")
 
@@ -207,9 +215,14 @@ def test_infinite_samples_in_a_chunked_array_are_counted_with_the_coarse_copy():
 
     a = tzyx_array()
     a[50, 1, 2, 4] = np.inf  # beyond the coarse copy's first 48 nodes
-    field = Field4D(dsa.from_array(a, chunks=(16, 8, 8, 8)), axes="wzyx")
+    field = Field4D(dsa.from_array(a, chunks=(16, 8, 8, 8)), axes="wzyx", memory_budget=0)  # never read whole
     with pytest.warns(NonFiniteWarning, match=r"1 \+inf of 30720 samples\. They are kept"):
         field.slice(np.eye(4), 0.0, coarse=True)
+    # read whole (it fits the default budget): counted in memory, where the first one is said
+    loaded = Field4D(dsa.from_array(a, chunks=(16, 8, 8, 8)), axes="wzyx")
+    with pytest.warns(NonFiniteWarning, match=r"1 \+inf of 30720 samples \(the first at index \(50, 1, 2, 4\)"):
+        loaded.slice(np.eye(4), 0.0, coarse=True)
+    assert loaded.resident is not None and loaded.data_range_source == "data"
 
 
 # ---------------------------------------------------------------- which side is inside; caps

@@ -26,6 +26,7 @@ MAX_CLASS_LINES = 400
 #: package modules that may be imported inside a function: what importing them pulls in
 HEAVY_MODULES = {
     "rot4d_widget.keep.figures": "matplotlib and Pillow (~0.5 s)",
+    "rot4d_widget.keep.drawing": "matplotlib (~0.35 s; keep.volume draws with it, the widget imports keep.volume)",
     "rot4d_widget.sources.fields": "numba and scikit-image (~0.5 s)",
     "rot4d_widget.view.scene": "pythreejs (~0.3 s)",
 }

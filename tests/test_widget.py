@@ -232,7 +232,7 @@ def test_builds_a_displayable_hbox_with_canvas_readout_help(make):
     assert w.state.c0_step == pytest.approx(polytope("5-cell").circumradius / 64)
     canvas, side = w.children
     assert canvas.children == (w.scene.canvas, w.companion)
-    assert side.children == (w.readout, w.help_panel, w.errors)
+    assert side.children == (w.progress_bar.box, w.readout, w.help_panel, w.errors)  # the bar hidden until a read
     assert w.events.source is w.scene.canvas
     assert set(w.events.watched_events) >= {"keydown", "keyup", "mouseleave"}
     assert w.events.prevent_default_action

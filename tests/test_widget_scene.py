@@ -78,7 +78,7 @@ def test_layout_holds_canvas_companion_readout_help_and_errors(make):
     w = make()
     canvas, side = w.children
     assert canvas.children == (w.scene.canvas, w.companion)
-    assert side.children == (w.readout, w.help_panel, w.errors)
+    assert side.children == (w.progress_bar.box, w.readout, w.help_panel, w.errors)  # the bar hidden until a read
     assert w.events.source is w.scene.canvas
     assert w.companion.canvas_class == w.scene.canvas_class
     assert w.scene.canvas_class in w.scene.canvas._dom_classes

@@ -50,7 +50,10 @@ from scipy.ndimage import map_coordinates
 from ..core import look
 from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering
 from ..core.progress import progress as make_progress
-from .drawing import _Z_BASE, CAMERA_DISTANCE
+
+#: How far the live view's camera is from the centre (`rot4d_widget.keep.drawing.CAMERA_DISTANCE`,
+#: the same number: that module imports matplotlib, which the widget's import does not need)
+CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
 __all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
            "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
@@ -409,6 +412,8 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         close()
     if not images:
         return None
+    from .drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
+
     (x0, x1), (y0, y1) = limits
     image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",
                       aspect="auto", zorder=_Z_BASE - 5.0)

@@ -28,20 +28,30 @@ def _array_kind(values) -> str:
 
 
 class _ChunkReader:
-    """Reads chunks of a lazy 4-D array (dask, zarr, anything sliceable) and keeps recent ones."""
+    """Reads chunks of a lazy 4-D array (dask, zarr, anything sliceable) and keeps recent ones.
 
-    def __init__(self, values, cache_bytes: int):
+    The chunks are the array's own (dask's chunks, a zarr array's chunk shape; ``chunked`` True),
+    else blocks of ``block`` samples (default 16 a side).  ``chunk_slices(idx)`` is where chunk
+    ``idx`` lies in the array."""
+
+    def __init__(self, values, cache_bytes: int, block=None):
         self.values = values
         self.kind = _array_kind(values)
         shape = tuple(int(s) for s in values.shape)
         chunks = getattr(values, "chunks", None)
         bounds = None
-        if self.kind == "dask":
+        if block is not None and self.kind == "dask":
+            raise ValueError("A dask array is read by its own chunks, not by blocks")
+        if block is not None:
+            bounds = [np.unique(np.r_[np.arange(0, n, int(c)), n]).astype(np.int64) for n, c in zip(shape, block)]
+        elif self.kind == "dask":
             bounds = [np.concatenate([[0], np.cumsum(c)]).astype(np.int64) for c in chunks]
         elif isinstance(chunks, tuple) and len(chunks) == 4 and all(isinstance(c, (int, np.integer)) for c in chunks):
             bounds = [np.unique(np.r_[np.arange(0, n, int(c)), n]).astype(np.int64) for n, c in zip(shape, chunks)]
         elif isinstance(chunks, tuple) and len(chunks) == 4 and all(isinstance(c, tuple) for c in chunks):
             bounds = [np.concatenate([[0], np.cumsum(c)]).astype(np.int64) for c in chunks]
+        #: the array's own chunk grid is used (not blocks chosen here)
+        self.chunked = bounds is not None and block is None
         if bounds is None:  # no chunk grid known: one chunk per 16 samples along each axis (reads are sub-blocks)
             bounds = [np.unique(np.r_[np.arange(0, n, 16), n]).astype(np.int64) for n in shape]
         self.bounds = bounds
@@ -57,7 +67,7 @@ class _ChunkReader:
         #: [min, max] of the finite values of every chunk read so far (the "first cut" range)
         self.seen = [math.inf, -math.inf]
 
-    def _slices(self, idx):
+    def chunk_slices(self, idx):
         return tuple(slice(int(b[i]), int(b[i + 1])) for b, i in zip(self.bounds, idx))
 
     def read(self, wanted):
@@ -79,7 +89,7 @@ class _ChunkReader:
                     self._delayed = self.values.to_delayed()
                 parts = dask.compute(*[self._delayed[idx] for idx in missing])
             else:
-                parts = [self.values[self._slices(idx)] for idx in missing]
+                parts = [self.values[self.chunk_slices(idx)] for idx in missing]
             with self._lock:
                 self.reads += len(missing)
                 for idx, a in zip(missing, parts):

@@ -1,9 +1,14 @@
-"""The coarse copy of a `Field4D`: in memory, at most `COARSE_SAMPLES` nodes per axis over the
-same box, for held keys and for the data range of a chunked array.
+"""What a `Field4D` keeps in memory: the coarse copy -- at most `COARSE_SAMPLES` nodes per axis
+over the same box, for held keys and for the data range of a chunked array -- and, for a chunked
+or lazy array that fits the field's memory budget (`MEMORY_BUDGET`), the whole array.
 
-`CoarseCopy` builds it once (linear resampling onto evenly spaced fractional indices): now, or on
-a daemon thread (`prepare`), reading a chunked or lazy array chunk by chunk (memory: the copy
-plus a few chunks), counting its +-inf samples on the way.
+`CoarseCopy` builds them once, in one pass over the data: now (`get`), or on a daemon thread
+(`prepare`, counted by a `rot4d_widget.core.progress.Progress`).  The pass reads the array chunk by
+chunk (an array in memory in blocks of 16 samples a side); each chunk's share of the linear
+resampling onto evenly spaced fractional indices is added into the copy (memory: the copy plus a
+few chunks) and, when the array fits the budget, the chunk is copied into the array being loaded;
++-inf samples of a chunked array are counted on the way.  Once loaded, a field's steps run on the
+array in memory (`Field4D.resident`): as fast as data given in memory.
 """
 
 from __future__ import annotations
@@ -18,25 +23,39 @@ from ..core.progress import progress
 from .chunks import CHUNK_BATCH, _ChunkReader
 from .field_checks import _AXES
 
-__all__ = ["COARSE_SAMPLES", "CoarseCopy"]
+__all__ = ["COARSE_SAMPLES", "MEMORY_BUDGET", "CoarseCopy"]
 
 #: Nodes per axis, at most, of the in-memory coarse copy (`Field4D.coarse`).
 COARSE_SAMPLES = 48
 
+#: Bytes a chunked or lazy array may take in memory (float32 kept, other types as float64) to be read
+#: whole by the background read (`Field4D.memory_budget`, settable per field): 1 GiB.  Bigger data keep
+#: the coarse copy and read, for a full step, only the chunks its samples touch.
+MEMORY_BUDGET = 1024**3
+
+#: Samples a side of the blocks an array in memory is resampled in (its coarse copy: the same numbers
+#: as a chunked array's, a third of the time of whole-array resampling at 64^4, and little memory).
+_BLOCK = 16
+
 
 class CoarseCopy:
-    """The coarse copy of ``field`` (`copy` once built; `get` builds it or waits for the build).
+    """The coarse copy of ``field`` (`copy` once built; `get` builds it or waits for the build) and,
+    when the field is chunked or lazy and fits its memory budget, the whole array (`loaded`).
 
-    ``counted((n +inf, n -inf, None))`` receives the +-inf counts of a chunk-by-chunk build;
-    ``progress``: (chunks done, chunks in all) of that build once it started; ``error``: what
-    made the background build fail."""
+    ``counted((n +inf, n -inf, None))`` receives the +-inf counts of a chunk-by-chunk build of a
+    chunked array not loaded (a loaded one, or one in memory, is counted by the field itself);
+    ``progress``: (chunks done, chunks in all) of that build once it started; ``counter``: the
+    `Progress` of the background read (`prepare`); ``error``: what made it fail."""
 
     def __init__(self, field, counted):
         self._field = field
         self._counted = counted
         self.copy = None
+        #: the whole array in memory once the read made it (float32 or float64, read-only), else None
+        self.loaded = None
         self._lock = threading.Lock()
         self._thread = None  # the background build (`prepare`)
+        self.counter = None
         self.error = None
         self.progress = None
 
@@ -45,35 +64,79 @@ class CoarseCopy:
         return self.copy is not None
 
     def get(self):
-        """The copy, built now when nobody started it, else when the background build ends
-        (RuntimeError from its error when it failed)."""
+        """The copy, built now when nobody started it (the array loaded in the same pass when it fits
+        the budget), else when the background build ends (RuntimeError from its error when it
+        failed)."""
         if self.copy is None:
             with self._lock:
                 t = self._thread
                 if self.copy is None and t is None:
-                    self.copy = self._make()
+                    self._run(self._load_wanted(), None)
             if t is not None:
                 t.join()
                 if self.copy is None:
                     raise RuntimeError("Field4D: building the coarse copy failed") from self.error
         return self.copy
 
-    def prepare(self, show_progress: bool = True) -> None:
-        """Start the build on a daemon thread (nothing when built or being built)."""
+    def _load_wanted(self) -> bool:
+        f = self._field
+        return f.kind not in ("numpy", "function") and self.loaded is None and f.fits_in_memory
+
+    def prepare(self, show_progress: bool = True):
+        """Start the background read on a daemon thread: the coarse copy and, when the field fits its
+        budget, the whole array, in one pass.  Returns its `Progress` (the running one when it was
+        started before; created here, in the caller's thread, so that the kernel's bar goes to the
+        caller's cell: ``show_progress``), or None when there is nothing to read."""
         with self._lock:
-            if self.copy is not None or self._thread is not None:
-                return
-            t = threading.Thread(target=self._build, args=(bool(show_progress),), daemon=True,
-                                 name=f"rot4d coarse copy {self._field.name or ''}".strip())
+            t = self._thread
+            if t is not None:
+                return self.counter if t.is_alive() else None
+            load = self._load_wanted()
+            if self.copy is not None and not load:
+                return None
+            f = self._field
+            if f.kind == "function" or (f.kind == "numpy" and max(f.values.shape) <= COARSE_SAMPLES):
+                self.copy = f  # its own coarse copy: nothing to read
+                return None
+            total = _count(_reader(f.values, load))
+            if load and self.copy is None:  # then the copy, from memory, in blocks
+                total += math.prod(-(-int(n) // _BLOCK) for n in f.values.shape)
+            what = (f"reading {f.name or 'the field'} into memory" if load
+                    else f"coarse copy of {f.name or 'the field'}")
+            self.counter = progress(total, what, mode=None if show_progress else "none",
+                                    reserve=bool(show_progress))
+            t = threading.Thread(target=self._build, args=(load, self.counter), daemon=True,
+                                 name=f"rot4d background read {f.name or ''}".strip())
             self._thread = t
         t.start()
+        return self.counter
 
-    def _build(self, show: bool) -> None:
+    def _build(self, load: bool, counter) -> None:
         try:
-            c = self._make(progress_bar=show)
-            self.copy = c
+            self._run(load, counter)
         except BaseException as e:  # noqa: BLE001 - kept for `get` to raise
             self.error = e
+        finally:
+            counter.close()
+
+    def _run(self, load: bool, counter) -> None:
+        """One pass over the data: the coarse copy (unless built) and, with ``load``, the whole array
+        -- read first (large reads), the copy then made from it in memory, block by block (the
+        same numbers; resampling large slabs at once is slower than the read)."""
+        f = self._field
+        if not load:
+            self.copy = self._make(counter)
+            return
+        vals = f.values
+        rd = _reader(vals, True)
+        whole = np.empty(tuple(int(n) for n in vals.shape), dtype=rd.dtype)
+        self._by_chunks(counter, rd, into=whole, coarse=False)
+        whole.flags.writeable = False
+        copy = None if self.copy is not None else self._by_chunks(counter, _reader(whole, False))
+        f.drop_chunk_cache()  # steps read the array in memory from now on
+        self.loaded = whole  # before the copy: once `ready`, steps find the data in memory
+        if copy is not None:
+            self.copy = copy
 
     def building(self) -> bool:
         """True while the background build runs."""
@@ -85,7 +148,7 @@ class CoarseCopy:
         return type(f)(x, axes=f.axes, extent=f.extent, name=f.name, units=f.units,
                        w_per_unit=f.w_per_unit, w_units=f.w_units, _coords=coords, _copy_of=f)
 
-    def _make(self, progress_bar: bool = False):
+    def _make(self, counter=None):
         f = self._field
         if f.kind == "function":
             return f
@@ -93,35 +156,20 @@ class CoarseCopy:
         target = [min(int(n), COARSE_SAMPLES) for n in nshape]
         if f.kind == "numpy" and list(nshape) == target:
             return f
-        if f.kind != "numpy":
-            return self._by_chunks(progress_bar)
-        x = f.values
-        coords = list(f.coords)
-        for a in np.argsort([t / n for t, n in zip(target, nshape)]):  # biggest reduction first
-            n, m = int(nshape[a]), target[a]
-            if m == n:
-                continue
-            u = np.linspace(0.0, n - 1.0, m)
-            i0 = np.minimum(np.floor(u).astype(np.int64), n - 2)
-            t = (u - i0).reshape([-1 if k == a else 1 for k in range(4)])
-            x = np.take(x, i0, axis=a) * (1 - t) + np.take(x, i0 + 1, axis=a) * t
-            di = _AXES.index(f.axes[a])
-            if coords[di] is not None:
-                coords[di] = _sealed(np.interp(u, np.arange(n), coords[di]))
-        x = np.asarray(x, dtype=np.float64 if np.dtype(f.values.dtype) != np.float32 else np.float32)
-        x = np.ascontiguousarray(x)
-        x.flags.writeable = False
-        return self._copy(x, coords)
+        return self._by_chunks(counter, _reader(f.values, False), report=f.kind != "numpy")
 
-    def _by_chunks(self, progress_bar: bool = False):
-        """The coarse copy of a chunked or lazy array, read chunk by chunk: each chunk's share of
-        the linear resampling (the same nodes and weights as for an array in memory) is added into
-        the copy and the chunk dropped; the +-inf counts ride along."""
+    def _by_chunks(self, counter, rd, into=None, coarse: bool = True, report: bool = False):
+        """The coarse copy of the field's array read chunk by chunk through ``rd`` (a `_ChunkReader`
+        without cache): each chunk's share of the linear resampling (evenly spaced fractional
+        indices, axis by axis, the biggest reduction first) is added into the copy and the chunk
+        dropped -- or first copied into ``into`` (the whole array, being loaded).  The +-inf counts
+        ride along, reported with ``report`` (a chunked array not loaded: the only pass over its
+        data; one in memory is counted by the field, where the first one is too).  ``coarse``
+        False: only copy into ``into``; returns None then."""
         f = self._field
         vals = f.values
         nshape = tuple(int(n) for n in vals.shape)
         target = [min(n, COARSE_SAMPLES) for n in nshape]
-        rd = _ChunkReader(vals, 0)  # no cache: every chunk once, then dropped
         nch = tuple(len(b) - 1 for b in rd.bounds)
         plans = []  # per axis, per chunk: (rows, local i0, has i0, local i0+1, has i0+1, 1-t, t), or rows only
         for a, (n, m) in enumerate(zip(nshape, target)):
@@ -150,47 +198,33 @@ class CoarseCopy:
         chunk_bytes = math.prod(int(np.diff(b).max()) for b in rd.bounds) * rd.dtype.itemsize
         batch = max(1, min(CHUNK_BATCH, (64 * 1024**2) // max(1, chunk_bytes)))
         self.progress = (0, total)
-        bar = None
-        if progress_bar:
-            bar = progress(total, f"coarse copy of {f.name or 'the field'} (chunks)")
         done = 0
-        try:
-            ids = list(np.ndindex(*nch))
-            for b0 in range(0, total, batch):
-                part = ids[b0:b0 + batch]
-                got = rd.read(part)
-                for idx in part:
-                    x = got.pop(idx)
+        ids = list(np.ndindex(*nch))
+        for b0 in range(0, total, batch):
+            part = ids[b0:b0 + batch]
+            got = rd.read(part)
+            for idx in part:
+                x = got.pop(idx)
+                if into is not None:
+                    into[rd.chunk_slices(idx)] = x
+                if coarse:
                     if floating:
                         inf = np.isinf(x)
                         if inf.any():
                             p = int(np.count_nonzero(inf & (x > 0)))
                             npos += p
                             nneg += int(np.count_nonzero(inf)) - p
-                    rows = [None] * 4
-                    for a in order:
-                        plan = plans[a][idx[a]]
-                        rows[a] = plan[0]
-                        if len(plan) == 1 or not len(plan[0]):
-                            continue
-                        _, l0, m0, l1, m1, w0, w1 = plan
-                        shp = [-1 if k == a else 1 for k in range(4)]
-                        with np.errstate(invalid="ignore"):
-                            A = np.take(x, l0, axis=a) * w0.reshape(shp)
-                            B = np.take(x, l1, axis=a) * w1.reshape(shp)
-                            x = np.where(m0.reshape(shp), A, 0.0) + np.where(m1.reshape(shp), B, 0.0)
-                    if all(len(r) for r in rows):
-                        out[np.ix_(*rows)] += x
-                    del x
-                    done += 1
-                    self.progress = (done, total)
-                    if bar is not None:
-                        bar.update(1)
-                del got
-        finally:
-            if bar is not None:
-                bar.close()
-        self._counted((npos, nneg, None) if floating else (0, 0, None))
+                    _add_share(out, x, idx, plans, order)
+                del x
+                done += 1
+                self.progress = (done, total)
+            del got
+            if counter is not None:  # once a batch: the count a bar shows is never a batch behind
+                counter.update(len(part))
+        if not coarse:
+            return None
+        if report:
+            self._counted((npos, nneg, None) if floating else (0, 0, None))
         x = out.astype(np.float32) if np.dtype(vals.dtype) == np.float32 else out
         x.flags.writeable = False
         coords = list(f.coords)
@@ -199,3 +233,41 @@ class CoarseCopy:
             if m != n and coords[di] is not None:
                 coords[di] = _sealed(np.interp(np.linspace(0.0, n - 1.0, m), np.arange(n), coords[di]))
         return self._copy(x, coords)
+
+
+def _add_share(out, x, idx, plans, order) -> None:
+    """Add chunk ``idx``'s values ``x`` to the coarse copy ``out``: its share of the linear
+    resampling along each axis (``plans``: per axis, per chunk, the copy's rows it reaches and their
+    local nodes and weights), the axes in ``order``."""
+    rows = [None] * 4
+    for a in order:
+        plan = plans[a][idx[a]]
+        rows[a] = plan[0]
+        if len(plan) == 1 or not len(plan[0]):
+            continue
+        _, l0, m0, l1, m1, w0, w1 = plan
+        shp = [-1 if k == a else 1 for k in range(4)]
+        with np.errstate(invalid="ignore"):
+            A = np.take(x, l0, axis=a) * w0.reshape(shp)
+            B = np.take(x, l1, axis=a) * w1.reshape(shp)
+            x = np.where(m0.reshape(shp), A, 0.0) + np.where(m1.reshape(shp), B, 0.0)
+    if all(len(r) for r in rows):
+        out[np.ix_(*rows)] += x
+
+
+def _count(rd: _ChunkReader) -> int:
+    return math.prod(len(b) - 1 for b in rd.bounds)
+
+
+def _reader(values, load: bool) -> _ChunkReader:
+    """A reader without cache for one pass over ``values``: the array's own chunks; for an array in
+    memory blocks of `_BLOCK` samples a side; for a lazy array without a chunk grid that is being
+    loaded, slabs along its first axis of about 16 MB (fewer, larger reads of the file)."""
+    if isinstance(values, np.ndarray):
+        return _ChunkReader(values, 0, block=(_BLOCK,) * 4)
+    rd = _ChunkReader(values, 0)
+    if load and not rd.chunked:
+        shape = tuple(int(n) for n in values.shape)
+        per = max(1, (16 * 1024**2) // max(1, math.prod(shape[1:]) * rd.dtype.itemsize))
+        rd = _ChunkReader(values, 0, block=(min(per, shape[0]),) + shape[1:])
+    return rd

@@ -85,10 +85,12 @@ def sample_field(field, matrix, c0, resolution: int = 64, *, coarse: bool = Fals
     -------
     `FieldGrid`: values (nx, ny, nz) float32 read-only, NaN outside the data's box (a node on a
     face counts as inside); origin, spacing and extent in slice coordinates; the field's name,
-    units and data range.  The values are `slice_field`'s samples: multilinear interpolation of
-    an array (order 1, no prefilter), a function evaluated exactly at the nodes.
+    units and data range (`Field4D.known_range`: of chunked data, the chunks read so far until the
+    coarse copy is ready).  The values are `slice_field`'s samples: multilinear interpolation of
+    an array (order 1, no prefilter), a function evaluated exactly at the nodes.  Of chunked data,
+    only the chunks the samples touch are read.
     """
-    if not all(hasattr(field, a) for a in ("half_widths", "offset", "coarse", "data_range")):
+    if not all(hasattr(field, a) for a in ("half_widths", "offset", "coarse")):  # plain members: nothing is read
         raise TypeError(f"Expected `field` to be a Field4D, got {type(field).__name__}")
     d = field.offset(c0)
     m = as_rotation_matrix(matrix)
@@ -98,8 +100,8 @@ def sample_field(field, matrix, c0, resolution: int = 64, *, coarse: bool = Fals
     outline = (sealed(np.asarray(box.vertices, dtype=np.float64).reshape(-1, 3).copy()),
                sealed(np.asarray(box.edges, dtype=np.intp).reshape(-1, 2).copy()))
     s = _sample_raw(src, m, d, res, box=box)
-    name, units = getattr(field, "name", None), getattr(field, "units", None)
-    rng = tuple(float(v) for v in field.data_range)
+    name, units = field.name, field.units
+    rng = tuple(float(v) for v in field.known_range)  # never a full read of chunked data for it
     if s is None:
         return FieldGrid(sealed(np.zeros((0, 0, 0), dtype=np.float32)), sealed(np.zeros(3)), 0.0,
                          ((0.0, 0.0),) * 3, name, units, rng, outline)

@@ -4,8 +4,10 @@ files opened, and what a state file keeps of them.
 `_as_array` checks an array and the ``axes`` naming its dims; `_xarray_arguments` maps a
 DataArray's dims and coordinates to a field's arguments (`Field4D.from_xarray`); `_open_dataarray`
 opens a netCDF file or zarr store (`Field4D.open`).  A variable's data range is read from its
-metadata (`_metadata_range`); a reopenable origin from xarray's encoding (`_encoding_origin`);
-selections and chunks are written as JSON (`_selection_json`, `_chunks_json`) and read back.
+metadata (`_metadata_range`); a reopenable origin from xarray's encoding: the Dataset's
+``encoding["source"]``, which xarray sets for every engine (`_dataset_origin`), or a DataArray's own,
+which only the netCDF4 and h5netcdf engines set (`_encoding_origin`); selections and chunks are
+written as JSON (`_selection_json`, `_chunks_json`) and read back.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import warnings
 
 import numpy as np
 
@@ -25,8 +28,27 @@ def _dataset_error(ds) -> TypeError:
     names = [str(k) for k in getattr(ds, "data_vars", {})]
     first = names[0] if names else "name"
     listed = ", ".join(repr(n) for n in names) if names else "none"
-    return TypeError(f"Expected an xarray.DataArray (one variable), got an xarray.Dataset with data variables "
-                     f"{listed}; pick one: ds[{first!r}]")
+    return TypeError(f"Field4D(values) takes a plain array, got an xarray.Dataset with data variables {listed}; "
+                     f"use Field4D.from_xarray(ds, {first!r}, w='time') (the Dataset and a variable's name: "
+                     "a state file can then reopen the file it came from)")
+
+
+def _dataset_variable(ds, variable):
+    """``(variable name, DataArray)`` of the Dataset ``ds`` for `Field4D.from_xarray`: ``variable``, or
+    its one data variable; ValueError naming the data variables otherwise."""
+    names = [str(k) for k in ds.data_vars]
+    listed = ", ".join(repr(n) for n in names) if names else "none"
+    if variable is None:
+        if len(names) != 1:
+            first = names[0] if names else "name"
+            raise ValueError(f"The xarray.Dataset has data variables {listed}; name one: "
+                             f"Field4D.from_xarray(ds, {first!r}, w='time')")
+        variable = names[0]
+    if not isinstance(variable, str):
+        raise TypeError(f"Expected `variable` to be a data variable's name (a string), got {type(variable).__name__}")
+    if variable not in ds.data_vars:
+        raise ValueError(f"The xarray.Dataset has no data variable {variable!r}; it has {listed}")
+    return variable, ds[variable]
 
 
 class _LazyXarray:
@@ -158,6 +180,42 @@ def _encoding_origin(da, chosen):
             "load": bool(da.chunks is None and getattr(da.variable, "_in_memory", False))}
 
 
+def _dataset_origin(ds, variable, da, chosen):
+    """``(origin, why)`` for `Field4D.from_xarray` given a Dataset: what a state file needs to reopen
+    ``variable`` from the file or store xarray opened -- its path from ``ds.encoding["source"]``, set
+    by ``xarray.open_dataset`` / ``open_zarr`` whatever the engine (scipy and zarr included) -- or
+    (None, why not).  The file is opened again (metadata and coordinates only) to tell the whole
+    variable from a selection made after opening (``ds.isel(...)``: its shape or coordinates differ),
+    which a state file would reopen whole: refused, naming `Field4D.open`'s ``isel=`` / ``sel=``."""
+    import xarray  # optional: from_xarray was given a Dataset, so it is installed
+
+    src = (getattr(ds, "encoding", None) or {}).get("source")
+    if not isinstance(src, str) or not os.path.exists(src):
+        return None, ("xarray does not know the file this Dataset came from (no encoding['source']: made in "
+                      "memory, or opened from a file object)")
+    engine = "zarr" if os.path.isdir(src) or src.rstrip("/").endswith(".zarr") else None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", category=RuntimeWarning)  # zarr: no consolidated metadata
+            with xarray.open_dataset(src, engine=engine) as whole:
+                stored = whole[variable] if variable in whole.data_vars else None
+                same = stored is not None and stored.dims == da.dims and stored.shape == da.shape and all(
+                    np.array_equal(np.asarray(stored.coords[d].values), np.asarray(da.coords[d].values))
+                    for d in da.dims if d in da.coords and d in stored.coords)
+    except (OSError, ValueError, KeyError) as exc:
+        return None, f"the file {src!r} cannot be opened again ({type(exc).__name__}: {exc})"
+    if not same:
+        return None, (f"the field is a selection of {variable!r} in {src!r} (made after opening), which a state "
+                      f"file would reopen whole; use Field4D.open(path, {variable!r}, isel=..., sel=...)")
+    if da.chunks is not None:
+        chunks = {str(d): int(c[0]) for d, c in zip(da.dims, da.chunks)}
+    else:
+        chunks = None
+    return ({"kind": "xarray", "path": os.path.abspath(src), "variable": str(variable), "engine": engine,
+             "chunks": chunks, "isel": None, "sel": None, "kwargs": dict(chosen),
+             "load": bool(da.chunks is None and getattr(da.variable, "_in_memory", False))}, None)
+
+
 def _label_json(v, where):
     if isinstance(v, (np.datetime64, np.timedelta64)):
         return str(v)
@@ -279,15 +337,24 @@ def _as_array(values, axes):
     return values, kind, axis_of, shape
 
 
-def _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs):
-    """``(values, arguments, dims, meta_range, origin, long_name)`` for `Field4D.from_xarray`: the
-    DataArray's values (`_xarray_values`), the field's keyword arguments (``kwargs`` given for it
-    are consumed: name, units, w_units, space_units), its dim names, its data range from metadata,
-    the file it came from (`_encoding_origin`) and its ``long_name`` attribute (`_long_name`)."""
-    if _is_xarray(da, "Dataset") or (hasattr(da, "data_vars") and hasattr(da, "dims")):
-        raise _dataset_error(da)
+def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
+    """``(values, arguments, dims, meta_range, (origin, why not), long_name)`` for
+    `Field4D.from_xarray`: the values of the DataArray ``data`` (or of ``variable`` of the Dataset
+    ``data``: `_dataset_variable`) (`_xarray_values`), the field's keyword arguments (``kwargs``
+    given for it are consumed: name, units, w_units, space_units), its dim names, its data range
+    from metadata, the file it came from (`_dataset_origin`, `_encoding_origin`) and its
+    ``long_name`` attribute (`_long_name`)."""
+    ds = None
+    if _is_xarray(data, "Dataset") or (hasattr(data, "data_vars") and hasattr(data, "dims")):
+        ds = data
+        variable, da = _dataset_variable(ds, variable)
+    else:
+        da = data
+        if variable is not None:
+            raise TypeError(f"`variable` ({variable!r}) names a data variable of an xarray.Dataset; "
+                            "a DataArray is one already: Field4D.from_xarray(da, w=...)")
     if not (hasattr(da, "dims") and hasattr(da, "coords") and hasattr(da, "isel")):
-        raise TypeError(f"Expected an xarray.DataArray, got {type(da).__name__}")
+        raise TypeError(f"Expected an xarray.DataArray or Dataset, got {type(da).__name__}")
     dims = tuple(str(d) for d in da.dims)
     if len(dims) != 4:
         raise ValueError(f"Expected a 4-D DataArray, got dims {dims}; select a 4-D part first "
@@ -321,7 +388,13 @@ def _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs):
             f"{', '.join(few)}; dims {dict((d, int(da.sizes[d])) for d in dims)}. A single time step is a "
             f"3-D field, not a 4-D one: select a range, e.g. da.isel({chosen['w']}=slice(0, 2))")
     meta_range = _metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None), getattr(da, "dtype", None))
-    origin = _encoding_origin(da, chosen)
+    if ds is not None:
+        origin = _dataset_origin(ds, variable, da, chosen)
+    else:
+        found = _encoding_origin(da, chosen)
+        origin = (found, None) if found is not None else (None, (
+            "a DataArray does not say which file it came from (xarray's netCDF4 and h5netcdf engines write it "
+            "into its encoding; scipy, which xarray uses when netCDF4 is not installed, and zarr do not)"))
     flips, coords, extent = {}, [None] * 4, []
     for d_i, k in enumerate(_AXES):
         dim = chosen[k]

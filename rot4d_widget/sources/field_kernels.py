@@ -2,8 +2,17 @@
 
 `_resample_affine` fills f (the field) and g (the signed in-slice distance to the box's faces) on
 an affine grid of index coordinates, `_resample_points` interpolates at a list of index points.
-Both run numba kernels (compiled once, cached on disk; parallel from `PARALLEL_MIN_POINTS`
-points on) and fall back to scipy's ``map_coordinates`` (order 1, the same numbers) without numba.
+Both run numba kernels (parallel from `PARALLEL_MIN_POINTS` points on) and fall back to scipy's
+``map_coordinates`` (order 1, the same numbers) without numba.
+
+numba is imported and the kernels compiled (or loaded from its cache) at the first step, not when
+the package is imported (numba's import alone is ~0.2 s).  Each kernel is compiled with
+``cache=True``: numba keeps the machine code in ``__pycache__`` beside this file, or, when that
+folder cannot be written (a package installed read-only), in the user's cache folder
+(``~/.cache/numba``, or ``$NUMBA_CACHE_DIR``), so a new kernel loads it in a fraction of a second.
+The serial and the parallel kernel are separate Python functions: numba's cache keys an entry by
+the function and its signature, not by ``parallel``, so one function jitted both ways loaded
+whichever was cached first for both (measured: the parallel dispatcher hit the serial entry).
 """
 
 from __future__ import annotations
@@ -11,16 +20,11 @@ from __future__ import annotations
 import threading
 
 import numpy as np
-from scipy.ndimage import map_coordinates
 
 __all__ = ["PARALLEL_MIN_POINTS"]
 
-try:
-    import numba as _numba
-    from numba import prange as _prange
-except ImportError:  # pragma: no cover - numba is optional at import: scipy stands in without it
-    _numba = None
-    _prange = range
+_numba = None  # the numba module once the kernels are made (`_get_kernels`); False: not installed
+_prange = range  # numba.prange once imported (read by the parallel kernels when they compile)
 
 #: Grids with fewer points run the serial kernel: waking a second thread costs a
 #: scheduler time slice (several ms) when the other core is busy, more than the work.
@@ -30,18 +34,39 @@ _kernels = {}
 _kernel_lock = threading.Lock()
 
 
-def _get_kernels(parallel: bool = True):
-    """(affine, points) numba kernels, compiled (or loaded from numba's cache) on first call;
-    None without numba."""
+def _import_numba():
+    """numba, imported once (None when it is not installed: scipy stands in)."""
+    global _numba, _prange, _lerp4_jit, _affine_rows_jit
     if _numba is None:
+        with _kernel_lock:
+            if _numba is None:
+                try:  # numba's import (~0.2 s) waits for the first step, not the package's import
+                    import numba
+                except ImportError:  # pragma: no cover - numba is optional: scipy stands in without it
+                    _numba = False
+                    return None
+                # the kernels call the inner functions compiled (inlined into each kernel)
+                _lerp4_jit = numba.njit(cache=True, inline="always")(_lerp4)
+                _affine_rows_jit = numba.njit(cache=True, inline="always")(_affine_rows)
+                _prange = numba.prange
+                _numba = numba
+    return _numba or None
+
+
+def _get_kernels(parallel: bool = True):
+    """(affine, points) numba kernels, serial or parallel, compiled (or loaded from numba's cache)
+    on first call; None without numba."""
+    numba = _import_numba()
+    if numba is None:
         return None  # pragma: no cover
     k = _kernels.get(parallel)
     if k is None:
         with _kernel_lock:
             k = _kernels.get(parallel)
             if k is None:
-                jit = _numba.njit(parallel=parallel, cache=True, nogil=True)
-                k = _kernels[parallel] = (jit(_affine_kernel), jit(_points_kernel))
+                jit = numba.njit(parallel=parallel, cache=True, nogil=True)
+                k = _kernels[parallel] = ((jit(_affine_parallel), jit(_points_parallel)) if parallel
+                                          else (jit(_affine_serial), jit(_points_serial)))
     return k
 
 
@@ -72,7 +97,7 @@ def _lerp4(a, x0, x1, x2, x3):  # pragma: no cover - compiled by numba
     return acc
 
 
-def _affine_kernel(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pragma: no cover - numba
+def _affine_serial(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pragma: no cover - numba
     """f and the box distance g on the affine grid ``base + i step[0] + j step[1] + k step[2]``.
 
     a : 4-D array (a block of the data, native axis order); base (4,), step (3, 4):
@@ -82,31 +107,51 @@ def _affine_kernel(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pra
     > 0 inside; see `_in_slice_distance`).
     Points outside the box are not interpolated (f = 0 there).
     """
-    n0, n1, n2 = n[0], n[1], n[2]
-    for i in _prange(n0):
-        for j in range(n1):
-            b0 = base[0] + i * step[0, 0] + j * step[1, 0]
-            b1 = base[1] + i * step[0, 1] + j * step[1, 1]
-            b2 = base[2] + i * step[0, 2] + j * step[1, 2]
-            b3 = base[3] + i * step[0, 3] + j * step[1, 3]
-            for k in range(n2):
-                x0 = b0 + k * step[2, 0]
-                x1 = b1 + k * step[2, 1]
-                x2 = b2 + k * step[2, 2]
-                x3 = b3 + k * step[2, 3]
-                g = (halfn[0] - abs(x0 - centre[0])) * inv_s[0]
-                g = min(g, (halfn[1] - abs(x1 - centre[1])) * inv_s[1])
-                g = min(g, (halfn[2] - abs(x2 - centre[2])) * inv_s[2])
-                g = min(g, (halfn[3] - abs(x3 - centre[3])) * inv_s[3])
-                g_out[i, j, k] = g
-                if g < 0.0:
-                    f_out[i, j, k] = 0.0
-                else:
-                    f_out[i, j, k] = _lerp4_jit(a, x0, x1, x2, x3)
+    for i in range(n[0]):
+        _affine_rows_jit(a, base, step, n, centre, halfn, inv_s, f_out, g_out, i)
 
 
-def _points_kernel(a, idx, inside, out):  # pragma: no cover - numba
+def _affine_parallel(a, base, step, n, centre, halfn, inv_s, f_out, g_out):  # pragma: no cover - numba
+    """`_affine_serial` with the grid's first axis shared among threads."""
+    for i in _prange(n[0]):
+        _affine_rows_jit(a, base, step, n, centre, halfn, inv_s, f_out, g_out, i)
+
+
+def _affine_rows(a, base, step, n, centre, halfn, inv_s, f_out, g_out, i):  # pragma: no cover - numba
+    """Row ``i`` of `_affine_serial`'s grid."""
+    n1, n2 = n[1], n[2]
+    for j in range(n1):
+        b0 = base[0] + i * step[0, 0] + j * step[1, 0]
+        b1 = base[1] + i * step[0, 1] + j * step[1, 1]
+        b2 = base[2] + i * step[0, 2] + j * step[1, 2]
+        b3 = base[3] + i * step[0, 3] + j * step[1, 3]
+        for k in range(n2):
+            x0 = b0 + k * step[2, 0]
+            x1 = b1 + k * step[2, 1]
+            x2 = b2 + k * step[2, 2]
+            x3 = b3 + k * step[2, 3]
+            g = (halfn[0] - abs(x0 - centre[0])) * inv_s[0]
+            g = min(g, (halfn[1] - abs(x1 - centre[1])) * inv_s[1])
+            g = min(g, (halfn[2] - abs(x2 - centre[2])) * inv_s[2])
+            g = min(g, (halfn[3] - abs(x3 - centre[3])) * inv_s[3])
+            g_out[i, j, k] = g
+            if g < 0.0:
+                f_out[i, j, k] = 0.0
+            else:
+                f_out[i, j, k] = _lerp4_jit(a, x0, x1, x2, x3)
+
+
+def _points_serial(a, idx, inside, out):  # pragma: no cover - numba
     """Quadrilinear values of ``a`` at the rows of ``idx`` (N, 4) where ``inside``; 0 elsewhere."""
+    for p in range(idx.shape[0]):
+        if inside[p]:
+            out[p] = _lerp4_jit(a, idx[p, 0], idx[p, 1], idx[p, 2], idx[p, 3])
+        else:
+            out[p] = 0.0
+
+
+def _points_parallel(a, idx, inside, out):  # pragma: no cover - numba
+    """`_points_serial` with the points shared among threads."""
     for p in _prange(idx.shape[0]):
         if inside[p]:
             out[p] = _lerp4_jit(a, idx[p, 0], idx[p, 1], idx[p, 2], idx[p, 3])
@@ -114,8 +159,9 @@ def _points_kernel(a, idx, inside, out):  # pragma: no cover - numba
             out[p] = 0.0
 
 
-# the kernels call the inner function compiled (inlined into each kernel)
-_lerp4_jit = _lerp4 if _numba is None else _numba.njit(cache=True, inline="always")(_lerp4)
+# the compiled inner functions once numba is imported (`_import_numba`)
+_lerp4_jit = _lerp4
+_affine_rows_jit = _affine_rows
 
 
 def _resample_affine(a, base, step, n, centre, halfn, inv_s):
@@ -129,6 +175,8 @@ def _resample_affine(a, base, step, n, centre, halfn, inv_s):
         k[0](a, args[0], args[1], np.array(n, dtype=np.int64), args[2], args[3], args[4], f, g)
         return f, g
     # pragma: no cover - without numba: the same numbers through scipy
+    from scipy.ndimage import map_coordinates
+
     ijk = np.indices(n, dtype=np.float64).reshape(3, -1)
     x = args[0][:, None] + args[1].T @ ijk  # (4, N)
     g[...] = ((args[3][:, None] - np.abs(x - args[2][:, None])) * args[4][:, None]).min(axis=0).reshape(n)
@@ -144,6 +192,8 @@ def _resample_points(a, idx, inside):
     if k is not None:
         k[1](a, np.ascontiguousarray(idx, dtype=np.float64), np.ascontiguousarray(inside), out)
         return out
+    from scipy.ndimage import map_coordinates  # pragma: no cover
+
     out[...] = map_coordinates(a, idx.T, order=1, prefilter=False, mode="nearest")  # pragma: no cover
     out[~inside] = 0.0  # pragma: no cover
     return out  # pragma: no cover

@@ -111,8 +111,10 @@ def _describe(field) -> dict:
         d["array"] = f"read from {origin.get('path')!r} (reopened from there)"
         d["rebuild"] = True
     else:
-        d["rebuild"] = (f"its values are a {d.get('array', 'array').replace(' (not recordable)', '')} held in "
-                        "memory, not written into a state file; open the file with Field4D.open(path, variable, "
-                        "w=...) (or rot4d_widget.keep.export.open_field) to record where it comes from -- "
-                        "the only way for a zarr store or a file xarray read with the scipy engine")
+        what = d.get("array", "array").replace(" (not recordable)", "")
+        why = (f"its values are a {what}: {field.origin_missing}" if field.origin_missing
+               else f"its values are a {what} held in memory, not written into a state file")
+        d["rebuild"] = (f"{why}; give from_xarray the Dataset and the variable's name, "
+                        "Field4D.from_xarray(ds, 'T', w=...), or open the file with Field4D.open(path, variable, "
+                        "w=...), to record where the data come from")
     return d

@@ -50,6 +50,23 @@ class _Samples:
     __slots__ = ("origin", "spacing", "f", "g", "k", "box")
 
 
+class LastCut:
+    """The last cut sampled from a chunked or lazy array (`_sample_raw`), so that the same cut asked
+    twice -- the first cut that sets the default level and range, then the view's first picture,
+    both at rest -- reads its chunks once (a big store's cut can hold more chunks than the chunk
+    cache).  One entry, replaced whole (safe to read from another thread)."""
+
+    def __init__(self):
+        self._entry = (None, None)
+
+    def get(self, key):
+        k, s = self._entry
+        return s if k == key else None
+
+    def keep(self, key, samples) -> None:
+        self._entry = (key, samples)
+
+
 #: A box face whose normal has less than this in-slice part is parallel to the slice: left out of g.
 _PARALLEL = 1e-9
 
@@ -89,7 +106,21 @@ def _sample(field, m, c0, res, first_cut: bool = False, box=None) -> _Samples | 
 
 
 def _sample_raw(field, m, c0, res, box=None) -> _Samples | None:
-    """`_sample` without K (``s.k`` None)."""
+    """`_sample` without K (``s.k`` None).  Of a chunked or lazy array, the last cut is kept
+    (`LastCut`): asked again for the same one, nothing is read."""
+    chunked = field.kind not in ("numpy", "function") and field.resident is None
+    key = (m.tobytes(), float(c0), int(res), tuple(field.half_widths)) if chunked else None
+    if chunked:
+        s = field.last_cut.get(key)
+        if s is not None:
+            return s
+    s = _sample_grid(field, m, c0, res, box)
+    if chunked:
+        field.last_cut.keep(key, s)
+    return s
+
+
+def _sample_grid(field, m, c0, res, box):
     if box is None:
         box = _box_slice(field, m, c0)
     if box.dim < 3:
@@ -137,8 +168,9 @@ def _sample_raw(field, m, c0, res, box=None) -> _Samples | None:
             centre[a] = (field.shape[j] - 1) / 2
             inv_s[a] = 1.0 / (sc[j] * _face_norms(m)[j])
         halfn = np.where(_face_norms(m)[list(_AXES.index(c) for c in field.axes)] > _PARALLEL, centre, 1e300)
-        if field.kind == "numpy":
-            s.f, s.g = _resample_affine(field.values, base, step, n, centre, halfn, inv_s)
+        resident = field.resident
+        if resident is not None:  # in memory: given so, or read whole in the background
+            s.f, s.g = _resample_affine(resident, base, step, n, centre, halfn, inv_s)
             return s
         # chunked or lazy: the same numbers, each touched chunk read once (memory stays bounded)
         ijk = np.indices(tuple(int(v) for v in n), dtype=np.float64).reshape(3, -1).T
@@ -165,9 +197,11 @@ def _slice_offset(field, m, d, levels, res, *, coarse, box=None) -> tuple:
     """One `FieldSlice` per level of ``levels`` (a tuple of floats) at the offset ``d`` (slice units)
     after the validated rotation ``m``, sampled at ``res`` along the longest side; of
     ``field.coarse()`` with ``coarse``.  ``box``: the box's cut there, when known (the coarse copy
-    has the field's box)."""
+    has the field's box).  A full step of a chunked field reads only the chunks its samples touch:
+    its cap scale comes from this cut's samples until the coarse copy is ready (`Field4D.cap_scale`),
+    never from a coarse copy built for it."""
     src = field.coarse() if coarse else field
-    s = _sample(src, m, d, res, box=box)
+    s = _sample(src, m, d, res, first_cut=not coarse, box=box)
     if s is None:
         return tuple(_empty_slice(lv, 0.0) for lv in levels)
     return tuple(_surface(s, lv, field.inside, field.caps) for lv in levels)

@@ -118,13 +118,14 @@ class FieldStatistics:
                 finite = np.isfinite(a)
                 rng = (float(a[finite].min()), float(a[finite].max())) if finite.any() else (math.nan, math.nan)
                 self._range = (rng, "probe grid")
-            elif f.kind == "numpy":
+            elif f.resident is not None:  # in memory: given so, or read whole (`Field4D.prepare`)
                 self.report_infinite()
-                self._range = (_finite_range(f.values), "data")
-            else:
+                self._range = (_finite_range(f.resident), "data")
+            else:  # chunked or lazy: one pass over the data (read whole when it fits the budget)
                 c = f.coarse()
                 self.report_infinite()
-                self._range = (c.data_range, "coarse copy")
+                self._range = ((_finite_range(f.resident), "data") if f.resident is not None
+                               else (c.data_range, "coarse copy"))
         return self._range
 
     def probe_values(self):
@@ -139,7 +140,8 @@ class FieldStatistics:
         """K for one step's samples ``s``: the field's (`statistics`), or, for a chunked or lazy array
         whose coarse copy is not ready, the 95th percentile of |grad f| within the first cut's
         samples (kept until the coarse copy is ready, so the pictures agree) -- with ``first_cut``
-        (`Field4D.slice`; `slice_field` builds the coarse copy) or once K was taken so."""
+        (every full step: `Field4D.slice`, `slice_field`) or once K was taken so.  A full step
+        therefore never builds the coarse copy (which reads every chunk)."""
         f = self._field
         if ((first_cut or self._k_first is not None) and self._stats is None
                 and f.kind not in ("numpy", "function") and not f.coarse_ready):
@@ -209,7 +211,7 @@ class FieldStatistics:
         self.infinite_reported = True
         f = self._field
         if self.infinite is None:
-            a = f.values
+            a = f.resident if f.resident is not None else f.values
             self.infinite = _count_infinite(a) if np.dtype(a.dtype).kind == "f" else (0, 0, None)
         npos, nneg, first = self.infinite
         if npos == 0 and nneg == 0:

@@ -31,13 +31,15 @@ coordinates about the box's centre, with w divided by ``w_per_unit`` (how
 much data-w one unit of space is): a data point q is drawn at
 ``matrix @ (q - centre)`` with its w so scaled.
 
-Chunked data (dask, zarr, anything with ``chunks``): a full-resolution step
-reads only the chunks the hyperplane comes within one sample of (the whole
-4-D bounding block is never read), into a zero-filled buffer whose untouched
-pages are never committed; recently read chunks are kept up to
+Chunked data (dask, zarr, anything with ``chunks``) and lazily read files: a
+full-resolution step reads only the chunks its samples' cells touch (the whole
+4-D bounding block is never read); recently read chunks are kept up to
 ``chunk_cache_bytes``.  ``field.coarse()`` is an in-memory copy with at most
 `COARSE_SAMPLES` nodes per axis over the same box (built once, the only time
-every chunk is read) for the held-key steps and for the data range.
+every chunk is read) for the held-key steps and for the data range.  Data that
+fit ``memory_budget`` (`MEMORY_BUDGET`, 1 GiB) are read whole in that same pass
+(`prepare`: in the background, with a progress bar; the widget starts it), after
+which steps run on the array in memory (`resident`).
 
 Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
@@ -62,7 +64,7 @@ from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
 from ..geometry.polytopes import check_scale
 from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
-from .coarse import COARSE_SAMPLES, CoarseCopy
+from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
 from .field_checks import (
     _AXES,
     BYTES_PER_SAMPLE,
@@ -89,13 +91,14 @@ from .field_input import (  # noqa: F401,E402  (export reads them)
 )
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
 from .field_levels import FieldLevels
+from .field_memory import FieldMemory
 from .field_readout import _describe, _order_text, _readout
-from .field_slicing import _box_slice, _sample, _sample_raw, _slice_offset
+from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
-           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES"]
+           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
 
 _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
                _resample_affine, _sample_raw, _surface)
@@ -105,7 +108,7 @@ _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINT
 _SORT_PASSES = True
 
 
-class Field4D(FieldLevels):
+class Field4D(FieldLevels, FieldMemory):
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
 
     Parameters
@@ -147,7 +150,7 @@ class Field4D(FieldLevels):
     levels : float or sequence of floats, optional
         Iso levels (default: one, midway between the min and max of `data_range`: for a chunked
         array, of the first slice's chunks until `coarse` is ready -- the first picture never
-        reads the whole array; `prepare_coarse` builds the copy in the background).
+        reads the whole array; `prepare` builds the copy in the background).
     inside : "above" or "below"
         Which side of each level the surface encloses: ``"above"`` {f >= level} (a density,
         a phase field), ``"below"`` {f <= level} (a signed distance, negative inside: the ball,
@@ -160,12 +163,17 @@ class Field4D(FieldLevels):
     chunk_cache_bytes : int
         Recently read chunks of a chunked array kept in memory (default 128 MiB: with the
         rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
+    memory_budget : int
+        Bytes a chunked or lazy array may take in memory (float32 kept, other types as
+        float64) to be read whole when the coarse copy is made (`prepare`, `coarse`); default
+        `MEMORY_BUDGET` (1 GiB); 0: never.  Bigger data keep the coarse copy and read, for a full
+        step, only the chunks its samples touch.
     """
 
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, space_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
-                 _coords=None, _function=None, _copy_of=None):
+                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None):
         self._function = _function
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
@@ -210,13 +218,19 @@ class Field4D(FieldLevels):
         self.resolution = resolution
         self.coarse_resolution = max(24, self.resolution // 2) if coarse_resolution is None else coarse_resolution
         self.chunk_cache_bytes = int(chunk_cache_bytes)
+        self.memory_budget = memory_budget
         self._reader = None
+        #: the last cut sampled from chunked data (`rot4d_widget.sources.field_slicing.LastCut`)
+        self.last_cut = LastCut()
         self._levels = None if levels is None else _as_levels(levels)
         self.inside = inside
         self.caps = caps
         #: Where the values come from, for a state file to reopen them (`Field4D.open`; `from_xarray`
-        #: when xarray's encoding names the file): a JSON-able dict, or None (not reopenable)
+        #: of a Dataset, or of a DataArray when xarray's encoding names the file): a JSON-able dict, or
+        #: None (not reopenable)
         self.origin = None
+        #: Why `from_xarray` found no origin (said when a state file is saved), or None
+        self.origin_missing = None
 
     # -- constructors ---------------------------------------------------------
     @classmethod
@@ -232,22 +246,29 @@ class Field4D(FieldLevels):
                    _function=f, **kwargs)
 
     @classmethod
-    def from_xarray(cls, da, *, x=None, y=None, z=None, w=None, w_per_unit=None, **kwargs) -> "Field4D":
-        """A field from a 4-D ``xarray.DataArray`` (dims by name; extents from coordinates).
+    def from_xarray(cls, data, variable=None, *, x=None, y=None, z=None, w=None, w_per_unit=None,
+                    **kwargs) -> "Field4D":
+        """A field from a 4-D ``xarray.DataArray``, or ``variable`` of an ``xarray.Dataset`` (dims by
+        name; extents from coordinates).  ``from_xarray(xarray.open_dataset("run.nc"), "T", w="time")``
+        (or ``open_zarr``): the Dataset knows its file whatever the engine, so a state file reopens
+        the field (``origin``); ``variable`` may be omitted when there is one.  A DataArray names its
+        file only with the netCDF4 and h5netcdf engines, and a selection made after opening is not
+        kept (`open` keeps ``isel=`` / ``sel=``): saving such a field warns, saying why.
 
-        Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one
-        left over is w (``("time", "z", "y", "x")``); otherwise name them with
-        ``x=, y=, z=, w=``.  Coordinates may be unevenly spaced (each maps to a
-        fractional index) and decreasing (read reversed, lazily); not monotonic
-        -> ValueError.  datetime64 coordinates become seconds since their first
-        value.  A dask-backed array stays lazy.  ``w_per_unit`` defaults to the
-        mean w spacing over the mean spatial spacing (voxels are cubes).
+        Dims named ``x``, ``y``, ``z`` (any case) are found by themselves and the one left over is w
+        (``("time", "z", "y", "x")``); otherwise name them with ``x=, y=, z=, w=``.  Coordinates may
+        be unevenly spaced (each maps to a fractional index) and decreasing (read reversed, lazily);
+        not monotonic -> ValueError.  datetime64 coordinates become seconds since their first value.
+        A dask-backed array stays lazy.  ``w_per_unit`` defaults to the mean w spacing over the mean
+        spatial spacing (voxels are cubes).
         """
-        values, args, dims, meta_range, origin, long_name = _xarray_arguments(da, x, y, z, w, w_per_unit, kwargs)
+        values, args, dims, meta_range, (origin, why), long_name = _xarray_arguments(
+            data, variable, x, y, z, w, w_per_unit, kwargs)
         field = cls(values, **args, **kwargs)
         field._dims, field.long_name = dims, long_name
         field._stat.meta_range = meta_range
         field.origin = origin
+        field.origin_missing = why
         return field
 
     @classmethod
@@ -272,6 +293,7 @@ class Field4D(FieldLevels):
         da, record = _open_dataarray(path, variable, engine, chunks, isel, sel, load)
         field = cls.from_xarray(da, x=x, y=y, z=z, w=w, **kwargs)
         field.origin = {**record, "kwargs": dict(zip(field.axes, field._dims)), "load": bool(load)}
+        field.origin_missing = None
         return field
 
     # -- geometry and resolution ------------------------------------------------
@@ -329,6 +351,14 @@ class Field4D(FieldLevels):
         chunks read so far, until the coarse copy is ready), ``"probe grid"``,
         ``"actual_range"``, ``"valid_range"`` or ``"valid_min/valid_max"``."""
         return self._stat.range_info()[1]
+
+    @property
+    def known_range(self) -> tuple:
+        """`data_range` as far as it is known without reading every chunk: the same, except for a
+        chunked or lazy array whose coarse copy is not ready, whose range is then the first cut's
+        (the chunks read so far; the cut at rest is read when nothing was).  What a full step's
+        grid (`sample_field`) reports, so that it never triggers a full read."""
+        return self._stat.range_info(first_cut=True)[0]
 
     def _statistics(self):
         """((min, max), K): `data_range` and a typical |grad f| (level units per slice unit)."""
@@ -397,6 +427,16 @@ class Field4D(FieldLevels):
                  "unit": _sealed(self._unit.copy())}
         return FieldSliceData.assemble(slices, box, readout, frame)
 
+    def outline(self, matrix, c0) -> "FieldSliceData":
+        """The slice's bars without its surface: the cut of the data's box at w = ``c0`` after
+        ``matrix``, read from nothing (the source protocol's ``outline``: what the widget sizes its
+        buffers and ball radius from, so that building a view reads no chunk but its first cut's)."""
+        m = as_rotation_matrix(matrix)
+        d = self.offset(c0)
+        frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
+                 "unit": _sealed(self._unit.copy())}
+        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), _box_slice(self, m, d), (), frame)
+
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
 
@@ -453,49 +493,12 @@ class Field4D(FieldLevels):
         """(N,) float64: quadrilinear values at the (N, 4) array-index coordinates ``idx`` (clamped
         into the array) where ``inside``, 0 elsewhere; a chunked or lazy array is read chunk by chunk
         (its chunk reader and cache), never assembled."""
-        if self._kind == "numpy":
-            return _resample_points(self._values, idx, inside)
+        resident = self.resident
+        if resident is not None:
+            return _resample_points(resident, idx, inside)
         if self._reader is None:
             self._reader = _ChunkReader(self._values, self.chunk_cache_bytes)
         return _chunked_values(self._reader, idx, inside, _SORT_PASSES)
-
-    # -- coarse copy -------------------------------------------------------------
-    def coarse(self) -> "Field4D":
-        """An in-memory copy with at most `COARSE_SAMPLES` nodes per axis over the same box
-        (linear resampling onto evenly spaced fractional indices), built once.
-
-        The field itself when it already is that small and in memory, or a function.  A chunked or
-        lazy array is read chunk by chunk (each downsampled into the copy and dropped: memory is the
-        copy plus a few chunks).  Blocks until the copy is built: when `prepare_coarse` started it
-        in the background, waits for that build."""
-        return self._coarse_copy.get()
-
-    @property
-    def coarse_ready(self) -> bool:
-        """True once the coarse copy is built (`coarse`, or the background build of `prepare_coarse`)."""
-        return self._coarse_copy.ready
-
-    @property
-    def coarse_progress(self):
-        """(chunks done, chunks in all) of the coarse copy's build, once it started (else None)."""
-        return self._coarse_copy.progress
-
-    @property
-    def _coarse_error(self):
-        """What made the background build of the coarse copy fail (None so far)."""
-        return self._coarse_copy.error
-
-    def prepare_coarse(self, progress: bool = True) -> None:
-        """Start building the coarse copy (`coarse`) on a daemon thread and return at once.
-
-        The build reads the array chunk by chunk (memory: the copy plus a few chunks), counting
-        chunks on a progress bar (`rot4d_widget.view.progress`, shown after a second: a widget in a
-        kernel, a line on a terminal) when ``progress`` is true; `coarse_progress` holds
-        (chunks done, chunks in all).  Until `coarse_ready`, held keys meanwhile slice at full
-        resolution (``slice(..., coarse=True)`` returns the full-resolution slice and says so), the
-        data range and default level come from the chunks read so far ("first cut"); `coarse`
-        waits for the build.  Does nothing when the copy is built or being built."""
-        self._coarse_copy.prepare(progress)
 
     def __repr__(self) -> str:
         if self._kind == "function":

@@ -54,6 +54,15 @@ that comes from these optional members, never from its class (`inner_source`,
 ``coarse_steps`` (optional)
     True when ``slice(matrix, c0, coarse=True)`` gives a cheaper slice for held
     keys (a field's coarse copy); by default read from ``slice``'s signature.
+``outline(matrix, c0)`` (optional)
+    A slice with the balls and bars ``slice`` gives and no surface, made without reading
+    the source's data (a field's: the cut of its data box): what the widget sizes its buffers
+    and its default ball radius from (`outline_of`; default: ``slice`` itself).
+``prepare(progress=True)`` (optional)
+    Start the background work that makes later slices fast (a field's read into memory and
+    its coarse copy) and return at once: a `rot4d_widget.core.progress.Progress` counting it
+    (the widget shows it in its own bar), or None when there is nothing to do
+    (`prepare_in_background`; default: nothing).
 ``sample(matrix, c0, resolution=None, *, coarse=False)`` (optional)
     The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
     spacing, units, data range): what the volume and maximum-intensity renderings
@@ -99,6 +108,8 @@ __all__ = [
     "settings_of",
     "apply_setting",
     "takes_coarse",
+    "outline_of",
+    "prepare_in_background",
 ]
 
 
@@ -274,6 +285,22 @@ def takes_coarse(source) -> bool:
         return "coarse" in inspect.signature(source.slice).parameters
     except (TypeError, ValueError):
         return False
+
+
+def outline_of(source, matrix, c0):
+    """``source.outline(matrix, c0)`` (the slice's balls and bars, no surface, nothing read), or
+    ``source.slice(matrix, c0)`` for a source without one."""
+    outline = getattr(source, "outline", None)
+    return source.slice(matrix, c0) if outline is None else outline(matrix, c0)
+
+
+def prepare_in_background(source, progress: bool = True):
+    """Start ``source``'s background work (its ``prepare``: a field's read into memory and coarse
+    copy) and return what counts it, a `rot4d_widget.core.progress.Progress`, or None (a source
+    without ``prepare``, or nothing left to do).  ``progress``: also show the kernel's own bar
+    (in the cell's output); the widget passes False and shows the returned progress in its own."""
+    prepare = getattr(source, "prepare", None)
+    return None if prepare is None else prepare(progress=progress)
 
 
 def data_w_text(source, w: float, matrix=None) -> str:

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..core.look import as_rgb, cell_palette, group_palette
 from ..core.rotation import random_rotation
-from ..sources.protocol import BadSlice
+from ..sources.protocol import BadSlice, outline_of
 
 __all__ = [
     "ROW_FLOATS",
@@ -167,13 +167,15 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0, *, name: str = "t
 
     Central slices are usually the largest; the estimate includes `HEADROOM`.
     It is a starting size, not a bound: the scene grows the table safely if a
-    larger slice ever comes.  A slice over the update cap raises `UpdateTooLarge` at once
-    (the other samples are not taken).
+    larger slice ever comes.  Each orientation is the source's outline
+    (`rot4d_widget.sources.protocol.outline_of`: a field's box cut, its data not read; any other
+    source's slice).  An outline over the update cap raises `UpdateTooLarge` at once (the other
+    samples are not taken).
     """
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):
-        data = source.slice(random_rotation(rng), 0.0)
+        data = outline_of(source, random_rotation(rng), 0.0)
         check_update_size(data, name=name)
         most = max(most, rows_needed(data))
     return capacity_for(most)

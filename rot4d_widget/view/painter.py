@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core import look
 from ..keep.volume import default_clim
-from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source
+from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source, outline_of
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut
@@ -66,13 +66,17 @@ def title(source) -> str:
     return str(name) if name else type(source).__name__
 
 
-def checked_slice(source, matrix, c0, coarse, lock):
+def checked_slice(source, matrix, c0, coarse, lock, *, outline: bool = False):
     """``source.slice`` validated once (`rot4d_widget.sources.protocol.check_slice`): a bad slice (None,
     non-finite points, indices out of range, a group beyond ``n_groups``) raises a ValueError
     or TypeError naming the source and the member that is wrong, and is never drawn; a slice
-    over the update cap raises `rot4d_widget.view.buffers.UpdateTooLarge`."""
+    over the update cap raises `rot4d_widget.view.buffers.UpdateTooLarge`.
+    ``outline``: the source's outline instead (`outline_of`: balls and bars, no data read)."""
     with lock:
-        data = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
+        if outline:
+            data = outline_of(source, matrix, c0)
+        else:
+            data = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
         n_groups = int(source.n_groups)
     try:
         check_slice(data, n_groups)

@@ -55,7 +55,7 @@ from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
 from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
 from ..sources.tomography import ARRANGEMENTS
 from . import markup
-from . import progress as _progress  # noqa: F401 - registers the kernel's progress bar with the core
+from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
 from . import traits as t
 from .buffers import estimate_capacity
 from .companion import Companion
@@ -162,6 +162,7 @@ class Rot4DWidget(widgets.HBox):
     stats : counters of the update pump (updates, acks, timeouts)
     readout, help_panel : ipywidgets.HTML
     errors : ipywidgets.Output -- exceptions raised by key handling
+    progress_bar : `rot4d_widget.view.progress.ViewBar` -- shown while the source is read (``follow``)
     """
 
     theta0 = t.Angle(DEFAULT_THETA0, help="step angle of every rotation key, radians in (0, pi]")
@@ -518,12 +519,12 @@ def _wire(w, keypad) -> None:
 
     # The initial picture is part of the models' state: not "in flight".
     w._pump.send_now(expect_ack=False)
-    # A big field's coarse copy (for held keys) is built in the background from now on, with
-    # a progress bar; its first picture above read only the chunks the cut touches.  Only with
-    # the ticker running (a live widget): scripts and tests stay deterministic.
-    prepare = getattr(inner_source(w.source), "prepare_coarse", None)
-    if prepare is not None and w._pump.autotick:
-        prepare(progress=True)
+    # A field is read in the background from now on (the whole of it into memory when it fits its
+    # budget, else its coarse copy for held keys), counted on the widget's own bar above the
+    # readout; its first picture above read only the chunks the cut touches.  Only with the
+    # ticker running (a live widget): scripts and tests stay deterministic.
+    if w._pump.autotick:
+        w.progress_bar.follow(inner_source(w.source))
 
 
 def _unwire(w) -> None:
@@ -546,6 +547,9 @@ def _close_children(w) -> None:
     before the canvas does."""
     w._keypad.close()
     w._projection.close()
+    bar = getattr(w, "progress_bar", None)
+    if bar is not None:
+        bar.close_widgets()
     for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
         x = getattr(w, name, None)
         if x is not None:
@@ -579,10 +583,12 @@ def _build_children(w, options) -> None:
             ignore_modifier_key_events=True,
         )
         built.append(w.events)
+        w.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
+        built += w.progress_bar.widgets
         # the canvas keeps its size; the side panel wraps below it when narrow
         w._canvas_box = widgets.VBox([w.scene.canvas, w.companion], layout=widgets.Layout(flex="0 0 auto"))
         w._side_box = widgets.VBox(
-            [w.readout, w.help_panel, w.errors],
+            [w.progress_bar.box, w.readout, w.help_panel, w.errors],
             layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
         )
         w._side_box.add_class("rot4d-side")
@@ -637,10 +643,11 @@ def _fit_c0_range(state, source) -> None:
 
 
 def _default_ball_radius(source, scale, state) -> float:
-    """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment."""
+    """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment
+    (of its outline, `outline_of`: a field's box cut, nothing read)."""
     edge = getattr(source, "edge_length", None)
     if edge is None:
-        data = checked_slice(source, state.matrix, state.c0, False, threading.RLock())
+        data = checked_slice(source, state.matrix, state.c0, False, threading.RLock(), outline=True)
         seg = np.asarray(data.segments)
         if len(seg):
             p = np.asarray(data.points, dtype=np.float64)
