@@ -26,6 +26,8 @@ from rot4d_widget import widget as wmod
 from rot4d_widget.core.keymap import RESERVED_KINDS
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import DEFAULT_THETA0
+from rot4d_widget.view.pagecut import PageCut
+from rot4d_widget.view.transfer import Transfers
 from rot4d_widget.view.widget import Rot4DWidget
 
 
@@ -130,6 +132,9 @@ class FakeCompanion(ipywidgets.DOMWidget):
         self._clock = CallbackDispatcher()
         self.config = {}  # as `Companion`: what the page steps its state by, and the kernel's state
         self.kernel_state = {}
+        self.page_data, self.draw_config = {}, {}  # what the page holds and how it draws its own pictures
+        self.transfers = Transfers(self)
+        self.page_cut = PageCut(self)
         self.last_draw_time = None  # as `Companion`: the page's time for the last update it drew
 
     def on_drawn(self, callback, remove=False):

@@ -80,6 +80,7 @@ from ipywidgets import CallbackDispatcher, Layout
 from traitlets import Dict, List, Unicode
 
 from .bundle import page_module
+from .pagecut import PageCut
 from .transfer import Transfers
 
 __all__ = ["Companion"]
@@ -117,6 +118,9 @@ class Companion(anywidget.AnyWidget):
     #: the one-time transfers the kernel offers, name -> key (`transfer.Transfers`): a page that does
     #: not hold one asks for it
     page_data = Dict().tag(sync=True)
+    #: how the page draws its own pictures of a polytope it cuts (`pagecut.PageCut`): the scale, the
+    #: group colours packed as the row buffer holds them, one colour for all faces or None
+    draw_config = Dict().tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -136,6 +140,7 @@ class Companion(anywidget.AnyWidget):
         self._screenshot_handlers = CallbackDispatcher()
         self._clock_handlers = CallbackDispatcher()
         self.transfers = Transfers(self)
+        self.page_cut = PageCut(self)
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
@@ -185,10 +190,10 @@ class Companion(anywidget.AnyWidget):
             reason, t = content.get("reason"), content.get("t")
             ok = isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)
             self._focus_handlers(reason if isinstance(reason, str) else "", float(t) if ok else None)
-        elif event == "want":
+        elif event in ("want", "holds"):
             name, key = content.get("name"), content.get("key")
             if isinstance(name, str) and isinstance(key, str):
-                self.transfers.want(name, key)
+                (self.transfers.want if event == "want" else self.page_cut.holds)(name, key)
         elif event == "clock":
             t = content.get("t")
             if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):

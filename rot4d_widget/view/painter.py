@@ -147,6 +147,13 @@ class Painter:
         w = self.w
         st, scene = w.state, w.scene
         held = bool(w._keys.held)
+        single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+        cut = w.companion.page_cut
+        cut.sync(w.source, self.group_colors(), w._scale, single)
+        if held and cut.page_draws:  # the page draws the pictures of the keys held: no work here
+            self.send_state("pending")
+            self.readout_stale = True  # at rest the picture and the readout follow (`KeyPath.settle`)
+            return None
         coarse = held and self.coarse_ok
         shown, rows = self.shown, self.rows_key
         cast = w.rendering != "surface" and can_sample(w.source)  # ray-cast from the cut on grids
@@ -178,7 +185,6 @@ class Painter:
                 self.grid_cache = (m, c0, version, coarse_, cut)
             clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
-            single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
             labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
                 self.labelled = bool(labels)
@@ -187,7 +193,6 @@ class Painter:
             self.rows_data = cut.data
             self.shown = self.rows_key = key
         else:
-            single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
             rows_turn = key.turn_from(rows) if same_cut else None
             if (self.coarse_ok and rows_turn is not None and not rows.coarse and not coarse
                     and self.rows_data is not None):
@@ -217,7 +222,11 @@ class Painter:
                 self.labelled = bool(labels)
             self.rows_data = data
             self.shown = self.rows_key = key
-        self.send_state(picture=sent)  # the state and its id; which picture shows it, if one was sent
+        # the state and its id, and which picture shows it: this one, if it is of the state now (keys
+        # may have changed it while the picture was made), else one is owed
+        now_shown = key.matrix is w.state.matrix and key.c0 == w.state.c0
+        self.send_state(picture=(sent if now_shown else "pending") if sent is not None else
+                        (None if now_shown else "pending"))
         w._shots.send_owed()  # screenshots asked meanwhile: of this picture
         now = w._pump.clock()
         w._error_area.clear_update_errors()  # a good picture: the widget has recovered

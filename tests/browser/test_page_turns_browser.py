@@ -101,15 +101,18 @@ def _two_keys(jupyter_server, page, var):
     jp.page.keyboard.up("c")
     before = _page(jp, sel)  # the page's state right after the release (its steps all made)
     # a screenshot asked at once waits until page and kernel agree: the picture of the final state
-    jp.kernel(f"{var}.screenshot('first-{var}.png')")
+    tag = f"{var}-{getattr(jupyter_server, 'rtt_ms', 0):g}"  # the local and remote runs share the server's folder
+    shots = [jupyter_server.root / f"{n}-{tag}.png" for n in ("first", "second")]
+    for p in shots:
+        p.unlink(missing_ok=True)
+    jp.kernel(f"{var}.screenshot({shots[0].name!r})")
     assert jp.wait_for(lambda: _settled(jp, var, sel), timeout=60), (_page(jp, sel), _kernel(jp, var))
     after, kernel = _page(jp, sel), _kernel(jp, var)
     np.testing.assert_allclose(after["matrix"], kernel["m"], rtol=0, atol=1e-12)
     assert (after["theta0"], after["alpha"], after["c0"]) == (kernel["theta0"], kernel["alpha"], kernel["c0"])
     np.testing.assert_allclose(before["matrix"], after["matrix"], rtol=0, atol=1e-12)  # no jump at release
     time.sleep(1.0)
-    jp.kernel(f"{var}.screenshot('second-{var}.png')")
-    shots = [jupyter_server.root / f"{n}-{var}.png" for n in ("first", "second")]
+    jp.kernel(f"{var}.screenshot({shots[1].name!r})")
     assert jp.wait_for(lambda: all(p.exists() and p.stat().st_size for p in shots), timeout=30)
     from PIL import Image
 

@@ -365,7 +365,8 @@ _WATCH_ACKS = """
 
 
 def test_drawn_acks_follow_the_pixels_and_at_most_three_updates_are_in_flight(jupyter_server, page):
-    """Flow control on a page made slow on purpose (CPU throttled 6x, 600-cell).
+    """Flow control on a page made slow on purpose (CPU throttled 6x, the 600-cell as a user's source:
+    the page cannot cut it, so the kernel makes every picture of a held key).
 
     The page draws slower than the tick rate: without a bound on the updates in
     flight the kernel would queue updates and the view would keep moving after release.
@@ -376,7 +377,17 @@ def test_drawn_acks_follow_the_pixels_and_at_most_three_updates_are_in_flight(ju
     # ack_timeout far above this page's round trip: the acknowledgement path is what is tested.
     # (With the default 0.5 s a 6x-throttled page on a loaded machine answers later than that:
     # the pump then sends on timeouts, unacknowledged, and the view falls behind.)
-    jp = _open_case(page, jupyter_server, "flow.ipynb", polytope_name="600-cell", widget_args=", ack_timeout=10.0")
+    write_notebook(jupyter_server.root / "flow.ipynb", [
+        "from rot4d_widget import Rot4DWidget, polytope\n"
+        "from rot4d_widget.sources.protocol import PolytopeSource\n"
+        "class Users:  # a user's source: the page does not cut it\n"
+        "    def __init__(self): self._p = PolytopeSource(polytope('600-cell')); self.size = self._p.size; "
+        "self.n_groups = self._p.n_groups\n"
+        "    def slice(self, m, c0): return self._p.slice(m, c0)\n"
+        "    def describe(self): return {'kind': 'users'}\n"
+        "w = Rot4DWidget(Users(), ack_timeout=10.0)\nw"])
+    jp = JupyterPage(page, jupyter_server, "flow.ipynb").open()
+    jp.run_all()
     sel = _canvas(jp)
     _hover(jp, sel)
     jp.watch_pixels(sel)

@@ -58,8 +58,7 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { decodePolytope, slicePolytope, sliceData } from "./slicer.js";
-import { sliceRows } from "./rows.js";
+import { drawsOwn, ownPicture, polytopeArrived } from "./pictures.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -157,7 +156,9 @@ async function render({ model, el }) {
 
   // 9. one-time transfers (transfer.js): asked for when offered and not held, put together here
   const onPageData = () => askForTransfers(model);
-  const onTransfer = (msg, buffers) => receiveChunk(model, msg, buffers && buffers[0]);
+  const onTransfer = (msg, buffers) => {
+    if (receiveChunk(model, msg, buffers && buffers[0]) && msg.name === "polytope") polytopeArrived(model);
+  };
   if (typeof model.on === "function") {
     model.on("change:page_data", onPageData);
     model.on("msg:custom", onTransfer);
@@ -244,8 +245,10 @@ async function render({ model, el }) {
         });
       };
       // The whole view turned in 3-D (keys that leave w alone): one rotation for every mesh.
+      let own = false; // the layers draw the page's own picture (pictures.js), not the kernel's rows
+      const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
       const applyTurn = () => {
-        const m = buffer.get("_rot4d_turn");
+        const m = own ? IDENTITY : buffer.get("_rot4d_turn");  // the page's rows are in the final frame
         if (!Array.isArray(m) || m.length !== 16) return;
         for (const mesh of meshes) {
           const obj = mesh.obj;
@@ -410,11 +413,11 @@ async function render({ model, el }) {
         if (e.geometry.dispose) e.geometry.dispose();
       };
       cleanups.push(() => layers.forEach(release));
-      const expand = () => {
-        const obj = buffer.obj;
+      const expand = (picture) => {
+        const obj = picture ? { array: picture.rows, stride: picture.stride, version: picture.version } : buffer.obj;
         if (!obj || !obj.array || !(obj.stride > 0)) return;
         const held = Math.floor(obj.array.length / obj.stride);
-        const counts = buffer.get("_rot4d_counts") || [];
+        const counts = picture ? picture.counts : buffer.get("_rot4d_counts") || [];
         layers.forEach((layer, i) => {
           const inst = layer.model.obj;
           const mesh = layer.mesh && layer.mesh.obj;
@@ -479,12 +482,23 @@ async function render({ model, el }) {
         projections.set(lo, g);
         return g;
       };
+      let ownProj = null; // the state message of the page's own state, made once per state
+      const ownProjection = (p) => {
+        if (!ownProj || ownProj.version !== p.version) {
+          const c0 = p.state.c0;
+          ownProj = { version: p.version, msg: { matrix: Array.from(p.state.matrix), offsets: [c0], middle: c0 } };
+        }
+        return ownProj.msg;
+      };
       const projectionBefore = () => {
         const lo = proj && proj.lines.obj, po = proj && proj.points.obj;
         if (!lo || !po) return;
         const g = projectionShared(lo);
         if (!g) return;
-        const sk = buffer.get("_rot4d_skeleton"), st = buffer.get("_rot4d_project");
+        const sk = buffer.get("_rot4d_skeleton");
+        // the page's own state while it draws its own picture (a single polytope: one hyperplane, c0)
+        const mine = own && turning(model).prediction;
+        const st = mine && mine.state ? ownProjection(mine) : buffer.get("_rot4d_project");
         if (g.sk !== sk) {
           g.sk = sk;
           g.decoded = decodeSkeleton(sk);
@@ -733,11 +747,28 @@ async function render({ model, el }) {
           ratioRenderer.setPixelRatio(baseRatio);
         }
       });
-      const beforeRender = (_scene, renderer) => {
+      const beforeRender = (_scene, renderer, camera) => {
         settle();
-        expand();
+        const p = turning(model).prediction;
+        const mine = polytopeArrived(model) !== null && drawsOwn(model, p, buffer.get("_rot4d_seq"));
+        if (mine !== own) {
+          own = mine;
+          applyTurn();
+        }
+        const eye = camera && camera.position ? [camera.position.x, camera.position.y, camera.position.z] : null;
+        expand(own ? ownPicture(model, p, eye) : null);
         applyRatio(renderer);
       };
+      // the page's own picture changes with its state: draw again
+      const redraw = () => {
+        if (own || drawsOwn(model, turning(model).prediction, buffer.get("_rot4d_seq"))) {
+          scene.trigger("rerender", scene, {});
+          projectionRerender();
+        }
+      };
+      const sharedTurn = turning(model);
+      sharedTurn.listeners.add(redraw);
+      cleanups.push(() => sharedTurn.listeners.delete(redraw));
       scene.on("beforeRender", beforeRender);
       cleanups.push(() => scene.off("beforeRender", beforeRender));
 

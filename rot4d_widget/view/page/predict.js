@@ -19,7 +19,7 @@ export class Prediction {
     this.kernel = null;
     this.state = null;
     this.applied = [];
-    this.lastLabel = null;
+    this.version = 0;  // counts changes of the predicted state (a picture's cache key)
     if (kernel) this.adopt(kernel);
   }
 
@@ -31,6 +31,7 @@ export class Prediction {
     this.base = new PageState(kernel.state, this.config.bounds);
     this.state = this.base.copy();
     this.applied = [];
+    this.version += 1;
   }
 
   // A key event the page steps itself: {action, inverted, kid} or null (not ours: the kernel's).
@@ -76,6 +77,7 @@ export class Prediction {
       changed = this.state.apply(s.action, s.inverted) || changed;
       this.applied.push(s);
     }
+    if (changed) this.version += 1;
     return changed;
   }
 

@@ -101,12 +101,19 @@ export function attachKeys(model, { listen, hovered, canvases }) {
   listen(document, "visibilitychange", () => {
     if (document.visibilityState === "hidden") releaseAll(performance.now());
   });
-  // ipyevents forwards the canvas's mouseleave (its timeStamp) and the kernel releases then
-  listen(document, "mouseout", (event) => {
+  // ipyevents forwards the canvas's mouseleave (its timeStamp) and the kernel releases then: the
+  // same listener on each canvas element of this widget, added as they appear (a pointer over one)
+  const watched = new WeakSet();
+  const onLeave = (event) => releaseAll(event.timeStamp);
+  const watchCanvases = () => {
     for (const c of canvases()) {
-      if (event.target === c && !(event.relatedTarget && c.contains(event.relatedTarget))) releaseAll(event.timeStamp);
+      if (watched.has(c)) continue;
+      watched.add(c);
+      listen(c, "mouseleave", onLeave);
     }
-  }, true);
+  };
+  listen(document, "mouseover", watchCanvases, true);
+  watchCanvases();
 }
 
 // The kernel's state arrived (`kernel_state`): adopted, the page's later steps on top.
