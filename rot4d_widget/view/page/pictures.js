@@ -10,6 +10,11 @@ import { sliceRows } from "./rows.js";
 import { transferStore, unpack } from "./transfer.js";
 
 const cuts = new WeakMap();  // model -> {key, polytope, rows cache}
+const forced = new WeakMap();  // model -> true: draw the page's own picture at rest too (tests compare the two)
+
+export function forceOwn(model, on) {
+  forced.set(model, !!on);
+}
 
 // The polytope the page holds for this widget, decoded once when its transfer is whole.
 export function polytopeArrived(model) {
@@ -34,7 +39,7 @@ export function drawsOwn(model, prediction, seq) {
   const offered = (model.get("page_data") || {}).polytope;
   const cfg = model.get("draw_config") || {};
   if (!c || !prediction || !prediction.state || c.key !== offered || !Array.isArray(cfg.palette)) return false;
-  if (prediction.held.length || prediction.pending) return true;
+  if (prediction.held.length || prediction.pending || forced.get(model)) return true;
   const ks = model.get("kernel_state") || {};
   return ks.picture === "pending" || (Number.isInteger(ks.picture) && !(seq >= ks.picture));
 }
