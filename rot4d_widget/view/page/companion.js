@@ -56,7 +56,7 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
-import { adoptKernel, attachKeys, turning } from "./turning.js";
+import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 import { drawsOwn, forceOwn, ownPicture, polytopeArrived } from "./pictures.js";
 
@@ -129,6 +129,7 @@ async function render({ model, el }) {
   };
   turning(model);
   attachKeys(model, { listen, hovered: () => canvasClasses().some(canvasHovered), canvases });
+  attachPad(model, { listen, canvasClass: () => model.get("canvas_class") });
   const onKernelState = () => adoptKernel(model);
   const onConfig = () => turning(model);
   if (typeof model.on === "function") {
