@@ -50,6 +50,7 @@ from scipy.ndimage import map_coordinates
 from ..core import look
 from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering
 from ..core.progress import progress as make_progress
+from . import volume_kernels
 
 #: How far the live view's camera is from the centre (`rot4d_widget.keep.drawing.CAMERA_DISTANCE`,
 #: the same number: that module imports matplotlib, which the widget's import does not need)
@@ -139,10 +140,10 @@ def _trilinear(flat, shape, x, y, z):
 
 
 def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
-    """Pixels per ray side: ``pixels_per_ray``, or (None) the most that keeps two rays per grid
+    """Pixels per ray side: ``pixels_per_ray``, or ("auto") the most that keeps two rays per grid
     spacing where the grid is nearest the eye (a ray per pixel for a small picture)."""
-    if pixels_per_ray is not None:
-        return max(1, int(pixels_per_ray))
+    if pixels_per_ray != "auto":
+        return _check_pitch(pixels_per_ray)
     w_px = int(size[0])
     (x0, x1), _ = limits
     near = float(shift[2]) + scale * (float(grid.origin[2]) + grid.spacing * (grid.values.shape[2] - 1))
@@ -150,6 +151,12 @@ def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
         return 1
     voxel_px = scale * grid.spacing * distance / (distance - near) * w_px / (x1 - x0)
     return max(1, int(voxel_px // 2))
+
+
+def _check_pitch(pixels_per_ray) -> int:
+    if isinstance(pixels_per_ray, bool) or not isinstance(pixels_per_ray, (int, np.integer)) or pixels_per_ray < 1:
+        raise ValueError(f"Expected `pixels_per_ray` to be an int >= 1 or 'auto', got {pixels_per_ray!r}")
+    return int(pixels_per_ray)
 
 
 def _progress_sink(progress, description: str):
@@ -167,7 +174,7 @@ def _progress_sink(progress, description: str):
 
 def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None, scale: float = 1.0,
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
-                step: float = 0.5, pixels_per_ray=None, sections=DEFAULT_SECTIONS, progress=True) -> np.ndarray:
+                step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True) -> np.ndarray:
     """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
     ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
@@ -176,9 +183,11 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     optical depth across the grid's longest side at the top of the ramp; ``step``: samples every
     ``step`` spacings along a ray; ``sections``: (fx, fy, fz), the planes' places as fractions of
     the grid's extent.  ``pixels_per_ray``: one ray for every p x p pixels, the picture between
-    the rays' pixels bilinear in premultiplied colour (1: a ray through every pixel's centre);
-    None: two rays per grid spacing where the grid is nearest, at most one per pixel (sections:
-    always one per pixel).  ``progress``: True a progress bar once the casting took a second
+    the rays' pixels bilinear in premultiplied colour (1, the default: a ray through every pixel's
+    centre, the full resolution); "auto": two rays per grid spacing where the grid is nearest, at
+    most one per pixel (sections: always one per pixel).  The rays are cast by a compiled kernel
+    (`rot4d_widget.keep.volume_kernels`) when numba is installed, else in numpy: the same picture.
+    ``progress``: True a progress bar once the casting took a second
     (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1)."""
     # matplotlib's colour map registry: the keep wing's, looked up by name
     from matplotlib import colormaps
@@ -198,7 +207,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     tick, close = _progress_sink(progress, f"ray casting ({rendering})")
     try:
         if rendering == "sections":
-            pitch = 1 if pixels_per_ray is None else max(1, int(pixels_per_ray))
+            pitch = 1 if pixels_per_ray == "auto" else _check_pitch(pixels_per_ray)
         else:
             pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
         args = (grid, rendering, colormap, clim)
@@ -241,8 +250,15 @@ def _box_entry(eye, dirs, lo_box, hi_box):
 
 
 def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
-          tick=lambda f: None):
-    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes."""
+          tick=lambda f: None, *, compiled: bool = True):
+    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes.  The
+    compiled kernel's picture (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is
+    there and ``compiled``, else numpy's (every ray at once, a step at a time)."""
+    if compiled:
+        out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
+                                  step, fractions, tick)
+        if out is not None:
+            return out
     vals = np.asarray(grid.values)
     spacing = float(grid.spacing)
     w_px, h_px = size
