@@ -242,15 +242,96 @@ def _draw_colorbar(fig, rect, cmap: str, clim, label: str, marks=(), fontsize: f
     return cax
 
 
-def _draw_box_labels(ax, labels, scale: float, centre, fontsize: float = 7.0, height: float = 5.0) -> list:
+#: Labels are placed this many pixels from the extent they keep clear of (the page's LABEL_GAP).
+LABEL_GAP = 4.0
+_STEPS = (0, 1, -1, 2, -2, 3, -3, 4, -4)
+_OUTWARD = (0, 1, 2, 3, 4, 5, 6, 7, 8)
+
+
+def _overlaps(a, b) -> bool:
+    return a[0] < b[0] + b[2] and b[0] < a[0] + a[2] and a[1] < b[1] + b[3] and b[1] < a[1] + a[3]
+
+
+def _label_candidates(x, y, w, h, kind, keep, width, height, gap):
+    def clamp(v, lo, hi):
+        return max(lo, min(hi, v))
+
+    out = []
+    if kind == "slice" or keep is None:
+        return [(clamp(x - w / 2, 0, width - w), y + gap + k * (h + 1)) for k in _OUTWARD]
+    x0, y0, x1, y1 = keep
+    dist = {"left": x - x0, "right": x1 - x, "top": y - y0, "bottom": y1 - y}
+    for side in sorted(("left", "right", "top", "bottom"), key=lambda s: dist[s]):  # stable: ties in this order
+        if side in ("left", "right"):
+            left = min(x0, x) - gap - w if side == "left" else max(x1, x) + gap
+            out += [(left, clamp(y - h / 2 + k * (h + 1), 0, height - h)) for k in _STEPS]
+        else:
+            left = clamp(x - w / 2, 0, width - w)
+            out += [(left, min(y0, y) - gap - h - k * (h + 1) if side == "top" else max(y1, y) + gap + k * (h + 1))
+                    for k in _OUTWARD]
+    return out
+
+
+def place_labels(items, keep, width: float, height: float, gap: float = LABEL_GAP, placed=()) -> list:
+    """Where each label goes, in pixels of a picture ``width`` x ``height`` (y down): ``items``
+    ``[(x, y, w, h, kind), ...]`` -- a label's point and its box's size, placed in that order --
+    ``keep`` the rectangle ``(x0, y0, x1, y1)`` the data's extent projects into (or None);
+    ``placed``: boxes ``(left, top, w, h)`` already taken (an annotation).  Returns ``[(left, top,
+    free), ...]``, free False where no place was free (the first place tried, clamped).
+
+    The page's rule (``page/labels.js`` ``placeLabels``, the same places in the same order): a box
+    label ("corner", "edge") goes outside ``keep`` on the side nearest its point, level with the
+    point on the left or right (moved a line at a time, down and up alternately) or above or
+    below it (moved outward a row at a time) until it overlaps no box placed before it, inside the
+    picture; the next side when none of 9 places is free.  A "slice" label is centred under its
+    point, moved down past the boxes placed before it."""
+    taken = [tuple(float(v) for v in b) for b in placed]
+    keep_box = None if keep is None else (keep[0], keep[1], keep[2] - keep[0], keep[3] - keep[1])
+    out = []
+    for x, y, w, h, kind in items:
+        tries = _label_candidates(float(x), float(y), float(w), float(h), kind, keep, width, height, gap)
+        found = None
+        for left, top in tries:
+            box = (left, top, w, h)
+            if left < 0 or top < 0 or left + w > width or top + h > height:
+                continue
+            if keep_box is not None and kind != "slice" and _overlaps(box, keep_box):
+                continue
+            if any(_overlaps(box, b) for b in taken):
+                continue
+            found = (left, top, True)
+            break
+        if found is None:
+            left, top = tries[0]
+            found = (max(0.0, min(width - w, left)), max(0.0, min(height - h, top)), False)
+        taken.append((found[0], found[1], w, h))
+        out.append(found)
+    return out
+
+
+def text_size(text: str, fontsize: float, linespacing: float = 1.2) -> tuple:
+    """(width, height) in points of ``text`` (lines split at newlines) at ``fontsize``, drawn
+    literally (no mathtext): the widest line's advance, and the lines at ``linespacing``."""
+    # matplotlib's text layout: imported when a label is placed
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    prop = FontProperties(size=fontsize)
+    lines = text.split("\n")
+    width = max(text_to_path.get_text_width_height_descent(s, prop, ismath=False)[0] for s in lines)
+    return width, fontsize * (1.0 + linespacing * (len(lines) - 1)) * 1.25
+
+
+def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, height: float = 5.0,
+                     placed=()) -> list:
     """``labels`` (`rot4d_widget.sources.field_labels.box_labels`: the origin corner first, then the
     far ends of the three edges leaving it, in slice coordinates) drawn at the points placed at
     ``scale * p`` and projected: the three edges as thin dashed lines (what the texts label), each
-    text small, one data coordinate a line, set off from the projected ``centre`` of the box on
-    its outer side so that it reads beside the picture rather than across it, moved inward where
-    it would leave the axes and to another side of its point (or a text's height above or below)
-    where it would cover a text already placed (``height``: the axes' height in inches).  Returns
-    the Text artists (gid "box-label")."""
+    text small, one data coordinate a line, outside the rectangle the data's ``extent`` (its
+    corners, slice coordinates) projects into, so that no label covers the picture
+    (`place_labels`, the page's rule), with a dotted line from its point when moved away from it
+    (``height``: the axes' height in inches; ``placed``: boxes in axes pixels already taken, y
+    down).  Returns the Text artists (gid "box-label")."""
     # matplotlib collections: imported when a field's box is labelled
     from matplotlib.collections import LineCollection
 
@@ -258,34 +339,44 @@ def _draw_box_labels(ax, labels, scale: float, centre, fontsize: float = 7.0, he
         return []
     pts = np.asarray([p for p, _ in labels], dtype=np.float64).reshape(-1, 3) * float(scale)
     xy, _ = perspective(pts)
-    (c,), _ = perspective(np.asarray(centre, dtype=np.float64).reshape(1, 3) * float(scale))
     edges = LineCollection([[xy[0], xy[k]] for k in range(1, len(xy))], colors="#777777", linewidths=0.6,
                            linestyles=(0, (3, 2)), zorder=_Z_LABEL - 2.0, gid="box-edge")
     ax.add_collection(edges, autolim=False)
     (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
-    point = (y1 - y0) / (float(height) * 72.0)  # data units per typographic point
-    gap = 3.0 * point
-    out, placed = [], []
-    box = dict(facecolor="white", alpha=0.7, edgecolor="none", pad=1.0)
-    for (x, y), (_, text) in zip(xy, labels):
-        if not text:
-            continue
-        lines = text.split(", ")
-        wd = (0.6 * fontsize * max(len(s) for s in lines) + 2.0) * point  # the text's size, roughly
-        ht = (1.2 * fontsize * len(lines) + 2.0) * point
-        sx, sy = (1.0 if x >= c[0] else -1.0), (1.0 if y >= c[1] else -1.0)  # outward from the centre
-        choices = []
-        for shift in (0.0, 1.0, -1.0, 2.0, -2.0):  # beside the point, else a text's height above or below
-            for fx, fy in ((sx, sy), (-sx, sy), (sx, -sy), (-sx, -sy)):
-                tx = x + gap if fx > 0 else x - gap - wd
-                ty = (y + gap if fy > 0 else y - gap - ht) + shift * ht
-                tx = min(max(tx, x0 + point), x1 - wd - point)  # inside the picture
-                ty = min(max(ty, y0 + point), y1 - ht - point)
-                choices.append((tx, ty))
-        free = [(tx, ty) for tx, ty in choices
-                if not any(tx < b[2] and b[0] < tx + wd and ty < b[3] and b[1] < ty + ht for b in placed)]
-        tx, ty = (free or choices)[0]
-        placed.append((tx, ty, tx + wd, ty + ht))
-        out.append(ax.text(tx, ty, "\n".join(lines), ha="left", va="bottom", fontsize=fontsize, color="#333333",
+    dpi = float(ax.figure.dpi)
+    hpx = float(height) * dpi
+    wpx = hpx * (x1 - x0) / (y1 - y0)
+    px = dpi / 72.0  # pixels per point
+
+    def to_px(p):
+        p = np.asarray(p, dtype=np.float64).reshape(-1, 2)
+        return np.column_stack([(p[:, 0] - x0) / (x1 - x0) * wpx, (y1 - p[:, 1]) / (y1 - y0) * hpx])
+
+    def to_data(u, v):
+        return x0 + u / wpx * (x1 - x0), y1 - v / hpx * (y1 - y0)
+
+    ext = np.asarray(extent, dtype=np.float64).reshape(-1, 3) * float(scale)
+    keep = None
+    if len(ext):
+        e = to_px(perspective(ext)[0])
+        keep = (float(e[:, 0].min()), float(e[:, 1].min()), float(e[:, 0].max()), float(e[:, 1].max()))
+    pad = 1.0  # the text's box, points
+    shown = [(p, "\n".join(text.split(", "))) for p, (_, text) in zip(to_px(xy), labels) if text]
+    items = []
+    for (u, v), text in shown:
+        w, h = text_size(text, fontsize, 1.1)
+        items.append((u, v, (w + 2 * pad) * px + 1, (h + 2 * pad) * px + 1, "edge"))
+    boxes = place_labels(items, keep, wpx, hpx, LABEL_GAP, placed)
+    out, leaders = [], []
+    box = dict(facecolor="white", alpha=0.7, edgecolor="none", pad=pad)
+    for ((u, v), text), (left, top, _free), item in zip(shown, boxes, items):
+        tx, ty = to_data(left + pad * px, top + pad * px)
+        out.append(ax.text(tx, ty, text, ha="left", va="top", fontsize=fontsize, color="#333333",
                            zorder=_Z_LABEL - 1.0, gid="box-label", bbox=box, linespacing=1.1))
+        nu, nv = min(max(u, left), left + item[2]), min(max(v, top), top + item[3])
+        if math.hypot(nu - u, nv - v) > 3.0:
+            leaders.append([to_data(u, v), to_data(nu, nv)])
+    if leaders:
+        ax.add_collection(LineCollection(leaders, colors="#777777", linewidths=0.5, linestyles=(0, (1.5, 1.5)),
+                                         zorder=_Z_LABEL - 2.0, gid="label-leader"), autolim=False)
     return out

@@ -256,11 +256,10 @@ def render_tomography(
     if right:
         _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
     if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
-        grid = grids[0] if grids else _slice_box(data, offs, soff)
-        if grid is not None:
-            labels = box_labels(inner, matrix, c0, grid)
-            centre = np.asarray(grid.origin) + 0.5 * np.diff(np.asarray(grid.extent), axis=1).ravel()
-            _draw_box_labels(ax, labels, scale, centre, small_font(height) - 0.5, height)
+        box = _slice_box(data, offs, soff)  # the data's extent, never the padded sampling grid
+        if box is not None:
+            labels = box_labels(inner, matrix, c0, box)
+            _draw_box_labels(ax, labels, scale, box.corners, small_font(height) - 0.5, height)
     if annotate:
         lines, legend = annotation(src, data, c0, theta0=_theta0, cmap=cmap, clim=clim)
         if volume:
@@ -313,13 +312,14 @@ def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top
 
 def _slice_box(data, offs, soff):
     """The bounding box of a single cut's box edges (the slice's segments) as what `box_labels`
-    reads of a grid (``origin``, ``extent``); None when the cut is empty."""
+    reads of a grid (``origin``, ``extent``), with the points they join (``corners``: the data's
+    extent in slice coordinates); None when the cut is empty."""
     seg = np.asarray(data.segments[soff[0]:soff[1]])
     if not len(seg):
         return None
     pts = np.asarray(data.points[offs[0]:offs[1]], dtype=np.float64)[np.unique(seg) - offs[0]]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)))
+    return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)), corners=pts)
 
 
 def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):

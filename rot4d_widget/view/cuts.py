@@ -8,14 +8,14 @@ no isosurface is computed for a single field, so a held key costs a coarse sampl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..sources.field_labels import box_labels
 from ..sources.protocol import SliceData, inner_source
 
-__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "STACK_NODES"]
+__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "data_extent", "STACK_NODES"]
 
 #: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
 STACK_NODES = 4 * 64 ** 3
@@ -77,8 +77,24 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
     return GridCut(data, parts, grids)
 
 
+@dataclass(frozen=True)
+class CutLabels:
+    """What the page needs to label a picture of a cut, whichever picture it is (the kernel's or the
+    page's own): ``labels``, ``(point (3,), text, kind)`` in slice coordinates (the source's units)
+    -- kind ``"corner"`` (the box's origin corner, every data coordinate there), ``"edge"`` (the far
+    end of an edge leaving it, what changes along it) or ``"slice"`` (a stack's slice, its w) --
+    and ``extent`` (n, 3) float64, the corners of the data's extent (the box's cut) that the box
+    labels keep clear of where they project.  False when there is no label."""
+
+    labels: tuple = ()
+    extent: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    def __bool__(self) -> bool:
+        return bool(self.labels)
+
+
 class _Box:
-    """The bounding box of a slice's points in the shape `box_labels` reads (``origin``, ``extent``)."""
+    """The bounding box of points in the shape `box_labels` reads (``origin``, ``extent``)."""
 
     def __init__(self, points):
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -87,19 +103,29 @@ class _Box:
         self.values = None
 
 
-def cut_labels(source, matrix, c0, data, grid=None) -> tuple:
-    """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels`): its box's
-    origin corner and the far ends of the three edges leaving it, with the data coordinates there,
-    in slice coordinates; ``grid`` the cut's `FieldGrid` (ray-cast renderings) or None (the
-    bounding box of ``data``'s points, the box's cut).  () for a stack, a source that maps no
-    slice point to its data (no ``to_data``) or an empty cut."""
+def data_extent(data) -> np.ndarray:
+    """(n, 3) float64: the corners of a single cut's data extent -- the points its bars (the box's
+    cut, ``data.segments``) join; the padded sampling grid of a ray-cast picture is never counted."""
+    seg = np.asarray(data.segments, dtype=np.intp).reshape(-1, 2)
+    if not len(seg):
+        return np.zeros((0, 3))
+    return np.asarray(data.points, dtype=np.float64).reshape(-1, 3)[np.unique(seg)]
+
+
+def cut_labels(source, matrix, c0, data) -> CutLabels:
+    """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels` of the
+    data's extent: the bounding box of the box's cut, ``data``'s bars, in every rendering): its
+    origin corner with every data coordinate there, the far ends of the three edges leaving it
+    with what changes along each, and the extent's corners.  An empty `CutLabels` for a stack, a
+    source that maps no slice point to its data (no ``to_data``) or a cut that misses the data."""
     if inner_source(source) is not source or not callable(getattr(source, "to_data", None)):
-        return ()
-    if grid is None:
-        if not len(data.points):
-            return ()
-        grid = _Box(data.points)
-    return box_labels(source, matrix, c0, grid)
+        return CutLabels()
+    extent = data_extent(data)
+    if not len(extent):
+        return CutLabels()
+    pairs = box_labels(source, matrix, c0, _Box(extent))
+    kinds = ("corner",) + ("edge",) * (len(pairs) - 1)
+    return CutLabels(tuple((p, t, k) for (p, t), k in zip(pairs, kinds)), extent)
 
 
 def _sample(inner, matrix, c0, resolution, coarse):

@@ -185,7 +185,7 @@ class Painter:
                 self.grid_cache = (m, c0, version, coarse_, cut)
             clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
-            labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
+            labels = cut_labels(w.source, m, c0, cut.data)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
                 self.labelled = bool(labels)
                 sent = scene.update_id

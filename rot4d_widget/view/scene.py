@@ -71,6 +71,7 @@ from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
+from .cuts import CutLabels
 from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
@@ -114,14 +115,31 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     _rot4d_surface = Dict().tag(sync=True)
     #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
     _rot4d_volume = Dict().tag(sync=True)
-    #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str}): the
-    #: companion draws them over the canvas where the points project, turned with the view.
+    #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str, "kind":
+    #: "corner" | "edge" | "slice"}): the companion draws them over the canvas where the points
+    #: project, turned with the view (`rot4d_widget.view.cuts.CutLabels`).
     _rot4d_labels = List(Dict()).tag(sync=True)
+    #: The data's extent as points ([x, y, z] displayed units): the companion keeps the box labels
+    #: ("corner", "edge") clear of the rectangle these project into.  [] = none.
+    _rot4d_label_extent = List(List(CFloat())).tag(sync=True)
     #: The projection's skeleton, sent once per source (`projection.skeleton_message`).  {} = none.
     _rot4d_skeleton = Dict().tag(sync=True)
     #: The projection's state, with every update while it is shown (`projection.state_message`).
     _rot4d_project = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
+
+
+#: A picture without labels.
+NO_LABELS = CutLabels()
+
+
+def _pinned(labels: CutLabels, scale: float) -> tuple:
+    """``(labels, extent)`` as the buffer's traits hold them, in displayed units (`CutLabels`:
+    ``(point, text, kind)`` and the extent's corners; no extent without a label)."""
+    pinned = [{"p": [float(v) * scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t),
+               "kind": str(kind)} for p, t, kind in labels.labels]
+    extent = np.asarray(labels.extent, dtype=np.float64).reshape(-1, 3) * scale
+    return pinned, [[float(v) for v in row] for row in extent] if pinned else []
 
 
 # -- option validation -------------------------------------------------------
@@ -379,8 +397,8 @@ class Scene:
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None, labels=(),
-             projection=None) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None,
+             labels: CutLabels = NO_LABELS, projection=None) -> bool:
         """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
@@ -391,8 +409,9 @@ class Scene:
         travel quantised in the same message (``_rot4d_surface``, coloured by
         ``group_rgb`` if given), the rows carry its points' bars.  ``volume``: a ray-cast
         rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
-        of any surface (None: no volume; one shown before is hidden).  ``labels``: ``(point (3,)
-        in the source's units, text)`` pairs drawn over the canvas where the points project.
+        of any surface (None: no volume; one shown before is hidden).  ``labels``: a `CutLabels`
+        (points in the source's units, texts, the data's extent) drawn over the canvas where the
+        points project.
         ``projection``: what the projection view draws of this state (`ProjectionView.message`:
         ``{"state": ..., "skeleton": ...}``, the skeleton only when new), in the same message.
         """
@@ -411,9 +430,11 @@ class Scene:
             surface = {}
         if volume is None and self._volume_shown:
             volume = {}
-        pinned = [{"p": [float(v) * self.scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t)}
-                  for p, t in labels]
-        pinned = None if pinned == self._buffer._rot4d_labels else pinned
+        pinned, extent = _pinned(labels, self.scale)
+        if pinned == self._buffer._rot4d_labels and extent == self._buffer._rot4d_label_extent:
+            pinned = None
+        else:
+            pinned = (pinned, extent)
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -506,7 +527,7 @@ class Scene:
             if projection is not None:
                 _put_projection(self._buffer, projection)
             if labels is not None:
-                buf._rot4d_labels = labels
+                buf._rot4d_label_extent, buf._rot4d_labels = labels[1], labels[0]
             if surface is not None:
                 buf._rot4d_surface = surface
                 self._surface_shown = bool(surface)
