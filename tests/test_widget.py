@@ -87,6 +87,9 @@ class FakeScene:
     def on_eye_moved(self, cb, remove=False):
         _register(self._eye_cbs, cb, remove)
 
+    def move_camera(self, eye):
+        self.camera.position = [float(v) for v in eye]
+
     @staticmethod
     def check_display(options):
         from rot4d_widget.view.scene import Scene

@@ -37,6 +37,8 @@ from .validate import int_in_range
 __all__ = [
     "REFERENCE_RADIUS",
     "CAMERA_POSITION",
+    "SECTIONS_CAMERA_POSITION",
+    "default_eye",
     "CAMERA_FOV",
     "CAMERA_NEAR",
     "CAMERA_FAR",
@@ -69,11 +71,23 @@ REFERENCE_RADIUS = 2.0 * math.sqrt(2.0 / 5.0)
 
 #: Where the eye is (displayed units); it looks down -z at the origin.
 CAMERA_POSITION = (0.0, 0.0, 5.0)
+#: Where the eye is by default in the "sections" rendering (displayed units, 5 from the origin as
+#: `CAMERA_POSITION`, looking at it, up +y): above, right of and in front of the cut, so that all
+#: three section planes are seen at a slant, none edge-on (issue 37).
+SECTIONS_CAMERA_POSITION = tuple(5.0 * v / math.sqrt(2.1**2 + 1.7**2 + 4.2**2) for v in (2.1, 1.7, 4.2))
 #: Vertical field of view in degrees (three.js ``PerspectiveCamera.fov``).
 CAMERA_FOV = 40.0
 #: Near and far clipping distances of the live camera.
 CAMERA_NEAR = 0.1
 CAMERA_FAR = 100.0
+
+
+
+def default_eye(rendering: str) -> tuple:
+    """Where the camera is by default for ``rendering``: `SECTIONS_CAMERA_POSITION` for
+    "sections" (three planes, none edge-on), else `CAMERA_POSITION` (the paper's viewpoint)."""
+    return SECTIONS_CAMERA_POSITION if rendering == "sections" else CAMERA_POSITION
+
 
 # -- colours -------------------------------------------------------------------
 

@@ -323,7 +323,7 @@ def text_size(text: str, fontsize: float, linespacing: float = 1.2) -> tuple:
 
 
 def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, height: float = 5.0,
-                     placed=()) -> list:
+                     placed=(), view=None) -> list:
     """``labels`` (`rot4d_widget.sources.field_labels.box_labels`: the origin corner first, then the
     far ends of the three edges leaving it, in slice coordinates) drawn at the points placed at
     ``scale * p`` and projected: the three edges as thin dashed lines (what the texts label), each
@@ -331,13 +331,15 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
     corners, slice coordinates) projects into, so that no label covers the picture
     (`place_labels`, the page's rule), with a dotted line from its point when moved away from it
     (``height``: the axes' height in inches; ``placed``: boxes in axes pixels already taken, y
-    down).  Returns the Text artists (gid "box-label")."""
+    down; ``view``: the camera's rotation, None the identity).  Returns the Text artists (gid
+    "box-label")."""
     # matplotlib collections: imported when a field's box is labelled
     from matplotlib.collections import LineCollection
 
     if not labels:
         return []
-    pts = np.asarray([p for p, _ in labels], dtype=np.float64).reshape(-1, 3) * float(scale)
+    view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
+    pts = np.asarray([p for p, _ in labels], dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
     xy, _ = perspective(pts)
     edges = LineCollection([[xy[0], xy[k]] for k in range(1, len(xy))], colors="#777777", linewidths=0.6,
                            linestyles=(0, (3, 2)), zorder=_Z_LABEL - 2.0, gid="box-edge")
@@ -355,7 +357,7 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
     def to_data(u, v):
         return x0 + u / wpx * (x1 - x0), y1 - v / hpx * (y1 - y0)
 
-    ext = np.asarray(extent, dtype=np.float64).reshape(-1, 3) * float(scale)
+    ext = np.asarray(extent, dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
     keep = None
     if len(ext):
         e = to_px(perspective(ext)[0])

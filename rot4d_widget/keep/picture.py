@@ -49,7 +49,7 @@ from .framing import (
     small_font,
     value_label,
 )
-from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume
+from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume, view_rotation
 
 
 def render_tomography(
@@ -85,6 +85,7 @@ def render_tomography(
     colorbar: bool = True,
     axis_labels: bool = True,
     progress=True,
+    eye=None,
     _data=None,
     _theta0=None,
     _canvas=None,
@@ -131,6 +132,10 @@ def render_tomography(
     surfaces' colours (surface rendering).  ``axis_labels``: a single cut's box labelled with its
     data coordinates (`rot4d_widget.sources.field_labels.box_labels`: the origin corner's, and
     what changes along each edge leaving it), so the picture says which way time runs.
+    ``eye``: where the camera is (displayed units; it looks at the origin, +y up, as the live view's
+    OrbitControls do; only its direction counts, the distance is the live view's 5); None: the
+    live view's default for ``rendering`` (`look.default_eye`: for "sections" above, right of and in
+    front of the cut, so that no plane is edge-on).
     """
     # a source that wraps another is parallel slices already (the protocol's ``wraps``)
     src = source if getattr(source, "wraps", None) is not None else None
@@ -162,6 +167,9 @@ def render_tomography(
     data = src.slice(matrix, c0) if _data is None else _data
     # a volume rendering's cuts, sampled once (drawn, and the box labelled); no `sample`: a TypeError here
     grids = cut_grids(src, data, matrix) if volume else None
+    view = view_rotation(look.default_eye(rendering) if eye is None else eye)
+    cut = data  # the slice in the scene's coordinates (labels, grids); `data` as the camera sees it
+    data = seen_from(data, view)
     ex = data.extra
     n = src.slices
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
@@ -210,7 +218,8 @@ def render_tomography(
         bar = look.default_bar_radius(ball) if bar_radius is None else bar_radius
         if poly is not None:
             s = ex["slices"][k]
-            placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
+            vertices = np.asarray(s.vertices) * scales[k] + np.asarray(cut.extra["centres"][k]) if n > 1 else s.vertices
+            placed = Slice(np.asarray(vertices, dtype=np.float64) @ view.T if data is not cut else vertices,
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
                            s.volume, s.dim, n_fill=int(getattr(s, "n_fill", 0)))
             if palette is not None:
@@ -250,16 +259,16 @@ def render_tomography(
     ax.set_ylim(y0, y1)
     used = None
     if volume:
-        image = draw_volume(ax, src, data, matrix, rendering, size=(round(width * dpi), round(height * dpi)),
-                            cmap=cmap, clim=clim, sections=sections, grids=grids, progress=progress)
+        image = draw_volume(ax, src, cut, matrix, rendering, size=(round(width * dpi), round(height * dpi)),
+                            cmap=cmap, clim=clim, sections=sections, grids=grids, progress=progress, view=view)
         used = image.get_clim() if image is not None else None
     if right:
         _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
     if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
-        box = _slice_box(data, offs, soff)  # the data's extent, never the padded sampling grid
+        box = _slice_box(cut, offs, soff)  # the data's extent, never the padded sampling grid
         if box is not None:
             labels = box_labels(inner, matrix, c0, box)
-            _draw_box_labels(ax, labels, scale, box.corners, small_font(height) - 0.5, height)
+            _draw_box_labels(ax, labels, scale, box.corners, small_font(height) - 0.5, height, view=view)
     if annotate:
         lines, legend = annotation(src, data, c0, theta0=_theta0, cmap=cmap, clim=clim)
         if volume:
@@ -320,6 +329,20 @@ def _slice_box(data, offs, soff):
     pts = np.asarray(data.points[offs[0]:offs[1]], dtype=np.float64)[np.unique(seg) - offs[0]]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)), corners=pts)
+
+
+def seen_from(data, view):
+    """``data`` (a stack's slice) as the camera whose rotation is ``view`` (3, 3) sees it: every
+    point, normal and slice centre turned by it about the origin (the whole scene, as an orbit of
+    the live view's camera turns it); ``data`` itself for the identity."""
+    view = np.asarray(view, dtype=np.float64).reshape(3, 3)
+    if np.array_equal(view, np.eye(3)):
+        return data
+    extra = {**data.extra, "centres": np.asarray(data.extra["centres"], dtype=np.float64) @ view.T}
+    normals = None if data.normals is None else np.asarray(data.normals) @ view.T
+    return type(data).build(np.asarray(data.points) @ view.T, data.segments, data.triangles, data.groups,
+                            normals=normals, volume=data.volume, readout=data.readout, convex=data.convex,
+                            show_points=data.show_points, extra=extra, corner_only=data.corner_only)
 
 
 def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
@@ -518,6 +541,7 @@ def render_state(
     colorbar: bool = True,
     axis_labels: bool = True,
     progress=True,
+    eye=None,
     _prepared=None,
     _canvas=None,
 ) -> Figure:
@@ -533,7 +557,9 @@ def render_state(
     ``show_balls`` / ``show_bars`` / ``show_faces``.
 
     The scene is the live view's: every source scaled to the displayed circumradius
-    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z with the vertical
+    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z (``eye``: elsewhere,
+    looking at the origin; None: `look.default_eye` of ``rendering``, the live view's default camera
+    -- for "sections" an oblique one) with the vertical
     field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
     `look.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
@@ -579,9 +605,10 @@ def render_state(
     face_color = None
     if color_by != "group":
         face_color = look.as_rgb(color_by, "color_by")
+    view = view_rotation(look.default_eye(rendering) if eye is None else eye)
     if _prepared is None:
         _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
-                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps)
+                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps, view=view)
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
@@ -591,18 +618,18 @@ def render_state(
         bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
         annotate=annotate, rendering=rendering, cmap=cmap, clim=clim, sections=sections, colorbar=colorbar,
-        axis_labels=axis_labels, progress=progress, _data=data, _theta0=state.theta0, _canvas=_canvas,
+        axis_labels=axis_labels, progress=progress, eye=eye, _data=data, _theta0=state.theta0, _canvas=_canvas,
     )
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
-             show_balls=True, data=None, inside=None, caps=None, **_ignored):
+             show_balls=True, data=None, inside=None, caps=None, view=None, **_ignored):
     """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
     source with the settings applied (`state_source`), its slice at ``state``, the ball radius
     in displayed units (None: the stack's default) and the projected bounding box of the
     drawing (`frame_extent`; None when empty).  ``data``: the slice, computed before.  An
     animation takes the boxes of all its frames first to frame them alike, and draws each frame
-    from the slice computed then."""
+    from the slice computed then.  ``view``: the camera's rotation (the box as it sees the slice)."""
     stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
                          inside=inside, caps=caps)
     if ball_radius is None:
@@ -615,4 +642,5 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
         ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
     else:
         ball = 0.0
-    return stack, data, ball_radius, frame_extent(data, stack, ball_radius=ball)
+    seen = data if view is None else seen_from(data, view)
+    return stack, data, ball_radius, frame_extent(seen, stack, ball_radius=ball)

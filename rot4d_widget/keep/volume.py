@@ -57,7 +57,7 @@ from . import volume_kernels
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
 __all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
-           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
+           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids", "view_rotation"]
 
 # RENDERINGS (what `render_state` draws for a field) and check_rendering are core.look's, named here too.
 #: The renderings ray-cast here.
@@ -68,6 +68,28 @@ DEFAULT_DENSITY = 4.0
 _BATCH_POINTS = 400_000
 #: A ray this transparent no longer changes a pixel (front-to-back compositing stops for it).
 _OPAQUE = 1e-4
+
+
+def view_rotation(eye) -> np.ndarray:
+    """(3, 3) float64: the rotation taking scene coordinates to those of a camera at ``eye`` (3,)
+    looking at the origin with +y up (three.js ``lookAt``): its rows are the camera's x, y and z
+    axes, so that the camera sits on its own +z axis at ``|eye|``, as the static pictures' camera
+    does.  The identity for `look.CAMERA_POSITION`.
+
+    >>> view_rotation((0.0, 0.0, 5.0)).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    e = np.asarray(eye, dtype=np.float64).reshape(3)
+    n = float(np.linalg.norm(e))
+    if not (np.all(np.isfinite(e)) and n > 0):
+        raise ValueError(f"Expected `eye` to be a finite point other than the origin, got {tuple(e)}")
+    z = e / n
+    x = np.cross((0.0, 1.0, 0.0), z)
+    if np.linalg.norm(x) < 1e-12:
+        raise ValueError(f"Expected `eye` off the vertical axis (the camera looks at the origin with +y up), "
+                         f"got {tuple(e)}")
+    x /= np.linalg.norm(x)
+    return np.vstack([x, np.cross(z, x), z])
 
 
 def default_clim(values) -> tuple:
@@ -174,7 +196,8 @@ def _progress_sink(progress, description: str):
 
 def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None, scale: float = 1.0,
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
-                step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True) -> np.ndarray:
+                step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True,
+                view=None) -> np.ndarray:
     """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
     ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
@@ -188,7 +211,9 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     most one per pixel (sections: always one per pixel).  The rays are cast by a compiled kernel
     (`rot4d_widget.keep.volume_kernels`) when numba is installed, else in numpy: the same picture.
     ``progress``: True a progress bar once the casting took a second
-    (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1)."""
+    (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1).
+    ``view``: (3, 3) the camera's rotation (`view_rotation` of its position; None: the identity,
+    the eye on +z): the rays are turned back into the scene, so the grid is seen from there."""
     # matplotlib's colour map registry: the keep wing's, looked up by name
     from matplotlib import colormaps
 
@@ -211,7 +236,8 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
         else:
             pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
         args = (grid, rendering, colormap, clim)
-        rest = (scale, shift, distance, density, step, fractions, tick)
+        view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
+        rest = (scale, shift, distance, density, step, fractions, tick, view)
         if pitch == 1:
             out = _cast(*args, (w_px, h_px), limits, *rest)
             tick(1.0)
@@ -250,13 +276,15 @@ def _box_entry(eye, dirs, lo_box, hi_box):
 
 
 def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
-          tick=lambda f: None, *, compiled: bool = True):
-    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes.  The
-    compiled kernel's picture (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is
-    there and ``compiled``, else numpy's (every ray at once, a step at a time)."""
+          tick=lambda f: None, view=None, *, compiled: bool = True):
+    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes; ``view``
+    the camera's rotation (None: the identity).  The compiled kernel's picture
+    (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
+    numpy's (every ray at once, a step at a time)."""
+    view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
     if compiled:
         out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
-                                  step, fractions, tick)
+                                  step, fractions, tick, view)
         if out is not None:
             return out
     vals = np.asarray(grid.values)
@@ -268,6 +296,8 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
     hi_box = lo_box + scale * spacing * (np.asarray(shape) - 1)
     eye, dirs = pixel_rays(size, limits, distance)
     dirs = dirs.reshape(-1, 3)
+    if not np.array_equal(view, np.eye(3)):  # the rays back into the scene: p_scene = view.T p_camera
+        eye, dirs = view.T @ eye, dirs @ view
     t_in, t_out = _box_entry(eye, dirs, lo_box, hi_box)
     hit = np.flatnonzero(t_out > t_in)
     if not len(hit):
@@ -391,7 +421,7 @@ def grids_clim(grids) -> tuple:
 
 
 def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis", clim=None,
-                density: float = DEFAULT_DENSITY, sections=DEFAULT_SECTIONS, grids=None, progress=True):
+                density: float = DEFAULT_DENSITY, sections=DEFAULT_SECTIONS, grids=None, progress=True, view=None):
     """Paint the cut(s) of ``stack``'s field (a `StackSource` whose inner source has ``sample``,
     like `Field4D.sample`) on ``ax`` as ``rendering`` ("mip", "volume" or "sections"): every slice
     of ``data`` (the stack's slice at ``matrix``) sampled at its cut (``grids``: sampled before,
@@ -414,7 +444,8 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
         scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
         limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
-        order = np.argsort(centres[:, 2], kind="stable") if n > 1 else np.arange(n)
+        depth = centres[:, 2] if view is None else (centres @ np.asarray(view, dtype=np.float64).reshape(3, 3).T)[:, 2]
+        order = np.argsort(depth, kind="stable") if n > 1 else np.arange(n)
         images = []
         for rank, k in enumerate(order):
             if grids[k].empty:
@@ -422,7 +453,7 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
             shift = scale * centres[k] if n > 1 else np.zeros(3)
             sc = scale * scales[k] if n > 1 else scale
             images.append(render_grid(grids[k], rendering, size=size, limits=limits, cmap=cmap, clim=clim, scale=sc,
-                                      shift=shift, density=density, sections=sections,
+                                      shift=shift, density=density, sections=sections, view=view,
                                       progress=lambda f, r=rank: tick((1.0 + r + f) / (n + 1))))
     finally:
         close()

@@ -81,11 +81,12 @@ def _lookup(lut, x):  # pragma: no cover - compiled by numba
     return min(max(int(k), 0), n - 1)
 
 
-def _cast_rows(vals, cells, shape, view, box, grid, mode, lut, clim, optics, planes, row0, row1,
+def _cast_rows(vals, cells, shape, view, rot, box, grid, mode, lut, clim, optics, planes, row0, row1,
                out):  # pragma: no cover - compiled by numba
     """Rows ``row0`` ... ``row1 - 1`` of the picture ``out`` (H, W, 4), straight RGBA.
 
     ``view`` = (x0, x1, y0, y1, distance): the picture plane's limits and the eye's distance;
+    ``rot`` (3, 3) the camera's rotation (a ray's direction in the scene is ``rot.T @ d``);
     ``box`` (6,) the grid's box in scene units (lo, hi); ``grid`` (6,) the eye in grid indices
     (a0) and scene units per spacing, then step (scene units per sample) and the slack at the
     box's faces; ``optics`` = (extinction per scene unit at ramp 1, opaque); ``planes`` (3,) the
@@ -101,9 +102,12 @@ def _cast_rows(vals, cells, shape, view, box, grid, mode, lut, clim, optics, pla
         for c in range(w_px):
             X = x0 + (c + 0.5) * ((x1 - x0) / w_px)
             norm = math.sqrt(X * X + Y * Y + dist * dist)
-            d0, d1, d2 = X / norm, Y / norm, -dist / norm
+            v0, v1, v2 = X / norm, Y / norm, -dist / norm
+            d0 = rot[0, 0] * v0 + rot[1, 0] * v1 + rot[2, 0] * v2
+            d1 = rot[0, 1] * v0 + rot[1, 1] * v1 + rot[2, 1] * v2
+            d2 = rot[0, 2] * v0 + rot[1, 2] * v1 + rot[2, 2] * v2
             dirs = (d0, d1, d2)
-            eye = (0.0, 0.0, dist)
+            eye = (rot[2, 0] * dist, rot[2, 1] * dist, rot[2, 2] * dist)
             t_in, t_out = -np.inf, np.inf
             for a in range(3):
                 if dirs[a] == 0.0:
@@ -187,9 +191,9 @@ _BAND = 64
 
 
 def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
-         tick=lambda f: None):
+         tick=lambda f: None, view=None):
     """`volume._cast`'s picture (H, W, 4) straight RGBA float64 from the compiled kernel, or None
-    without numba (the caller casts in numpy)."""
+    without numba (the caller casts in numpy); ``view`` the camera's rotation (None: identity)."""
     kernel = _get_kernel()
     if kernel is None:  # pragma: no cover - numba is optional
         return None
@@ -204,7 +208,8 @@ def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, 
     cells = _cell_flags(vals).ravel()
     lo_box = shift + scale * np.asarray(grid.origin, dtype=np.float64)
     hi_box = lo_box + scale * spacing * (shape - 1)
-    eye = np.array([0.0, 0.0, float(distance)])
+    rot = np.eye(3) if view is None else np.ascontiguousarray(view, dtype=np.float64).reshape(3, 3)
+    eye = rot.T @ np.array([0.0, 0.0, float(distance)])
     a0 = ((eye - shift) / scale - np.asarray(grid.origin, dtype=np.float64)) / spacing
     unit = scale * spacing
     (x0, x1), (y0, y1) = limits
@@ -219,7 +224,7 @@ def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, 
     planes = (shape - 1).astype(np.float64) * np.asarray(fractions, dtype=np.float64)
     mode = MODES[rendering]
     for r0 in range(0, h_px, _BAND):
-        kernel(flat, cells, shape, view, box, gridv, mode, lut, np.array([lo, hi]), optics, planes, r0,
+        kernel(flat, cells, shape, view, rot, box, gridv, mode, lut, np.array([lo, hi]), optics, planes, r0,
                min(h_px, r0 + _BAND), out)
         tick(min(h_px, r0 + _BAND) / h_px)
     return out

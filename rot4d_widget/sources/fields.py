@@ -92,7 +92,7 @@ from .field_input import (  # noqa: F401,E402  (export reads them)
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
 from .field_levels import FieldLevels
 from .field_memory import FieldMemory
-from .field_readout import _describe, _order_text, _readout
+from .field_readout import _describe, _order_text, _outline_readout, _readout
 from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
@@ -430,12 +430,14 @@ class Field4D(FieldLevels, FieldMemory):
     def outline(self, matrix, c0) -> "FieldSliceData":
         """The slice's bars without its surface: the cut of the data's box at w = ``c0`` after
         ``matrix``, read from nothing (the source protocol's ``outline``: what the widget sizes its
-        buffers and ball radius from, so that building a view reads no chunk but its first cut's)."""
+        buffers and ball radius from, so that building a view reads no chunk but its first cut's),
+        and the readout rows that do not depend on the surfaces (field, axes, w cut, w per unit)."""
         m = as_rotation_matrix(matrix)
         d = self.offset(c0)
         frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
                  "unit": _sealed(self._unit.copy())}
-        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), _box_slice(self, m, d), (), frame)
+        box = _box_slice(self, m, d)
+        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box, _outline_readout(self, m, d, box), frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)

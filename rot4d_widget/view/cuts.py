@@ -12,10 +12,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..sources.field_labels import box_labels
-from ..sources.protocol import SliceData, inner_source
+from ..core.look import number_text
+from ..sources.field_labels import axis_names, axis_units, box_labels
+from ..sources.protocol import SliceData, inner_source, outline_of, settings_of
 
-__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "data_extent", "STACK_NODES"]
+__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "data_extent", "rendering_rows",
+           "STACK_NODES"]
 
 #: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
 STACK_NODES = 4 * 64 ** 3
@@ -61,7 +63,10 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
         if inner is source:
             grid = _sample(inner, matrix, c0, None, coarse)
             pts, segs = grid.outline
-            data = SliceData.build(pts, segs, show_points=False, readout=_readout(grid))
+            rows = tuple(outline_of(inner, matrix, c0).readout)
+            n = sum(1 for k, _ in rows if k in ("field", "axes"))  # the level where the surfaces' readout has it
+            rows = rows[:n] + _level_row(inner, grid) + rows[n:] + _readout(grid)
+            data = SliceData.build(pts, segs, show_points=False, readout=rows)
             return GridCut(data, (_part(grid, np.zeros(3), scale),), (grid,))
         sliced = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
         ex = sliced.extra
@@ -135,6 +140,57 @@ def _sample(inner, matrix, c0, resolution, coarse):
         res = resolution if resolution is not None else getattr(inner, "coarse_resolution", None)
         return inner.sample(matrix, c0, res)
     return inner.sample(matrix, c0, resolution, coarse=coarse)
+
+
+def _level_row(source, grid) -> tuple:
+    """The iso level(s) in a ray-cast picture: named, and said not to be drawn (the surface
+    rendering draws them), so that no row reads as if the picture showed them."""
+    levels = settings_of(source).get("levels") or ()
+    if not levels:
+        return ()
+    units = f" {grid.units}" if grid.units else ""
+    return (("level" if len(levels) == 1 else "levels",
+             f"{', '.join(f'{v:.4g}' for v in levels)}{units}: the surface rendering's (v), not drawn here"),)
+
+
+#: What each ray-cast rendering shows, for the readout ({name}: the field's name).
+RENDERING_TEXT = {
+    "mip": "maximum intensity: the highest {name} along each line of sight",
+    "volume": "volume: {name} glows and absorbs, the more the higher it is (colour bar)",
+    "sections": "sections: {name} on three planes of the cut",
+}
+
+
+def rendering_rows(source, matrix, c0, rendering: str, sections, grid) -> tuple:
+    """Readout rows saying what a ray-cast picture of a single field's cut shows: the rendering,
+    and for "sections" where its planes are, in the data's own coordinates -- for each plane (keys
+    a, s, d: the picture's x, y, z), the data coordinates that change across it, at the point where
+    it crosses the middle of the cut ("time 0.0025 s" after a turn into time; "(outside the data)"
+    for a plane in the grid's padding, past the data's box)."""
+    name = grid.name or "the value"
+    rows = [("rendering", RENDERING_TEXT[rendering].format(name=name))]
+    if rendering != "sections" or grid.empty or inner_source(source) is not source:
+        return tuple(rows)
+    ext = np.asarray(grid.extent, dtype=np.float64).reshape(3, 2)
+    mid = ext.mean(axis=1)
+    span = np.abs(np.diff(np.asarray(source.extent, dtype=np.float64).reshape(4, 2), axis=1)).ravel()
+    names, units = axis_names(source), axis_units(source)
+    planes = []
+    for a in range(3):
+        p = mid.copy()
+        p[a] = ext[a, 0] + float(sections[a]) * (ext[a, 1] - ext[a, 0])
+        q = p.copy()
+        q[a] += ext[a, 1] - ext[a, 0]
+        data = np.asarray(source.to_data(np.vstack([p, q]), matrix, c0), dtype=np.float64).reshape(2, 4)
+        moved = [c for c in range(4) if abs(data[1, c] - data[0, c]) > 1e-6 * max(span[c], 1e-300)]
+        moved.sort(key=lambda c: -abs(data[1, c] - data[0, c]) / max(span[c], 1e-300))
+        text = ", ".join(f"{names[c]} {number_text(data[0, c], span[c], 3)}" + (f" {units[c]}" if units[c] else "")
+                         for c in moved)
+        lo, hi = np.asarray(source.extent, dtype=np.float64).reshape(4, 2).T
+        outside = np.any((data[0] < lo - 1e-9 * span) | (data[0] > hi + 1e-9 * span))
+        planes.append(text + (" (outside the data)" if outside else ""))
+    rows.append(("planes a / s / d", "; ".join(planes)))
+    return tuple(rows)
 
 
 def _readout(grid) -> tuple:

@@ -17,7 +17,7 @@ from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source, outline_of
 from . import markup as ro
 from .buffers import check_update_size
-from .cuts import can_sample, cut_labels, grid_cut
+from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
 from .pagestate import state_message
 from .volume_layer import volume_message
 
@@ -299,21 +299,35 @@ class Painter:
             ("last", last),
         ]
         rows += [(k, str(v)) for k, v in getattr(data, "readout", ())]
+        cast = self.cast_shown
+        single = inner_source(source) is source
+        if cast and single and self.labelled:  # what the ray-cast picture shows, and where its planes are
+            cut = self.grid_cache[4] if self.grid_cache is not None else None
+            if cut is not None and len(cut.grids) == 1:
+                rows += rendering_rows(source, self.shown.matrix, self.shown.c0, w.rendering, w.sections,
+                                       cut.grids[0])
         colors, labels = self.colours()
-        if labels is not None and w.color_by == "group":  # the legend: what each colour is
-            rows.append(("colours", ro.legend_html(labels, colors)))
-        bar = self.colourbar(colors if labels is not None and inner_source(source) is source else None)
+        if labels is not None and w.color_by == "group" and not cast:  # the legend: what each colour is
+            rows.append(("colours", ro.legend_html(labels, colors)))  # (a ray-cast picture: the bar says)
+        bar = self.colourbar(colors if labels is not None and single else None)
         if bar:
             rows.append(("colour", bar))
         volume = getattr(data, "volume", None)
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
+        elif cast and single and getattr(inner_source(source), "levels", None):
+            rows.append(("volume", "\u2014 (inside the level: the surface rendering's)"))
         if self.note:
             rows.append(("picture", self.note))
         views = w._projection.readout_row()  # which view is which, with the projection shown
         if views is not None:
             rows.insert(0, views)
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
+
+    @property
+    def cast_shown(self) -> bool:
+        """True while the scene shows a ray-cast picture (volume, mip, sections), not surfaces."""
+        return self.shown is not None and self.shown.scale[2:3] not in ((), ("surface",))
 
     def colourbar(self, level_rgb=None) -> ro.Markup | str:
         """The colour bar of a field's values (`markup.colourbar_html`): ``cmap`` over ``clim`` (or
@@ -327,7 +341,7 @@ class Painter:
         levels = getattr(inner, "levels", None)
         if not levels:
             return ""
-        cast = self.shown is not None and self.shown.scale[2:3] not in ((), ("surface",))
+        cast = self.cast_shown
         if cast and self.cast_clim is not None:  # a ray-cast picture: the limits its colours used
             lo, hi = self.cast_clim
         else:

@@ -129,6 +129,26 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     version = CInt(0).tag(sync=True, echo_update=False)
 
 
+def _quaternion(r) -> tuple:
+    """(x, y, z, w): the unit quaternion of the rotation matrix ``r`` (3, 3), as three.js reads
+    ``Object3D.quaternion`` (Shepperd's method: the largest of the four squares first)."""
+    r = np.asarray(r, dtype=np.float64)
+    t = np.trace(r)
+    if t > 0:
+        s = 2.0 * np.sqrt(t + 1.0)
+        q = ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, 0.25 * s)
+    else:
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
+        q = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
+        q[i] = 0.25 * s
+        q[j] = (r[j, i] + r[i, j]) / s
+        q[k] = (r[k, i] + r[i, k]) / s
+        q = tuple(q)
+    return q
+
+
 #: A picture without labels.
 NO_LABELS = CutLabels()
 
@@ -325,6 +345,17 @@ class Scene:
     def on_view_count(self, callback, remove=False) -> None:
         """Call ``callback(n)`` when the number of displayed views of the canvas changes."""
         _register(self._view_callbacks, callback, remove)
+
+    def move_camera(self, eye) -> None:
+        """Put the camera at ``eye`` (displayed units), looking at the origin with +y up (its
+        position and its turn, in one message: three.js does not turn a camera that moves); the eye
+        callbacks follow (`on_eye_moved`: the faces are re-sent in the order for it)."""
+        from ..keep.volume import view_rotation  # the static pictures' camera: the same look-at
+
+        x, y, z, w = _quaternion(view_rotation(eye).T)
+        with self._camera.hold_sync():
+            self._camera.quaternion = (float(x), float(y), float(z), float(w))
+            self._camera.position = [float(v) for v in eye]
 
     def on_eye_moved(self, callback, remove=False) -> None:
         """Call ``callback(eye)`` when the camera's position changes (a mouse orbit ended)."""
