@@ -24,7 +24,7 @@ import numpy as np
 from ..core.progress import progress as make_progress
 from ..core.state import RotationState
 from ..geometry.polytopes import pentachoron
-from ..sources.protocol import PolytopeSource, as_source
+from ..sources.protocol import PolytopeSource, as_source, note_matrix
 from .recorder import (
     SOURCE_SETTINGS,
     VIEW_SETTINGS,
@@ -77,7 +77,9 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
 
     def set_source(name, value):  # the copy is ours: replace it where the widget would
         nonlocal src
+        note_matrix(src, state.matrix)  # as the widget tells its source: a default spacing along today's w
         src = _with_source_setting(src, name, value)
+        note_matrix(src, state.matrix)
 
     setter = None if src is None else set_source
     if src is not None:

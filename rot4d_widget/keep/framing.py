@@ -14,7 +14,6 @@ import numpy as np
 
 from ..core import look
 from ..core.look import REFERENCE_RADIUS
-from ..sources.protocol import w_frame
 from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
@@ -138,10 +137,9 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
     n = int(getattr(source, "slices", 1) or 1)
     ws = np.asarray(source.cuts_at(c0)) if n > 1 and hasattr(source, "cuts_at") else np.zeros(0)
     if len(ws):
-        spacing = getattr(source, "spacing", None)
-        per = w_frame(source)[1]  # the protocol's reader: a stack answers for its inner source
+        spacing = getattr(source, "spacing", None)  # in the source's w units, as c0 (issue 37)
         lines.append(f"{n} slices w = {ws[0]:+.4g} \u2026 {ws[-1]:+.4g}{wu}"
-                     + (f", \u0394 = {spacing * per:.3g}{wu}" if spacing else ""))
+                     + (f", \u0394 = {spacing:.3g}{wu}" if spacing else ""))
     legend = []
     group_rgb = (getattr(data, "extra", None) or {}).get("group_rgb")
     if len(ws) and group_rgb is not None:

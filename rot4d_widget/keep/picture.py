@@ -21,7 +21,7 @@ from ..core.look import REFERENCE_RADIUS
 from ..core.state import RotationState
 from ..geometry.slicing import Slice
 from ..sources.field_labels import box_labels
-from ..sources.protocol import apply_setting, as_source, inner_source, settings_of
+from ..sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
 from ..sources.tomography import StackSource
 from .canvas import LiteralTextFigure
 from .drawing import (
@@ -248,7 +248,8 @@ def render_tomography(
                           src.source, face_alpha, z_shift, bar_width, show_faces=show_faces and not volume,
                           cmap=cmap, clim=clim)
         if labels:
-            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, cuts[k], k == hi, z_shift))
+            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, data_w_text(src, float(cuts[k]), matrix), k == hi,
+                         z_shift))
     # labels that would overlap one already placed are left out: the highlighted slice's first,
     # then the nearer (bigger) slices' (far, small slices of the oval crowd together)
     placed: list = []
@@ -345,16 +346,17 @@ def seen_from(data, view):
                             show_points=data.show_points, extra=extra, corner_only=data.corner_only)
 
 
-def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
-    """'w = ...' at the upper left of a slice's projected bounding circle (inside its square, like a
-    CT film's corner text), painted with its slice (nearer slices cover it); the highlighted slice
-    ringed, its label bold.  With ``point`` (data units per point) and ``placed`` (boxes of the
-    labels drawn so far), a label overlapping one of them is left out (not the highlighted one)."""
+def _label_slice(ax, centre, radius, text, highlighted, z_shift, *, point=None, placed=None):
+    """``text`` (the slice's w in the data's units, `data_w_text`: "time 0.0025 s", "(outside the
+    data)" for a slice that misses it) at the upper left of a slice's projected bounding circle
+    (inside its square, like a CT film's corner text), painted with its slice (nearer slices
+    cover it); the highlighted slice ringed, its label bold.  With ``point`` (data units per point)
+    and ``placed`` (boxes of the labels drawn so far), a label overlapping one of them is left out
+    (not the highlighted one)."""
     (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
     r = radius * f
     fs = max(5.0, min(9.0, 30.0 * r))
     z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
-    text = f"w = {w:.3g}"
     x0, y1 = xy[0] - 0.98 * r, xy[1] + 0.98 * r
     if point is not None and placed is not None:
         # the upper left corner of the slice's square, else its upper right, else just above it
@@ -529,7 +531,7 @@ def render_state(
     show_faces: bool = True,
     size=(600, 500),
     dpi: float = 100,
-    labels: bool = False,
+    labels=None,
     title: str | None = None,
     frame="fit",
     annotate=False,
@@ -563,7 +565,8 @@ def render_state(
     field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
     `look.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
-    camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
+    camera the user dragged.  ``labels`` writes each parallel slice's w in the data's units (None, the
+    default: when there are several, so every slice of the view carries its time); ``title`` goes above.
 
     ``frame="fit"`` (the default) keeps that eye and perspective but zooms so that the projected
     bounding box of what is drawn fills `FIT_FILL` (90 %) of the picture's width or height;
@@ -614,7 +617,8 @@ def render_state(
         frame = "camera" if box is None else box
     return render_tomography(
         stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi,
-        dpi=dpi, title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
+        dpi=dpi, title=title if title else None, labels=stack.slices > 1 if labels is None else labels,
+        face_alpha=face_opacity, ball_radius=ball_radius,
         bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
         annotate=annotate, rendering=rendering, cmap=cmap, clim=clim, sections=sections, colorbar=colorbar,
@@ -632,6 +636,7 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
     from the slice computed then.  ``view``: the camera's rotation (the box as it sees the slice)."""
     stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
                          inside=inside, caps=caps)
+    note_matrix(stack, state.matrix)  # a default spacing not spread yet: along this picture's w
     if ball_radius is None:
         edge = getattr(stack, "edge_length", None)
         if edge:

@@ -93,6 +93,7 @@ from ..core.look import number_text
 from ..geometry.polytopes import POLYTOPE_NAMES, Polytope
 from ..geometry.polytopes import polytope as get_polytope
 from ..geometry.slicing import slice_polytope
+from .field_labels import axis_names
 
 __all__ = [
     "Source",
@@ -103,6 +104,8 @@ __all__ = [
     "check_slice",
     "BadSlice",
     "data_w_text",
+    "note_matrix",
+    "w_value_text",
     "w_frame",
     "inner_source",
     "settings_of",
@@ -294,6 +297,15 @@ def outline_of(source, matrix, c0):
     return source.slice(matrix, c0) if outline is None else outline(matrix, c0)
 
 
+def note_matrix(source, matrix) -> None:
+    """Tell ``source`` the orientation the view shows now (its optional ``note_matrix``: a stack
+    spreads its default spacing along that w when N next changes); nothing for a source without one.
+    Whoever runs a source's action or changes its settings (the widget, a replay) tells it first."""
+    note = getattr(source, "note_matrix", None)
+    if note is not None:
+        note(matrix)
+
+
 def prepare_in_background(source, progress: bool = True):
     """Start ``source``'s background work (its ``prepare``: a field's read into memory and coarse
     copy) and return what counts it, a `rot4d_widget.core.progress.Progress`, or None (a source
@@ -304,17 +316,31 @@ def prepare_in_background(source, progress: bool = True):
 
 
 def data_w_text(source, w: float, matrix=None) -> str:
-    """A cut's label in the source's own w, c0's units: ``"w 30 s"`` for a field (its time, in its
-    ``w_units``), ``"w +0.5"`` for a polytope.  ``w`` is a c0 (`w_frame`); ``matrix`` is unused
-    (kept for callers of the older form)."""
+    """A cut's label in the source's own w, c0's units: ``"time 30 s"`` for a field (w's name -- its
+    dim's, "w" without one -- and its time in its ``w_units``), ``"w +0.5"`` for a polytope.  ``w``
+    is a c0 (`w_frame`).  With ``matrix``, a field's cut that misses its data (``w`` outside
+    ``w_range(matrix)``: before or after the record along that w) says so: ``"time 0.5 s (outside
+    the data)"``."""
     inner = getattr(source, "source", source)
     extent = getattr(inner, "extent", None)
     if extent is None:
         text = number_text(w, getattr(source, "size", 1.0), 3)
         return f"w {'+' if not text.startswith('-') else ''}{text}"
-    lo, hi = float(extent[3][0]), float(extent[3][1])
+    text = f"{axis_names(inner)[3]} {w_value_text(inner, w)}"
+    if matrix is not None and callable(getattr(inner, "w_range", None)):
+        lo, hi = (float(v) for v in inner.w_range(matrix))
+        slack = 1e-9 * max(abs(lo), abs(hi), hi - lo)
+        if not lo - slack <= float(w) <= hi + slack:
+            text += " (outside the data)"
+    return text
+
+
+def w_value_text(source, w: float) -> str:
+    """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits."""
+    inner = getattr(source, "source", source)
+    lo, hi = (float(v) for v in inner.extent[3])
     unit = getattr(inner, "w_units", None)
-    return f"w {number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+    return f"{number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
 
 
 class BadSlice(ValueError):

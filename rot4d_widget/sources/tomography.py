@@ -5,9 +5,10 @@
 
     w_k = c0 + (k - (N - 1) / 2) Δ,        k = 0 ... N - 1,
 
-all under one orientation, and returns ONE `SliceData` in which slice k is moved and shrunk to
-its place in the arrangement: a point p of it is drawn at ``centre_k + scale_k * p`` (its
-normals unchanged), so every slice keeps the same x, y, z orientation.  The widget shows it
+(c0 and Δ in the source's w units: a field's time) all under one orientation, and returns ONE
+`SliceData` in which slice k is moved and shrunk to its place in the arrangement: a point p of
+it is drawn at ``centre_k + scale_k * p`` (its normals unchanged), so every slice keeps the
+same x, y, z orientation.  The widget shows it
 like any source and stays unaware of stacks; ``slices=1`` is the single slice, point for point.
 
 Arrangements (`arrangement_layout`, designed in displayed units -- the object's circumradius
@@ -81,6 +82,7 @@ from .protocol import (
     settings_of,
     takes_coarse,
     w_frame,
+    w_value_text,
 )
 
 __all__ = [
@@ -153,9 +155,29 @@ def _check_color_by(c) -> str:
 
 
 # ------------------------------------------------------------------ levels and layouts
-def default_spacing(size: float, n: int) -> float:
-    """The default Δ = 2 size / N: N slices spread over the object's extent."""
-    return 2.0 * float(size) / _check_slices(n)
+def default_spacing(source, n: int, matrix=None) -> float:
+    """The default Δ, in ``source``'s w units.  A record (a source with an ``extent``: a field): its
+    extent along the current w -- the c0 at which the hyperplane w = c0 after ``matrix`` (default
+    the identity) first and last touches the data, its ``w_range`` -- over N, so that N slices
+    about the middle of it each take one N-th of it.  Any other source (a polytope): 2 size / N, as
+    before there were records (times its w per unit of space)."""
+    n = _check_slices(n)
+    if getattr(source, "extent", None) is not None:
+        lo, hi = _w_range(source, np.eye(4) if matrix is None else as_rotation_matrix(matrix))
+        if math.isfinite(lo) and math.isfinite(hi) and hi > lo:
+            return (hi - lo) / n
+    return 2.0 * float(source.size) * w_frame(source)[1] / n
+
+
+def _w_range(source, matrix) -> tuple:
+    """``source.w_range(matrix)``, or (-size, size) for a source without one (a polytope's own w)."""
+    f = getattr(source, "w_range", None)
+    return tuple(float(v) for v in f(matrix)) if f is not None else (-float(source.size), float(source.size))
+
+
+def _w_units(source):
+    """The unit of ``source``'s w (a field's ``w_units``), or None."""
+    return getattr(source, "w_units", None)
 
 
 def stack_levels(c0: float, n: int, spacing: float) -> np.ndarray:
@@ -311,7 +333,10 @@ class StackSource:
     ----------
     source : a polytope name, a `Polytope` or any source (`rot4d_widget.Source`)
     slices : int in 1 ... 64 -- N
-    spacing : float > 0 or None -- Δ, in the source's units; None: ``2 size / N`` (follows N)
+    spacing : float > 0 or None -- Δ, in the source's w units (c0's: a field's time); None: the
+        default, the record's extent along the current w over N (`default_spacing`), spread when the
+        stack is made and whenever N changes, for the orientation noted last (`note_matrix`)
+    matrix : (4, 4) rotation or None -- the orientation the default is spread for at first
     arrangement : "oval", "grid" or "stack" (see the module docstring)
     color_by : "w" (a colormap over the N levels) or "cell" (the inner source's groups)
 
@@ -320,8 +345,11 @@ class StackSource:
     c0)`` takes ``coarse=`` exactly when the inner source's slice does.
     """
 
-    def __init__(self, source, slices: int = 5, spacing=None, arrangement: str = "oval", color_by: str = "w"):
+    def __init__(self, source, slices: int = 5, spacing=None, arrangement: str = "oval", color_by: str = "w",
+                 matrix=None):
         self.source = as_source(source)
+        self._matrix = np.eye(4) if matrix is None else as_rotation_matrix(matrix)
+        self._default = None  # the default Δ once spread (`_spread`); None: to be spread at the next need
         self.slices = slices
         self.spacing = spacing
         self.arrangement = arrangement
@@ -339,11 +367,13 @@ class StackSource:
     @slices.setter
     def slices(self, value) -> None:
         self._slices = _check_slices(value)
+        self._default = None  # a new N: the default is spread again
 
     @property
     def spacing(self) -> float:
-        """Δ in the source's units (the default ``2 size / N`` unless set; setting None restores it)."""
-        return self._spacing if self._spacing is not None else default_spacing(self.size, self._slices)
+        """Δ in the source's w units, c0's (a field's time): the one set, else the default spread over
+        the record (`default_spacing`; setting None restores it)."""
+        return self._spacing if self._spacing is not None else self._spread()
 
     @spacing.setter
     def spacing(self, value) -> None:
@@ -351,14 +381,32 @@ class StackSource:
         if d is not None:
             lo, hi = self.spacing_range
             if not lo <= d <= hi:
-                raise ValueError(f"Expected `spacing` in [{lo:.4g}, {hi:.4g}] ({SPACING_MIN:g} \u2026 {SPACING_MAX:g} "
-                                 f"times the source's size {self.size:.4g}) or None, got {d!r}")
+                unit = f" {_w_units(self.source)}" if _w_units(self.source) else ""
+                raise ValueError(f"Expected `spacing` in [{lo:.4g}, {hi:.4g}]{unit} ({SPACING_MIN:g} \u2026 "
+                                 f"{SPACING_MAX:g} times the source's size {self.size:.4g}, in its w units) or "
+                                 f"None, got {d!r}")
+        else:
+            self._default = None
         self._spacing = d
 
     @property
     def spacing_range(self) -> tuple:
-        """(lowest, highest) Δ allowed: `SPACING_MIN` and `SPACING_MAX` times the source's size."""
-        return SPACING_MIN * self.size, SPACING_MAX * self.size
+        """(lowest, highest) Δ allowed, in the source's w units: `SPACING_MIN` and `SPACING_MAX`
+        times the source's size (times its w per unit of space, `w_frame`)."""
+        per = w_frame(self.source)[1]
+        return SPACING_MIN * self.size * per, SPACING_MAX * self.size * per
+
+    def note_matrix(self, matrix) -> None:
+        """The orientation the view shows now (the source protocol's ``note_matrix``, told before an
+        action or a setting changes N): a default spacing spread from now on is spread along its w.
+        A turn alone never moves the slices: the default is spread only when the stack is made, when N
+        changes and when the spacing is set back to None."""
+        self._matrix = as_rotation_matrix(matrix)
+
+    def _spread(self) -> float:
+        if self._default is None:
+            self._default = default_spacing(self.source, self._slices, self._matrix)
+        return self._default
 
     @property
     def spacing_is_default(self) -> bool:
@@ -405,8 +453,7 @@ class StackSource:
         return float(e) * float(self.layout()[1].max())
 
     def w_range(self, matrix) -> tuple:
-        f = getattr(self.source, "w_range", None)
-        return tuple(f(matrix)) if f is not None else (-self.size, self.size)
+        return _w_range(self.source, matrix)
 
     @property
     def wraps(self):
@@ -433,20 +480,23 @@ class StackSource:
             apply_setting(self.source, name, value)
 
     def __copy__(self) -> "StackSource":
-        """A stack around a copy of the inner source (replaying its actions changes the copy only)."""
-        return StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
-                           arrangement=self._arrangement, color_by=self._color_by)
+        """A stack around a copy of the inner source (replaying its actions changes the copy only),
+        its default spacing as spread here."""
+        new = StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
+                          arrangement=self._arrangement, color_by=self._color_by, matrix=self._matrix)
+        new._default = self._default
+        return new
 
     @property
     def w_frame(self) -> tuple:
-        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0 and the
-        cuts are in its w units, Δ in the drawn units (a cut is Δ * per_unit from the next)."""
+        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0, Δ
+        and the cuts are in its w units."""
         return w_frame(self.source)
 
     def cuts_at(self, c0: float) -> np.ndarray:
         """The stack's cuts for the plane w = ``c0``: the w of each of the N slices, in c0's units,
-        ``c0 + (k - (N - 1)/2) Δ per_unit`` (N,) float64."""
-        return stack_levels(c0, self._slices, self.spacing * w_frame(self.source)[1])
+        ``c0 + (k - (N - 1)/2) Δ`` (N,) float64."""
+        return stack_levels(c0, self._slices, self.spacing)
 
     def levels_at(self, c0: float) -> np.ndarray:
         """The old name of `cuts_at` (kept for code written before it; "levels" are a field's iso values)."""
@@ -487,7 +537,7 @@ class StackSource:
         n = self._slices + (1 if sign > 0 else -1)
         if not 1 <= n <= MAX_SLICES:
             return False
-        self._slices = n
+        self.slices = n  # a default spacing is spread again for N (never one the user set)
         return n
 
     def step_spacing(self, sign: int):
@@ -572,10 +622,9 @@ class StackSource:
         time, `data_w_text`), its census (polytopes) and volume (the source's own units)."""
         n = len(cuts)
         how = "colour by w (viridis, low w dark)" if self._color_by == "w" else "colour by cell"
-        wpu = getattr(self.source, "w_per_unit", None)
-        unit = getattr(self.source, "w_units", None)
-        delta = look.number_text(self.spacing * (wpu if wpu is not None else 1.0))
-        delta += f" {unit}" if wpu is not None and unit else ""
+        unit = _w_units(self.source)
+        delta = look.number_text(self.spacing) + (f" {unit}" if unit else "")
+        delta += "" if self._spacing is not None else " (spread over the record)"
         rows = [("stack", f"{n} slices, \u0394 = {delta}, {self._arrangement}, {how}")]
         polytope = self._polytope is not None
         if n <= 12:
@@ -584,14 +633,16 @@ class StackSource:
                 parts = []
                 if polytope:
                     parts.append(_short_census(piece.slice))
-                if v is not None:
+                if v is not None and not label.endswith("(outside the data)"):
                     space = getattr(self.source, "space_units", None)
                     parts.append(f"vol {look.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
-            rows.append(("w", f"{data_w_text(self.source, cuts[0], m)[2:]} \u2026 "
-                              f"{data_w_text(self.source, cuts[-1], m)[2:]} "
-                              f"(\u25b8 {data_w_text(self.source, cuts[hi], m)[2:]})"))
+            if getattr(self.source, "extent", None) is None:  # a polytope's own w
+                ends = [data_w_text(self.source, cuts[i])[2:] for i in (0, -1, hi)]
+            else:
+                ends = [w_value_text(self.source, cuts[i]) for i in (0, -1, hi)]
+            rows.append(("w", f"{ends[0]} \u2026 {ends[1]} (\u25b8 {ends[2]})"))
             if any(v is not None for v in volumes):
                 rows.append(("volumes", " ".join("\u2014" if v is None else f"{v:.3g}" for v in volumes)))
         if polytope:  # a hemi or non-orientable polytope: its slices have no volume, and why

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core.look import number_text
 from ..sources.field_labels import axis_names, axis_units, box_labels
-from ..sources.protocol import SliceData, inner_source, outline_of, settings_of
+from ..sources.protocol import SliceData, data_w_text, inner_source, outline_of, settings_of
 
 __all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "data_extent", "rendering_rows",
            "STACK_NODES"]
@@ -121,9 +121,12 @@ def cut_labels(source, matrix, c0, data) -> CutLabels:
     """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels` of the
     data's extent: the bounding box of the box's cut, ``data``'s bars, in every rendering): its
     origin corner with every data coordinate there, the far ends of the three edges leaving it
-    with what changes along each, and the extent's corners.  An empty `CutLabels` for a stack, a
-    source that maps no slice point to its data (no ``to_data``) or a cut that misses the data."""
-    if inner_source(source) is not source or not callable(getattr(source, "to_data", None)):
+    with what changes along each, and the extent's corners.  A stack's: each slice's w under it
+    (`_slice_labels`).  An empty `CutLabels` for a source that maps no slice point to its data (no
+    ``to_data``) or a cut that misses the data."""
+    if inner_source(source) is not source:
+        return _slice_labels(source, matrix, c0, data)
+    if not callable(getattr(source, "to_data", None)):
         return CutLabels()
     extent = data_extent(data)
     if not len(extent):
@@ -131,6 +134,22 @@ def cut_labels(source, matrix, c0, data) -> CutLabels:
     pairs = box_labels(source, matrix, c0, _Box(extent))
     kinds = ("corner",) + ("edge",) * (len(pairs) - 1)
     return CutLabels(tuple((p, t, k) for (p, t), k in zip(pairs, kinds)), extent)
+
+
+def _slice_labels(stack, matrix, c0, data) -> CutLabels:
+    """A stack's labels: under each slice (its centre and scale, ``data.extra``), the w it cuts at in
+    the data's own units (`data_w_text`: "time 0.0025 s", "(outside the data)" for a slice that
+    misses it), kind "slice" -- every slice carries its w, an empty one too."""
+    ex = data.extra
+    cuts = np.asarray(ex["cuts"], dtype=np.float64)
+    centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
+    scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+    if len(cuts) < 2:
+        return CutLabels()
+    radius = float(inner_source(stack).size)
+    labels = tuple((centres[k] + np.array([0.0, -1.02 * scales[k] * radius, 0.0]),
+                    data_w_text(stack, float(w), matrix), "slice") for k, w in enumerate(cuts))
+    return CutLabels(labels)
 
 
 def _sample(inner, matrix, c0, resolution, coarse):

@@ -36,11 +36,13 @@ da = xr.DataArray(T, dims=("time", "z", "y", "x"), coords={"time": ("time", t, {
     name="T", attrs={"units": "K", "long_name": "temperature"})
 field = Field4D.from_xarray(da)
 w = Rot4DWidget(field)
+s = Rot4DWidget(field, slices=5, arrangement="grid")
 def extent():
     box = field.outline(w.state.matrix, w.c0)
     seg = np.unique(np.asarray(box.segments))
     return (np.asarray(box.points)[seg] * w.scene.scale).tolist()
 w'''
+STACK_CELL = "s"
 
 RECTS = """(sel) => {
   const canvas = document.querySelector(sel);
@@ -106,3 +108,29 @@ def test_labels_stay_clear_of_the_data_after_a_turn_in_every_rendering(jupyter_s
         jp.kernel(f"w.rendering = {rendering!r}")
         texts = check_labels(jp, sel, f"turned-{rendering}", artifacts)
         assert texts[1] == "time 0.004 \u2192 0.001 s", texts  # the horizontal edge is time, running back
+
+
+def test_every_slice_of_a_grid_carries_its_time(jupyter_server, page, artifacts):
+    if jupyter_server.kind != "lab":
+        pytest.skip("JupyterLab only")
+    write_notebook(jupyter_server.root / "slices.ipynb", [CELL, STACK_CELL])
+    jp = JupyterPage(page, jupyter_server, "slices.ipynb").open()
+    jp.run_all(timeout=300)
+    sel = _canvas(jp, "s")
+    page.locator(sel).scroll_into_view_if_needed()
+    want = jp.kernel_json("[lab['text'] for lab in s.scene._buffer._rot4d_labels]")
+    assert want == ["time 0.0013 s", "time 0.0019 s", "time 0.0025 s", "time 0.0031 s", "time 0.0037 s"], want
+    got = {}
+
+    def shown():
+        got.update(jp.page.evaluate(RECTS, sel))
+        return [lab["text"] for lab in got["labels"]] == want
+
+    assert jp.wait_for(shown, timeout=20), (got, want)
+    boxes = got["labels"]
+    for a in boxes:  # each on the canvas, none over another
+        assert 0 <= a["x0"] and a["x1"] <= got["w"] + 0.5 and 0 <= a["y0"] and a["y1"] <= got["h"] + 0.5, a
+        for b in boxes:
+            if a is not b:
+                assert a["x1"] <= b["x0"] or b["x1"] <= a["x0"] or a["y1"] <= b["y0"] or b["y1"] <= a["y0"], (a, b)
+    page.locator(sel).locator("xpath=..").screenshot(path=str(artifacts / "labels-grid.png"))
