@@ -38,6 +38,7 @@ __all__ = [
     "REFERENCE_RADIUS",
     "CAMERA_POSITION",
     "SECTIONS_CAMERA_POSITION",
+    "RENDERING_TEXT",
     "default_eye",
     "CAMERA_FOV",
     "CAMERA_NEAR",
@@ -237,6 +238,12 @@ RENDERINGS = ("surface", "volume", "mip", "sections")
 #: Where the three planes of ``"sections"`` cross the cut's grid: a fraction of its extent along
 #: each of x, y, z (0 the first node, 1 the last).
 DEFAULT_SECTIONS = (0.5, 0.5, 0.5)
+#: What each ray-cast rendering shows, for readouts and annotations ({name}: the field's name).
+RENDERING_TEXT = {
+    "mip": "maximum intensity: the highest {name} along each line of sight",
+    "volume": "volume: {name} glows and absorbs, the more the higher it is (colour bar)",
+    "sections": "sections: {name} on three planes of the cut",
+}
 
 
 def check_projection(value, name: str = "projection") -> bool:

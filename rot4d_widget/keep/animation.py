@@ -156,7 +156,8 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     bounding boxes of all frames' slices (`figures.frame_extent`), which fills 90 % of the
     picture's width or height -- the slices are computed once for this, in a first pass, and
     kept for drawing (up to 256 MB); ``"camera"`` or a box as `render_state`.  ``annotate``
-    (default True): each frame carries "t = ... s, frame k/n", θ0, c0 and what the source tells
+    (default True): each frame carries "frame k/n", θ0, c0 in the data's units, the turn
+    (`figures.turn_text`: how far the cut is turned from the data's own w) and what the source tells
     of itself (`figures.annotation`), and a legend; False for a bare picture.
     """
     for f in _frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames, titles=titles,
@@ -201,7 +202,7 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         frame = "camera" if box is None else box
     for k, (t, state, src, view) in enumerate(_steps(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
-        note = f"t = {t:.2f} s, frame {k + 1}/{n}" if annotate else False
+        note = f"frame {k + 1}/{n}" if annotate else False  # c0 and the turn follow (`figures.annotation`)
         drawn = src if src is not None else "5-cell"
         extra = {}
         if k < len(cache) and cache[k] is not None:

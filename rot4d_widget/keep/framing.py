@@ -14,6 +14,7 @@ import numpy as np
 
 from ..core import look
 from ..core.look import REFERENCE_RADIUS
+from ..sources.field_labels import axis_names
 from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
@@ -108,11 +109,12 @@ def level_rgb(inner, cmap: str = look.LEVEL_COLORMAP, clim=None):
 
 
 def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: str = look.LEVEL_COLORMAP,
-               clim=None):
+               clim=None, matrix=None):
     """``(lines, legend)`` describing slice ``data`` of ``source`` (a `StackSource`) at ``c0``:
     ``lines`` of text (θ0 when given and c0; the inner source's ``name`` and ``units``; its
     ``levels``; the w span of the slice from its ``readout`` row "w cut" (in ``w_units``); a
     polytope slice's census, its readout row "slice"; a stack's slices' w, from ``cuts_at``)
+    -- with ``matrix``, how far the cut is turned from the data's own w, `turn_text` --
     and ``legend``, ``[(rgb, label), ...]``: the colours of a field's levels (along ``cmap``, by
     value over ``clim`` when given: `level_rgb`) or of a stack's slices.  Only attributes the
     sources have are read, never their class."""
@@ -122,6 +124,8 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
     wu = f" {wu}" if wu else ""  # c0 and the slices' w are in the source's w units (a field's time)
     state = f"c0 = {float(c0):+.4g}{wu}"
     lines.append(state if theta0 is None else f"\u03b80 = {_fmt_angle(float(theta0))}, {state}")
+    if matrix is not None:
+        lines.append(turn_text(matrix, axis_names(inner)))
     name, units = getattr(inner, "name", None), getattr(inner, "units", None)
     u = f" {units}" if units else ""
     if name:
@@ -149,6 +153,46 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
         rgb = level_rgb(inner, cmap, clim)
         legend = [(tuple(rgb[k]), f"{v:.4g}{u}") for k, v in enumerate(levels)]
     return lines, legend
+
+
+def turn_text(matrix, names=("x", "y", "z", "w")) -> str:
+    """How far the cut w = c0 is turned from the data's own w ("time") after ``matrix`` (4, 4), and
+    towards which axes: the angle between its normal, row 3 of ``matrix`` in the data's axes, and
+    the w axis -- "turn 22.5° in the x–time plane", "turn 30° from constant time towards 0.8 x +
+    0.6 y", or "turn none (the cut is at constant time)".  ``names``: the data's x, y, z, w names.
+
+    >>> turn_text(np.eye(4), ("x", "y", "z", "time"))
+    'turn none (the cut is at constant time)'
+    """
+    n = np.asarray(matrix, dtype=np.float64).reshape(4, 4)[3]
+    tilt = math.degrees(math.acos(min(1.0, abs(float(n[3])))))
+    w = names[3]
+    if tilt < 1e-3:
+        return f"turn none (the cut is at constant {w})"
+    space = n[:3] * (1.0 if n[3] >= 0 else -1.0)
+    size = float(np.linalg.norm(space))
+    parts = [(abs(v) / size, names[a], v < 0) for a, v in enumerate(space) if abs(v) > 1e-6 * size]
+    if len(parts) == 1:
+        return f"turn {tilt:.3g}\u00b0 in the {parts[0][1]}\u2013{w} plane"
+    towards = " + ".join(("\u2212" if neg else "") + f"{c:.2g} {name}" for c, name, neg in parts)
+    return f"turn {tilt:.3g}\u00b0 from constant {w} towards {towards}"
+
+
+def annotation_boxes(lines, legend, height: float, dpi: float, size_px) -> list:
+    """Where `_draw_annotation` puts its text and legend in a picture of ``size_px`` (width,
+    height) pixels ``height`` inches high: ``[(left, top, w, h), ...]`` in pixels, y down (what the
+    box labels keep clear of), from the text's measured size; generous by a few pixels."""
+    fs = max(6.0, min(10.0, 1.7 * height))
+    px = dpi / 72.0
+    out = []
+    if lines:
+        w, h = text_size("\n".join(lines), fs)
+        out.append((0.015 * size_px[0] - 2 * px, 0.015 * size_px[1] - 2 * px, (w + 6) * px, (h + 6) * px))
+    if legend:
+        w = max(text_size(label, fs)[0] for _, label in legend) + 2.6 * fs
+        h = len(legend) * 1.5 * fs + 1.2 * fs
+        out.append((0.0, size_px[1] - (h + 0.6 * fs) * px, (w + 0.9 * fs) * px, (h + 0.6 * fs) * px))
+    return out
 
 
 def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
@@ -320,6 +364,41 @@ def text_size(text: str, fontsize: float, linespacing: float = 1.2) -> tuple:
     return width, fontsize * (1.0 + linespacing * (len(lines) - 1)) * 1.25
 
 
+def box_label_layout(xlim, ylim, labels, scale: float, extent, fontsize: float, height: float, dpi: float,
+                     placed=(), view=None):
+    """Where `_draw_box_labels` puts ``labels`` in axes with limits ``xlim``, ``ylim`` (a picture
+    ``height`` inches high at ``dpi``): ``(xy, shown, items, boxes)`` -- the projected label points,
+    the ``((u, v) pixel point, text)`` of each label drawn, their `place_labels` items and places
+    (``free`` False where none was free).  Nothing is drawn: `render_tomography` zooms a fitted
+    frame out until every label is free."""
+    view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
+    pts = np.asarray([p for p, _ in labels], dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
+    xy, _ = perspective(pts)
+    (x0, x1), (y0, y1) = xlim, ylim
+    hpx = float(height) * float(dpi)
+    wpx = hpx * (x1 - x0) / (y1 - y0)
+    px = float(dpi) / 72.0  # pixels per point
+
+    def to_px(p):
+        p = np.asarray(p, dtype=np.float64).reshape(-1, 2)
+        return np.column_stack([(p[:, 0] - x0) / (x1 - x0) * wpx, (y1 - p[:, 1]) / (y1 - y0) * hpx])
+
+    ext = np.asarray(extent, dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
+    keep = None
+    if len(ext):
+        e = to_px(perspective(ext)[0])
+        keep = (float(e[:, 0].min()), float(e[:, 1].min()), float(e[:, 0].max()), float(e[:, 1].max()))
+    shown = [(p, "\n".join(text.split(", "))) for p, (_, text) in zip(to_px(xy), labels) if text]
+    items = []
+    for _p, text in shown:
+        w, h = text_size(text, fontsize, 1.1)
+        items.append((_p[0], _p[1], (w + 2 * _LABEL_PAD) * px + 1, (h + 2 * _LABEL_PAD) * px + 1, "edge"))
+    return xy, shown, items, place_labels(items, keep, wpx, hpx, LABEL_GAP, placed)
+
+
+_LABEL_PAD = 1.0  # a box label's text box, points
+
+
 def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, height: float = 5.0,
                      placed=(), view=None) -> list:
     """``labels`` (`rot4d_widget.sources.field_labels.box_labels`: the origin corner first, then the
@@ -327,50 +406,33 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
     ``scale * p`` and projected: the three edges as thin dashed lines (what the texts label), each
     text small, one data coordinate a line, outside the rectangle the data's ``extent`` (its
     corners, slice coordinates) projects into, so that no label covers the picture
-    (`place_labels`, the page's rule), with a dotted line from its point when moved away from it
-    (``height``: the axes' height in inches; ``placed``: boxes in axes pixels already taken, y
-    down; ``view``: the camera's rotation, None the identity).  Returns the Text artists (gid
-    "box-label")."""
+    (`place_labels`, the page's rule; `box_label_layout`), with a dotted line from its point when
+    moved away from it (``height``: the axes' height in inches; ``placed``: boxes in axes pixels
+    already taken, y down; ``view``: the camera's rotation, None the identity).  Returns the Text
+    artists (gid "box-label")."""
     # matplotlib collections: imported when a field's box is labelled
     from matplotlib.collections import LineCollection
 
     if not labels:
         return []
-    view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
-    pts = np.asarray([p for p, _ in labels], dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
-    xy, _ = perspective(pts)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    dpi = float(ax.figure.dpi)
+    xy, shown, items, boxes = box_label_layout((x0, x1), (y0, y1), labels, scale, extent, fontsize, height, dpi,
+                                               placed, view)
     edges = LineCollection([[xy[0], xy[k]] for k in range(1, len(xy))], colors="#777777", linewidths=0.6,
                            linestyles=(0, (3, 2)), zorder=_Z_LABEL - 2.0, gid="box-edge")
     ax.add_collection(edges, autolim=False)
-    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
-    dpi = float(ax.figure.dpi)
     hpx = float(height) * dpi
     wpx = hpx * (x1 - x0) / (y1 - y0)
-    px = dpi / 72.0  # pixels per point
-
-    def to_px(p):
-        p = np.asarray(p, dtype=np.float64).reshape(-1, 2)
-        return np.column_stack([(p[:, 0] - x0) / (x1 - x0) * wpx, (y1 - p[:, 1]) / (y1 - y0) * hpx])
+    px = dpi / 72.0
 
     def to_data(u, v):
         return x0 + u / wpx * (x1 - x0), y1 - v / hpx * (y1 - y0)
 
-    ext = np.asarray(extent, dtype=np.float64).reshape(-1, 3) @ view.T * float(scale)
-    keep = None
-    if len(ext):
-        e = to_px(perspective(ext)[0])
-        keep = (float(e[:, 0].min()), float(e[:, 1].min()), float(e[:, 0].max()), float(e[:, 1].max()))
-    pad = 1.0  # the text's box, points
-    shown = [(p, "\n".join(text.split(", "))) for p, (_, text) in zip(to_px(xy), labels) if text]
-    items = []
-    for (u, v), text in shown:
-        w, h = text_size(text, fontsize, 1.1)
-        items.append((u, v, (w + 2 * pad) * px + 1, (h + 2 * pad) * px + 1, "edge"))
-    boxes = place_labels(items, keep, wpx, hpx, LABEL_GAP, placed)
     out, leaders = [], []
-    box = dict(facecolor="white", alpha=0.7, edgecolor="none", pad=pad)
+    box = dict(facecolor="white", alpha=0.7, edgecolor="none", pad=_LABEL_PAD)
     for ((u, v), text), (left, top, _free), item in zip(shown, boxes, items):
-        tx, ty = to_data(left + pad * px, top + pad * px)
+        tx, ty = to_data(left + _LABEL_PAD * px, top + _LABEL_PAD * px)
         out.append(ax.text(tx, ty, text, ha="left", va="top", fontsize=fontsize, color="#333333",
                            zorder=_Z_LABEL - 1.0, gid="box-label", bbox=box, linespacing=1.1))
         nu, nv = min(max(u, left), left + item[2]), min(max(v, top), top + item[3])

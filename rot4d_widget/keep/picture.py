@@ -43,6 +43,8 @@ from .framing import (
     _draw_colorbar,
     _frame_limits,
     annotation,
+    annotation_boxes,
+    box_label_layout,
     colorbar_width,
     frame_extent,
     level_rgb,
@@ -200,6 +202,27 @@ def render_tomography(
     else:
         box = _as_box(frame)
     (x0, x1), (y0, y1) = _frame_limits(box, aspect)
+    notes = None  # the annotation's lines and legend, and where they go (pixels, y down)
+    if annotate:
+        lines, legend = annotation(src, cut, c0, theta0=_theta0, cmap=cmap, clim=clim, matrix=matrix)
+        if volume:
+            legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
+            name = getattr(inner, "name", None) or "the value"  # no level drawn: say what is
+            lines = [look.RENDERING_TEXT[rendering].format(name=name) if ln.startswith(("level ", "levels ")) else ln
+                     for ln in lines]
+        if isinstance(annotate, str):
+            lines = [annotate, *lines]
+        notes = (lines, legend, annotation_boxes(lines, legend, height, dpi, (width * dpi, height * dpi)))
+        if box is not None:  # a fitted frame: the picture moves down, out from under the text
+            (x0, x1), (y0, y1) = _below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
+    box_text = None  # a single field's box labels: ``(labels, extent)`` of the data's extent
+    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
+        extent = _slice_box(cut, data.extra["point_offsets"], data.extra["segment_offsets"])
+        if extent is not None:  # the data's extent, never the padded sampling grid
+            box_text = (box_labels(inner, matrix, c0, extent), extent.corners)
+    if box_text is not None and box is not None:  # a fitted frame: out until every label has room
+        (x0, x1), (y0, y1) = _room_for_labels((x0, x1), (y0, y1), box_text, scale, small_font(height) - 0.5,
+                                              height, dpi, notes[2] if notes else (), view)
     limit = 0.5 * (y1 - y0)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
@@ -265,18 +288,13 @@ def render_tomography(
         used = image.get_clim() if image is not None else None
     if right:
         _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
-    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
-        box = _slice_box(cut, offs, soff)  # the data's extent, never the padded sampling grid
-        if box is not None:
-            labels = box_labels(inner, matrix, c0, box)
-            _draw_box_labels(ax, labels, scale, box.corners, small_font(height) - 0.5, height, view=view)
-    if annotate:
-        lines, legend = annotation(src, data, c0, theta0=_theta0, cmap=cmap, clim=clim)
-        if volume:
-            legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
-        if isinstance(annotate, str):
-            lines = [annotate, *lines]
-        _draw_annotation(ax, lines, legend, height, _canvas)
+    taken = []  # what the box labels keep clear of besides the data: the annotation
+    if notes is not None:
+        _draw_annotation(ax, notes[0], notes[1], height, _canvas)
+        taken = notes[2]
+    if box_text is not None:
+        _draw_box_labels(ax, box_text[0], scale, box_text[1], small_font(height) - 0.5, height, placed=taken,
+                         view=view)
     if title:
         name = getattr(src.source, "name", None) or type(src.source).__name__
         text = title if isinstance(title, str) else (
@@ -295,6 +313,42 @@ def render_tomography(
         _canvas.end()
     _save(fig, path)
     return fig
+
+
+#: A fitted frame with box labels grows by this factor at a time until every label has room.
+_LABEL_ZOOM = 1.08
+
+
+def _room_for_labels(xlim, ylim, box_text, scale, fontsize, height, dpi, placed, view):
+    """The limits of a fitted frame grown about their middle (`_LABEL_ZOOM` at a time, at most 12
+    times) until every box label has a free place outside the data (`box_label_layout`): a small
+    picture shows its data smaller rather than labels over it."""
+    labels, extent = box_text
+    (x0, x1), (y0, y1) = xlim, ylim
+    for _ in range(12):
+        boxes = box_label_layout((x0, x1), (y0, y1), labels, scale, extent, fontsize, height, dpi, placed, view)[3]
+        if all(free for _l, _t, free in boxes):
+            break
+        cx, cy, hx, hy = 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (x1 - x0) * _LABEL_ZOOM, 0.5 * (y1 - y0) * _LABEL_ZOOM
+        (x0, x1), (y0, y1) = (cx - hx, cx + hx), (cy - hy, cy + hy)
+    return (x0, x1), (y0, y1)
+
+
+def _below_notes(box, xlim, ylim, note, height_px):
+    """The limits ``xlim``, ``ylim`` of a fitted frame grown (about the box's bottom, keeping the
+    aspect) until the top of ``box`` (x0, x1, y0, y1: what is drawn) lies below the annotation's
+    text box ``note`` (left, top, w, h in pixels of a picture ``height_px`` high, y down), so the
+    text covers none of the picture."""
+    (x0, x1), (y0, y1) = xlim, ylim
+    need = (note[1] + note[3]) / height_px  # of the picture's height, from its top
+    top_room = (y1 - box[3]) / (y1 - y0)
+    if top_room >= need:
+        return xlim, ylim
+    # keep the box's bottom margin; grow the height h so that (y1 - box top) = need * h
+    below = box[2] - y0
+    h = (box[3] - box[2] + below) / (1.0 - need)
+    cx, aspect = 0.5 * (x0 + x1), (x1 - x0) / (y1 - y0)
+    return (cx - 0.5 * h * aspect, cx + 0.5 * h * aspect), (box[2] - below, box[2] - below + h)
 
 
 def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top, right):

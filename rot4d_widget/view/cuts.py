@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.look import number_text
+from ..core.look import RENDERING_TEXT, number_text
 from ..sources.field_labels import axis_names, axis_units, box_labels
 from ..sources.protocol import SliceData, data_w_text, inner_source, outline_of, settings_of
 
@@ -170,14 +170,6 @@ def _level_row(source, grid) -> tuple:
     units = f" {grid.units}" if grid.units else ""
     return (("level" if len(levels) == 1 else "levels",
              f"{', '.join(f'{v:.4g}' for v in levels)}{units}: the surface rendering's (v), not drawn here"),)
-
-
-#: What each ray-cast rendering shows, for the readout ({name}: the field's name).
-RENDERING_TEXT = {
-    "mip": "maximum intensity: the highest {name} along each line of sight",
-    "volume": "volume: {name} glows and absorbs, the more the higher it is (colour bar)",
-    "sections": "sections: {name} on three planes of the cut",
-}
 
 
 def rendering_rows(source, matrix, c0, rendering: str, sections, grid) -> tuple:
