@@ -23,7 +23,7 @@ handed to every child as an .npy file), 8 taps of "4" (9 frames, a turn into tim
 ``render_grid`` given ``pixels_per_ray=1`` by the benchmark (its default cast a ray every few
 pixels and interpolated between them); REV's default is timed too.
 
-    python benchmarks/animation.py --rev 2a6f126 --repeats 2
+    python benchmarks/animation.py --rev 2a6f126 --repeats 2 [--new 349e157]
 """
 
 from __future__ import annotations
@@ -167,11 +167,11 @@ def flame_worker(npy: str, rendering: str, repeats: int, per_pixel: bool) -> dic
     return {"times": times, "package": rot4d_widget.__file__}
 
 
-def flame_main(rev: str, repeats: int) -> None:
+def flame_main(rev: str, repeats: int, new_rev=None) -> None:
     from revisions import Revisions
 
     rows = []
-    with tempfile.TemporaryDirectory() as tmp, Revisions([rev, None]) as (old, new):
+    with tempfile.TemporaryDirectory() as tmp, Revisions([rev, new_rev]) as (old, new):
         npy = os.path.join(tmp, "flame.npy")
         _flame(npy)
         for rendering in FLAME_RENDERINGS:
@@ -216,6 +216,7 @@ def main(argv=None) -> None:
                    "encoder tail")
     p.add_argument("--worker", nargs=3, help=argparse.SUPPRESS)
     p.add_argument("--rev", help="time the flame's ray-cast animations on this git revision and the working tree")
+    p.add_argument("--new", help="with --rev: this git revision instead of the working tree")
     p.add_argument("--flame-worker", nargs=4, help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     if a.flame_worker:
@@ -223,7 +224,7 @@ def main(argv=None) -> None:
         print(json.dumps(flame_worker(npy, rendering, int(repeats), per_pixel == "1")))
         return
     if a.rev:
-        flame_main(a.rev, a.repeats)
+        flame_main(a.rev, a.repeats, a.new)
         return
     if a.worker:
         case, ext, repeats = a.worker
