@@ -15,6 +15,7 @@ import numpy as np
 from ..core import look
 from ..core.look import REFERENCE_RADIUS
 from ..sources.field_labels import axis_names
+from ..sources.protocol import c0_text
 from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
@@ -122,7 +123,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
     lines = []
     wu = getattr(inner, "w_units", None)
     wu = f" {wu}" if wu else ""  # c0 and the slices' w are in the source's w units (a field's time)
-    state = f"c0 = {float(c0):+.4g}{wu}"
+    state = c0_text(inner, c0) or f"c0 = {float(c0):+.4g}{wu}"
     lines.append(state if theta0 is None else f"\u03b80 = {_fmt_angle(float(theta0))}, {state}")
     if matrix is not None:
         lines.append(turn_text(matrix, axis_names(inner)))

@@ -10,6 +10,7 @@ import numpy as np
 
 from .field_checks import _axes_text
 from .field_input import _LazyXarray
+from .protocol import w_span_text
 
 
 def _readout(field, m, c0, slices, box, coarse) -> tuple:
@@ -48,6 +49,9 @@ def _what_rows(field) -> tuple:
     rows = [("field", f"{field.name or 'field'}" + (f" [{field.units}]" if field.units else ""))]
     if field.kind != "function":
         rows.append(("axes", f"{_order_text(field)}, shape {tuple(int(n) for n in field.values.shape)}"))
+        missing = field.missing
+        if missing is not None:
+            rows.append(("missing", missing))
     return tuple(rows)
 
 
@@ -59,8 +63,12 @@ def _cut_rows(field, m, c0, box) -> tuple:
     if len(box.vertices):
         p = np.column_stack([np.asarray(box.vertices), np.full(len(box.vertices), c0)])
         w = (p @ m)[:, 3] * field.w_per_unit + field.centre[3]
-        rows.append(("w cut", f"{w.min():.4g} \u2026 {w.max():.4g}{wu} (data {field.extent[3][0]:.4g} \u2026 "
-                              f"{field.extent[3][1]:.4g})"))
+        if field.w_epoch is not None:  # dates and times
+            rows.append(("w cut", f"{w_span_text(field, w.min(), w.max())} "
+                                  f"(data {w_span_text(field, *field.extent[3])})"))
+        else:
+            rows.append(("w cut", f"{w.min():.4g} \u2026 {w.max():.4g}{wu} (data {field.extent[3][0]:.4g} \u2026 "
+                                  f"{field.extent[3][1]:.4g})"))
     else:
         rows.append(("w cut", "none (w = c0 misses the data)"))
     per = field.space_units if field.space_units else "unit of space"

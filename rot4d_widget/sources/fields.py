@@ -71,6 +71,7 @@ from .field_checks import (
     MAX_SAMPLE_BYTES,
     AxesWarning,
     NonFiniteWarning,
+    UnitsWarning,
     _as_levels,
     _check_extent,
     _check_positive,
@@ -98,7 +99,7 @@ from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
-           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
+           "NonFiniteWarning", "UnitsWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
 
 _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
                _resample_affine, _sample_raw, _surface)
@@ -173,7 +174,7 @@ class Field4D(FieldLevels, FieldMemory):
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, space_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
-                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None):
+                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None, _w_epoch=None):
         self._function = _function
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
@@ -200,6 +201,9 @@ class Field4D(FieldLevels, FieldMemory):
             wpu = 1.0 if w_per_unit is None else w_per_unit
             self.w_units = None if w_units is None else str(w_units)
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
+        #: The date and time w = 0 stands for when the times were datetime64 (`from_xarray`: w counts
+        #: seconds from the first; labels and the readout write dates and times), else None
+        self.w_epoch = None if _w_epoch is None else np.datetime64(_w_epoch)
         self.name = None if name is None else str(name)
         self.units = None if units is None else str(units)
         self.space_units = None if space_units is None else str(space_units)
@@ -440,6 +444,16 @@ class Field4D(FieldLevels, FieldMemory):
         return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box, _outline_readout(self, m, d, box), frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
+
+    @property
+    def missing(self):
+        """Where the data are missing, for the readout: "NaN in time 0.0021 … 0.0026 s (8 of 60
+        steps), 12.5 % of the samples" -- steps of w holding NaN beyond 1 % of their samples more
+        than the step with fewest (a block: a failed write, a gap; `NonFiniteWarning` says it once)
+        -- or None.  Counted over an array in memory at first need; a chunked or lazy one's by its
+        background read (None until that read ends)."""
+        self._stat.count_nonfinite()
+        return self._stat.nan_text()
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
 
     def describe(self) -> dict:

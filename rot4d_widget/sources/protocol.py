@@ -93,7 +93,7 @@ from ..core.look import number_text
 from ..geometry.polytopes import POLYTOPE_NAMES, Polytope
 from ..geometry.polytopes import polytope as get_polytope
 from ..geometry.slicing import slice_polytope
-from .field_labels import axis_names
+from .field_labels import axis_names, coordinate_text
 
 __all__ = [
     "Source",
@@ -106,6 +106,8 @@ __all__ = [
     "data_w_text",
     "note_matrix",
     "w_value_text",
+    "c0_text",
+    "w_span_text",
     "w_frame",
     "inner_source",
     "settings_of",
@@ -336,11 +338,35 @@ def data_w_text(source, w: float, matrix=None) -> str:
 
 
 def w_value_text(source, w: float) -> str:
-    """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits."""
+    """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits -- or, for times
+    that were datetime64 (``w_epoch``), the date and time."""
     inner = getattr(source, "source", source)
     lo, hi = (float(v) for v in inner.extent[3])
+    if getattr(inner, "w_epoch", None) is not None:
+        return coordinate_text(inner, 3, float(w), max(abs(lo), abs(hi)))
     unit = getattr(inner, "w_units", None)
     return f"{number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+
+
+def c0_text(source, c0: float):
+    """How c0 reads for ``source`` when a number with its unit would not do: the date and time for a
+    field whose times were datetime64 (``w_epoch``; c0 counts seconds from it), with those seconds
+    -- "2021-03-04 12:05:00 (c0 = 300 s)" -- else None."""
+    inner = getattr(source, "source", source)
+    if getattr(inner, "w_epoch", None) is None:
+        return None
+    return f"{w_value_text(inner, c0)} (c0 = {number_text(float(c0), 0.0, 6)} s)"
+
+
+def w_span_text(source, a: float, b: float) -> str:
+    """Two of a field's w as a range: "0.0021 … 0.0026 s" (the unit once), or two date-times."""
+    inner = getattr(source, "source", source)
+    if getattr(inner, "w_epoch", None) is not None:
+        return f"{w_value_text(inner, a)} \u2026 {w_value_text(inner, b)}"
+    lo, hi = (float(v) for v in inner.extent[3])
+    unit = getattr(inner, "w_units", None)
+    big = max(abs(lo), abs(hi))
+    return f"{number_text(float(a), big, 4)} \u2026 {number_text(float(b), big, 4)}{' ' + unit if unit else ''}"
 
 
 class BadSlice(ValueError):
@@ -525,6 +551,23 @@ class PolytopeSource:
         return f"PolytopeSource({self.polytope.name!r})"
 
 
+def _data_hint(obj) -> str:
+    """What to write instead when ``obj`` is data rather than a source: an xarray DataArray or
+    Dataset, or an array (numpy, dask, zarr) -- "" for anything else."""
+    kind = type(obj)
+    module = (kind.__module__ or "").split(".")[0]
+    if module == "xarray" and kind.__name__ == "DataArray":
+        return ("; an xarray.DataArray is a field: Rot4DWidget(Field4D.from_xarray(da)) (dims found by name, "
+                "or named: Field4D.from_xarray(da, w='time'))")
+    if module == "xarray" and kind.__name__ == "Dataset":
+        return ("; an xarray.Dataset holds fields: Rot4DWidget(Field4D.from_xarray(ds, 'T')) with the "
+                "variable's name (a state file can then reopen its file)")
+    if isinstance(obj, np.ndarray) or module in ("dask", "zarr"):
+        return ("; a 4-D array is a field: Rot4DWidget(Field4D(a, axes='wzyx')) (axes: which of x, y, z, w "
+                "each array axis is), or Field4D.from_xarray for a DataArray")
+    return ""
+
+
 def as_source(obj):
     """A polytope name, a `Polytope` or any `Source` -> a source.
 
@@ -537,6 +580,7 @@ def as_source(obj):
         raise TypeError(
             "Expected a polytope name (e.g. '24-cell'), a rot4d_widget.Polytope or a source with "
             f"slice(matrix, c0), size, n_groups and describe(); {type(obj).__name__} lacks {', '.join(missing)}"
+            + _data_hint(obj)
         )
     if not callable(obj.slice) or not callable(obj.describe):
         raise TypeError("Expected `source.slice` and `source.describe` to be methods")

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core import look
 from ..keep.volume import default_clim
-from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source, outline_of
+from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, outline_of
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
@@ -263,6 +263,20 @@ class Painter:
         message = self.w._projection.message(key.matrix, key.c0, key.version)
         return {} if message is None else {"projection": message}
 
+    def data_read(self) -> None:
+        """The source's background read is over (`ViewBar.follow`): draw again from the data now in
+        memory, the readout with what the read found (a field's blocks of NaN: its "missing" row)."""
+        w = self.w
+        try:
+            with w._pump.lock:
+                if w._closed:
+                    return
+                w._source_version += 1  # the same source, read: slice it again
+                w._pump.mark_dirty()
+                w._pump.flush()
+        except Exception as exc:
+            w._report_error(exc)
+
     def eye_moved(self, eye) -> None:
         """Scene: the camera moved (a mouse orbit ended): send the faces in the order for the new eye."""
         w = self.w
@@ -295,7 +309,8 @@ class Painter:
             ("\u03b80", ro.angle_text(st.theta0)),
             ("\u03b1", ro.angle_text(st.alpha)),
             ("\u03b2", ro.angle_text(st.beta)),
-            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None))),
+            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None),
+                                 text=c0_text(inner_source(source), st.c0))),
             ("last", last),
         ]
         rows += [(k, str(v)) for k, v in getattr(data, "readout", ())]

@@ -528,7 +528,7 @@ def _wire(w, keypad) -> None:
     # readout; its first picture above read only the chunks the cut touches.  Only with the
     # ticker running (a live widget): scripts and tests stay deterministic.
     if w._pump.autotick:
-        w.progress_bar.follow(inner_source(w.source))
+        w.progress_bar.follow(inner_source(w.source), on_done=w._painter.data_read)
 
 
 def _unwire(w) -> None:
