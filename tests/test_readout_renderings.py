@@ -71,7 +71,7 @@ def test_the_camera_shows_all_three_planes_unless_the_user_moved_it(make):
     w.rendering = "mip"
     np.testing.assert_allclose(w.scene.eye, look.CAMERA_POSITION)
     w.rendering = "sections"
-    w.scene.move_camera((0.0, 3.0, 4.0))  # the user orbits: the camera stays where it is put
+    w.scene.canvas.camera.position = (0.0, 3.0, 4.0)  # the user orbits: the camera stays where it is put
     w.rendering = "surface"
     np.testing.assert_allclose(w.scene.eye, (0.0, 3.0, 4.0))
     v = make(flame(), rendering="sections")  # made to show sections

@@ -38,6 +38,10 @@ pytestmark = pytest.mark.usefixtures("recording_comms")
 # --------------------------------------------------------------------- fakes
 class FakeCamera(traitlets.HasTraits):
     position = traitlets.Tuple((0.0, 0.0, 5.0))
+    quaternion = traitlets.Tuple((0.0, 0.0, 0.0, 1.0))
+
+    def hold_sync(self):
+        return self.hold_trait_notifications()
 
 
 def _register(cbs, cb, remove):
@@ -59,6 +63,7 @@ class FakeScene:
         self.canvas._view_count = 0
         self.canvas_class = "rot4d-canvas-fake"
         self.camera = FakeCamera()
+        self.canvas.camera = self.camera  # as the Renderer's
         self.shown = []  # the slices passed to show()
         self.single = []  # their single_rgb
         self.turns = []  # the 3-D turns passed to turn()
@@ -86,9 +91,6 @@ class FakeScene:
 
     def on_eye_moved(self, cb, remove=False):
         _register(self._eye_cbs, cb, remove)
-
-    def move_camera(self, eye):
-        self.camera.position = [float(v) for v in eye]
 
     @staticmethod
     def check_display(options):

@@ -40,6 +40,7 @@ __all__ = [
     "SECTIONS_CAMERA_POSITION",
     "RENDERING_TEXT",
     "default_eye",
+    "view_rotation",
     "CAMERA_FOV",
     "CAMERA_NEAR",
     "CAMERA_FAR",
@@ -88,6 +89,29 @@ def default_eye(rendering: str) -> tuple:
     """Where the camera is by default for ``rendering``: `SECTIONS_CAMERA_POSITION` for
     "sections" (three planes, none edge-on), else `CAMERA_POSITION` (the paper's viewpoint)."""
     return SECTIONS_CAMERA_POSITION if rendering == "sections" else CAMERA_POSITION
+
+
+def view_rotation(eye) -> np.ndarray:
+    """(3, 3) float64: the rotation taking scene coordinates to those of a camera at ``eye`` (3,)
+    looking at the origin with +y up (three.js ``lookAt``): its rows are the camera's x, y and z
+    axes, so that the camera sits on its own +z axis at ``|eye|``, as the static pictures' camera
+    does.  The identity for `look.CAMERA_POSITION`.
+
+    >>> view_rotation((0.0, 0.0, 5.0)).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    e = np.asarray(eye, dtype=np.float64).reshape(3)
+    n = float(np.linalg.norm(e))
+    if not (np.all(np.isfinite(e)) and n > 0):
+        raise ValueError(f"Expected `eye` to be a finite point other than the origin, got {tuple(e)}")
+    z = e / n
+    x = np.cross((0.0, 1.0, 0.0), z)
+    if np.linalg.norm(x) < 1e-12:
+        raise ValueError(f"Expected `eye` off the vertical axis (the camera looks at the origin with +y up), "
+                         f"got {tuple(e)}")
+    x /= np.linalg.norm(x)
+    return np.vstack([x, np.cross(z, x), z])
+
 
 
 # -- colours -------------------------------------------------------------------

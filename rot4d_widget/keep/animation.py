@@ -194,7 +194,8 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         boxes, kept = [], 0
         for _t, state, src, view in _steps(recording, initial_state, source, per=per, fps=fps):
             _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep,
-                                               view=_view_of({**start_view, **view}, settings))
+                                               rendering={**start_view, **view}.get("rendering", "surface"),
+                                               eye=settings.get("eye"))
             boxes.append(box)
             kept += _data_bytes(data)
             cache.append(data if kept <= _SLICE_CACHE_BYTES else None)
@@ -207,22 +208,13 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         extra = {}
         if k < len(cache) and cache[k] is not None:
             extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep,
-                                                  view=_view_of({**start_view, **view}, settings))
+                                                  rendering={**start_view, **view}.get("rendering", "surface"),
+                                                  eye=settings.get("eye"))
             cache[k] = None  # drawn once: let it go
         look_now = {**start_view, **{n: v for n, v in view.items() if n in takes}}
         fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,
                                    **look_now, **settings)
         yield canvas.rgba() if fig is canvas.fig else _figure_rgb(fig)
-
-
-def _view_of(view_settings: dict, settings: dict):
-    """The camera's rotation a frame is drawn from: ``eye`` if given, else the default of the frame's
-    rendering (`look.default_eye`)."""
-    from ..core import look
-    from .volume import view_rotation
-
-    eye = settings.get("eye")
-    return view_rotation(look.default_eye(view_settings.get("rendering", "surface")) if eye is None else eye)
 
 
 def _as_rgb(frame) -> np.ndarray:

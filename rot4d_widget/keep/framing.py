@@ -443,3 +443,54 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
         ax.add_collection(LineCollection(leaders, colors="#777777", linewidths=0.5, linestyles=(0, (1.5, 1.5)),
                                          zorder=_Z_LABEL - 2.0, gid="label-leader"), autolim=False)
     return out
+
+
+# --------------------------------------------------------------------------- where the camera looks from
+def seen_from(data, view):
+    """``data`` (a stack's slice) as the camera whose rotation is ``view`` (3, 3) sees it: every
+    point, normal and slice centre turned by it about the origin (the whole scene, as an orbit of
+    the live view's camera turns it); ``data`` itself for the identity."""
+    view = np.asarray(view, dtype=np.float64).reshape(3, 3)
+    if np.array_equal(view, np.eye(3)):
+        return data
+    extra = {**data.extra, "centres": np.asarray(data.extra["centres"], dtype=np.float64) @ view.T}
+    normals = None if data.normals is None else np.asarray(data.normals) @ view.T
+    return type(data).build(np.asarray(data.points) @ view.T, data.segments, data.triangles, data.groups,
+                            normals=normals, volume=data.volume, readout=data.readout, convex=data.convex,
+                            show_points=data.show_points, extra=extra, corner_only=data.corner_only)
+
+
+#: A fitted frame with box labels grows by this factor at a time until every label has room.
+_LABEL_ZOOM = 1.08
+
+
+def room_for_labels(xlim, ylim, box_text, scale, fontsize, height, dpi, placed, view):
+    """The limits of a fitted frame grown about their middle (`_LABEL_ZOOM` at a time, at most 12
+    times) until every box label has a free place outside the data (`box_label_layout`): a small
+    picture shows its data smaller rather than labels over it."""
+    labels, extent = box_text
+    (x0, x1), (y0, y1) = xlim, ylim
+    for _ in range(12):
+        boxes = box_label_layout((x0, x1), (y0, y1), labels, scale, extent, fontsize, height, dpi, placed, view)[3]
+        if all(free for _l, _t, free in boxes):
+            break
+        cx, cy, hx, hy = 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (x1 - x0) * _LABEL_ZOOM, 0.5 * (y1 - y0) * _LABEL_ZOOM
+        (x0, x1), (y0, y1) = (cx - hx, cx + hx), (cy - hy, cy + hy)
+    return (x0, x1), (y0, y1)
+
+
+def below_notes(box, xlim, ylim, note, height_px):
+    """The limits ``xlim``, ``ylim`` of a fitted frame grown (about the box's bottom, keeping the
+    aspect) until the top of ``box`` (x0, x1, y0, y1: what is drawn) lies below the annotation's
+    text box ``note`` (left, top, w, h in pixels of a picture ``height_px`` high, y down), so the
+    text covers none of the picture."""
+    (x0, x1), (y0, y1) = xlim, ylim
+    need = (note[1] + note[3]) / height_px  # of the picture's height, from its top
+    top_room = (y1 - box[3]) / (y1 - y0)
+    if top_room >= need:
+        return xlim, ylim
+    # keep the box's bottom margin; grow the height h so that (y1 - box top) = need * h
+    below = box[2] - y0
+    h = (box[3] - box[2] + below) / (1.0 - need)
+    cx, aspect = 0.5 * (x0 + x1), (x1 - x0) / (y1 - y0)
+    return (cx - 0.5 * h * aspect, cx + 0.5 * h * aspect), (box[2] - below, box[2] - below + h)

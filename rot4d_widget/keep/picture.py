@@ -44,10 +44,12 @@ from .framing import (
     _frame_limits,
     annotation,
     annotation_boxes,
-    box_label_layout,
+    below_notes,
     colorbar_width,
     frame_extent,
     level_rgb,
+    room_for_labels,
+    seen_from,
     small_font,
     value_label,
 )
@@ -214,14 +216,14 @@ def render_tomography(
             lines = [annotate, *lines]
         notes = (lines, legend, annotation_boxes(lines, legend, height, dpi, (width * dpi, height * dpi)))
         if box is not None:  # a fitted frame: the picture moves down, out from under the text
-            (x0, x1), (y0, y1) = _below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
+            (x0, x1), (y0, y1) = below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
     box_text = None  # a single field's box labels: ``(labels, extent)`` of the data's extent
     if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
         extent = _slice_box(cut, data.extra["point_offsets"], data.extra["segment_offsets"])
         if extent is not None:  # the data's extent, never the padded sampling grid
             box_text = (box_labels(inner, matrix, c0, extent), extent.corners)
     if box_text is not None and box is not None:  # a fitted frame: out until every label has room
-        (x0, x1), (y0, y1) = _room_for_labels((x0, x1), (y0, y1), box_text, scale, small_font(height) - 0.5,
+        (x0, x1), (y0, y1) = room_for_labels((x0, x1), (y0, y1), box_text, scale, small_font(height) - 0.5,
                                               height, dpi, notes[2] if notes else (), view)
     limit = 0.5 * (y1 - y0)
     ax.set_xlim(x0, x1)
@@ -315,42 +317,6 @@ def render_tomography(
     return fig
 
 
-#: A fitted frame with box labels grows by this factor at a time until every label has room.
-_LABEL_ZOOM = 1.08
-
-
-def _room_for_labels(xlim, ylim, box_text, scale, fontsize, height, dpi, placed, view):
-    """The limits of a fitted frame grown about their middle (`_LABEL_ZOOM` at a time, at most 12
-    times) until every box label has a free place outside the data (`box_label_layout`): a small
-    picture shows its data smaller rather than labels over it."""
-    labels, extent = box_text
-    (x0, x1), (y0, y1) = xlim, ylim
-    for _ in range(12):
-        boxes = box_label_layout((x0, x1), (y0, y1), labels, scale, extent, fontsize, height, dpi, placed, view)[3]
-        if all(free for _l, _t, free in boxes):
-            break
-        cx, cy, hx, hy = 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (x1 - x0) * _LABEL_ZOOM, 0.5 * (y1 - y0) * _LABEL_ZOOM
-        (x0, x1), (y0, y1) = (cx - hx, cx + hx), (cy - hy, cy + hy)
-    return (x0, x1), (y0, y1)
-
-
-def _below_notes(box, xlim, ylim, note, height_px):
-    """The limits ``xlim``, ``ylim`` of a fitted frame grown (about the box's bottom, keeping the
-    aspect) until the top of ``box`` (x0, x1, y0, y1: what is drawn) lies below the annotation's
-    text box ``note`` (left, top, w, h in pixels of a picture ``height_px`` high, y down), so the
-    text covers none of the picture."""
-    (x0, x1), (y0, y1) = xlim, ylim
-    need = (note[1] + note[3]) / height_px  # of the picture's height, from its top
-    top_room = (y1 - box[3]) / (y1 - y0)
-    if top_room >= need:
-        return xlim, ylim
-    # keep the box's bottom margin; grow the height h so that (y1 - box top) = need * h
-    below = box[2] - y0
-    h = (box[3] - box[2] + below) / (1.0 - need)
-    cx, aspect = 0.5 * (x0 + x1), (x1 - x0) / (y1 - y0)
-    return (cx - 0.5 * h * aspect, cx + 0.5 * h * aspect), (box[2] - below, box[2] - below + h)
-
-
 def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top, right):
     """A field's colour bar in the strip right of its picture: ``cmap`` over ``used`` (the limits a
     volume rendering coloured by; None: ``given``, the caller's clim, else the field's data range),
@@ -384,20 +350,6 @@ def _slice_box(data, offs, soff):
     pts = np.asarray(data.points[offs[0]:offs[1]], dtype=np.float64)[np.unique(seg) - offs[0]]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)), corners=pts)
-
-
-def seen_from(data, view):
-    """``data`` (a stack's slice) as the camera whose rotation is ``view`` (3, 3) sees it: every
-    point, normal and slice centre turned by it about the origin (the whole scene, as an orbit of
-    the live view's camera turns it); ``data`` itself for the identity."""
-    view = np.asarray(view, dtype=np.float64).reshape(3, 3)
-    if np.array_equal(view, np.eye(3)):
-        return data
-    extra = {**data.extra, "centres": np.asarray(data.extra["centres"], dtype=np.float64) @ view.T}
-    normals = None if data.normals is None else np.asarray(data.normals) @ view.T
-    return type(data).build(np.asarray(data.points) @ view.T, data.segments, data.triangles, data.groups,
-                            normals=normals, volume=data.volume, readout=data.readout, convex=data.convex,
-                            show_points=data.show_points, extra=extra, corner_only=data.corner_only)
 
 
 def _label_slice(ax, centre, radius, text, highlighted, z_shift, *, point=None, placed=None):
@@ -662,10 +614,10 @@ def render_state(
     face_color = None
     if color_by != "group":
         face_color = look.as_rgb(color_by, "color_by")
-    view = view_rotation(look.default_eye(rendering) if eye is None else eye)
     if _prepared is None:
         _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
-                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps, view=view)
+                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps,
+                             rendering=rendering, eye=eye)
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
@@ -681,13 +633,14 @@ def render_state(
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
-             show_balls=True, data=None, inside=None, caps=None, view=None, **_ignored):
+             show_balls=True, data=None, inside=None, caps=None, rendering="surface", eye=None, **_ignored):
     """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
     source with the settings applied (`state_source`), its slice at ``state``, the ball radius
     in displayed units (None: the stack's default) and the projected bounding box of the
     drawing (`frame_extent`; None when empty).  ``data``: the slice, computed before.  An
     animation takes the boxes of all its frames first to frame them alike, and draws each frame
-    from the slice computed then.  ``view``: the camera's rotation (the box as it sees the slice)."""
+    from the slice computed then.  ``rendering`` and ``eye``: where the camera is (`render_state`'s:
+    the box as it sees the slice)."""
     stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
                          inside=inside, caps=caps)
     note_matrix(stack, state.matrix)  # a default spacing not spread yet: along this picture's w
@@ -701,5 +654,5 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
         ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
     else:
         ball = 0.0
-    seen = data if view is None else seen_from(data, view)
+    seen = seen_from(data, view_rotation(look.default_eye(rendering) if eye is None else eye))
     return stack, data, ball_radius, frame_extent(seen, stack, ball_radius=ball)

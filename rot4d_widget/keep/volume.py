@@ -48,7 +48,7 @@ import numpy as np
 from scipy.ndimage import map_coordinates
 
 from ..core import look
-from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering
+from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering, view_rotation
 from ..core.progress import progress as make_progress
 from . import volume_kernels
 
@@ -68,28 +68,6 @@ DEFAULT_DENSITY = 4.0
 _BATCH_POINTS = 400_000
 #: A ray this transparent no longer changes a pixel (front-to-back compositing stops for it).
 _OPAQUE = 1e-4
-
-
-def view_rotation(eye) -> np.ndarray:
-    """(3, 3) float64: the rotation taking scene coordinates to those of a camera at ``eye`` (3,)
-    looking at the origin with +y up (three.js ``lookAt``): its rows are the camera's x, y and z
-    axes, so that the camera sits on its own +z axis at ``|eye|``, as the static pictures' camera
-    does.  The identity for `look.CAMERA_POSITION`.
-
-    >>> view_rotation((0.0, 0.0, 5.0)).tolist()
-    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    """
-    e = np.asarray(eye, dtype=np.float64).reshape(3)
-    n = float(np.linalg.norm(e))
-    if not (np.all(np.isfinite(e)) and n > 0):
-        raise ValueError(f"Expected `eye` to be a finite point other than the origin, got {tuple(e)}")
-    z = e / n
-    x = np.cross((0.0, 1.0, 0.0), z)
-    if np.linalg.norm(x) < 1e-12:
-        raise ValueError(f"Expected `eye` off the vertical axis (the camera looks at the origin with +y up), "
-                         f"got {tuple(e)}")
-    x /= np.linalg.norm(x)
-    return np.vstack([x, np.cross(z, x), z])
 
 
 def default_clim(values) -> tuple:
@@ -284,7 +262,8 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
     view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
     if compiled:
         out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
-                                  step, fractions, tick, view)
+                                  step, fractions, tick, view, cells=_cell_flags(np.asarray(grid.values)),
+                                  opaque=_OPAQUE)
         if out is not None:
             return out
     vals = np.asarray(grid.values)

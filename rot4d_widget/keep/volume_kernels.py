@@ -191,9 +191,11 @@ _BAND = 64
 
 
 def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
-         tick=lambda f: None, view=None):
+         tick=lambda f: None, view=None, *, cells, opaque):
     """`volume._cast`'s picture (H, W, 4) straight RGBA float64 from the compiled kernel, or None
-    without numba (the caller casts in numpy); ``view`` the camera's rotation (None: identity)."""
+    without numba (the caller casts in numpy); ``view`` the camera's rotation (None: identity);
+    ``cells`` (nx, ny, nz) bool the cells of eight finite nodes and ``opaque`` the transparency at
+    which a volume ray stops -- `volume`'s rule, handed in."""
     kernel = _get_kernel()
     if kernel is None:  # pragma: no cover - numba is optional
         return None
@@ -203,9 +205,7 @@ def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, 
     w_px, h_px = (int(v) for v in size)
     out = np.zeros((h_px, w_px, 4))
     flat = np.ascontiguousarray(np.where(np.isfinite(vals), vals, 0.0), dtype=np.float64).ravel()
-    from .volume import _cell_flags  # numpy's half: the same cell rule
-
-    cells = _cell_flags(vals).ravel()
+    cells = np.ascontiguousarray(cells, dtype=bool).ravel()
     lo_box = shift + scale * np.asarray(grid.origin, dtype=np.float64)
     hi_box = lo_box + scale * spacing * (shape - 1)
     rot = np.eye(3) if view is None else np.ascontiguousarray(view, dtype=np.float64).reshape(3, 3)
@@ -218,9 +218,7 @@ def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, 
     gridv = np.array([a0[0], a0[1], a0[2], unit, step * spacing * scale, 1e-6 * unit], dtype=np.float64)
     lut = np.asarray(colormap(np.arange(colormap.N)), dtype=np.float64)
     lo, hi = (float(v) for v in clim)
-    from .volume import _OPAQUE  # the same stopping rule
-
-    optics = np.array([float(density) / (unit * (max(vals.shape) - 1)), _OPAQUE], dtype=np.float64)
+    optics = np.array([float(density) / (unit * (max(vals.shape) - 1)), float(opaque)], dtype=np.float64)
     planes = (shape - 1).astype(np.float64) * np.asarray(fractions, dtype=np.float64)
     mode = MODES[rendering]
     for r0 in range(0, h_px, _BAND):

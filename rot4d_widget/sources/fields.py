@@ -201,9 +201,7 @@ class Field4D(FieldLevels, FieldMemory):
             wpu = 1.0 if w_per_unit is None else w_per_unit
             self.w_units = None if w_units is None else str(w_units)
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
-        #: The date and time w = 0 stands for when the times were datetime64 (`from_xarray`: w counts
-        #: seconds from the first; labels and the readout write dates and times), else None
-        self.w_epoch = None if _w_epoch is None else np.datetime64(_w_epoch)
+        self.w_epoch = None if _w_epoch is None else np.datetime64(_w_epoch)  #: w = 0's date, from datetime64
         self.name = None if name is None else str(name)
         self.units = None if units is None else str(units)
         self.space_units = None if space_units is None else str(space_units)
@@ -432,28 +430,16 @@ class Field4D(FieldLevels, FieldMemory):
         return FieldSliceData.assemble(slices, box, readout, frame)
 
     def outline(self, matrix, c0) -> "FieldSliceData":
-        """The slice's bars without its surface: the cut of the data's box at w = ``c0`` after
-        ``matrix``, read from nothing (the source protocol's ``outline``: what the widget sizes its
-        buffers and ball radius from, so that building a view reads no chunk but its first cut's),
-        and the readout rows that do not depend on the surfaces (field, axes, w cut, w per unit)."""
-        m = as_rotation_matrix(matrix)
-        d = self.offset(c0)
+        """The slice's bars without its surface, and the readout rows that do not depend on it: the
+        cut of the data's box at w = ``c0`` after ``matrix``, read from nothing (the source protocol's
+        ``outline``: the widget sizes its buffers and ball radius from it, reading no chunk)."""
+        m, d = as_rotation_matrix(matrix), self.offset(c0)
         frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
                  "unit": _sealed(self._unit.copy())}
-        box = _box_slice(self, m, d)
-        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box, _outline_readout(self, m, d, box), frame)
+        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box := _box_slice(self, m, d),
+                                       _outline_readout(self, m, d, box), frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
-
-    @property
-    def missing(self):
-        """Where the data are missing, for the readout: "NaN in time 0.0021 … 0.0026 s (8 of 60
-        steps), 12.5 % of the samples" -- steps of w holding NaN beyond 1 % of their samples more
-        than the step with fewest (a block: a failed write, a gap; `NonFiniteWarning` says it once)
-        -- or None.  Counted over an array in memory at first need; a chunked or lazy one's by its
-        background read (None until that read ends)."""
-        self._stat.count_nonfinite()
-        return self._stat.nan_text()
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
 
     def describe(self) -> dict:

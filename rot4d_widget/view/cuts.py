@@ -16,7 +16,7 @@ from ..core.look import RENDERING_TEXT, number_text
 from ..sources.field_labels import axis_names, axis_units, box_labels
 from ..sources.protocol import SliceData, data_w_text, inner_source, outline_of, settings_of
 
-__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "data_extent", "rendering_rows",
+__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "NO_LABELS", "data_extent", "rendering_rows",
            "STACK_NODES"]
 
 #: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
@@ -96,6 +96,19 @@ class CutLabels:
 
     def __bool__(self) -> bool:
         return bool(self.labels)
+
+    def traits(self, scale: float) -> tuple:
+        """``(labels, extent)`` as the scene's buffer holds them (``_rot4d_labels``: ``{"p": [x, y,
+        z], "text", "kind"}``; ``_rot4d_label_extent``: ``[x, y, z]`` rows), in displayed units
+        (``scale`` times the source's); no extent without a label."""
+        pinned = [{"p": [float(v) * scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t),
+                   "kind": str(kind)} for p, t, kind in self.labels]
+        extent = np.asarray(self.extent, dtype=np.float64).reshape(-1, 3) * scale
+        return pinned, [[float(v) for v in row] for row in extent] if pinned else []
+
+
+#: A picture without labels.
+NO_LABELS = CutLabels()
 
 
 class _Box:

@@ -14,6 +14,7 @@ surface rendering: setting another is a ValueError that says so, and the keys do
 from __future__ import annotations
 
 from ..core import look
+from ..core.rotation import quaternion_xyzw
 from .cuts import can_sample
 from .painter import title
 
@@ -35,11 +36,17 @@ class Renderings:
 
     def follow_camera(self, old: str, new: str) -> None:
         """The camera to ``new``'s default (`look.default_eye`: sections at a slant, so that all three
-        planes show) when it is at ``old``'s, i.e. the user has not moved it; else left alone."""
+        planes show) when it is at ``old``'s, i.e. the user has not moved it; else left alone.  The
+        camera (the canvas's) gets its position and its turn in one message -- three.js turns no
+        camera that moves -- looking at the origin, +y up (`look.view_rotation`, the static
+        pictures' look-at); the scene's eye callbacks follow (the faces re-sent in their order)."""
         scene = self.w.scene
         before, after = look.default_eye(old), look.default_eye(new)
         if before != after and all(abs(a - b) < 1e-9 for a, b in zip(scene.eye, before)):
-            scene.move_camera(after)
+            camera = scene.canvas.camera
+            with camera.hold_sync():
+                camera.quaternion = quaternion_xyzw(look.view_rotation(after).T)
+                camera.position = [float(v) for v in after]
 
     # -- traits -----------------------------------------------------------------------------
     def on_trait(self, change) -> None:

@@ -71,7 +71,7 @@ from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
-from .cuts import CutLabels
+from .cuts import NO_LABELS, CutLabels
 from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
@@ -115,51 +115,15 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     _rot4d_surface = Dict().tag(sync=True)
     #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
     _rot4d_volume = Dict().tag(sync=True)
-    #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str, "kind":
-    #: "corner" | "edge" | "slice"}): the companion draws them over the canvas where the points
-    #: project, turned with the view (`rot4d_widget.view.cuts.CutLabels`).
+    #: Texts pinned to points of the view, turned with it, and the data's extent the box labels keep
+    #: clear of ([x, y, z] displayed units; `rot4d_widget.view.cuts.CutLabels.traits`).
     _rot4d_labels = List(Dict()).tag(sync=True)
-    #: The data's extent as points ([x, y, z] displayed units): the companion keeps the box labels
-    #: ("corner", "edge") clear of the rectangle these project into.  [] = none.
     _rot4d_label_extent = List(List(CFloat())).tag(sync=True)
     #: The projection's skeleton, sent once per source (`projection.skeleton_message`).  {} = none.
     _rot4d_skeleton = Dict().tag(sync=True)
     #: The projection's state, with every update while it is shown (`projection.state_message`).
     _rot4d_project = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
-
-
-def _quaternion(r) -> tuple:
-    """(x, y, z, w): the unit quaternion of the rotation matrix ``r`` (3, 3), as three.js reads
-    ``Object3D.quaternion`` (Shepperd's method: the largest of the four squares first)."""
-    r = np.asarray(r, dtype=np.float64)
-    t = np.trace(r)
-    if t > 0:
-        s = 2.0 * np.sqrt(t + 1.0)
-        q = ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, 0.25 * s)
-    else:
-        i = int(np.argmax(np.diag(r)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
-        q = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
-        q[i] = 0.25 * s
-        q[j] = (r[j, i] + r[i, j]) / s
-        q[k] = (r[k, i] + r[i, k]) / s
-        q = tuple(q)
-    return q
-
-
-#: A picture without labels.
-NO_LABELS = CutLabels()
-
-
-def _pinned(labels: CutLabels, scale: float) -> tuple:
-    """``(labels, extent)`` as the buffer's traits hold them, in displayed units (`CutLabels`:
-    ``(point, text, kind)`` and the extent's corners; no extent without a label)."""
-    pinned = [{"p": [float(v) * scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t),
-               "kind": str(kind)} for p, t, kind in labels.labels]
-    extent = np.asarray(labels.extent, dtype=np.float64).reshape(-1, 3) * scale
-    return pinned, [[float(v) for v in row] for row in extent] if pinned else []
 
 
 # -- option validation -------------------------------------------------------
@@ -346,17 +310,6 @@ class Scene:
         """Call ``callback(n)`` when the number of displayed views of the canvas changes."""
         _register(self._view_callbacks, callback, remove)
 
-    def move_camera(self, eye) -> None:
-        """Put the camera at ``eye`` (displayed units), looking at the origin with +y up (its
-        position and its turn, in one message: three.js does not turn a camera that moves); the eye
-        callbacks follow (`on_eye_moved`: the faces are re-sent in the order for it)."""
-        from ..keep.volume import view_rotation  # the static pictures' camera: the same look-at
-
-        x, y, z, w = _quaternion(view_rotation(eye).T)
-        with self._camera.hold_sync():
-            self._camera.quaternion = (float(x), float(y), float(z), float(w))
-            self._camera.position = [float(v) for v in eye]
-
     def on_eye_moved(self, callback, remove=False) -> None:
         """Call ``callback(eye)`` when the camera's position changes (a mouse orbit ended)."""
         _register(self._eye_callbacks, callback, remove)
@@ -441,8 +394,7 @@ class Scene:
         ``group_rgb`` if given), the rows carry its points' bars.  ``volume``: a ray-cast
         rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
         of any surface (None: no volume; one shown before is hidden).  ``labels``: a `CutLabels`
-        (points in the source's units, texts, the data's extent) drawn over the canvas where the
-        points project.
+        (in the source's units) drawn over the canvas where its points project.
         ``projection``: what the projection view draws of this state (`ProjectionView.message`:
         ``{"state": ..., "skeleton": ...}``, the skeleton only when new), in the same message.
         """
@@ -461,11 +413,8 @@ class Scene:
             surface = {}
         if volume is None and self._volume_shown:
             volume = {}
-        pinned, extent = _pinned(labels, self.scale)
-        if pinned == self._buffer._rot4d_labels and extent == self._buffer._rot4d_label_extent:
-            pinned = None
-        else:
-            pinned = (pinned, extent)
+        pinned = labels.traits(self.scale)
+        pinned = None if pinned == (self._buffer._rot4d_labels, self._buffer._rot4d_label_extent) else pinned
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))

@@ -135,12 +135,9 @@ class Rot4DWidget(widgets.HBox):
     slices, spacing, arrangement : int, float, str, optional
         Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
         `rot4d_widget.sources.tomography.StackSource`), placed "oval" (on a parabola, the slice at
-        c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the
-        spacing, which is in the source's w units like c0 (a field's time).  By default the
-        slices are spread over the record's extent along the current w (spacing = extent / N),
-        computed when the view is made and on n / b, never during a turn and never over a
-        spacing you set.  Also traits: setting `slices` (or pressing n) on a single view turns
-        it into parallel slices (oval, default spacing).
+        c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the spacing (in
+        the source's w units, like c0; default: the record's extent along w over N, spread when
+        made and on n / b).  Also traits: `slices` (or n) on a single view makes parallel slices.
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
@@ -189,8 +186,7 @@ class Rot4DWidget(widgets.HBox):
                                               "(False); None for sources without one")
     slices = t.Count(None, low=1, high=64, allow_none=True,
                      help="parallel slices shown; None for a single view until set (or n pressed)")
-    spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's w units "
-                        "(c0's: a field's time); None spreads them over the record along the current w")
+    spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's w units")
     arrangement = t.Choice(None, ARRANGEMENTS, allow_none=True, help="where the parallel slices are placed")
     cmap = t.Cmap(look.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
     clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
