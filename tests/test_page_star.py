@@ -26,6 +26,7 @@ import test_vertex_heights as vh
 from page_node import run_page
 from test_page_slicer import wire
 
+from rot4d_widget import Polytope
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry import starslice
 from rot4d_widget.geometry.catalogue import polytope
@@ -130,6 +131,19 @@ def test_the_pages_slices_pass_the_vertex_height_property(kind, name):
     problems = [why for (m, c0), g in zip(cases, page_slices([(p, cases)])[0])
                 if (why := vh.points_mismatch(p, m, c0, g["points"], g["segments"]))]
     assert not problems, f"{len(problems)} levels:\n" + "\n".join(problems[:12])
+
+
+def test_scaled_by_powers_of_ten():
+    """The unit scale (a power of two) as the kernel's: scaled by 1e-100 and 1e100 the page's slices
+    are the kernel's; by 1e149 and 1e-149 the volume leaves float64's range (None, as the source's)."""
+    q = polytope("small stellated 120-cell")
+    m = random_rotation(5)
+    for scale in (1e-100, 1e100, 1e149, 1e-149):
+        p = Polytope(np.asarray(q.vertices) * scale, [f.tolist() for f in q.faces], q.cells, name=f"{q.name} x {scale}")
+        w = np.unique(np.asarray(p.vertices)[:, 3])
+        compare(p, [(IDENTITY, 0.0)] + [(IDENTITY, float(c)) for c in w[::3]] + [(m, 0.1 * scale)])
+        if abs(np.log10(scale)) > 120:
+            assert _volume_or_none(slice_polytope(p, IDENTITY, 0.0)) is None
 
 
 def test_the_kernels_paths_are_reached(monkeypatch):
