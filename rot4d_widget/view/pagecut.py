@@ -1,7 +1,8 @@
 """Whether the page cuts the source itself (issue 34), and what it needs for it.
 
-A single polytope whose cells are convex (``PolytopeSource``, no star faces or non-convex cells)
-is cut in the page while it is ahead of the kernel (``page/pictures.js``): its slicer's tables go
+A single polytope is cut in the page while it is ahead of the kernel (``page/pictures.js``) -- one
+with star faces or non-convex cells as its balls and bars only (its fills are the kernel's, at
+rest: never a picture mixing two states): its slicer's tables go
 to the page once (`rot4d_widget.view.pagegeometry.polytope_message`, as the one-time transfer
 ``"polytope"``), and how it is drawn -- the scale, the group colours packed as the row buffer
 holds them, one colour for every face or none -- is the companion's synced ``draw_config``.
@@ -23,14 +24,12 @@ from .transfer import pack
 __all__ = ["PageCut", "page_cuttable"]
 
 #: the arrays of `polytope_message` that are float64 (the others are int32 indices)
-_FLOATS = frozenset({"vertices", "cell_normals", "cell_centres"})
+_FLOATS = frozenset({"vertices", "cell_normals", "cell_centres", "face_basis", "face_rho"})
 
 
 def page_cuttable(source):
-    """The polytope of ``source`` if the page can cut it (a single polytope with convex cells), else None."""
-    if type(source) is PolytopeSource and source.polytope.star is None:
-        return source.polytope
-    return None
+    """The polytope of ``source`` if the page can cut it (a single polytope), else None."""
+    return source.polytope if type(source) is PolytopeSource else None
 
 
 def polytope_transfer(polytope) -> tuple[dict, bytes]:

@@ -247,6 +247,7 @@ async function render({ model, el }) {
       };
       // The whole view turned in 3-D (keys that leave w alone): one rotation for every mesh.
       let own = false; // the layers draw the page's own picture (pictures.js), not the kernel's rows
+      let drawnCounts = []; // the rows each layer drew last (balls, bars, faces): for the test hook
       const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
       const applyTurn = () => {
         const m = own ? IDENTITY : buffer.get("_rot4d_turn");  // the page's rows are in the final frame
@@ -419,6 +420,7 @@ async function render({ model, el }) {
         if (!obj || !obj.array || !(obj.stride > 0)) return;
         const held = Math.floor(obj.array.length / obj.stride);
         const counts = picture ? picture.counts : buffer.get("_rot4d_counts") || [];
+        drawnCounts = Array.from(counts);
         layers.forEach((layer, i) => {
           const inst = layer.model.obj;
           const mesh = layer.mesh && layer.mesh.obj;
@@ -780,6 +782,7 @@ async function render({ model, el }) {
               scene.trigger("rerender", scene, {});
             };
             host.rot4dDrawsOwn = () => own;
+            host.rot4dCounts = () => drawnCounts.slice();
           }
         }
       };

@@ -5,7 +5,7 @@
 // key's picture never waits for a round trip.  At rest, with the kernel's picture of the same
 // state arrived, the layers draw the kernel's rows again (the same rows: the switch shows nothing).
 
-import { decodePolytope, sliceData } from "./slicer.js";
+import { decodePolytope, sliceData, sliceStarEdges } from "./slicer.js";
 import { sliceRows } from "./rows.js";
 import { transferStore, unpack } from "./transfer.js";
 
@@ -51,7 +51,9 @@ export function ownPicture(model, prediction, eye) {
   const cfg = model.get("draw_config") || {};
   const key = `${prediction.version}|${eye ? eye.join(",") : ""}|${cfg.scale}|${cfg.single}|${cfg.palette.length}`;
   if (c.cacheKey === key && c.picture) return c.picture;
-  const data = sliceData(c.polytope, prediction.state.matrix, prediction.state.c0);
+  // a polytope with star faces or non-convex cells: its balls and bars (the fills are the kernel's)
+  const cut = c.polytope.star ? sliceStarEdges : sliceData;
+  const data = cut(c.polytope, prediction.state.matrix, prediction.state.c0);
   const { rows, counts } = sliceRows(data, { scale: cfg.scale, palette: cfg.palette, eye,
                                              singleRgb: Number.isFinite(cfg.single) ? cfg.single : null });
   c.cacheKey = key;
