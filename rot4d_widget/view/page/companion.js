@@ -58,7 +58,7 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { drawsOwn, ownPicture, polytopeArrived } from "./pictures.js";
+import { drawsOwn, ownHyperplanes, ownPicture, polytopeArrived } from "./pictures.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -485,8 +485,7 @@ async function render({ model, el }) {
       let ownProj = null; // the state message of the page's own state, made once per state
       const ownProjection = (p) => {
         if (!ownProj || ownProj.version !== p.version) {
-          const c0 = p.state.c0;
-          ownProj = { version: p.version, msg: { matrix: Array.from(p.state.matrix), offsets: [c0], middle: c0 } };
+          ownProj = { version: p.version, msg: ownHyperplanes(model, p.state) };
         }
         return ownProj.msg;
       };
@@ -496,7 +495,7 @@ async function render({ model, el }) {
         const g = projectionShared(lo);
         if (!g) return;
         const sk = buffer.get("_rot4d_skeleton");
-        // the page's own state while it draws its own picture (a single polytope: one hyperplane, c0)
+        // the page's own state while it draws its own picture (c0, or a stack's every cut)
         const mine = own && turning(model).prediction;
         const st = mine && mine.state ? ownProjection(mine) : buffer.get("_rot4d_project");
         if (g.sk !== sk) {
