@@ -58,7 +58,7 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { drawsOwn, ownHyperplanes, ownPicture, polytopeArrived } from "./pictures.js";
+import { drawsOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -168,13 +168,15 @@ async function render({ model, el }) {
     });
   }
   onPageData();
-  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
-  const pageHook = () => {
+  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it, the
+  // pictures it made itself (`rows`: with the last one's rows)
+  const pageHook = (rows = false) => {
     const p = turning(model).prediction;
     if (!p || !p.state) return null;
     const k = p.kernel || {};
     return { matrix: Array.from(p.state.matrix), theta0: p.state.theta0, alpha: p.state.alpha, c0: p.state.c0,
-             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held };
+             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held, version: p.version,
+             own: ownPictureReport(model, rows) };
   };
   const hookPage = () => {
     for (const host of canvases()) host.rot4dPage = pageHook;

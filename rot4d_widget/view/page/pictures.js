@@ -40,7 +40,7 @@ export function polytopeArrived(model) {
     const { arrays, scalars } = unpack(t.meta, t.bytes);
     const msg = { ...scalars };
     for (const [name, a] of Object.entries(arrays)) msg[name] = new DataView(a.buffer, a.byteOffset, a.byteLength);
-    c = { key: t.key, polytope: decodePolytope(msg), cacheKey: null, picture: null };
+    c = { key: t.key, polytope: decodePolytope(msg), cacheKey: null, picture: null, built: 0 };
     cuts.set(model, c);
     model.send({ event: "holds", name: "polytope", key: t.key });
   }
@@ -74,7 +74,19 @@ export function ownPicture(model, prediction, eye) {
                                              singleRgb: Number.isFinite(cfg.single) ? cfg.single : null });
   c.cacheKey = key;
   c.picture = { rows, stride: 20, counts, version: prediction.version };
+  c.built++;
   return c.picture;
+}
+
+// For tests (the canvas's rot4dPage() hook): how many pictures the page has built of its own
+// states, the last one's state version and counts, and with `withRows` its rows (numbers); null
+// before the page holds a polytope.
+export function ownPictureReport(model, withRows = false) {
+  const c = cuts.get(model);
+  if (!c) return null;
+  const p = c.picture;
+  return { built: c.built, version: p ? p.version : null, counts: p ? p.counts : null,
+           rows: withRows && p ? Array.from(p.rows) : null };
 }
 
 // What the projection marks for the page's state `state` ({matrix, c0}), as the kernel's
