@@ -139,6 +139,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
 
 from browser_setup import (  # noqa: E402  (the browser tests' building blocks, not their conftest)
+    RemoteServer,
     CHROMIUM_FLAGS,
     INSTALL_HINT,
     JupyterServer,
@@ -1342,8 +1343,9 @@ def summary(runs: list[dict]) -> str:
     return "\n".join(lines + renderings_summary(runs, base_per_run))
 
 
-def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
-    """One full measurement: a server, a browser, every case.  (results, meta, failed)."""
+def measure(args, rng: random.Random, rtt: float = 0.0) -> tuple[dict, dict, dict]:
+    """One full measurement: a server, a browser, every case.  (results, meta, failed).  ``rtt`` (ms):
+    the page sees the server through a proxy holding every byte for half of it each way."""
     from playwright.sync_api import sync_playwright
 
     started = time.monotonic()
@@ -1369,8 +1371,11 @@ def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
         server.env["PYTHONPATH"] = os.pathsep.join(filter(None, pythonpath))
     results: dict = {}
     failed: dict = {}
+    meta["rtt_ms"] = rtt
+    remote = None
     try:
         server.start()
+        remote = RemoteServer(server, rtt) if rtt else None
         server.log.flush()
         nodelay = "TCP_NODELAY" in pathlib.Path(server.log.name).read_text()
         meta["server"] = ("rot4d_widget server extension: TCP_NODELAY on kernel WebSockets" if nodelay
@@ -1387,7 +1392,7 @@ def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
                 for case in args.case_list:
                     t0 = time.monotonic()
                     try:
-                        r = run_case(context, server, case, args, rng, hold_baseline=not results)
+                        r = run_case(context, remote or server, case, args, rng, hold_baseline=not results)
                     except Exception as exc:  # report the others; say which failed and why
                         failed[case] = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
                         print(f"{case}: FAILED {failed[case]}", file=sys.stderr, flush=True)
@@ -1404,6 +1409,8 @@ def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
             finally:
                 context.close()
     finally:
+        if remote is not None:
+            remote.stop()
         server.stop()
         if args.keep:
             print(f"kept {tmp}", file=sys.stderr)
@@ -1415,6 +1422,40 @@ def measure(args, rng: random.Random) -> tuple[dict, dict, dict]:
     meta["load_after"] = os.getloadavg()
     meta["elapsed"] = time.monotonic() - started
     return results, meta, failed
+
+
+def rtt_table(by_rtt: dict) -> str:
+    """Per round trip and case: the held frame rate as a ratio to the same run's baseline (median
+    over runs), that ratio against the same case's at the smallest round trip, and the tap's key ->
+    first changed pixel (median of the presses, median over runs) beside the baseline's."""
+    rtts = sorted(by_rtt)
+    cases = sorted({c for runs in by_rtt.values() for r in runs for c in r}, key=str)
+
+    def ratio(r):
+        f, b = r["widget"]["hold"].get("fps") if r["widget"]["hold"] else None, r.get("base_fps")
+        return f / b if f and b and b == b else math.nan
+
+    def med(xs):
+        xs = [x for x in xs if x == x]
+        return statistics.median(xs) if xs else math.nan
+
+    lines = ["| round trip ms | baseline held fps | " + " | ".join(f"{c} held (x base) | {c} tap ms" for c in cases)
+             + " |", "|" + "---|" * (2 + 2 * len(cases))]
+    first = {}
+    for rtt in rtts:
+        runs = by_rtt[rtt]
+        base = med([r.get("base_fps", math.nan) for res in runs for r in res.values()][:1] or [math.nan])
+        row = [f"{rtt:g}", f"{base:.1f}"]
+        for c in cases:
+            rs = [res[c] for res in runs if c in res]
+            x = med([ratio(r) for r in rs])
+            first.setdefault(c, x)
+            tap = med([median(r["widget"]["latency_ms"]) for r in rs])
+            btap = med([median(r["base"]["latency_ms"]) for r in rs])
+            rel = f" ({x / first[c]:.2f} of {rtts[0]:g} ms)" if rtt != rtts[0] and first[c] == first[c] else ""
+            row += [f"{x:.2f}{rel}", f"{tap:.0f} ({btap:.0f})"]
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
@@ -1462,6 +1503,10 @@ def main(argv=None) -> int:
     ap.add_argument("--trace-dir", default=None, help="with --trace: also keep each raw trace here")
     ap.add_argument("--in-flight", type=int, default=None,
                     help="updates the widget may have in flight (default: the package's; 1 = the old protocol)")
+    ap.add_argument("--rtt", default="0",
+                    help="round trips to measure through a proxy delaying every byte by half of it each way "
+                         "(ms, comma-separated, e.g. 0,120,300; default 0: no proxy); ends with a table of "
+                         "held frame rates as ratios to the baseline at each round trip")
     ap.add_argument("--volume-step", type=float, default=None,
                     help="ray-cast renderings (blob64-volume, -mip): sample every this many grid spacings "
                          "(default: the package's volume_layer.STEP, 0.5); a diagnosis of the shader's cost")
@@ -1497,6 +1542,11 @@ def main(argv=None) -> int:
     if unknown or not cases:
         ap.error(f"unknown cases {unknown}; choose from {', '.join(ALL_CASES)}")
     args.case_list = cases
+    try:
+        args.rtts = [float(x) for x in args.rtt.split(",") if x.strip()]
+        assert args.rtts and all(0 <= x < 5000 for x in args.rtts)
+    except (ValueError, AssertionError):
+        ap.error("--rtt: milliseconds, comma-separated, each in [0, 5000)")
     rng = random.Random(args.seed)
 
     try:
@@ -1508,10 +1558,13 @@ def main(argv=None) -> int:
 
 def _main_runs(args, rng) -> int:
     runs, raw, any_failed = [], [], False
-    for k in range(args.runs):
-        if args.runs > 1:
-            print(f"-- run {k + 1} of {args.runs}", file=sys.stderr, flush=True)
-        results, meta, failed = measure(args, rng)
+    by_rtt: dict = {}  # rtt -> [results of each run]
+    for k in range(args.runs * len(args.rtts)):
+        rtt = args.rtts[k % len(args.rtts)]
+        if args.runs > 1 or len(args.rtts) > 1:
+            print(f"-- run {k // len(args.rtts) + 1} of {args.runs}, round trip {rtt:g} ms", file=sys.stderr, flush=True)
+        results, meta, failed = measure(args, rng, rtt)
+        by_rtt.setdefault(rtt, []).append(results)
         if args.runs > 1:
             print(f"\n### Run {k + 1} of {args.runs}\n")
         if results:
@@ -1521,9 +1574,12 @@ def _main_runs(args, rng) -> int:
             print(f"\n{case}: not measured ({why})")
         any_failed = any_failed or bool(failed)
         raw.append({"meta": meta, "results": results, "failed": failed})
-    if args.runs > 1 and runs:
+    if args.runs > 1 and runs and len(args.rtts) == 1:
         print("\n### Summary\n")
         print(summary(runs))
+    if len(args.rtts) > 1 or args.rtts != [0.0]:
+        print("\n### Round trips\n")
+        print(rtt_table(by_rtt))
     if args.json:
         doc = raw[0] if args.runs == 1 else {"runs": raw}
         pathlib.Path(args.json).write_text(json.dumps(doc, indent=1, default=str))

@@ -135,3 +135,20 @@ def test_a_second_keydown_of_a_held_key_is_a_repeat(make, clock):
     down(w, "4", t=1.05)
     up(w, "4", t=1.1)
     assert_same(w, reference(w, [("4", False, 1000.0, 1100.0)]))
+
+
+def test_a_long_hold_keeps_a_bounded_window_of_steps_and_ends_on_the_page_s_state(make, clock):
+    """Steps the page said it made more than SETTLED_MS ago are done (a rolling checkpoint): each
+    heartbeat costs the same however long the hold, and the end state is still the page's."""
+    from rot4d_widget.view.pagesteps import ROLL_STEPS
+
+    w = make("24-cell")
+    down(w, "8", t=1.0)
+    kept = 0
+    for t in range(1000, 21000, 33):  # 20 s of heartbeats
+        heartbeat(w, float(t))
+        kept = max(kept, len(w._keys.page._applied))
+    up(w, "8", t=20.99)
+    assert kept <= ROLL_STEPS + 2
+    assert_same(w, reference(w, [("8", False, 1000.0, 20990.0)]))
+    assert_replays(w, make)

@@ -81,6 +81,9 @@ class KeyPad:
                     layout=widgets.Layout(width="auto", min_width="3.6em", height="2.2em", padding="0 0.3em"),
                 )
                 b.add_class("rot4d-pad-button")
+                # for the page, which steps the pad's keys itself (page/turning.js): whose, which key
+                b.add_class(f"{self.w.scene.canvas_class}-pad")
+                b.add_class(f"rot4d-pad-key-{ord(key):x}" + ("-shift" if shift else ""))
                 ev = Event(source=b, watched_events=list(PAD_EVENTS), prevent_default_action=True)
                 ev.on_dom_event(lambda event, key=key, shift=shift: self.handle(key, shift, event))
                 self.events.append(ev)

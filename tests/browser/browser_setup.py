@@ -247,12 +247,18 @@ class DelayProxy:
         self._loop.run_forever()
 
     def stop(self) -> None:
-        def close():
+        import asyncio
+
+        async def close():
             if self._server is not None:
                 self._server.close()
+            tasks = [t for t in asyncio.all_tasks(self._loop) if t is not asyncio.current_task()]
+            for t in tasks:
+                t.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
             self._loop.stop()
 
-        self._loop.call_soon_threadsafe(close)
+        asyncio.run_coroutine_threadsafe(close(), self._loop)
         self._thread.join(timeout=5)
 
 

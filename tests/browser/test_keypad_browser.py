@@ -110,6 +110,12 @@ def test_keypad_with_mouse_and_touch(jupyter_server, page, artifacts):
     time.sleep(0.5)
     assert _xw_steps(jp) == touched
     cdp.send("Emulation.setTouchEmulationEnabled", {"enabled": False})
+    # the page stepped the pad's keys itself (issue 34) and ends on the kernel's state
+    cls = jp.kernel("print(w.scene.canvas_class)").strip()
+    pg = page.evaluate(f"() => document.querySelector('.{cls}').rot4dPage()")
+    k = jp.kernel_json("w.state.matrix.reshape(-1).tolist()")
+    assert pg and max(abs(a - b) for a, b in zip(pg["matrix"], k)) <= 1e-12, (pg, k)
+    assert jp.kernel_json("w._keys.page.state_id[1]") == pg["upto"]  # every step of the pad was the page's
     page.locator(".rot4d-keypad").screenshot(path=str(artifacts / "keypad.png"))
     assert not _bad_console(page), _bad_console(page)
     assert jp.kernel_json("len(w.errors.outputs)") == 0

@@ -6,7 +6,9 @@ Keys held over the view step the page's copy at once (its test hook on the canva
 timestamps and heartbeats.  Two keys held together -- on a kernel made slow on purpose (a
 source whose slice sleeps, and a heartbeat handler held up) -- end equal on both sides, and the
 page's state does not jump at the release: the state the page shows after every key is up is
-the one it showed on the last frame before (it adopts the kernel's, which is the same).
+the one it showed on the last frame before (it adopts the kernel's, which is the same); a
+screenshot asked at the release is of the final state; the recording made while the page
+predicted replays bit for bit to where the view ended.
 """
 
 from __future__ import annotations
@@ -118,5 +120,8 @@ def _two_keys(jupyter_server, page, var):
 
     a, b = (np.asarray(Image.open(p).convert("RGB"), dtype=int) for p in shots)
     assert a.shape == b.shape and np.abs(a - b).max() <= 2, "the first screenshot was not of the final state"
+    # a replay of the recording made while the page predicted ends where the view ended, bit for bit
+    same = jp.kernel_json(f"bool((({var}.recording.replay().matrix == {var}.state.matrix)).all())")
+    assert same, "the recording does not replay to the view's state"
     steps = jp.kernel(f"print(sum(1 for e in {var}.recording.events if getattr(e, 'key', 0) is None))")
     assert int(steps.strip()) > 10  # both keys repeated

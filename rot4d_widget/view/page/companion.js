@@ -56,9 +56,9 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
-import { adoptKernel, attachKeys, turning } from "./turning.js";
+import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { drawsOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
+import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -129,6 +129,7 @@ async function render({ model, el }) {
   };
   turning(model);
   attachKeys(model, { listen, hovered: () => canvasClasses().some(canvasHovered), canvases });
+  attachPad(model, { listen, canvasClass: () => model.get("canvas_class") });
   const onKernelState = () => adoptKernel(model);
   const onConfig = () => turning(model);
   if (typeof model.on === "function") {
@@ -770,6 +771,21 @@ async function render({ model, el }) {
       const sharedTurn = turning(model);
       sharedTurn.listeners.add(redraw);
       cleanups.push(() => sharedTurn.listeners.delete(redraw));
+      // the test hook: draw the page's own picture at rest too (to compare it with the kernel's), and
+      // say which is drawn
+      const hookDraw = () => {
+        for (const cls of canvasClasses()) {
+          for (const host of document.getElementsByClassName(cls)) {
+            host.rot4dForceOwn = (on) => {
+              forceOwn(model, on);
+              scene.trigger("rerender", scene, {});
+            };
+            host.rot4dDrawsOwn = () => own;
+          }
+        }
+      };
+      listen(document, "mouseover", hookDraw, true);
+      hookDraw();
       scene.on("beforeRender", beforeRender);
       cleanups.push(() => scene.off("beforeRender", beforeRender));
 

@@ -12,6 +12,12 @@ import { decodeStack, stackData, stackHyperplanes } from "./stack.js";
 import { transferStore, unpack } from "./transfer.js";
 
 const cuts = new WeakMap();  // model -> {key, polytope, rows cache}
+const forced = new WeakMap();  // model -> true: draw the page's own picture at rest too (tests compare the two)
+
+export function forceOwn(model, on) {
+  forced.set(model, !!on);
+}
+
 const stacks = new WeakMap();  // draw_config -> {stack (decoded) or null, text (what the cache keys on), bad}
 
 // The stack of a draw_config (stack.js decodeStack; null for a single slice), decoded once per
@@ -55,7 +61,7 @@ export function drawsOwn(model, prediction, seq) {
   const cfg = model.get("draw_config") || {};
   if (!c || !prediction || !prediction.state || c.key !== offered || !Array.isArray(cfg.palette)) return false;
   if (stackOf(cfg).bad) return false;
-  if (prediction.held.length || prediction.pending) return true;
+  if (prediction.held.length || prediction.pending || forced.get(model)) return true;
   const ks = model.get("kernel_state") || {};
   return ks.picture === "pending" || (Number.isInteger(ks.picture) && !(seq >= ks.picture));
 }

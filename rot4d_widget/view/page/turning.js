@@ -116,6 +116,51 @@ export function attachKeys(model, { listen, hovered, canvases }) {
   watchCanvases();
 }
 
+// The key pad's buttons (rot4d_widget.view.keypad): ipyevents forwards a button's mousedown and
+// touchstart (a press, its timeStamp) and mouseup, mouseleave, touchend, touchcancel (a release);
+// the page steps them as the kernel does, as the key "pad:<key>[+shift]" the button stands for
+// (its classes: `<canvas class>-pad`, `rot4d-pad-key-<code point, hex>[-shift]`).
+const PAD_KEY = /^rot4d-pad-key-([0-9a-f]+)(-shift)?$/;
+
+export function attachPad(model, { listen, canvasClass }) {
+  const button = (event) => {
+    const el = event.target && event.target.closest ? event.target.closest(".rot4d-pad-button") : null;
+    if (!el || !el.classList.contains(canvasClass() + "-pad")) return null;
+    for (const c of el.classList) {
+      const m = PAD_KEY.exec(c);
+      if (m) return { key: String.fromCodePoint(parseInt(m[1], 16)), shift: !!m[2] };
+    }
+    return null;
+  };
+  const press = (event) => {
+    const b = button(event);
+    const s = turning(model);
+    const p = s.prediction;
+    if (!b || !p || s.silent || (event.type === "mousedown" && event.button !== 0)) return;
+    const found = p.keymap.resolve(b.key, b.shift);
+    if (!found || !p.predicted.has(found.action.kind)) return;
+    if (!p.held.length) s.lastKernel = Math.max(s.lastKernel, event.timeStamp);
+    if (!p.press(`pad:${b.key}${b.shift ? "+shift" : ""}`, found.action, found.inverted, event.timeStamp)) return;
+    frame(s, event.timeStamp);
+    schedule(s);
+  };
+  const release = (event) => {
+    const b = button(event);
+    const s = turning(model);
+    if (b && s.prediction && s.prediction.release(`pad:${b.key}${b.shift ? "+shift" : ""}`, event.timeStamp)) {
+      frame(s, event.timeStamp);
+    }
+  };
+  for (const type of ["mousedown", "touchstart"]) listen(document, type, press, true);
+  for (const type of ["mouseup", "touchend", "touchcancel"]) listen(document, type, release, true);
+  listen(document, "mouseout", (event) => {  // leaving the button (ipyevents' mouseleave)
+    const b = button(event);
+    if (b && !(event.relatedTarget && event.target.closest(".rot4d-pad-button").contains(event.relatedTarget))) {
+      release(event);
+    }
+  }, true);
+}
+
 // The kernel's state arrived (`kernel_state`): adopted, the page's later steps on top.
 export function adoptKernel(model) {
   const s = turning(model);
