@@ -16,6 +16,7 @@ import time
 import numpy as np
 import pytest
 from jupyter_page import JupyterPage, write_notebook
+from test_page_pictures_browser import _pixels
 from test_widget_browser import _canvas, _hover
 
 pytestmark = pytest.mark.browser
@@ -124,3 +125,46 @@ def _held_oval(jupyter_server, page):
     assert after["updates"] >= held["updates"] + 1  # the picture the keys rest on
     assert (diff <= 2).mean() >= 0.995, "the kernel's picture of the final state differs from the page's"
     assert len(late) == len(changes_then), "the canvas changed when the kernel's picture came"
+
+
+#: label -> the widget's source: stacks in the other arrangements, coloured by cell
+AT_REST = {"8-cell, 5-slice grid by cell": "StackSource('8-cell', slices=5, arrangement='grid', color_by='cell')",
+           "600-cell, 2-slice stack by cell": "StackSource('600-cell', slices=2, arrangement='stack', color_by='cell')"}
+
+
+def test_the_page_s_picture_of_a_stack_at_rest_is_the_kernel_s(jupyter_server, page, artifacts):
+    """As test_page_pictures_browser for single polytopes: a turned state at rest, the kernel's
+    picture read back, then the page's own rows of it (``rot4dForceOwn``): the same pixels."""
+    if jupyter_server.kind != "lab":
+        pytest.skip("JupyterLab only: the page's pictures are the same code in Notebook 7")
+    cells = ["from rot4d_widget import Rot4DWidget, StackSource\nws = {}"]
+    cells += [f"ws[{name!r}] = Rot4DWidget({args}, width=320, height=260)\nws[{name!r}]"
+              for name, args in AT_REST.items()]
+    write_notebook(jupyter_server.root / "page_stack_rest.ipynb", cells)
+    jp = JupyterPage(page, jupyter_server, "page_stack_rest.ipynb").open()
+    jp.run_all()
+    worst = {}
+    for name in AT_REST:
+        jp.kernel(f"w = ws[{name!r}]")
+        sel = _canvas(jp, "w")
+        host = sel.rsplit(" canvas", 1)[0]
+        jp.page.locator(sel).scroll_into_view_if_needed()
+        _hover(jp, sel)
+        for key in ("4", "y", "l"):  # a turned state, off the centre
+            jp.page.keyboard.press(key)
+        assert jp.wait_for(lambda: jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dDrawsOwn()")
+                           is False, timeout=30), f"{name}: the kernel's picture never came"
+        jp.page.mouse.move(2, 2)  # the pointer away: nothing hovered
+        kernel = _pixels(jp, sel)
+        jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dForceOwn(true)")
+        assert jp.wait_for(lambda: jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dDrawsOwn()"),
+                           timeout=10), f"{name}: the page does not hold the polytope"
+        own = _pixels(jp, sel)
+        label = name.replace(", ", "-").replace(" ", "-")
+        jp.page.locator(sel).screenshot(path=str(artifacts / f"page-own-{label}-{jupyter_server.kind}.png"))
+        jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dForceOwn(false)")
+        diff = np.abs(own - kernel).max(axis=1)
+        worst[name] = (int(diff.max()), float((diff <= 2).mean()))
+        assert (diff <= 2).mean() >= 0.995, (name, worst[name])
+        assert (kernel != kernel[0]).any(axis=1).sum() > 500, f"{name}: nothing drawn"
+    print("stack at rest, page vs kernel, worst channel difference and share within 2/255:", worst)
