@@ -58,7 +58,7 @@ import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { drawsOwn, forceOwn, ownPicture, polytopeArrived } from "./pictures.js";
+import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -169,13 +169,15 @@ async function render({ model, el }) {
     });
   }
   onPageData();
-  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
-  const pageHook = () => {
+  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it, the
+  // pictures it made itself (`rows`: with the last one's rows)
+  const pageHook = (rows = false) => {
     const p = turning(model).prediction;
     if (!p || !p.state) return null;
     const k = p.kernel || {};
     return { matrix: Array.from(p.state.matrix), theta0: p.state.theta0, alpha: p.state.alpha, c0: p.state.c0,
-             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held };
+             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held, version: p.version,
+             own: ownPictureReport(model, rows) };
   };
   const hookPage = () => {
     for (const host of canvases()) host.rot4dPage = pageHook;
@@ -488,8 +490,7 @@ async function render({ model, el }) {
       let ownProj = null; // the state message of the page's own state, made once per state
       const ownProjection = (p) => {
         if (!ownProj || ownProj.version !== p.version) {
-          const c0 = p.state.c0;
-          ownProj = { version: p.version, msg: { matrix: Array.from(p.state.matrix), offsets: [c0], middle: c0 } };
+          ownProj = { version: p.version, msg: ownHyperplanes(model, p.state) };
         }
         return ownProj.msg;
       };
@@ -499,7 +500,7 @@ async function render({ model, el }) {
         const g = projectionShared(lo);
         if (!g) return;
         const sk = buffer.get("_rot4d_skeleton");
-        // the page's own state while it draws its own picture (a single polytope: one hyperplane, c0)
+        // the page's own state while it draws its own picture (c0, or a stack's every cut)
         const mine = own && turning(model).prediction;
         const st = mine && mine.state ? ownProjection(mine) : buffer.get("_rot4d_project");
         if (g.sk !== sk) {
