@@ -153,6 +153,10 @@ class PageSteps:
     def held_key(self, kid):
         return self.log.held_key(kid)
 
+    def held_since(self) -> list:
+        """The page's keys the state holds as held, with their press times (`StepLog.held_since`)."""
+        return self.log.held_since()
+
     @property
     def state_id(self) -> tuple:
         """``(epoch, upto)``: the state the kernel holds (module docs)."""

@@ -249,10 +249,10 @@ class Painter:
         w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
         epoch, upto = w._keys.page.state_id
         msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": state_message(w.state),
-               "picture": picture}
+               "keys": w._keys.page.held_since(), "picture": picture}
         old = w.companion.kernel_state
         if picture is None and old.get("picture") != "pending" and old.get("state") == msg["state"] \
-                and old.get("epoch") == epoch and old.get("upto") == msg["upto"]:
+                and old.get("epoch") == epoch and old.get("upto") == msg["upto"] and old.get("keys") == msg["keys"]:
             return  # unchanged: nothing to send (the picture named before still shows it)
         w.companion.kernel_state = msg
         self.state_at = now

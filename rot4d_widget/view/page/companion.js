@@ -56,7 +56,7 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
-import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
+import { adoptKernel, attachKeys, attachPad, releaseKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 
@@ -111,10 +111,15 @@ async function render({ model, el }) {
     cleanups.push(() => clearTimeout(t));
   }
 
-  // 2. focus loss (with the page's time: held keys are released then on both sides)
-  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur", t: performance.now() }));
+  // 2. focus loss (with the page's time: held keys are released then on both sides, one time)
+  const focusLost = (reason) => {
+    const t = performance.now();
+    send({ event: "focus_lost", reason, t });
+    releaseKeys(model, t);
+  };
+  listen(window, "blur", () => focusLost("blur"));
   listen(document, "visibilitychange", () => {
-    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden", t: performance.now() });
+    if (document.visibilityState === "hidden") focusLost("hidden");
   });
 
   // 8. the page turns: its own copy of the state, stepped by the keys over this widget's canvases
