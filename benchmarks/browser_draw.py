@@ -2,7 +2,7 @@
 
     python benchmarks/browser_draw.py [--cases 24-cell,600-cell]  (or star polychora by name)
         [--variants default,msaa] [--phases held,rest] [--hold 2] [--rounds 1]
-        [--screenshots DIR [--compare OTHER]] [--rev HEAD]
+        [--screenshots DIR [--compare OTHER]] [--rev HEAD~1,WORK]
 
 About 40 s per case and variant.  One JupyterLab 4 server, one headless
 Chromium; for each polychoron and variant a notebook shows
@@ -44,6 +44,13 @@ can be compared pixel by pixel: the variants against the first one, and with
 ``--compare OTHER`` each picture against the one of the same name in OTHER
 (say, made with ``--rev`` of an earlier version).
 
+``--rev`` names the code measured: git revisions (a clean ``git archive`` of each) and ``WORK``
+(the working tree, the default), comma-separated.  Each gets its own JupyterLab server in the same
+browser, and every round measures each case with each code in turn (a different one first each
+round), so two versions are compared under the same load (the machine is shared: runs minutes
+apart are not comparable).  With several, the table has a ``code`` column and ``--screenshots
+DIR`` keeps each code's pictures in a subfolder and compares them with the first code's.
+
 Variants: ``default`` (the widget as shipped: no multisampling), ``msaa``
 (``antialias=True``: WebGL's 4x multisampling).  Prints a table of medians
 (ms) per pass, their sum, and the median frame.  The figures this benchmark
@@ -53,6 +60,7 @@ produced, and the commands, are in docs/design.md and docs/performance.md.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import pathlib
 import re
@@ -255,11 +263,15 @@ def main(argv=None) -> int:
     ap.add_argument("--phases", default=",".join(PHASES), help=f"comma-separated, from {', '.join(PHASES)}")
     ap.add_argument("--hold", type=float, default=2.0,
                     help="seconds each phase is timed per pass, and again per frame (default 2)")
-    ap.add_argument("--rev", default=None, help="measure a clean `git archive` of this revision")
+    ap.add_argument("--rev", default="WORK",
+                    help="the code measured, comma-separated: git revisions (a clean `git archive` of each) "
+                         "and WORK (the working tree); interleaved in every round (default WORK)")
     ap.add_argument("--screenshots", default=None, help="save each canvas in the rest phase's state in this folder")
     ap.add_argument("--compare", default=None,
                     help="with --screenshots: compare each picture with the one of the same name in this "
                          "folder (e.g. made with --rev of another version)")
+    ap.add_argument("--json", default=None, help="also write every frame's figures, by code, case, variant and "
+                                                 "phase and round, to this file")
     ap.add_argument("--rounds", type=int, default=1,
                     help="repeat every case and variant, interleaved; frames are pooled (default 1)")
     args = ap.parse_args(argv)
@@ -280,18 +292,30 @@ def main(argv=None) -> int:
     chromium = find_chromium()
     version = subprocess.run([chromium, "--version"], capture_output=True, text=True).stdout.strip()
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-draw-"))
-    code = working_tree_description()
-    server = JupyterServer("lab", tmp / "server")
-    if args.rev:
-        code = export_revision(args.rev, tmp / "src")
-        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp / "src"), server.env.get("PYTHONPATH")]))
+    codes = [c.strip() for c in args.rev.split(",") if c.strip()]
+    if not codes or len(set(codes)) != len(codes):
+        ap.error("--rev: distinct revisions or WORK, comma-separated")
+    servers, described = {}, {}
+    for i, c in enumerate(codes):
+        servers[c] = JupyterServer("lab", tmp / f"server{i}")
+        if c == "WORK":
+            described[c] = working_tree_description()
+        else:
+            described[c] = export_revision(c, tmp / f"src{i}")
+            servers[c].env["PYTHONPATH"] = os.pathsep.join(
+                filter(None, [str(tmp / f"src{i}"), servers[c].env.get("PYTHONPATH")]))
     shots = pathlib.Path(args.screenshots) if args.screenshots else None
-    if shots is not None:
-        shots.mkdir(parents=True, exist_ok=True)
+    folders = {c: (shots if len(codes) == 1 else shots / re.sub(r"[^A-Za-z0-9._-]+", "_", c)) for c in codes} \
+        if shots is not None else {c: None for c in codes}
+    for f in folders.values():
+        if f is not None:
+            f.mkdir(parents=True, exist_ok=True)
     load_before = os.getloadavg()
     pooled: dict = {}
+    raw: list = []
     try:
-        server.start()
+        for server in servers.values():
+            server.start()
         with sync_playwright() as p:
             context = p.chromium.launch_persistent_context(
                 str(tmp / "profile"), executable_path=chromium, headless=True, args=CHROMIUM_FLAGS,
@@ -299,63 +323,78 @@ def main(argv=None) -> int:
             )
             context.add_init_script(DRAW_HOOK)
             try:
-                for _ in range(args.rounds):
+                for k in range(args.rounds):
                     for case in cases:
                         for variant in variants:
-                            r = run_one(context, server, case, variant, args.hold, shots, phases)
-                            print(f"{case} {variant}: " + ", ".join(f"{ph} {r[ph]['frames']} frames"
-                                                                    for ph in phases),
-                                  file=sys.stderr, flush=True)
-                            for ph in phases:
-                                acc = pooled.setdefault((case, variant, ph), {
-                                    "per": {q: [] for q in PASSES}, "frames": 0, "overhead": [], "frame": []})
-                                for q in PASSES:
-                                    acc["per"][q] += r[ph]["per"][q]
-                                acc["frames"] += r[ph]["frames"]
-                                acc["overhead"] += r[ph]["overhead"]
-                                acc["frame"] += r[ph]["frame"]
-                                acc["capacity"], acc["counts"] = r["capacity"], r["counts"]
+                            for c in codes[k % len(codes):] + codes[:k % len(codes)]:  # each code first in turn
+                                r = run_one(context, servers[c], case, variant, args.hold, folders[c], phases)
+                                raw.append({"code": c, "case": case, "variant": variant, "round": k,
+                                            **{ph: {"per": r[ph]["per"], "frame": r[ph]["frame"]} for ph in phases}})
+                                print(f"{c}, {case} {variant}: " + ", ".join(f"{ph} {r[ph]['frames']} frames"
+                                                                            for ph in phases),
+                                      file=sys.stderr, flush=True)
+                                for ph in phases:
+                                    acc = pooled.setdefault((c, case, variant, ph), {
+                                        "per": {q: [] for q in PASSES}, "frames": 0, "overhead": [], "frame": []})
+                                    for q in PASSES:
+                                        acc["per"][q] += r[ph]["per"][q]
+                                    acc["frames"] += r[ph]["frames"]
+                                    acc["overhead"] += r[ph]["overhead"]
+                                    acc["frame"] += r[ph]["frame"]
+                                    acc["capacity"], acc["counts"] = r["capacity"], r["counts"]
             finally:
                 context.close()
     finally:
-        server.stop()
+        for server in servers.values():
+            server.stop()
         shutil.rmtree(tmp, ignore_errors=True)
-    print("| case | variant | phase | balls, bars, faces | frames | " + " | ".join(PASSES)
-          + " | sum | frame (n) |")
-    print("|---|---|---|---|---|" + "---|" * len(PASSES) + "---|---|")
-    for (case, variant, ph), r in pooled.items():
+    if args.json:
+        pathlib.Path(args.json).write_text(json.dumps(raw))
+    several = len(codes) > 1
+    print("| " + ("code | " if several else "") + "case | variant | phase | balls, bars, faces | frames | "
+          + " | ".join(PASSES) + " | sum | frame (n) |")
+    print("|" + "---|" * (5 + several + len(PASSES) + 2))
+    for key in sorted(pooled, key=lambda k: (cases.index(k[1]), variants.index(k[2]), phases.index(k[3]),
+                                             codes.index(k[0]))):
+        c, case, variant, ph = key
+        r = pooled[key]
         meds = [median(r["per"][p]) for p in PASSES]
-        print(f"| {case} | {variant} | {ph} | {', '.join(str(c) for c in r['counts'])} | {r['frames']} | "
+        print("| " + (f"{c} | " if several else "") + f"{case} | {variant} | {ph} | "
+              f"{', '.join(str(n) for n in r['counts'])} | {r['frames']} | "
               + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | "
               f"{median(r['frame']):.1f} ({len(r['frame'])}) |")
-    if shots is not None and len(variants) > 1:
-        print(f"\nScreenshots in {shots}; pixels that differ from the `{variants[0]}` picture by more "
-              "than 8/255 in some channel:")
-        for case in cases:
-            ref = _pixels(shots / f"{case}-{variants[0]}.png")
-            for v in variants[1:]:
-                d = np.abs(_pixels(shots / f"{case}-{v}.png") - ref).max(axis=-1)
-                print(f"- {case}, {v}: {100 * np.mean(d > 8):.2f} % (largest difference {d.max():.0f}/255)")
-    if shots is not None and args.compare:
-        other = pathlib.Path(args.compare)
-        print(f"\nPixels that differ from the picture of the same name in {other}, by more than 2/255 and "
-              "by more than 8/255 in some channel:")
-        for case in cases:
-            for v in variants:
-                name = f"{case}-{v}.png"
-                if not (other / name).exists():
-                    print(f"- {name}: not in {other}")
-                    continue
-                d = np.abs(_pixels(shots / name) - _pixels(other / name)).max(axis=-1)
-                print(f"- {name}: {100 * np.mean(d > 2):.2f} %, {100 * np.mean(d > 8):.2f} % "
-                      f"(largest difference {d.max():.0f}/255)")
+    def compare(title, pairs):
+        print(f"\n{title} -- pixels that differ by more than 2/255 and by more than 8/255 in some channel:")
+        for label, mine, ref in pairs:
+            if not ref.exists():
+                print(f"- {label}: no {ref}")
+                continue
+            d = np.abs(_pixels(mine) - _pixels(ref)).max(axis=-1)
+            print(f"- {label}: {100 * np.mean(d > 2):.2f} %, {100 * np.mean(d > 8):.2f} % "
+                  f"(largest difference {d.max():.0f}/255)")
+
+    if shots is not None:
+        first = codes[0]
+        if len(variants) > 1:
+            compare(f"Screenshots in {folders[first]}: each variant against `{variants[0]}`",
+                    [(f"{case}, {v}", folders[first] / f"{case}-{v}.png", folders[first] / f"{case}-{variants[0]}.png")
+                     for case in cases for v in variants[1:]])
+        if several:
+            compare(f"Screenshots in {shots}: each code against {first}",
+                    [(f"{c}, {case}, {v}", folders[c] / f"{case}-{v}.png", folders[first] / f"{case}-{v}.png")
+                     for c in codes[1:] for case in cases for v in variants])
+        if args.compare:
+            other = pathlib.Path(args.compare)
+            compare(f"Against the pictures of the same name in {other}",
+                    [(f"{c}, {case}, {v}" if several else f"{case}, {v}", folders[c] / f"{case}-{v}.png",
+                      other / f"{case}-{v}.png") for c in codes for case in cases for v in variants])
     overhead = median([o for r in pooled.values() for o in r["overhead"]])
     print(f"\n{args.rounds} round(s), {args.hold:g} s per phase and timing; frames pooled. Medians in ms per "
           f"frame: per pass synchronised by 1-pixel reads (read overhead {overhead:.1f} ms subtracted), js the "
           f"rest of the frame's callback; frame unsynchronised but for its end (n frames). "
           f"{os.cpu_count()} CPUs ({cpu_name()}), load {' '.join(f'{x:.1f}' for x in load_before)} before, "
           f"{' '.join(f'{x:.1f}' for x in os.getloadavg())} after; {version.split(' built')[0]}, headless, "
-          f"SwiftShader; canvas 600×500; code: {code}.")
+          f"SwiftShader; canvas 600×500; code: {'; '.join(f'{c} = {described[c]}' for c in codes)}.")
     return 0
 
 
