@@ -9,7 +9,8 @@ then the keys ``SHOT_KEYS``).  Its balls, bars and faces, as pythreejs hands the
 -- the row table, each mesh's template, columns, shaders, uniforms and material settings, the
 camera -- are drawn in a bare page of headless Chromium (SwiftShader) on a WebGL2 canvas made as
 pythreejs makes it, with three.js r97's shader prefix and draw state, each layer unpacked into a
-plain geometry as the companion's ``expand.js`` does.  Every frame draws the layers of each code
+plain geometry by that code's own ``page/expand.js`` (as the companion does; the "unpack" column
+is its time for the three layers, once per update on the page).  Every frame draws the layers of each code
 in turn, so a busy machine loads them alike (runs minutes apart are not comparable on the shared
 machine; ``browser_draw.py`` measures the real page, this one only the drawing, with less noise).
 Each pass is timed between 1-pixel reads; the table gives medians over ``--rounds`` frames.
@@ -56,6 +57,7 @@ def describe(case: str) -> dict:
     from browser_draw import SHOT_KEYS
 
     from rot4d_widget import Rot4DWidget
+    from rot4d_widget.view.bundle import PAGE_DIR
     from rot4d_widget.view.pump import ACK_TIMEOUT
 
     w = Rot4DWidget(case)
@@ -80,7 +82,8 @@ def describe(case: str) -> dict:
         })
     cam = canvas.camera
     rows = np.ascontiguousarray(sc.rows, dtype="<f4")
-    return {"layers": layers, "rows": base64.b64encode(rows.tobytes()).decode(), "stride": rows.shape[1],
+    return {"expand": (PAGE_DIR / "expand.js").read_text(), "layers": layers,
+            "rows": base64.b64encode(rows.tobytes()).decode(), "stride": rows.shape[1],
             "camera": {"position": list(cam.position), "fov": cam.fov, "aspect": cam.aspect, "near": cam.near,
                        "far": cam.far},
             "size": [canvas.width, canvas.height], "counts": list(sc.counts)}
@@ -98,23 +101,6 @@ def describe_revision(rev: str, case: str, tmp: pathlib.Path) -> tuple[dict, str
 
 
 # -- the drawing, as three.js r97 in pythreejs does it ------------------------------------------
-def unpack(desc: dict) -> dict:
-    """Each layer's plain geometry (expand.js): the template repeated per row in use, every vertex
-    carrying its row's columns."""
-    rows = np.frombuffer(base64.b64decode(desc["rows"]), dtype="<f4").reshape(-1, desc["stride"])
-    out = {}
-    for layer in desc["layers"]:
-        n = min(layer["count"], len(rows))
-        tmpl = np.asarray(layer["template"], dtype=np.float32).reshape(-1, 3)
-        v = len(tmpl)
-        arrays = {"position": np.tile(tmpl, (n, 1))}
-        for name, (offset, size) in layer["columns"].items():
-            arrays[name] = np.repeat(rows[:n, offset:offset + size], v, axis=0)
-        out[layer["name"]] = {k: base64.b64encode(np.ascontiguousarray(a, dtype="<f4").tobytes()).decode()
-                              for k, a in arrays.items()}
-    return out
-
-
 def matrices(camera: dict) -> dict:
     """Column-major view and projection matrices of a three.js PerspectiveCamera looking at the origin."""
     eye = np.asarray(camera["position"], dtype=np.float64)
@@ -155,7 +141,20 @@ const b64 = (s) => {
   for (let i = 0; i < b.length; i++) u[i] = b.charCodeAt(i);
   return new Float32Array(u.buffer);
 };
-window.setup = (codes, size) => {
+// three.js r97 in miniature, for expand.js: the instanced geometry's parent class is the plain one
+class BufferGeometry {
+  constructor() { this.attributes = {}; this.drawRange = { start: 0, count: Infinity }; }
+  addAttribute(name, a) { this.attributes[name] = a; return this; }
+  setDrawRange(start, count) { this.drawRange = { start, count }; }
+  dispose() {}
+}
+class InstancedBufferGeometry extends BufferGeometry {}
+InstancedBufferGeometry.prototype.isInstancedBufferGeometry = true;
+class BufferAttribute {
+  constructor(array, itemSize) { this.array = array; this.itemSize = itemSize; this.version = 0; }
+  set needsUpdate(v) { if (v) this.version++; }
+}
+window.setup = async (codes, size) => {
   const canvas = document.getElementById('c');
   canvas.width = size[0]; canvas.height = size[1];
   // as pythreejs makes its renderer's context
@@ -169,25 +168,40 @@ window.setup = (codes, size) => {
     return s;
   };
   const built = {};
+  window.unpackTimes = {};
   for (const [key, code] of Object.entries(codes)) {
-    built[key] = code.layers.map((layer) => {
+    const expand = await import(URL.createObjectURL(new Blob([code.expand], { type: 'text/javascript' })));
+    const rows = b64(code.rows);
+    const unpack = () => code.layers.map((layer) => {
+      const g = new InstancedBufferGeometry();
+      g.addAttribute('position', new BufferAttribute(Float32Array.from(layer.template), 3));
+      for (const [name, [offset, itemSize]] of Object.entries(layer.columns)) {
+        g.addAttribute(name, { isInterleavedBufferAttribute: true, offset, itemSize });
+      }
+      const e = expand.makeExpansion(g, expand.layerLayout(g), rows.length / code.stride);
+      const t0 = performance.now();
+      expand.fillExpansion(e, rows, code.stride, layer.count);
+      return [e.geometry, performance.now() - t0];
+    });
+    const times = [];
+    for (let i = 0; i < 5; i++) times.push(unpack().reduce((t, [, ms]) => t + ms, 0));
+    window.unpackTimes[key] = times;
+    const geometries = unpack().map(([g]) => g);
+    built[key] = code.layers.map((layer, li) => {
       const p = gl.createProgram();
       gl.attachShader(p, compile(gl.VERTEX_SHADER, VERT + layer.vert));
       gl.attachShader(p, compile(gl.FRAGMENT_SHADER, FRAG + layer.frag));
       gl.linkProgram(p);
       if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
       const vao = gl.createVertexArray(); gl.bindVertexArray(vao);
-      let count = 0;
-      for (const [name, data] of Object.entries(code.geometry[layer.name])) {
+      const geometry = geometries[li];
+      for (const [name, a] of Object.entries(geometry.attributes)) {
         const loc = gl.getAttribLocation(p, name);
-        const a = b64(data);
-        if (name === 'position') count = a.length / 3;
         if (loc < 0) continue;
         const b = gl.createBuffer();
         gl.bindBuffer(gl.ARRAY_BUFFER, b);
-        gl.bufferData(gl.ARRAY_BUFFER, a, gl.STATIC_DRAW);
-        const size = name === 'position' ? 3 : layer.columns[name][1];
-        gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, size, gl.FLOAT, false, 0, 0);
+        gl.bufferData(gl.ARRAY_BUFFER, a.array, gl.STATIC_DRAW);
+        gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, a.itemSize, gl.FLOAT, false, 0, 0);
       }
       gl.bindVertexArray(null);
       gl.useProgram(p);
@@ -201,7 +215,7 @@ window.setup = (codes, size) => {
         else if (info.type === gl.FLOAT_VEC3) gl.uniform3fv(loc, v);
         else if (info.type === gl.FLOAT) gl.uniform1f(loc, v);
       }
-      return {layer, p, vao, count};
+      return {layer, p, vao, count: geometry.drawRange.count};
     });
   }
   // one frame of one code: three.js's order (opaque layers, then transparent) and state
@@ -266,9 +280,11 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
             for size, group in groups.items():
                 page = browser.new_page(viewport={"width": size[0] + 20, "height": size[1] + 20})
                 page.set_content(PAGE)
-                payload = {key: {"layers": c["desc"]["layers"], "geometry": unpack(c["desc"]),
+                payload = {key: {**{k: c["desc"][k] for k in ("layers", "expand", "rows", "stride")},
                                  "matrices": matrices(c["desc"]["camera"])} for key, c in group.items()}
                 page.evaluate("([codes, size]) => setup(codes, size)", [payload, list(size)])
+                for key, ms in page.evaluate("() => window.unpackTimes").items():
+                    times[key]["unpack"] = ms
                 pages.append((page, group))
             for k in range(-1, rounds):  # round -1 warms the shaders up (compiled at first draw)
                 for page, group in pages:
@@ -332,11 +348,12 @@ def main(argv=None) -> int:
     passes = ["clear", *LAYERS]
     counts = codes[revs[0]]["desc"]["counts"]
     print(f"{args.case}, rest state: {counts[0]} balls, {counts[1]} bars, {counts[2]} faces\n")
-    print("| code | " + " | ".join(passes) + " | sum |")
-    print("|---|" + "---:|" * (len(passes) + 1))
+    print("| code | " + " | ".join(passes) + " | sum | unpack |")
+    print("|---|" + "---:|" * (len(passes) + 2))
     for key, t in times.items():
         meds = [statistics.median(t[p]) if t.get(p) else math.nan for p in passes]
-        print(f"| {key} | " + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} |")
+        print(f"| {key} | " + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | "
+              f"{statistics.median(t['unpack']):.1f} |")
     if len(revs) > 1:  # each frame drew every code: the ratio frame by frame is steadier than the medians'
         print(f"\nFrame by frame, against {revs[0]} (median of the ratios): "
               + "; ".join(f"{r}: " + ", ".join(f"{p} {statistics.median(np.divide(times[r][p], times[revs[0]][p])):.2f}"
