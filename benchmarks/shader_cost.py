@@ -168,7 +168,7 @@ window.setup = async (codes, size) => {
     return s;
   };
   const built = {};
-  window.unpackTimes = {};
+  const unpacks = {};
   for (const [key, code] of Object.entries(codes)) {
     const expand = await import(URL.createObjectURL(new Blob([code.expand], { type: 'text/javascript' })));
     const rows = b64(code.rows);
@@ -183,9 +183,7 @@ window.setup = async (codes, size) => {
       expand.fillExpansion(e, rows, code.stride, layer.count);
       return [e.geometry, performance.now() - t0];
     });
-    const times = [];
-    for (let i = 0; i < 5; i++) times.push(unpack().reduce((t, [, ms]) => t + ms, 0));
-    window.unpackTimes[key] = times;
+    unpacks[key] = unpack;
     const geometries = unpack().map(([g]) => g);
     built[key] = code.layers.map((layer, li) => {
       const p = gl.createProgram();
@@ -228,6 +226,7 @@ window.setup = async (codes, size) => {
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT | gl.STENCIL_BUFFER_BIT);
     sync();
     t.clear = performance.now() - t0;
+    t.unpack = unpacks[key]().reduce((sum, [, ms]) => sum + ms, 0);  // the page does it once per update
     const order = built[key].filter((d) => !d.layer.transparent).concat(built[key].filter((d) => d.layer.transparent));
     for (const d of order) {
       gl.useProgram(d.p); gl.bindVertexArray(d.vao);
@@ -283,8 +282,6 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
                 payload = {key: {**{k: c["desc"][k] for k in ("layers", "expand", "rows", "stride")},
                                  "matrices": matrices(c["desc"]["camera"])} for key, c in group.items()}
                 page.evaluate("([codes, size]) => setup(codes, size)", [payload, list(size)])
-                for key, ms in page.evaluate("() => window.unpackTimes").items():
-                    times[key]["unpack"] = ms
                 pages.append((page, group))
             for k in range(-1, rounds):  # round -1 warms the shaders up (compiled at first draw)
                 for page, group in pages:
@@ -292,7 +289,7 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
                     for key in keys[k % len(keys):] + keys[: k % len(keys)]:
                         t = page.evaluate("([key, f]) => frame(key, f)", [key, group[key].get("depth", "lequal")])
                         if k >= 0:
-                            t["sum"] = sum(t.values())
+                            t["sum"] = sum(ms for name, ms in t.items() if name != "unpack")
                             for name, ms in t.items():
                                 times[key].setdefault(name, []).append(ms)
             if shots is not None:
@@ -357,7 +354,8 @@ def main(argv=None) -> int:
     if len(revs) > 1:  # each frame drew every code: the ratio frame by frame is steadier than the medians'
         print(f"\nFrame by frame, against {revs[0]} (median of the ratios): "
               + "; ".join(f"{r}: " + ", ".join(f"{p} {statistics.median(np.divide(times[r][p], times[revs[0]][p])):.2f}"
-                                                for p in ("balls", "bars", "faces", "sum")) for r in revs[1:]))
+                                                for p in ("balls", "bars", "faces", "sum", "unpack"))
+                         for r in revs[1:]))
     if shots is not None and len(revs) > 1:
         import matplotlib.image
 
