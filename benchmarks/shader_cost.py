@@ -21,7 +21,8 @@ Each pass is timed between 1-pixel reads; the table gives medians over ``--round
   pixels (rasterising, interpolating, writing) without the shaders' own work;
 * ``depth never``: the depth test rejects every pixel -- whether SwiftShader skips the fragment
   shader of a pixel its depth test rejects (an early depth test);
-* ``half size``: a 300 x 250 canvas, a quarter of the pixels (a pixel ratio of 0.5).
+* ``half size``: a 300 x 250 canvas, a quarter of the pixels (a pixel ratio of 0.5);
+* ``opaque faces``: the faces drawn without blending -- what blending costs.
 
 ``--screenshots DIR`` saves each code's picture and compares it with the first code's.  The
 figures this benchmark produced, and the commands, are in docs/design.md.
@@ -217,7 +218,7 @@ window.setup = async (codes, size) => {
     });
   }
   // one frame of one code: three.js's order (opaque layers, then transparent) and state
-  window.frame = (key, depthFunc) => {
+  window.frame = (key, depthFunc, blend) => {
     const t = {};
     gl.viewport(0, 0, canvas.width, canvas.height);
     gl.clearColor(1, 1, 1, 1); gl.depthMask(true); gl.colorMask(true, true, true, true);
@@ -234,7 +235,7 @@ window.setup = async (codes, size) => {
       if (d.layer.depthTest) { gl.enable(gl.DEPTH_TEST); gl.depthFunc(depthFunc === 'never' ? gl.NEVER : gl.LEQUAL); }
       else gl.disable(gl.DEPTH_TEST);
       gl.depthMask(d.layer.depthWrite);
-      if (d.layer.transparent) {
+      if (d.layer.transparent && blend) {
         gl.enable(gl.BLEND); gl.blendEquation(gl.FUNC_ADD);
         gl.blendFuncSeparate(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA, gl.ONE, gl.ONE_MINUS_SRC_ALPHA);
       } else gl.disable(gl.BLEND);
@@ -287,7 +288,8 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
                 for page, group in pages:
                     keys = list(group)
                     for key in keys[k % len(keys):] + keys[: k % len(keys)]:
-                        t = page.evaluate("([key, f]) => frame(key, f)", [key, group[key].get("depth", "lequal")])
+                        t = page.evaluate("([key, f, b]) => frame(key, f, b)",
+                                          [key, group[key].get("depth", "lequal"), group[key].get("blend", True)])
                         if k >= 0:
                             t["sum"] = sum(ms for name, ms in t.items() if name != "unpack")
                             for name, ms in t.items():
@@ -295,7 +297,8 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
             if shots is not None:
                 for page, group in pages:
                     for key, c in group.items():
-                        page.evaluate("([key, f]) => frame(key, f)", [key, c.get("depth", "lequal")])
+                        page.evaluate("([key, f, b]) => frame(key, f, b)",
+                                      [key, c.get("depth", "lequal"), c.get("blend", True)])
                         png = page.evaluate("() => picture()").split(",", 1)[1]
                         (shots / f"{key}.png").write_bytes(base64.b64decode(png))
         finally:
@@ -309,7 +312,8 @@ def main(argv=None) -> int:
     ap.add_argument("--rev", default="WORK", help="the code measured, comma-separated: git revisions and WORK "
                                                   "(the working tree); every frame draws each (default WORK)")
     ap.add_argument("--rounds", type=int, default=20, help="frames per code (default 20)")
-    ap.add_argument("--diagnose", action="store_true", help="also colour only, depth never, half size (first code)")
+    ap.add_argument("--diagnose", action="store_true",
+                    help="also colour only, depth never, half size, opaque faces (of the first code)")
     ap.add_argument("--screenshots", default=None, help="save each code's picture here and compare with the first")
     ap.add_argument("--describe", default=None, help=argparse.SUPPRESS)  # the subprocess of a --rev
     args = ap.parse_args(argv)
@@ -336,6 +340,7 @@ def main(argv=None) -> int:
             codes["colour only"] = {"desc": colour_only(first), "size": first["size"]}
             codes["depth never"] = {"desc": first, "size": first["size"], "depth": "never"}
             codes["half size"] = {"desc": first, "size": [first["size"][0] // 2, first["size"][1] // 2]}
+            codes["opaque faces"] = {"desc": first, "size": first["size"], "blend": False}
         shots = pathlib.Path(args.screenshots) if args.screenshots else None
         if shots is not None:
             shots.mkdir(parents=True, exist_ok=True)
