@@ -249,22 +249,48 @@ window.setup = async (codes, size) => {
     return t;
   };
   window.picture = () => canvas.toDataURL('image/png');
+  // the pixels each layer's triangles cover (every one runs the fragment shader), counted by adding
+  // 1/255 per fragment (a code whose shaders write that colour): per layer, and the layers' union
+  window.coverage = (key) => {
+    const all = new Uint8Array(canvas.width * canvas.height * 4);
+    const out = {};
+    const union = new Uint8Array(canvas.width * canvas.height);
+    gl.disable(gl.DEPTH_TEST); gl.depthMask(false); gl.colorMask(true, true, true, true);
+    gl.enable(gl.BLEND); gl.blendEquation(gl.FUNC_ADD); gl.blendFunc(gl.ONE, gl.ONE);
+    for (const d of built[key]) {
+      gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT);
+      gl.useProgram(d.p); gl.bindVertexArray(d.vao);
+      gl.drawArrays(gl.TRIANGLES, 0, d.count);
+      gl.readPixels(0, 0, canvas.width, canvas.height, gl.RGBA, gl.UNSIGNED_BYTE, all);
+      let n = 0, deepest = 0;
+      for (let i = 0; i < union.length; i++) {
+        const k = all[4 * i];
+        n += k; deepest = Math.max(deepest, k);
+        if (k) union[i] = 1;
+      }
+      out[d.layer.name] = { covered: n, deepest, drawn: d.count / (d.layer.template.length / 3) };
+    }
+    gl.bindVertexArray(null); gl.disable(gl.BLEND);
+    out.union = union.reduce((a, b) => a + b, 0);
+    return out;
+  };
 };
 </script>
 """
 
 
-def colour_only(desc: dict) -> dict:
+def colour_only(desc: dict, colour: str = "vec4(0.5, 0.5, 0.5, 0.35)") -> dict:
     """``desc`` with every fragment shader's main() writing a constant colour (and no depth)."""
     out = json.loads(json.dumps(desc))
     for layer in out["layers"]:
         head = layer["frag"][: layer["frag"].rindex("void main()")]
-        layer["frag"] = head + "void main() {\n    gl_FragColor = vec4(0.5, 0.5, 0.5, 0.35);\n}\n"
+        layer["frag"] = head + f"void main() {{\n    gl_FragColor = {colour};\n}}\n"
     return out
 
 
-def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
-    """{code key: {pass: [ms per frame]}}; codes = {key: {"desc": ..., "size": [w, h], "depth": func}}."""
+def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> tuple[dict, dict]:
+    """({code key: {pass: [ms per frame]}}, {code key: coverage}); codes = {key: {"desc": ...,
+    "size": [w, h], "depth": func, "blend": bool, "count": bool -- only counted, not timed}}."""
     from browser_latency import find_chromium
     from browser_setup import CHROMIUM_FLAGS
     from playwright.sync_api import sync_playwright
@@ -272,7 +298,8 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
     groups: dict = {}
     for key, c in codes.items():  # one page per canvas size
         groups.setdefault(tuple(c["size"]), {})[key] = c
-    times = {key: {} for key in codes}
+    times = {key: {} for key, c in codes.items() if not c.get("count")}
+    covered = {}
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=find_chromium(), headless=True, args=CHROMIUM_FLAGS)
         try:
@@ -284,9 +311,12 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
                                  "matrices": matrices(c["desc"]["camera"])} for key, c in group.items()}
                 page.evaluate("([codes, size]) => setup(codes, size)", [payload, list(size)])
                 pages.append((page, group))
+            for page, group in pages:
+                for key in [key for key, c in group.items() if c.get("count")]:
+                    covered[key] = page.evaluate("key => coverage(key)", key)
             for k in range(-1, rounds):  # round -1 warms the shaders up (compiled at first draw)
                 for page, group in pages:
-                    keys = list(group)
+                    keys = [key for key, c in group.items() if not c.get("count")]
                     for key in keys[k % len(keys):] + keys[: k % len(keys)]:
                         t = page.evaluate("([key, f, b]) => frame(key, f, b)",
                                           [key, group[key].get("depth", "lequal"), group[key].get("blend", True)])
@@ -296,14 +326,14 @@ def run(codes: dict, rounds: int, shots: pathlib.Path | None) -> dict:
                                 times[key].setdefault(name, []).append(ms)
             if shots is not None:
                 for page, group in pages:
-                    for key, c in group.items():
+                    for key, c in ((key, c) for key, c in group.items() if not c.get("count")):
                         page.evaluate("([key, f, b]) => frame(key, f, b)",
                                       [key, c.get("depth", "lequal"), c.get("blend", True)])
                         png = page.evaluate("() => picture()").split(",", 1)[1]
                         (shots / f"{key}.png").write_bytes(base64.b64decode(png))
         finally:
             browser.close()
-    return times
+    return times, covered
 
 
 def main(argv=None) -> int:
@@ -341,10 +371,11 @@ def main(argv=None) -> int:
             codes["depth never"] = {"desc": first, "size": first["size"], "depth": "never"}
             codes["half size"] = {"desc": first, "size": [first["size"][0] // 2, first["size"][1] // 2]}
             codes["opaque faces"] = {"desc": first, "size": first["size"], "blend": False}
+            codes["count"] = {"desc": colour_only(first, "vec4(1.0 / 255.0)"), "size": first["size"], "count": True}
         shots = pathlib.Path(args.screenshots) if args.screenshots else None
         if shots is not None:
             shots.mkdir(parents=True, exist_ok=True)
-        times = run(codes, args.rounds, shots)
+        times, covered = run(codes, args.rounds, shots)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     passes = ["clear", *LAYERS]
@@ -356,6 +387,13 @@ def main(argv=None) -> int:
         meds = [statistics.median(t[p]) if t.get(p) else math.nan for p in passes]
         print(f"| {key} | " + " | ".join(f"{m:.1f}" for m in meds) + f" | {sum(meds):.1f} | "
               f"{statistics.median(t['unpack']):.1f} |")
+    if "count" in covered:
+        c = covered["count"]
+        w, h = codes[revs[0]]["size"]
+        print(f"\nPixels each layer covers in {revs[0]}'s picture (its fragment shader runs on each), "
+              f"{w} x {h} canvas, {c['union']:,} covered by any layer: "
+              + "; ".join(f"{name} {c[name]['covered']:,} ({c[name]['covered'] / c['union']:.1f} deep on average, "
+                          f"{c[name]['deepest']} at most; {c[name]['drawn']:,} drawn)" for name in LAYERS))
     if len(revs) > 1:  # each frame drew every code: the ratio frame by frame is steadier than the medians'
         print(f"\nFrame by frame, against {revs[0]} (median of the ratios): "
               + "; ".join(f"{r}: " + ", ".join(f"{p} {statistics.median(np.divide(times[r][p], times[revs[0]][p])):.2f}"
