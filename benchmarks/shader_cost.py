@@ -1,7 +1,7 @@
 """What each pass of the widget's drawing costs in software WebGL, shader by shader, without Jupyter.
 
     python benchmarks/shader_cost.py [--case "great icosahedral 120-cell"] [--rev HEAD~1,WORK]
-        [--rounds 20] [--diagnose] [--screenshots DIR]
+        [--rounds 20] [--diagnose] [--screenshots DIR] [--keys KEYS]
 
 About a minute.  The widget is built here (for a git revision: in a subprocess running a clean
 ``git archive`` of it) and put in the fixed state of ``browser_draw.py``'s rest phase (reset,
@@ -53,8 +53,9 @@ LAYERS = ("balls", "bars", "faces")
 
 
 # -- the widget's layers, as pythreejs hands them to three.js ----------------------------------
-def describe(case: str) -> dict:
-    """The layers of ``Rot4DWidget(case)`` in the rest state, as plain JSON-able data."""
+def describe(case: str, keys: str | None = None) -> dict:
+    """The layers of ``Rot4DWidget(case)`` after reset and ``keys`` (default: browser_draw's
+    ``SHOT_KEYS``, its rest state), as plain JSON-able data."""
     from browser_draw import SHOT_KEYS
 
     from rot4d_widget import Rot4DWidget
@@ -63,7 +64,7 @@ def describe(case: str) -> dict:
 
     w = Rot4DWidget(case)
     w.press("r")
-    for k in SHOT_KEYS:
+    for k in SHOT_KEYS if keys is None else keys:
         w.press(k)
     # no page acknowledges updates here: the pump sends the latest state when the oldest in flight
     # times out (ACK_TIMEOUT); then the scene holds the slice of the last key
@@ -90,13 +91,14 @@ def describe(case: str) -> dict:
             "size": [canvas.width, canvas.height], "counts": list(sc.counts)}
 
 
-def describe_revision(rev: str, case: str, tmp: pathlib.Path) -> tuple[dict, str]:
+def describe_revision(rev: str, case: str, keys: str | None, tmp: pathlib.Path) -> tuple[dict, str]:
     from browser_latency import export_revision
 
     src = tmp / ("src-" + "".join(ch if ch.isalnum() else "_" for ch in rev))
     label = export_revision(rev, src)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(src), os.environ.get("PYTHONPATH")])))
-    out = subprocess.run([sys.executable, __file__, "--describe", case], env=env, check=True,
+    extra = [] if keys is None else ["--keys", keys]
+    out = subprocess.run([sys.executable, __file__, "--describe", case, *extra], env=env, check=True,
                          capture_output=True, text=True).stdout
     return json.loads(out), label
 
@@ -345,10 +347,12 @@ def main(argv=None) -> int:
     ap.add_argument("--diagnose", action="store_true",
                     help="also colour only, depth never, half size, opaque faces (of the first code)")
     ap.add_argument("--screenshots", default=None, help="save each code's picture here and compare with the first")
+    ap.add_argument("--keys", default=None,
+                    help="keys pressed after reset (default: browser_draw.py's SHOT_KEYS; '' for the reset view)")
     ap.add_argument("--describe", default=None, help=argparse.SUPPRESS)  # the subprocess of a --rev
     args = ap.parse_args(argv)
     if args.describe:
-        print(json.dumps(describe(args.describe)))
+        print(json.dumps(describe(args.describe, args.keys)))
         return 0
     revs = [r.strip() for r in args.rev.split(",") if r.strip()]
     if not revs or len(set(revs)) != len(revs):
@@ -361,9 +365,9 @@ def main(argv=None) -> int:
         codes, labels = {}, {}
         for rev in revs:
             if rev == "WORK":
-                desc, labels[rev] = describe(args.case), working_tree_description()
+                desc, labels[rev] = describe(args.case, args.keys), working_tree_description()
             else:
-                desc, labels[rev] = describe_revision(rev, args.case, tmp)
+                desc, labels[rev] = describe_revision(rev, args.case, args.keys, tmp)
             codes[rev] = {"desc": desc, "size": desc["size"]}
         if args.diagnose:
             first = codes[revs[0]]["desc"]
@@ -380,7 +384,8 @@ def main(argv=None) -> int:
         shutil.rmtree(tmp, ignore_errors=True)
     passes = ["clear", *LAYERS]
     counts = codes[revs[0]]["desc"]["counts"]
-    print(f"{args.case}, rest state: {counts[0]} balls, {counts[1]} bars, {counts[2]} faces\n")
+    state = "rest state" if args.keys is None else f"reset, then {args.keys!r}"
+    print(f"{args.case}, {state}: {counts[0]} balls, {counts[1]} bars, {counts[2]} faces\n")
     print("| code | " + " | ".join(passes) + " | sum | unpack |")
     print("|---|" + "---:|" * (len(passes) + 2))
     for key, t in times.items():
