@@ -205,6 +205,21 @@ def test_a_key_pressed_again_before_ipyevents_forwards_its_release_stays_held(ma
     assert_same(w, reference(w, [("c", False, 1000.0, 1100.0), ("c", False, 1500.0, 1900.0)]))
 
 
+def test_a_keyup_stamped_a_moment_before_its_keydown_is_a_tap_not_a_stuck_key(make, clock):
+    """A page whose stamps jitter (the soak's, seed 20240: keyup 0.28 ms before its keydown): the
+    release is the press's own, never one heard already -- one step, nothing held.  Compared with
+    the last press, as before, it was taken for an old release and the key stayed held for good."""
+    w = make("5-cell")
+    down(w, "2", t=368.48166)
+    up(w, "2", t=368.48138)
+    assert w.held_keys == ()
+    heartbeat(w, 369000.0, [])
+    assert_same(w, reference(w, [("2", False, 368481.66, 368481.66)]))
+    down(w, "2", t=369.5)  # the key works again
+    up(w, "2", t=369.55)
+    assert w.held_keys == ()
+
+
 def test_ipyevents_first_then_the_same_events_with_the_heartbeats(make, clock):
     """The usual order (ipyevents' event handled first): the heartbeat's copy changes nothing."""
     w = make("24-cell")

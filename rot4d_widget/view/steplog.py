@@ -18,8 +18,11 @@ A key's events can come twice, by two ways: ipyevents forwards them, and the com
 every key event the kernel has not acknowledged with each heartbeat -- the two travel on separate
 comms, which the kernel may handle on separate threads (JupyterLab 4.4+ sends widget messages on a
 subshell, ipykernel routes a comm's messages to the thread it last sent from), so the heartbeat can
-outrun the ipyevents event it follows.  A key's events are in time order, so an event no later than
-the last one heard of that key is one heard already (`StepLog.press` and `release` return False).
+outrun the ipyevents event it follows.  A key's events come in time order by either way, so a press
+no later than the key's last press heard, or a release no later than its last release heard, is one
+heard already (`StepLog.press` and `release` return False).  Presses and releases are compared with
+their own kind: a release stamped a moment before its own press (a page whose clock is coarse or
+jittered) is still that press's release -- a tap -- never taken for an old one, so no key sticks.
 
 `StepLog` is pure bookkeeping: no state, no threads, no widgets.
 """
@@ -90,18 +93,18 @@ class StepLog:
         self.heard = -math.inf  # the latest page time the kernel has heard of
         self.checked = -math.inf  # the page time of the last checkpoint
         self._order = 0
-        self._edges: dict[str, float] = {}  # kid -> page time of its latest event heard
+        self._edges: dict[str, list] = {}  # kid -> [page time of its last press, of its last release] heard
 
     def _heard_already(self, kid: str, t: float, press: bool) -> bool:
-        """An event of ``kid`` at ``t`` heard already: a press no later than the key's latest event,
-        a release earlier than it (a release at its press's time is a tap)."""
+        """An event of ``kid`` at ``t`` heard already: a press no later than the key's last press, a
+        release no later than its last release (module docs)."""
         last = self._edges.get(kid)
-        if last is None:
-            return False
-        return t <= last + SAME_MS if press else t < last - SAME_MS
+        return last is not None and t <= last[0 if press else 1] + SAME_MS
 
-    def _note_edge(self, kid: str, t: float) -> None:
-        self._edges[kid] = max(t, self._edges.pop(kid, -math.inf))  # the newest last
+    def _note_edge(self, kid: str, t: float, press: bool) -> None:
+        last = self._edges.pop(kid, [-math.inf, -math.inf])
+        last[0 if press else 1] = max(t, last[0 if press else 1])
+        self._edges[kid] = last  # the newest last
         if len(self._edges) > MAX_EDGES:
             for old in [k for k in self._edges if self.held_key(k) is None][: len(self._edges) - MAX_EDGES]:
                 del self._edges[old]
@@ -118,18 +121,18 @@ class StepLog:
             self.keys[f"{kid}#{held.order}"] = self.keys.pop(kid)
         self._order += 1
         self.keys[kid] = _Key(kid, action, bool(inverted), float(t), self._order, bool(repeats))
-        self._note_edge(kid, float(t))
+        self._note_edge(kid, float(t), True)
         self.hear(t)
         return True
 
     def release(self, kid: str, t: float) -> bool:
         """Key ``kid`` went up at page time ``t`` (at least its press); False if it was not held or the
-        release is older than its press (heard already: module docs)."""
+        release was heard already (module docs)."""
         key = self.keys.get(kid)
         if key is None or key.up is not None or self._heard_already(kid, t, False):
             return False
         key.up = max(float(t), key.down)
-        self._note_edge(kid, key.up)
+        self._note_edge(kid, float(t), False)
         self.hear(t)
         return True
 
