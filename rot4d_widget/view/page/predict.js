@@ -8,6 +8,10 @@ import { KeyLog } from "./keys.js";
 import { PageKeymap } from "./keymap.js";
 import { PageState } from "./state.js";
 
+// Two page times of one key event as the kernel heard it (through seconds) and the page made it
+// (rot4d_widget.view.steplog.SAME_MS).
+export const SAME_MS = 1e-6;
+
 export class Prediction {
   // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null
   constructor(config, kernel) {
@@ -23,15 +27,39 @@ export class Prediction {
     if (kernel) this.adopt(kernel);
   }
 
-  // The kernel's state for its id: the page's steps up to `upto` are in it.
+  // The kernel's state for its id: the page's steps up to `upto` are in it.  False (not adopted)
+  // when the page's own key events say otherwise (`agrees`).
   adopt(kernel) {
-    if (!kernel || !kernel.state) return;
+    if (!kernel || !kernel.state || !this.agrees(kernel)) return false;
     this.kernel = kernel;
     this.log.checkpoint(kernel.upto === null ? -Infinity : kernel.upto);
     this.base = new PageState(kernel.state, this.config.bounds);
     this.state = this.base.copy();
     this.applied = [];
     this.version += 1;
+    return true;
+  }
+
+  // Whether the kernel's state can be what the page's keys make by its `upto`: the keys it holds
+  // as held (`keys`: [kid, page time pressed]) are those the page held then.  It is not when the
+  // kernel holds a key the page released by then (it has not heard the release, and went on by
+  // its estimate of a page it did not hear from) or lacks one the page pressed by then (it went
+  // past the press by that estimate): the page's own steps stay until the kernel's state agrees.
+  agrees(kernel) {
+    if (!Array.isArray(kernel.keys) || typeof kernel.upto !== "number") return true;
+    const upto = kernel.upto;
+    const same = (a, b) => Math.abs(a - b) <= SAME_MS;
+    const mine = [...this.log.keys.values()];
+    const theirs = kernel.keys.filter((k) => Array.isArray(k) && typeof k[0] === "string" && typeof k[1] === "number");
+    for (const [kid, down] of theirs) {
+      const key = mine.find((k) => k.kid === kid && same(k.down, down));
+      if (key && key.up !== null && key.up <= upto + SAME_MS) return false;
+    }
+    for (const key of mine) {
+      const heldThen = key.down <= upto + SAME_MS && (key.up === null || key.up > upto + SAME_MS);
+      if (heldThen && !theirs.some(([kid, down]) => kid === key.kid && same(key.down, down))) return false;
+    }
+    return true;
   }
 
   // A key event the page steps itself: {action, inverted, kid} or null (not ours: the kernel's).
