@@ -18,13 +18,10 @@ from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.keep.figures import render_tomography
 from rot4d_widget.core.rotation import simple_rotation
 from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.arrangements import ARRANGEMENTS, GAP, OVAL_PARABOLA, arrangement_layout
 from rot4d_widget.sources.tomography import (
-    ARRANGEMENTS,
-    GAP,
-    OVAL_PARABOLA,
     SPACING_FACTOR,
     StackSource,
-    arrangement_layout,
     highlighted_index,
     stack_levels,
 )

@@ -53,8 +53,9 @@ from ..core import look
 from ..core.keymap import Action
 from ..core.rotation import as_rotation_matrix
 from ..core.state import STATE_FORMAT, RotationState, action_from_data, action_to_data, spacing_factor
+from ..sources.arrangements import ARRANGEMENTS
 from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of, w_frame
-from ..sources.tomography import ARRANGEMENTS, StackSource
+from ..sources.tomography import StackSource
 from .jsonfile import read_json
 from .rebuild import _jsonable
 

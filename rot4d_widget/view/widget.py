@@ -52,8 +52,8 @@ from ipyevents import Event
 from ..core import look
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
+from ..sources.arrangements import ARRANGEMENTS
 from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
-from ..sources.tomography import ARRANGEMENTS
 from . import markup
 from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
 from . import traits as t
