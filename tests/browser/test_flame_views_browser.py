@@ -68,7 +68,8 @@ def _shot(jp, var, name, artifacts, index):
                         or lab["y0"] >= keep[3] - 0.5), (name, lab, keep)
     side = page.locator(".rot4d-side").nth(index)
     text = side.inner_text()
-    for row in ("field", "axes", "w cut", "w per unit"):
+    # a single view: the field's rows; a stack: its own (the field's name in the title, each slice's time)
+    for row in (("field", "axes", "w cut", "w per unit") if var == "w" else ("stack", "c0", "time 0.0025 s")):
         assert row in text, (name, text)
     box, sbox = page.locator(sel).bounding_box(), side.bounding_box()
     clip = {"x": box["x"], "y": min(box["y"], sbox["y"]), "width": sbox["x"] + sbox["width"] - box["x"],
@@ -90,7 +91,9 @@ def test_the_flame_seen_as_a_scientist_would(jupyter_server, page, artifacts):
     for _ in range(32):  # 90 degrees in x-w, tapped in the page
         page.keyboard.press("4")
         time.sleep(0.05)
-    assert jp.wait_for(lambda: abs(jp.kernel_json("float(w.state.matrix[3, 0])")) > 0.999, timeout=60)
+    turned = jp.wait_for(lambda: abs(jp.kernel_json("float(w.state.matrix[3, 0])")) > 0.999, timeout=60)
+    steps = jp.kernel_json("round(float(np.degrees(np.arcsin(w.state.matrix[3, 0]) / np.degrees(w.state.theta0))), 3)")
+    assert turned, f"32 taps of 4 made {steps} R_xw steps; {jp.kernel_json('w.stats.as_dict()')}"
     page.mouse.move(5, 300)
     for rendering in ("surface", "volume", "mip", "sections"):
         jp.kernel(f"w.rendering = {rendering!r}")
