@@ -53,6 +53,21 @@ def test_the_default_follows_n_never_a_turn_and_never_a_set_spacing(make):
     assert w.spacing == pytest.approx((hi - lo) / 7)
 
 
+def test_the_default_is_spread_when_n_changes_not_when_first_read():
+    """The soak's replay (seed 20240) ended on another spacing than the live view: ``b`` made N = 1
+    at one orientation, and the default was spread only when next read -- at once by the live view's
+    readout, but in the replay by the next ``g``, after turns.  Spread when N changes, both agree."""
+    from rot4d_widget.sources.tomography import StackSource
+
+    f = flame()
+    stack = StackSource(f, slices=2)
+    stack.note_matrix(turned().matrix)  # told before the action that changes N, as the widget does
+    stack.slices = 1
+    spread = (lambda lo, hi: hi - lo)(*f.w_range(turned().matrix))
+    stack.note_matrix(np.eye(4))  # turns after it, before anything reads the spacing
+    assert stack.spacing == pytest.approx(spread)
+
+
 def test_every_slice_carries_its_time_and_one_outside_the_data_says_so(make):
     w = make(flame(), slices=5, arrangement="grid")
     labels = w.scene._buffer._rot4d_labels

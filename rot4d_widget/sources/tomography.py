@@ -214,7 +214,7 @@ class StackSource:
                  matrix=None):
         self.source = as_source(source)
         self._matrix = np.eye(4) if matrix is None else as_rotation_matrix(matrix)
-        self._default = None  # the default Δ once spread (`_spread`); None: to be spread at the next need
+        self._default = None  # the default Δ once spread (`_spread`)
         self.slices = slices
         self.spacing = spacing
         self.arrangement = arrangement
@@ -232,7 +232,8 @@ class StackSource:
     @slices.setter
     def slices(self, value) -> None:
         self._slices = _check_slices(value)
-        self._default = None  # a new N: the default is spread again
+        self._default = None  # a new N: the default is spread again, now (`_spread`)
+        self._spread()
 
     @property
     def spacing(self) -> float:
@@ -252,6 +253,7 @@ class StackSource:
                                  f"None, got {d!r}")
         else:
             self._default = None
+            self._spread()
         self._spacing = d
 
     @property
@@ -269,6 +271,10 @@ class StackSource:
         self._matrix = as_rotation_matrix(matrix)
 
     def _spread(self) -> float:
+        """The default Δ, spread along the w of the orientation noted last -- at the moments the
+        class docs name, never later: spread at its first use instead, it would take whatever
+        orientation was noted by then (a replay, which reads it later than the live view, ended on
+        another spacing)."""
         if self._default is None:
             self._default = default_spacing(self.source, self._slices, self._matrix)
         return self._default
