@@ -62,6 +62,13 @@ def _kernel(jp, var):
                           f"held=list({var}.held_keys))")
 
 
+def _why_not_settled(jp, var, sel) -> str:
+    """What `_settled` found: each side's held keys, the page's pending steps and both ids."""
+    k, p = _kernel(jp, var), _page(jp, sel) or {}
+    return (f"kernel held {k['held']}, id {k['sid']}; page held {p.get('held')}, pending {p.get('pending')}, "
+            f"upto {p.get('upto')}; same matrix {p.get('matrix') == k['m']}")
+
+
 def _settled(jp, var, sel):
     k = _kernel(jp, var)
     p = _page(jp, sel)
@@ -108,7 +115,7 @@ def _two_keys(jupyter_server, page, var):
     for p in shots:
         p.unlink(missing_ok=True)
     jp.kernel(f"{var}.screenshot({shots[0].name!r})")
-    assert jp.wait_for(lambda: _settled(jp, var, sel), timeout=60), (_page(jp, sel), _kernel(jp, var))
+    assert jp.wait_for(lambda: _settled(jp, var, sel), timeout=60), _why_not_settled(jp, var, sel)
     after, kernel = _page(jp, sel), _kernel(jp, var)
     np.testing.assert_allclose(after["matrix"], kernel["m"], rtol=0, atol=1e-12)
     assert (after["theta0"], after["alpha"], after["c0"]) == (kernel["theta0"], kernel["alpha"], kernel["c0"])
