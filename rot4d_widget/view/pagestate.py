@@ -50,12 +50,13 @@ def _matrix(m) -> list:
     return [float(x) for x in m.reshape(16)]
 
 
-def state_message(state: st.RotationState) -> dict:
+def state_message(state: st.RotationState, view: dict | None = None) -> dict:
     """``state`` as the page adopts it: the matrix (16 numbers, row by row), theta0, alpha, c0 and
-    its step, the c0 range and the reset point."""
+    its step, the c0 range and the reset point; with ``view``, a field's view settings
+    (`rot4d_widget.view.fieldview.view_message`)."""
     t, a, c, m = state.reset_point
     limit = state.c0_limit
-    return {
+    msg = {
         "matrix": _matrix(state.matrix),
         "theta0": state.theta0,
         "alpha": state.alpha,
@@ -65,3 +66,6 @@ def state_message(state: st.RotationState) -> dict:
         "c0_origin": state.c0_origin,
         "initial": {"matrix": _matrix(m), "theta0": t, "alpha": a, "c0": c},
     }
+    if view is not None:
+        msg["view"] = view
+    return msg

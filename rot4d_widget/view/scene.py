@@ -75,6 +75,7 @@ from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
+from .field_layer import FieldLayer
 from .volume_layer import VolumeLayer
 
 __all__ = ["Scene", "shader_source"]
@@ -273,13 +274,14 @@ class Scene:
 
     @property
     def mesh_model_ids(self) -> list:
-        """Model ids of the ball, bar, face, surface and volume meshes (the companion turns them)."""
-        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume")]
+        """Model ids of the ball, bar, face, surface, volume and field meshes (the companion turns them)."""
+        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume", "field")]
 
     @property
     def texture_model_ids(self) -> list:
-        """Model ids of the volume layer's atlas and colour-table textures (the companion fills them)."""
-        return self._volume.texture_model_ids
+        """Model ids of the volume layer's atlas and colour-table textures (the companion fills them) and
+        the field layer's placeholder 3-D texture (the page takes its class)."""
+        return [*self._volume.texture_model_ids, self._field.texture_model_id]
 
     @property
     def scene_model_id(self) -> str:
@@ -641,6 +643,8 @@ def _build_three(scene, antialias, display):
     )
     scene._volume = VolumeLayer()  # a field's cut ray-cast: hidden until a volume arrives
     scene._meshes["volume"] = scene._volume.build(shader_source)
+    scene._field = FieldLayer(scene._light)  # the page's own picture of a field (issue 36): hidden
+    scene._meshes["field"] = scene._field.build(shader_source)
     scene._camera = p3.PerspectiveCamera(
         position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=scene.width / scene.height,
         near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
@@ -668,6 +672,7 @@ def _build_three(scene, antialias, display):
         *(a for t in templates.values() for a in t.values()),
         scene._surface_geometry, *scene._surface_attrs.values(), scene._surface_index,
         *(w for w in scene._volume.widgets if w is not scene._meshes["volume"]),
+        *(w for w in scene._field.widgets if w is not scene._meshes["field"]),
     ]  # fmt: skip
     scene._surface_shown = False
     scene._volume_shown = False

@@ -4,6 +4,8 @@
 
 import { doubleRotation, matmul4, reorthonormalize, simpleRotation } from "./rotation.js";
 
+const copyView = (v) => ({ ...v, sections: v.sections.slice(), levels: v.levels.slice() });
+
 const finiteOr = (v, dflt) => (typeof v === "number" && Number.isFinite(v) ? v : dflt);
 
 export class PageState {
@@ -24,12 +26,15 @@ export class PageState {
     this.c0Origin = msg.c0_origin;
     const init = msg.initial;
     this.initial = { matrix: Float64Array.from(init.matrix), theta0: init.theta0, alpha: init.alpha, c0: init.c0 };
+    // a field's view settings (rot4d_widget.view.fieldview.view_message), or null
+    this.view = msg.view ? copyView(msg.view) : null;
     return this;
   }
 
   copy() {
     const c = Object.create(PageState.prototype);
-    Object.assign(c, this, { matrix: Float64Array.from(this.matrix), initial: { ...this.initial } });
+    Object.assign(c, this, { matrix: Float64Array.from(this.matrix), initial: { ...this.initial },
+                             view: this.view ? copyView(this.view) : null });
     return c;
   }
 
