@@ -2,8 +2,9 @@
 (`rot4d_widget.view.pagefield`) and the state it predicts.
 
 * `view_message`: the field's view settings that keys change -- the rendering, the section planes,
-  the iso levels -- carried in the kernel's state (`rot4d_widget.view.pagestate.state_message`) so
-  the page adopts them with the state.
+  the iso levels -- and the rules the page steps them by (`rot4d_widget.view.fieldkeys.view_rules`),
+  carried in the kernel's state (`rot4d_widget.view.pagestate.state_message`) so the page adopts
+  them with the state.
 * `field_config`: everything else, the companion's synced ``field_config``: the field's box (half
   widths, slice units) and w frame, the view's scale, where each cut lies and is placed (a stack's
   offsets, centres and scales), the kernel's grid resolutions and ray steps (held and at rest),
@@ -23,6 +24,7 @@ from ..keep.volume import DEFAULT_DENSITY, default_clim
 from ..sources.protocol import inner_source, w_frame
 from ..sources.tomography import StackSource
 from .cuts import STACK_NODES, can_sample
+from .fieldkeys import view_rules
 from .volume_layer import HELD_STEP, MAX_STEPS, STEP, colour_table
 
 __all__ = ["view_message", "field_config", "copy_clim", "MARCH", "HELD_MARCH"]
@@ -40,7 +42,7 @@ def view_message(widget):
         return None
     inner = inner_source(w.source)
     return {"rendering": w.rendering, "sections": [float(s) for s in w.sections],
-            "levels": [float(v) for v in inner.levels]}
+            "levels": [float(v) for v in inner.levels], **view_rules(w.source)}
 
 
 def _rgb(colours) -> list:

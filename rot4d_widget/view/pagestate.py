@@ -22,17 +22,21 @@ def action_message(action) -> dict:
     return {"kind": action.kind, "planes": action.planes, "sign": int(action.sign), "name": action.name}
 
 
-def page_config(keymap: Keymap, *, hold_delay: float, tick_rate: float, max_lag: float, predicted=()) -> dict:
+def page_config(keymap: Keymap, *, hold_delay: float, tick_rate: float, max_lag: float, predicted=(),
+                predicted_actions=None) -> dict:
     """The page's key table and rules: ``keymap`` (key name -> action), which kinds Shift inverts
     and which repeat while held, the state's bounds, the hold delay and tick rate (s, Hz) that give
     a held key's steps (`rot4d_widget.view.keyhold.steps_for`), the kernel's catch-up window
-    ``max_lag``, and the action kinds the page steps itself (``predicted``: the state's kinds;
-    a source's own actions run Python code and are the kernel's alone)."""
+    ``max_lag``, and the action kinds the page steps itself (``predicted``: the state's kinds, a
+    field's view kinds; a source's own actions run Python code and are the kernel's alone, but for
+    those ``predicted_actions`` names -- a field's levels, ``{name: {"rule": "levels", "sign",
+    "repeat"}}``: `rot4d_widget.view.fieldkeys`)."""
     return {
         "keymap": {k: action_message(a) for k, a in keymap.items()},
         "shift_kinds": sorted(SHIFT_KINDS),
         "repeating_kinds": sorted(REPEATING_KINDS),
         "predicted_kinds": sorted(predicted),
+        "predicted_actions": dict(predicted_actions or {}),
         "bounds": {
             "theta0_min": st.THETA0_MIN,
             "theta0_max": st.THETA0_MAX,

@@ -266,6 +266,7 @@ class Painter:
         w = self.w
         pf = w.companion.page_field
         pf.sync(w.source)
+        w._keys.send_config()  # a field's levels are predicted once its range is known without a read
         field = page_field(w.source)
         if field is None or not pf.offered:
             return

@@ -71,11 +71,11 @@ from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
+from .field_layer import FieldLayer
 from .keypad import close_quietly
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
-from .field_layer import FieldLayer
 from .volume_layer import VolumeLayer
 
 __all__ = ["Scene", "shader_source"]

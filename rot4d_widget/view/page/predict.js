@@ -14,6 +14,8 @@ export class Prediction {
     this.config = config;
     this.keymap = new PageKeymap(config.keymap, config.shift_kinds);
     this.predicted = new Set(config.predicted_kinds || []);
+    // a source's own actions the page steps too (a field's levels): name -> {rule, sign, repeat}
+    this.actions = new Map(Object.entries(config.predicted_actions || {}));
     this.repeating = new Set(config.repeating_kinds || []);
     this.log = new KeyLog(config.hold_delay, config.tick_rate);
     this.kernel = null;
@@ -34,15 +36,21 @@ export class Prediction {
     this.version += 1;
   }
 
+  // True for an action the page steps itself (the state's kinds, a field's view kinds and levels).
+  steps(action) {
+    return this.predicted.has(action.kind) || (action.kind === "custom" && this.actions.has(action.name));
+  }
+
   // A key event the page steps itself: {action, inverted, kid} or null (not ours: the kernel's).
   ours(event, kid) {
     const found = this.keymap.lookup(event);
-    if (!found || !kid || !this.predicted.has(found.action.kind)) return null;
+    if (!found || !kid || !this.steps(found.action)) return null;
     return { ...found, kid };
   }
 
   press(kid, action, inverted, t) {
-    return this.log.press(kid, action, inverted, t, this.repeating.has(action.kind));
+    const repeats = action.kind === "custom" ? !!this.actions.get(action.name).repeat : this.repeating.has(action.kind);
+    return this.log.press(kid, action, inverted, t, repeats);
   }
 
   release(kid, t) {
@@ -74,7 +82,7 @@ export class Prediction {
     }
     let changed = !same;
     for (const s of todo) {
-      changed = this.state.apply(s.action, s.inverted) || changed;
+      changed = this.state.apply(s.action, s.inverted, this.actions.get(s.action.name)) || changed;
       this.applied.push(s);
     }
     if (changed) this.version += 1;
