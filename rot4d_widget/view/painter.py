@@ -228,6 +228,7 @@ class Painter:
         # the state and its id, and which picture shows it: this one, if it is of the state now (keys
         # may have changed it while the picture was made), else one is owed
         now_shown = key.matrix is w.state.matrix and key.c0 == w.state.c0
+        self.sync_field()  # the colour limits this picture used (the page's while it draws)
         self.send_state(picture=(sent if now_shown else "pending") if sent is not None else
                         (None if now_shown else "pending"))
         w._shots.send_owed()  # screenshots asked meanwhile: of this picture

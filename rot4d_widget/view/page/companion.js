@@ -60,7 +60,7 @@ import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 import { drawsOwn, forceOwn, ownPicture, polytopeArrived } from "./pictures.js";
 import { fieldArrived, freeField, noteContext, wantsTransfer } from "./field.js";
-import { FieldPicture, fieldDrawsOwn, forceOwnField } from "./fieldpicture.js";
+import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField } from "./fieldpicture.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -816,6 +816,16 @@ async function render({ model, el }) {
               scene.trigger("rerender", scene, {});
             };
             host.rot4dDrawsOwn = () => own;
+            // the page's field picture as each pixel's first surface hit's distance (field.frag
+            // u_output), with the camera it was drawn with: read the canvas after a frame
+            host.rot4dFieldDepth = (on) => {
+              if (!fieldPic) return null;
+              fieldPic.setOutput(on);
+              scene.trigger("rerender", scene, {});
+              const cam = scene.obj && scene.obj.children.find((c) => c.isCamera);
+              return cam ? { world: Array.from(cam.matrixWorld.elements), projection: Array.from(cam.projectionMatrix.elements),
+                             scale: DEPTH_SCALE } : { scale: DEPTH_SCALE };
+            };
           }
         }
       };

@@ -18,6 +18,8 @@ export const MODES = { volume: 0, mip: 1, sections: 2, surface: 3 };
 // The shader's most levels (field.frag MAX_LEVELS) and boxes with colours of their own (u_box_rgb).
 export const MAX_LEVELS = 8;
 export const MAX_BOXES = 64;
+// Scene units of the largest distance the depth read-back encodes (tests).
+export const DEPTH_SCALE = 64;
 
 const forced = new WeakMap();  // model -> true: draw the page's own picture at rest too (tests)
 
@@ -76,6 +78,14 @@ export class FieldPicture {
     this.key = null;
     this.rows = null;
     this.matrices = null;
+    // tests: 1 writes each pixel's first surface hit's distance from the eye (field.frag u_output)
+    this.output = 0;
+  }
+
+  // The depth read-back of tests (field.frag's u_output 1, t / DEPTH_SCALE in 24 bits) on or off.
+  setOutput(on) {
+    this.output = on ? 1 : 0;
+    this.key = null;
   }
 
   hide() {
@@ -191,6 +201,8 @@ export class FieldPicture {
     put("u_opacity", translucent ? cfg.surface_opacity : 1);
     put("u_nlevels", levels.length);
     put("u_box_colours", cfg.box_rgb ? 1 : 0);
+    put("u_output", this.output);
+    put("u_depth_scale", DEPTH_SCALE);
     m.depthWrite = view.rendering === "surface" && !translucent;
     if (relink) m.needsUpdate = true;
     m.uniformsNeedUpdate = true;
