@@ -239,3 +239,20 @@ def test_a_stack_s_boxes_are_placed_as_the_kernel_places_its_grids():
     assert got["count"] == 3
     for k, (_values, lo, span) in enumerate(cut.parts):
         assert np.allclose(got["lo"][k], lo, atol=1e-5) and np.allclose(got["span"][k], span, atol=1e-5)
+
+
+def test_each_block_range_holds_every_node_of_its_cells():
+    """A block's range is the least and greatest code of its BLOCK + 1 nodes a side (shared with the next
+    block), so the shader may skip a block no level or colour reaches; a non-finite node opens it whole."""
+    rng = np.random.default_rng(0)
+    codes = rng.integers(0, pf.CODES + 1, (9, 7, 6, 10)).astype(np.uint16)
+    lo, hi = pf.block_ranges(codes)
+    assert lo.shape == (2, 2, 2, 3)
+    B = pf.BLOCK
+    for idx in np.ndindex(lo.shape):
+        part = codes[tuple(slice(b * B, min(b * B + B, n - 1) + 1) for b, n in zip(idx, codes.shape))]
+        assert lo[idx] == part.min() and hi[idx] == part.max()
+    bad = np.zeros(codes.shape, dtype=bool)
+    bad[4, 0, 0, 0] = True  # a node two blocks share along w
+    lo, hi = pf.block_ranges(codes, bad)
+    assert (lo[:, 0, 0, 0] == 0).all() and (hi[:, 0, 0, 0] == pf.CODES).all() and hi[0, 1, 1, 1] < pf.CODES + 1

@@ -22,6 +22,15 @@ one-time transfer ``"field"``, in chunks the page acknowledges, counted on the w
   linear filtering of the code: docs/fields.md "The page's WebGL").  The shader clamps sample
   points half a texel inside each tile, so filtering never reads a neighbouring tile.
 
+With the data goes their **block ranges**: the least and greatest code over each block of `BLOCK`
+cells a side in x, y, z and w (its `BLOCK` + 1 nodes, so a cell is inside one block whole), as
+an RGBA texture laid out as the data (a block's min's two bytes, its max's two), 1/256 of the
+data's size.  The shader skips a block along a ray where no level crosses it (isosurfaces) or it
+is below the colour limits (volume) or below the brightest sample so far (maximum intensity):
+the samples skipped would add nothing, so the picture is the same, sooner (empty-space skipping,
+Engel et al., *Real-Time Volume Graphics*).  A block holding a node that is not finite is never
+skipped.
+
 The box's cut (the outline bars) the page makes with its polytope slicer from the box's own tables
 (`rot4d_widget.view.pagegeometry.polytope_message` of the field's box), the small one-time
 transfer ``"field_box"``.  How the page draws -- the half widths, the layout of a stack, the
@@ -55,6 +64,8 @@ PAGE_FIELD_BUDGET = 64 * 2**20
 MAX_SIDE = 2048
 #: The largest code of a quantised value (16 bits).
 CODES = 65535
+#: Cells a side of a block of the block ranges (empty-space skipping).
+BLOCK = 4
 
 
 def page_field(source):
@@ -142,9 +153,44 @@ def field_transfer(values, axis_of) -> tuple[dict, bytes]:
     arrays = {"texels": texels.reshape(-1)}
     if mask is not None:
         arrays["mask"] = mask.reshape(tz, ty, tx, nz, ny, nx).transpose(0, 3, 1, 4, 2, 5).reshape(-1)
+    bmin, bmax = block_ranges(codes[:nw], None if mask is None else mask[:nw] == 0)
+    bw, bz, by, bx = bmin.shape
+    btx, bty, btz = tile_layout((bx, by, bz, bw))
+    blocks = np.zeros((btx * bty * btz, bz, by, bx, 4), dtype=np.uint8)
+    blocks[:bw, ..., 0], blocks[:bw, ..., 1] = bmin >> 8, bmin & 255
+    blocks[:bw, ..., 2], blocks[:bw, ..., 3] = bmax >> 8, bmax & 255
+    arrays["blocks"] = blocks.reshape(btz, bty, btx, bz, by, bx, 4).transpose(0, 3, 1, 4, 2, 5, 6).reshape(-1)
     scalars = {"shape": [nx, ny, nz, nw], "tiles": [tx, ty, tz], "size": [tx * nx, ty * ny, tz * nz],
-               "range": [lo, hi], "masked": masked}
+               "range": [lo, hi], "masked": masked, "block": BLOCK, "block_shape": [bx, by, bz, bw],
+               "block_tiles": [btx, bty, btz], "block_size": [btx * bx, bty * by, btz * bz]}
     return pack(arrays, scalars)
+
+
+def _block_reduce(a, axis, op):
+    """``op`` over each block of `BLOCK` cells along ``axis`` (its BLOCK + 1 nodes; the last block
+    shorter): (ceil((n - 1) / BLOCK) or 1) blocks."""
+    n = a.shape[axis]
+    starts = np.arange(0, max(n - 1, 1), BLOCK)
+    out = op.reduceat(a, starts, axis=axis)
+    nxt = np.minimum(starts + BLOCK, n - 1)  # each block's last node, shared with the next block
+    return op(out, np.take(a, nxt, axis=axis))
+
+
+def block_ranges(codes, bad=None):
+    """(min, max) uint16 codes of each block of ``codes`` ((nw, nz, ny, nx), `BLOCK` cells a side);
+    ``bad`` (same shape, True where a node is not finite): its blocks get the whole range (never
+    skipped)."""
+    lo, hi = codes, codes
+    for axis in range(4):
+        lo = _block_reduce(lo, axis, np.minimum)
+        hi = _block_reduce(hi, axis, np.maximum)
+    if bad is not None:
+        b = bad
+        for axis in range(4):
+            b = _block_reduce(b, axis, np.logical_or)
+        lo = np.where(b, 0, lo).astype(np.uint16)
+        hi = np.where(b, CODES, hi).astype(np.uint16)
+    return lo, hi
 
 
 class PageField:

@@ -8,7 +8,10 @@
 //          the ray in the kernel's grid box, a sample counting where its kernel grid cell's eight
 //          nodes lie in the data's box (as the kernel's grid is NaN outside it) and its data are
 //          finite; emission-absorption front to back, extinction u_density / (longest side).
-//   u_mode 1 "mip": the largest value along the ray, opaque.
+//          Blocks of the data below the colour limits are skipped (field_data.glsl's block
+//          ranges: their samples add nothing), the samples left where they were.
+//   u_mode 1 "mip": the largest value along the ray, opaque (blocks below the largest so far
+//          skipped).
 //   u_mode 2 "sections": the nearest of the planes x, y, z = lo + u_sections * span where a
 //          sample counts, opaque.
 //   u_mode 3 "surface": the isosurfaces of every level (u_sign: +1 encloses f >= level, -1
@@ -16,7 +19,8 @@
 //          (u_caps), marched every u_march scene units from where the ray enters the data's box,
 //          each crossing refined by bisection and shaded by the 4-D gradient projected into the
 //          slice (lighting.glsl, as the surface layer); one level opaque at its first crossing
-//          (its depth written), several blended front to back at u_opacity each.
+//          (its depth written), several blended front to back at u_opacity each.  Blocks no level
+//          crosses are skipped whole.
 // Values are in [0, 1] over the copy's range; u_clim, u_levels are the kernel's, in those units.
 // u_output 1 (tests): the first surface hit's distance from the eye, t / u_depth_scale in 24
 // bits (r, g, b high to low), a = 1 where hit.
@@ -174,8 +178,20 @@ void main() {
         }
         float tPrev = b_in;
         for (int k = 1; k < MAX_STEPS; k++) {
-            if (acc.a > 0.996) break;
-            float t = min(b_in + float(k) * u_march, b_out);
+            if (acc.a > 0.996 || tPrev >= b_out) break;
+            // a block no level crosses: on to where the ray leaves it (no side changes there)
+            vec4 blk = blockOf(gE + tPrev * gD);
+            vec2 range = blockRange(blk);
+            bool crossed = false;
+            for (int i = 0; i < MAX_LEVELS; i++) {
+                if (i >= nl) break;
+                crossed = crossed || (u_levels[i] >= range.x && u_levels[i] <= range.y);
+            }
+            if (!crossed) {
+                tPrev = min(max(blockExit(gE, gD, blk), tPrev) + 1e-4 * u_march, b_out);
+                continue;
+            }
+            float t = min(tPrev + u_march, b_out);
             vec2 sv = field(gAt(v_eye + t * dir));
             for (int i = 0; i < MAX_LEVELS; i++) {
                 if (i >= nl) break;
@@ -199,7 +215,6 @@ void main() {
                 if (i < 4) prev[i] = s; else prev2[i - 4] = s;
             }
             tPrev = t;
-            if (t >= b_out) break;
         }
         // caps where the ray leaves: the levels still inside there
         if (u_caps > 0.5 && acc.a <= 0.996) {
@@ -266,11 +281,44 @@ void main() {
     float best = -1.0;
     vec3 colour = vec3(0.0);
     float trans = 1.0;
+    vec4 gE = gAt(v_eye);
+    vec4 gD = v_gx * dir.x + v_gy * dir.y + v_gz * dir.z;
+    // where every kernel grid cell a sample can lie in is inside the data's box (its corners are
+    // within a cell's reach of the sample on each axis): there cellInside need not be asked
+    vec4 reach = v_cell.x * (abs(v_gx) + abs(v_gy) + abs(v_gz));
+    float s_in = t_in, s_out = t_out;
+    for (int j = 0; j < 4; j++) {
+        float e = gE[j], r = gD[j], lo = reach[j], hi = u_shape[j] - 1.0 - reach[j];
+        if (abs(r) < 1e-9) {
+            if (e < lo || e > hi) s_out = -1.0;
+            continue;
+        }
+        float a = (lo - e) / r, b = (hi - e) / r;
+        s_in = max(s_in, min(a, b));
+        s_out = min(s_out, max(a, b));
+    }
+    float fi = 0.0;  // the sample's index: samples stay where the kernel's are, skipped or not
+    float blockEnd = -1.0;  // the block of the last sample lasts to here along the ray
+    float peak = 1.0;  // the greatest value of that block, on the colour ramp
     for (int i = 0; i < MAX_STEPS; i++) {
-        float start = t_in + float(i) * dt;
+        float start = t_in + fi * dt;
         if (start >= t_out) break;
         float piece = min(dt, t_out - start);
-        vec2 s = sampleAt(v_eye + (start + 0.5 * piece) * dir);
+        float tm = start + 0.5 * piece;
+        // a block that adds nothing (below the colour limits; for mip, below the brightest so far):
+        // on to the first sample past where the ray leaves it
+        if (tm >= blockEnd) {
+            vec4 blk = blockOf(gE + tm * gD);
+            peak = ramp(blockRange(blk).y);
+            blockEnd = blockExit(gE, gD, blk);
+        }
+        if (mip ? peak <= best : peak < 0.5 / 255.0) {  // (below half a level of the kernel's 8 bits: 0 there)
+            fi = max(fi + 1.0, ceil((blockEnd - t_in) / dt - 0.5));
+            continue;
+        }
+        fi += 1.0;
+        bool counts = (tm >= s_in && tm <= s_out) || cellInside(v_eye + tm * dir);
+        vec2 s = counts ? field(gE + tm * gD) : vec2(0.0);
         if (s.y > 0.5) {
             float x = ramp(s.x);
             if (mip) {

@@ -47,3 +47,38 @@ vec2 field(vec4 g) {
     }
     return vec2(v, ok);
 }
+
+// The block ranges (rot4d_widget/view/pagefield.py): the least and greatest code over each block of
+// u_block cells a side in x, y, z and w, one RGBA texel a block (min high, min low, max high, max
+// low), laid out as the data (block-time tiles); read without filtering.
+uniform sampler3D u_blocks;
+uniform vec4 u_block_shape;  // blocks along x, y, z, w
+uniform vec3 u_block_tiles;
+uniform float u_block;
+
+// The block holding the cell (and the two times) the value at g is mixed from.
+vec4 blockOf(vec4 g) {
+    vec4 cell = min(floor(max(g, vec4(0.0))), max(u_shape - 2.0, vec4(0.0)));
+    return min(floor(cell / u_block), u_block_shape - 1.0);
+}
+
+// (least, greatest) value of block b, in [0, 1] over the copy's range
+vec2 blockRange(vec4 b) {
+    float row = floor((b.w + 0.5) / u_block_tiles.x);
+    float kz = floor((row + 0.5) / u_block_tiles.y);
+    vec3 origin = vec3(b.w - row * u_block_tiles.x, row - kz * u_block_tiles.y, kz) * u_block_shape.xyz;
+    vec4 t = texelFetch(u_blocks, ivec3(origin + b.xyz + 0.5), 0);
+    return vec2(t.r * 65280.0 + t.g * 255.0, t.b * 65280.0 + t.a * 255.0) / 65535.0;
+}
+
+// Where a ray g = gE + t gD leaves block b (its cells' index range on every axis).
+float blockExit(vec4 gE, vec4 gD, vec4 b) {
+    float t = 1e30;
+    for (int j = 0; j < 4; j++) {
+        float r = gD[j];
+        if (abs(r) < 1e-9) continue;
+        float bound = r > 0.0 ? (b[j] + 1.0) * u_block : b[j] * u_block;
+        t = min(t, (bound - gE[j]) / r);
+    }
+    return t;
+}

@@ -60,7 +60,7 @@ import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 import { drawsOwn, forceOwn, ownPicture, polytopeArrived } from "./pictures.js";
 import { fieldArrived, freeField, noteContext, wantsTransfer } from "./field.js";
-import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField } from "./fieldpicture.js";
+import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField, quickField } from "./fieldpicture.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -750,7 +750,7 @@ async function render({ model, el }) {
           ratioRenderer = renderer;
           baseRatio = renderer.getPixelRatio();
         }
-        const half = (v.n_boxes > 0 && v.held) || (fieldOwn && turning(model).prediction.held.length > 0);
+        const half = (v.n_boxes > 0 && v.held) || (fieldOwn && quickField(model));
         const want = half ? baseRatio / 2 : baseRatio;
         if (renderer.getPixelRatio() !== want) renderer.setPixelRatio(want);
       };

@@ -15,6 +15,8 @@ import { transferStore, unpack } from "./transfer.js";
 // three.js r97 constants
 const LUMINANCE = 1024;
 const LUMINANCE_ALPHA = 1025;
+const RGBA = 1023;
+const NEAREST = 1003;
 const UNSIGNED_BYTE = 1009;
 const LINEAR = 1006;
 
@@ -56,8 +58,13 @@ export function decodeField(meta, bytes) {
   if (!texels || texels.length !== 2 * size[0] * size[1] * size[2]) {
     throw new Error(`field transfer: ${texels ? texels.length : 0} texel bytes for a ${size.join(" x ")} texture`);
   }
+  const bs = scalars.block_size;
+  if (!arrays.blocks || arrays.blocks.length !== 4 * bs[0] * bs[1] * bs[2]) {
+    throw new Error(`field transfer: ${arrays.blocks ? arrays.blocks.length : 0} block bytes for ${bs.join(" x ")} blocks`);
+  }
   return { shape: scalars.shape, tiles: scalars.tiles, size, range: scalars.range, masked: !!scalars.masked,
-           texels, mask: arrays.mask || null };
+           texels, mask: arrays.mask || null, block: scalars.block, blockShape: scalars.block_shape,
+           blockTiles: scalars.block_tiles, blockSize: bs, blocks: arrays.blocks };
 }
 
 // The field and box the page holds for this widget, decoded once when their transfers are whole
@@ -85,16 +92,16 @@ export function fieldArrived(model) {
   return h.copy && h.box && h.key === offered.field && h.boxKey === offered.field_box ? h : null;
 }
 
-// The copy's 3-D textures ({data, mask}: the mask a 1-texel one when every node is finite), made
+// The copy's 3-D textures ({data, mask, blocks}: the mask a 1-texel one when every node is finite), made
 // once with the class `T3` (THREE.DataTexture3D).
 export function fieldTextures(h, T3) {
   if (h.textures) return h.textures;
   const c = h.copy;
-  const make = (data, format, w, ht, d) => {
+  const make = (data, format, w, ht, d, filter = LINEAR) => {
     const t = new T3(data, w, ht, d);
     t.format = format;
     t.type = UNSIGNED_BYTE;
-    t.magFilter = t.minFilter = LINEAR;
+    t.magFilter = t.minFilter = filter;
     t.unpackAlignment = 1;
     t.flipY = false;
     t.generateMipmaps = false;
@@ -105,6 +112,7 @@ export function fieldTextures(h, T3) {
   h.textures = {
     data: make(c.texels, LUMINANCE_ALPHA, w, ht, d),
     mask: c.mask ? make(c.mask, LUMINANCE, w, ht, d) : make(new Uint8Array([255]), LUMINANCE, 1, 1, 1),
+    blocks: make(c.blocks, RGBA, c.blockSize[0], c.blockSize[1], c.blockSize[2], NEAREST),
   };
   return h.textures;
 }

@@ -5,9 +5,11 @@
 // and the layers draw the outline of the box's cut (slicer.js, rows.js).  At rest, with the
 // kernel's picture of the same state arrived, the kernel's surface or volume is drawn again.
 //
-// While keys are held the picture is sampled as the kernel's held picture was (issue 21: rays every
-// 2 spacings of the coarse grid, half the pixel ratio; surfaces marched every coarse spacing); once
-// the keys are up and the kernel's picture is still owed, at the kernel's own sampling at rest.
+// The page's pictures are quick ones, sampled as the kernel's held picture was (issue 21: rays every
+// 2 spacings of the coarse grid, half the pixel ratio; surfaces marched every coarse spacing): the
+// last one stays up after a release until the kernel's full-resolution picture replaces it (a
+// picture at the kernel's own sampling at rest takes the software renderer half a second and
+// more).  Drawn at rest by the test hook (`forceOwnField`), the page's picture is at that sampling.
 
 import { fieldArrived, fieldTextures } from "./field.js";
 import { fieldBoxes } from "./raycast.js";
@@ -25,6 +27,11 @@ const forced = new WeakMap();  // model -> true: draw the page's own picture at 
 
 export function forceOwnField(model, on) {
   forced.set(model, !!on);
+}
+
+// The page's own picture is a quick one (half the pixel ratio, the held sampling): all but the tests'.
+export function quickField(model) {
+  return !forced.get(model);
 }
 
 // The page's view settings of its predicted state (the kernel's, stepped by the page's keys).
@@ -101,7 +108,7 @@ export class FieldPicture {
     const h = fieldArrived(model);
     const cfg = model.get("field_config") || {};
     if (!obj || !h || !obj.material || !obj.geometry) return null;
-    const held = prediction.held.length > 0;
+    const held = quickField(model);
     const key = `${prediction.version}|${held}`;
     if (this.key === key && this.cfg === cfg && this.h === h && obj.visible) return this.rows;
     const view = viewOf(prediction);
@@ -188,6 +195,10 @@ export class FieldPicture {
     put("u_tiles", c.tiles.slice());
     put("u_size", c.size.slice());
     put("u_masked", c.masked ? 1 : 0);
+    put("u_blocks", tex.blocks);
+    put("u_block", c.block);
+    put("u_block_shape", c.blockShape.slice());
+    put("u_block_tiles", c.blockTiles.slice());
     put("u_mode", MODES[view.rendering]);
     put("u_clim", [norm(clim[0]), norm(clim[1])]);
     put("u_sections", view.sections.slice());
