@@ -257,6 +257,7 @@ async function render({ model, el }) {
       // The whole view turned in 3-D (keys that leave w alone): one rotation for every mesh.
       let own = false; // the layers draw the page's own picture (pictures.js), not the kernel's rows
       let fieldOwn = false; // ... of a field (fieldpicture.js): its ray-cast mesh in place of the kernel's
+      let drawnVersion = null; // the prediction's version the page's own picture last drawn shows
       const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
       const applyTurn = () => {
         const m = own ? IDENTITY : buffer.get("_rot4d_turn");  // the page's rows are in the final frame
@@ -791,13 +792,16 @@ async function render({ model, el }) {
         }
         const eye = camera && camera.position ? [camera.position.x, camera.position.y, camera.position.z] : null;
         expand(mine ? ownPicture(model, p, eye) : fieldRows);
+        drawnVersion = own && p ? p.version : null;
         applyRatio(renderer);
       };
-      // the page's own picture changes with its state: draw again
+      // the page's own picture changes with its state: draw again (not for a state already drawn:
+      // the kernel's state of what the page shows, adopted, keeps its version)
       const redraw = () => {
         const p = turning(model).prediction;
         const seq = buffer.get("_rot4d_seq");
-        if (own || drawsOwn(model, p, seq) || (fieldPic !== null && fieldDrawsOwn(model, p, seq))) {
+        const want = drawsOwn(model, p, seq) || (fieldPic !== null && fieldDrawsOwn(model, p, seq));
+        if (want !== own || (want && (!p || p.version !== drawnVersion))) {
           scene.trigger("rerender", scene, {});
           projectionRerender();
         }

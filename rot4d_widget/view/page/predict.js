@@ -8,6 +8,13 @@ import { KeyLog } from "./keys.js";
 import { PageKeymap } from "./keymap.js";
 import { PageState } from "./state.js";
 
+// Two predicted states the same (every number a picture is made from).
+export function sameState(a, b) {
+  if (!a || !b || a.theta0 !== b.theta0 || a.alpha !== b.alpha || a.c0 !== b.c0) return false;
+  for (let i = 0; i < 16; i++) if (a.matrix[i] !== b.matrix[i]) return false;
+  return JSON.stringify(a.view) === JSON.stringify(b.view);
+}
+
 export class Prediction {
   // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null
   constructor(config, kernel) {
@@ -25,11 +32,14 @@ export class Prediction {
     if (kernel) this.adopt(kernel);
   }
 
-  // The kernel's state for its id: the page's steps up to `upto` are in it.
+  // The kernel's state for its id: the page's steps up to `upto` are in it.  The version moves
+  // only if the state predicted is another once the page's later steps are on it again (`advance`):
+  // adopting the kernel's state of what the page already shows draws nothing again.
   adopt(kernel) {
     if (!kernel || !kernel.state) return;
     this.kernel = kernel;
     this.log.checkpoint(kernel.upto === null ? -Infinity : kernel.upto);
+    this.adopted = { state: this.state, version: this.version };
     this.base = new PageState(kernel.state, this.config.bounds);
     this.state = this.base.copy();
     this.applied = [];
@@ -86,6 +96,12 @@ export class Prediction {
       this.applied.push(s);
     }
     if (changed) this.version += 1;
+    const before = this.adopted;
+    this.adopted = null;
+    if (before && sameState(before.state, this.state)) {
+      this.version = before.version;  // the kernel's state with the page's steps on it: what was shown
+      return false;
+    }
     return changed;
   }
 
