@@ -17,15 +17,28 @@ import pytest
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.view.steplog import step_time
-from test_widget import down, up
+from rot4d_widget.view.keys import key_id
+from test_widget import down, key_event, up
 from test_widget_scene import run_ticker
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
 
-def heartbeat(w, t_ms):
-    w.companion.comm.handler({"content": {"data": {"method": "custom", "content": {"event": "clock", "t": t_ms}}},
-                              "buffers": []})
+def heartbeat(w, t_ms, edges=None):
+    """The companion's ``clock`` message; ``edges``: the page's key events it repeats (`edge`)."""
+    content = {"event": "clock", "t": t_ms}
+    if edges is not None:
+        content["edges"] = edges
+    w.companion.comm.handler({"content": {"data": {"method": "custom", "content": content}}, "buffers": []})
+
+
+def edge(key, is_down, t_ms, shift=False):
+    """A key event as the page repeats it with its heartbeats (``page/turning.js``)."""
+    ev = key_event("keydown", key, shift=shift)
+    out = {"kid": key_id(ev), "down": is_down, "t": t_ms}
+    if is_down:
+        out.update(key=ev["key"], code=ev["code"], shift=shift)
+    return out
 
 
 def reference(w, presses):
@@ -135,3 +148,171 @@ def test_a_second_keydown_of_a_held_key_is_a_repeat(make, clock):
     down(w, "4", t=1.05)
     up(w, "4", t=1.1)
     assert_same(w, reference(w, [("4", False, 1000.0, 1100.0)]))
+
+
+def test_a_long_hold_keeps_a_bounded_window_of_steps_and_ends_on_the_page_s_state(make, clock):
+    """Steps the page said it made more than SETTLED_MS ago are done (a rolling checkpoint): each
+    heartbeat costs the same however long the hold, and the end state is still the page's."""
+    from rot4d_widget.view.pagesteps import ROLL_STEPS
+
+    w = make("24-cell")
+    down(w, "8", t=1.0)
+    kept = 0
+    for t in range(1000, 21000, 33):  # 20 s of heartbeats
+        heartbeat(w, float(t))
+        kept = max(kept, len(w._keys.page._applied))
+    up(w, "8", t=20.99)
+    assert kept <= ROLL_STEPS + 2
+    assert_same(w, reference(w, [("8", False, 1000.0, 20990.0)]))
+    assert_replays(w, make)
+
+
+def test_key_events_that_come_with_the_heartbeats_before_ipyevents_forwards_them_count_once(make, clock):
+    """A busy kernel (JupyterLab 4.4+ on ipykernel 7): the companion's messages are handled on a
+    subshell while ipyevents' wait for the cell to end.  The heartbeats carry the page's key events,
+    so the kernel releases the key when the page did, however long the heartbeats go on after it
+    (past the rolling checkpoint's `SETTLED_MS`), and ipyevents' events, when they come, are heard
+    already: the state is the page's, bit for bit."""
+    w = make("24-cell")
+    pressed = [edge("4", True, 1000.0)]
+    for t in range(1000, 2500, 33):  # held 1.5 s: ipyevents' keydown not handled yet
+        heartbeat(w, float(t), pressed)
+    events = pressed + [edge("4", False, 2500.0)]
+    for t in range(2500, 6000, 33):  # released; the page's clock goes on 3.5 s (it sends the events)
+        heartbeat(w, float(t), events)
+    assert w.held_keys == ()
+    ref = reference(w, [("4", False, 1000.0, 2500.0)])
+    assert_same(w, ref)
+    down(w, "4", t=1.0)  # the cell ended: ipyevents' events, heard already
+    up(w, "4", t=2.5)
+    assert_same(w, ref)
+    assert w.held_keys == ()
+    assert_replays(w, make)
+
+
+def test_a_key_pressed_again_before_ipyevents_forwards_its_release_stays_held(make, clock):
+    """The heartbeats bring press, release and a second press of one key; ipyevents' late release
+    of the first press is older than the second press: heard already, the key stays down."""
+    w = make("5-cell")
+    events = [edge("c", True, 1000.0), edge("c", False, 1100.0), edge("c", True, 1500.0)]
+    heartbeat(w, 1500.0, events)
+    down(w, "c", t=1.0)
+    up(w, "c", t=1.1)
+    assert w.held_keys == (key_id(key_event("keydown", "c")),)
+    heartbeat(w, 1900.0, [])
+    up(w, "c", t=1.9)
+    assert w.held_keys == ()
+    assert_same(w, reference(w, [("c", False, 1000.0, 1100.0), ("c", False, 1500.0, 1900.0)]))
+
+
+def test_a_keyup_stamped_a_moment_before_its_keydown_is_a_tap_not_a_stuck_key(make, clock):
+    """A page whose stamps jitter (the soak's, seed 20240: keyup 0.28 ms before its keydown): the
+    release is the press's own, never one heard already -- one step, nothing held.  Compared with
+    the last press, as before, it was taken for an old release and the key stayed held for good."""
+    w = make("5-cell")
+    down(w, "2", t=368.48166)
+    up(w, "2", t=368.48138)
+    assert w.held_keys == ()
+    heartbeat(w, 369000.0, [])
+    assert_same(w, reference(w, [("2", False, 368481.66, 368481.66)]))
+    down(w, "2", t=369.5)  # the key works again
+    up(w, "2", t=369.55)
+    assert w.held_keys == ()
+
+
+def test_ipyevents_first_then_the_same_events_with_the_heartbeats(make, clock):
+    """The usual order (ipyevents' event handled first): the heartbeat's copy changes nothing."""
+    w = make("24-cell")
+    down(w, "y", shift=True, t=2.0)
+    heartbeat(w, 2300.0, [edge("y", True, 2000.0, shift=True)])
+    up(w, "y", shift=True, t=2.4)
+    heartbeat(w, 2400.0, [edge("y", True, 2000.0, shift=True), edge("y", False, 2400.0)])
+    heartbeat(w, 2900.0, [edge("y", True, 2000.0, shift=True), edge("y", False, 2400.0)])
+    assert_same(w, reference(w, [("y", True, 2000.0, 2400.0)]))
+    assert_replays(w, make)
+
+
+@pytest.mark.parametrize("bad", [
+    None, 3, "edge", [], {"kid": 4, "down": True, "t": 1.0}, {"kid": "Digit4", "down": 1, "t": 1.0},
+    {"kid": "Digit4", "down": True, "t": float("nan")}, {"kid": "Digit4", "down": True, "t": True},
+    {"kid": "x" * 65, "down": True, "t": 1.0}, {"kid": "", "down": False, "t": 1.0},
+    {"kid": "Digit4", "down": True, "t": 1000.0, "key": "4", "code": "Digit8"},  # kid not the event's
+    {"kid": "pad:4", "down": True, "t": 1000.0, "key": "8", "pad": True},  # pad id not the key's
+    {"kid": "KeyQ", "down": True, "t": 1000.0, "key": "q", "code": "KeyQ"},  # not bound
+    {"kid": "KeyP", "down": True, "t": 1000.0, "key": "p", "code": "KeyP"},  # bound, not the page's kind
+])
+def test_a_malformed_or_foreign_key_event_in_a_heartbeat_is_left_out(make, clock, bad):
+    w = make("5-cell")
+    before = w.state.matrix.copy()
+    heartbeat(w, 1200.0, [bad])
+    heartbeat(w, 1300.0, bad)  # not even a list
+    assert w.held_keys == () and np.array_equal(w.state.matrix, before)
+    assert w.errors.outputs == ()  # left out, not an error: the page sends only what it stepped
+
+
+def test_a_pad_button_held_in_the_heartbeats_steps_as_the_page_does(make, clock):
+    w = make("24-cell")
+    pad = [{"kid": "pad:8+shift", "down": True, "t": 1000.0, "key": "8", "shift": True, "pad": True}]
+    for t in range(1000, 1600, 33):
+        heartbeat(w, float(t), pad)
+    heartbeat(w, 1700.0, pad + [{"kid": "pad:8+shift", "down": False, "t": 1600.0}])
+    assert w.held_keys == ()
+    assert_same(w, reference(w, [("8", True, 1000.0, 1600.0)]))
+
+
+def test_the_kernel_s_state_names_the_keys_it_holds(make, clock):
+    """``kernel_state["keys"]``: the page's keys the state holds as held, with their press times --
+    what the page checks it against (``Prediction.agrees``)."""
+    w = make("24-cell")
+    down(w, "4", t=1.0)
+    heartbeat(w, 1400.0)
+    assert w.companion.kernel_state["keys"] == [["Digit4", 1000.0]]
+    up(w, "4", t=1.5)
+    assert w.companion.kernel_state["keys"] == [] and w.companion.kernel_state["upto"] == 1500.0
+
+
+ADOPT = """
+import { Prediction } from "page:predict.js";
+const p = new Prediction(INPUT.config, INPUT.start);
+const mine = p.ours({ key: "4", code: "Digit4", shiftKey: false }, "Digit4");
+const out = [];
+let now = -Infinity;
+for (const [what, arg] of INPUT.script) {
+  if (what === "press") p.press("Digit4", mine.action, mine.inverted, (now = arg));
+  else if (what === "release") p.release("Digit4", (now = arg));
+  else if (what === "advance") p.advance((now = arg));
+  else out.push({ adopted: p.adopt(arg), matrix: (p.advance(now), Array.from(p.state.matrix)) });
+}
+console.log(JSON.stringify(out));
+"""
+
+
+def test_the_page_keeps_its_own_steps_over_a_kernel_state_its_keys_say_is_wrong(make, clock):
+    """The kernel went on by its estimate of a silent page past the page's keyup (ipyevents' way
+    held up): its state holds the key the page released.  The page keeps its own steps
+    (``Prediction.agrees``), and adopts the kernel's state once the kernel has the keyup -- the
+    same state.  A state that lacks a key the page pressed by its time is not adopted either."""
+    from page_node import run_page
+
+    w = make("24-cell")
+    start = dict(w.companion.kernel_state)
+    down(w, "4", t=1.0)
+    heartbeat(w, 1100.0)
+    held = dict(w.companion.kernel_state)
+    run_ticker(w, clock, clock.t + 1.5)  # the page silent: the kernel's estimate goes on
+    ahead = dict(w.companion.kernel_state)
+    assert ahead["keys"] == [["Digit4", 1000.0]] and ahead["upto"] > 1400.0
+    up(w, "4", t=1.4)
+    final = dict(w.companion.kernel_state)
+    assert final["keys"] == [] and final["upto"] >= 1400.0
+    ref = reference(w, [("4", False, 1000.0, 1400.0)])
+    lacking = dict(held, upto=1200.0, keys=[])  # past the page's press without it
+    script = [["press", 1000.0], ["advance", 1100.0], ["adopt", held], ["adopt", lacking],
+              ["release", 1400.0], ["advance", 1400.0], ["adopt", ahead], ["adopt", final]]
+    page = run_page(ADOPT, {"config": w.companion.config, "start": start, "script": script})
+    assert [r["adopted"] for r in page] == [True, False, False, True]
+    matrices = [np.array(r["matrix"]).reshape(4, 4) for r in page]
+    assert np.allclose(matrices[1], reference(w, [("4", False, 1000.0, 1100.0)]).matrix, atol=1e-12)
+    assert np.allclose(matrices[2], ref.matrix, atol=1e-12)  # its own steps, not the kernel's 40-odd
+    assert not np.allclose(np.array(ahead["state"]["matrix"]).reshape(4, 4), ref.matrix, atol=1e-6)
+    assert np.array_equal(matrices[3], ref.matrix)  # the kernel's, adopted: exact

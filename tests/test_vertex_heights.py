@@ -116,7 +116,13 @@ def vertex_heights(p, m, rng=None, k=None) -> list[float]:
 def mismatch(p, m, c0) -> str | None:
     """What differs between the slice's points and P ∩ H's at ``c0``, or None."""
     s = slice_polytope(p, m, c0)
-    got = np.asarray(s.vertices)[: len(s.vertices) - s.n_fill]
+    return points_mismatch(p, m, c0, np.asarray(s.vertices)[: len(s.vertices) - s.n_fill], s.edges)
+
+
+def points_mismatch(p, m, c0, got, edges) -> str | None:
+    """What differs between a slice's points ``got`` (its fill corners left out) and edges and P ∩ H
+    at ``c0``, or None: the kernel's slices here, the page's in tests/test_page_star.py."""
+    got = np.asarray(got, dtype=float).reshape(-1, 3)
     want = points_of_p_cap_h(p, m, c0)
     tol = SAME * _radius(p)
     if not len(got) or not len(want):
@@ -130,7 +136,7 @@ def mismatch(p, m, c0) -> str | None:
     flat = edges_in_h(p, m, c0)
     if len(flat):  # and each edge lying in H joins two of them in the slice
         ends = tree.query(flat.reshape(-1, 3))[1].reshape(-1, 2)
-        have = {frozenset(e) for e in np.asarray(s.edges).tolist()}
+        have = {frozenset(e) for e in np.asarray(edges).reshape(-1, 2).tolist()}
         lost = sum(frozenset(e) not in have for e in ends.tolist())
         if lost:
             return f"c0={c0:.6g}: {lost} of P's {len(flat)} edges lying in H are no edge of the slice"

@@ -91,6 +91,7 @@ __all__ = [
     "StackSliceData",
     "arrangement_layout",
     "stack_levels",
+    "stack_offsets",
     "default_spacing",
     "highlighted_index",
 ]
@@ -158,14 +159,20 @@ def default_spacing(size: float, n: int) -> float:
     return 2.0 * float(size) / _check_slices(n)
 
 
-def stack_levels(c0: float, n: int, spacing: float) -> np.ndarray:
-    """(n,) float64: w_k = c0 + (k - (n - 1) / 2) spacing; the middle one is c0 exactly for odd n.
+def stack_offsets(n: int, spacing: float) -> np.ndarray:
+    """(n,) float64: each cut's offset from c0, ``(k - (n - 1) / 2) spacing`` (`stack_levels` adds c0;
+    a page that cuts the stack itself adds its own c0 to these very numbers).
 
     Any n >= 1 (a `StackSource` holds at most `MAX_SLICES`; tests integrate with more)."""
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, Integral) or n < 1:
         raise ValueError(f"Expected `n` to be an int >= 1, got {n!r}")
-    n = int(n)
-    return float(c0) + (np.arange(n) - (n - 1) / 2.0) * float(spacing)
+    return (np.arange(int(n)) - (int(n) - 1) / 2.0) * float(spacing)
+
+
+def stack_levels(c0: float, n: int, spacing: float) -> np.ndarray:
+    """(n,) float64: w_k = c0 + (k - (n - 1) / 2) spacing (`stack_offsets` plus c0); the middle one
+    is c0 exactly for odd n."""
+    return float(c0) + stack_offsets(n, spacing)
 
 
 def highlighted_index(n: int) -> int:
@@ -386,8 +393,14 @@ class StackSource:
         return float(self.source.size)
 
     @property
+    def groups_by_w(self) -> bool:
+        """Triangles are grouped by slice (group k: slice k), not by the inner source's groups:
+        coloured by w with more than one slice."""
+        return self._color_by == "w" and self._slices > 1
+
+    @property
     def n_groups(self) -> int:
-        if self._color_by == "w" and self._slices > 1:
+        if self.groups_by_w:
             return self._slices
         return int(self.source.n_groups)
 
@@ -443,10 +456,15 @@ class StackSource:
         cuts are in its w units, Δ in the drawn units (a cut is Δ * per_unit from the next)."""
         return w_frame(self.source)
 
+    def cut_offsets(self) -> np.ndarray:
+        """(N,) float64: each cut's offset from c0, in c0's units, ``(k - (N - 1)/2) Δ per_unit``
+        (`stack_offsets`)."""
+        return stack_offsets(self._slices, self.spacing * w_frame(self.source)[1])
+
     def cuts_at(self, c0: float) -> np.ndarray:
         """The stack's cuts for the plane w = ``c0``: the w of each of the N slices, in c0's units,
-        ``c0 + (k - (N - 1)/2) Δ per_unit`` (N,) float64."""
-        return stack_levels(c0, self._slices, self.spacing * w_frame(self.source)[1])
+        ``c0 + cut_offsets()`` (N,) float64."""
+        return float(c0) + self.cut_offsets()
 
     def levels_at(self, c0: float) -> np.ndarray:
         """The old name of `cuts_at` (kept for code written before it; "levels" are a field's iso values)."""
@@ -458,7 +476,7 @@ class StackSource:
 
     def group_colors(self) -> np.ndarray:
         """(n_groups, 3) float64 colours when coloured by w (a colormap over the levels), else None."""
-        if self._color_by != "w" or self._slices == 1:
+        if not self.groups_by_w:
             return None
         return look.level_colors(np.arange(self._slices, dtype=float), 0.0, self._slices - 1.0)
 
@@ -525,7 +543,7 @@ class StackSource:
         cuts = self.cuts_at(float(c0))
         pieces = self._inner_slices(m, cuts, coarse)
         centres, scales = self.layout()
-        by_w = self._color_by == "w" and n > 1
+        by_w = self.groups_by_w
         pts, segs, tris, groups, nrms, corners = [], [], [], [], [], []
         p_off, s_off, t_off = [0], [0], [0]
         volumes = []

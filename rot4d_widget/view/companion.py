@@ -84,7 +84,10 @@ from .pagecut import PageCut
 from .pagefield import PageField
 from .transfer import Transfers
 
-__all__ = ["Companion"]
+__all__ = ["Companion", "MAX_CLOCK_EDGES"]
+
+#: The page's key events one heartbeat carries at most (the page keeps as many unacknowledged).
+MAX_CLOCK_EDGES = 256
 
 
 class Companion(anywidget.AnyWidget):
@@ -113,8 +116,10 @@ class Companion(anywidget.AnyWidget):
     config = Dict().tag(sync=True)
     #: the kernel's state and its id (`pagestate.state_message` under "state", "epoch", "upto": the
     #: page time in ms up to which it holds the page's steps, None before any; "picture": the id of
-    #: the scene update that shows it, None when the picture shown does, "pending" when one is owed):
-    #: the page adopts it and applies its later steps on top; a screenshot waits until they agree
+    #: the scene update that shows it, None when the picture shown does, "pending" when one is owed;
+    #: "keys": the page's keys it holds as held, ``[kid, page time pressed]``): the page adopts it and
+    #: applies its later steps on top -- unless its own key events say the state is not what they
+    #: make (a release the kernel has not heard yet) -- and a screenshot waits until they agree
     kernel_state = Dict().tag(sync=True)
     #: the one-time transfers the kernel offers, name -> key (`transfer.Transfers`): a page that does
     #: not hold one asks for it
@@ -164,8 +169,10 @@ class Companion(anywidget.AnyWidget):
         self._drawn_handlers.register_callback(callback, remove=remove)
 
     def on_clock(self, callback, remove=False):
-        """Call ``callback(t_ms)`` with the page's clock (ms, the key events' timeStamp clock) as the
-        page sends it with the steps it makes while a key is held."""
+        """Call ``callback(t_ms, edges)`` with the page's clock (ms, the key events' timeStamp clock)
+        as the page sends it with the steps it makes while a key is held and with each key event,
+        and the page's key events the kernel has not acknowledged (as the page sent them, at most
+        `MAX_CLOCK_EDGES`: `rot4d_widget.view.keys.KeyPath.heartbeat` checks each)."""
         self._clock_handlers.register_callback(callback, remove=remove)
 
     def on_holds(self, callback, remove=False):
@@ -212,9 +219,9 @@ class Companion(anywidget.AnyWidget):
                     self.page_field.holds(name, key)
                     self._holds_handlers(name)
         elif event == "clock":
-            t = content.get("t")
+            t, edges = content.get("t"), content.get("edges")
             if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
-                self._clock_handlers(float(t))
+                self._clock_handlers(float(t), edges[:MAX_CLOCK_EDGES] if isinstance(edges, list) else [])
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

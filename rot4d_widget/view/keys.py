@@ -22,7 +22,7 @@ from .fieldkeys import FieldKeys, level_actions
 from .pagestate import page_config
 from .pagesteps import HEARTBEAT_STALE, PREDICTED_KINDS, LastStep, PageSteps
 
-__all__ = ["KeyPath", "key_id", "page_time", "source_actions", "help_groups"]
+__all__ = ["KeyPath", "key_id", "page_edge", "page_time", "source_actions", "help_groups"]
 
 
 class KeyPath:
@@ -128,9 +128,12 @@ class KeyPath:
                 self.correct(action, inverted, correction)
             self.settle()
 
-    def heartbeat(self, t_ms) -> None:
-        """Companion: the page's clock has reached ``t_ms`` (it sends it with each step it makes).
-        Never raises."""
+    def heartbeat(self, t_ms, edges=()) -> None:
+        """Companion: the page's clock has reached ``t_ms`` (it sends it with each step it makes and
+        each key event), with the page's key events the kernel has not acknowledged (``edges``,
+        `page_edge`): applied first, each once whichever way it came (`StepLog`), so the time heard
+        never passes an event the kernel has not had -- ipyevents' way can be held up by a busy
+        kernel while this one is not.  Never raises."""
         w = self.w
         try:
             if isinstance(t_ms, bool) or not isinstance(t_ms, (int, float)) or not math.isfinite(t_ms):
@@ -138,8 +141,19 @@ class KeyPath:
             with w._pump.lock:
                 if w._closed:
                     return
+                released = False
+                heard = (page_edge(e, w.state.keymap) for e in (edges if isinstance(edges, (list, tuple)) else ()))
+                for edge in sorted(filter(None, heard), key=lambda e: e[2]):
+                    kid, down, t, found = edge
+                    if not down:
+                        released = self.page.release(kid, t) or released
+                    elif found is not None and found[0].kind in PREDICTED_KINDS and not self.no_view() \
+                            and w._repeater.held(kid) is None:
+                        self.page.press(kid, found[0], found[1], t, found[0].kind in REPEATING_KINDS)
                 self.page.heartbeat(float(t_ms))
                 self.advance()
+                if released:
+                    self.settle()
                 w._pump.flush()
         except Exception as exc:
             w._report_error(exc)
@@ -337,6 +351,30 @@ def page_time(event) -> float | None:
     except OverflowError:
         return None
     return t / 1000.0 if math.isfinite(t) else None
+
+
+def page_edge(edge, keymap=None):
+    """One key event as the companion repeats it -- ``{"kid", "down", "t"}`` and for a press what
+    finds its action: ``"key"``, ``"code"``, ``"shift"`` of a key, or ``"pad": true`` and the pad
+    button's key and shift -- as ``(kid, down, t_ms, found)``; None if malformed.  ``found`` is the
+    keymap's ``(action, inverted)`` (None: not bound, or no keymap given)."""
+    if not isinstance(edge, Mapping):
+        return None
+    kid, down, t = edge.get("kid"), edge.get("down"), edge.get("t")
+    if not isinstance(kid, str) or not 0 < len(kid) <= 64 or not isinstance(down, bool) \
+            or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        return None
+    found = None
+    if down and keymap is not None:
+        key, shift = edge.get("key"), edge.get("shift") is True
+        if edge.get("pad") is True:
+            if isinstance(key, str) and key and kid == f"pad:{key}{'+shift' if shift else ''}":
+                found = keymap.resolve(key, shift)
+        else:
+            event = {"key": key, "code": edge.get("code"), "shiftKey": shift}
+            if key_id(event) == kid:
+                found = keymap.lookup(event)
+    return kid, down, float(t), found
 
 
 def key_id(event: Mapping):

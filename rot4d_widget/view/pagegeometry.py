@@ -26,11 +26,25 @@ cell_normals              f64 4C   each cell's outward unit normal
 cell_centres              f64 4C   each cell's vertex mean, in the unit scale
 ========================  =======  ===========================================================
 
+A polytope with star faces or non-convex cells (``star``) adds what the star slicer's points
+and segments need (`rot4d_widget.geometry.starslice.star_tables`; ``page/starslicer.js``):
+
+========================  =======  ===========================================================
+face_basis                f64 8F   each face's two orthonormal in-plane axes (4 numbers each)
+face_rho                  f64 2F   +-1 per (face, its cell in ``face_cells``): which way the
+                                   face's chord runs in that cell's section (for the volume
+                                   that picks the side of a cell lying in H)
+slot_mate                 i32 2ΣF  per (face side k, cell j of the face), slot 2k + j: the slot
+                                   of the cell's other face at that side's edge, or -1
+========================  =======  ===========================================================
+
+and the flag ``volume_defined`` (False: a hemi or non-orientable polytope, its slices' volume None).
+
 Scalars: ``n_vertices`` V, ``n_edges`` E, ``n_faces`` F, ``n_cells`` C; ``unit`` (the power of
 two), ``tol`` (on H when ``|w - c0| <= tol``, unit scale), ``radius`` (circumradius, unit
-scale), ``nudge`` (how far the slicer's last fallback moves H, unit scale); ``convex``, ``star``
-(star faces or non-convex cells: the page does not cut those) and ``n_groups`` (the source's
-colour groups, its cells); ``name``.
+scale), ``nudge`` (how far the slicer's fallbacks move H, unit scale); ``convex``, ``star``
+(star faces or non-convex cells: the page draws only their points and segments) and ``n_groups``
+(the source's colour groups, its cells); ``name``.
 """
 
 from __future__ import annotations
@@ -40,6 +54,7 @@ import numpy as np
 from ..core import tolerances as tol_
 from ..geometry.mesh import Polytope
 from ..geometry.slicetables import tables
+from ..geometry.starslice import star_tables
 
 __all__ = ["polytope_message", "polytope_message_bytes"]
 
@@ -69,7 +84,7 @@ def polytope_message(polytope: Polytope) -> dict:
     """Everything ``page/slicer.js`` (``decodePolytope``, ``slicePolytope``) needs to cut
     ``polytope`` as `slice_polytope` does: see the module docstring for the names."""
     t = tables(polytope)
-    return {
+    msg = {
         "name": polytope.name,
         "n_vertices": int(t.V), "n_edges": int(len(t.ea)), "n_faces": int(t.F), "n_cells": int(t.C),
         "unit": float(t.unit), "tol": float(t.tol), "radius": float(t.radius),
@@ -89,6 +104,12 @@ def polytope_message(polytope: Polytope) -> dict:
         "cell_normals": _f64(t.cell_normals),
         "cell_centres": _f64(t.cell_centres),
     }
+    if polytope.star is not None:  # what the star slicer adds, its own tables
+        st = star_tables(polytope, t)
+        msg.update({"face_basis": _f64(st.face_basis), "face_rho": _f64(st.face_rho),
+                    "slot_mate": _i32(st.slot_mate, "slot_mate"),
+                    "volume_defined": bool(polytope.volume_defined)})
+    return msg
 
 
 def polytope_message_bytes(msg: dict) -> int:

@@ -39,6 +39,12 @@ PREDICTED_KINDS = frozenset({"rotate", "alpha", "c0", "theta0", "reset"})
 #: With a key held and no word from the page for this long (kernel seconds), the kernel goes on by
 #: its own clock's estimate of the page's (a front end without the companion's heartbeats).
 HEARTBEAT_STALE = 0.2
+#: During a long hold, steps older than this (page ms) behind the time heard are done (`_roll`): no
+#: event stamped that long before a heartbeat arrives after it (messages keep their order; only an
+#: event dispatched a moment after a heartbeat does, by a few ms) ...
+SETTLED_MS = 1000.0
+#: ... once this many steps are kept since the checkpoint (three seconds at 30 Hz).
+ROLL_STEPS = 90
 
 
 class LastStep:
@@ -89,18 +95,21 @@ class PageSteps:
         self.log = StepLog(hold_delay, tick_rate)
         self.epoch = 0
         self.upto = -math.inf  # page ms: the state has every step due by then
-        self._applied: list[tuple[PageStep, bool]] = []  # since the checkpoint: (step, it changed the state)
+        #: since the checkpoint: (step, it changed the state, the state and view, and last step after it)
+        self._applied: list[tuple[PageStep, bool, tuple, tuple]] = []
         self._base = self._snapshot()
         self._base_last = last.snapshot()
         self._made = self._base  # the state as the last step left it (a change since: the kernel's)
         self._offset = -math.inf  # page ms minus kernel ms: at least this (the latest page time heard, sent)
         self._heartbeat_at = -math.inf  # kernel time of the last word from the page
+        self._page_heard = -math.inf  # the latest page time the page itself said (not estimated)
 
     # -- what the page says -----------------------------------------------------------------
     def _heard_from_page(self, t_ms: float) -> None:
         now = self.clock()
         self._offset = max(self._offset, t_ms - 1000.0 * now)
         self._heartbeat_at = now
+        self._page_heard = max(self._page_heard, t_ms)
         self.log.hear(t_ms)
 
     def press(self, kid, action, inverted: bool, t_ms: float, repeats: bool) -> bool:
@@ -151,6 +160,10 @@ class PageSteps:
     def held_key(self, kid):
         return self.log.held_key(kid)
 
+    def held_since(self) -> list:
+        """The page's keys the state holds as held, with their press times (`StepLog.held_since`)."""
+        return self.log.held_since()
+
     @property
     def state_id(self) -> tuple:
         """``(epoch, upto)``: the state the kernel holds (module docs)."""
@@ -174,7 +187,7 @@ class PageSteps:
         checkpoint when those applied are no longer what the page made); at rest, a checkpoint."""
         self.sync_external()
         steps = self.log.steps()
-        done = [s for s, _ in self._applied]
+        done = [a[0] for a in self._applied]
         rebuilt = done != steps[: len(done)]
         if rebuilt:
             self.state.restore_snapshot(self._base[0])
@@ -194,15 +207,28 @@ class PageSteps:
                 changed = self.state.apply(step.action, step.inverted)
                 if changed:
                     self.recorder.record(None, False, step.action, step.inverted, t=self._stamp(step.t))
-            self._applied.append((step, changed))
             if changed:
                 self.last.note(step.action.label(step.inverted))
                 actions.append(step.action)
+            self._applied.append((step, changed, self._snapshot(), self.last.snapshot()))
         self.upto = max(self.upto, self.log.heard)
         self._made = self._snapshot()
         if not self.log.held and self.log.keys:
             self._checkpoint(self.upto)
+        elif len(self._applied) > ROLL_STEPS:  # only steps the page said it made, long enough ago
+            self._roll(min(self.upto, self._page_heard) - SETTLED_MS)
         return Applied(bool(actions) or rebuilt, rebuilt, tuple(actions))
+
+    def _roll(self, t: float) -> None:
+        """A checkpoint at page time ``t`` while keys are held (a long hold): the steps due by then
+        are done -- the state after the last of them becomes the base -- so each step costs the same
+        however long the hold, and a rebuild goes back only to ``t``."""
+        done = [i for i, a in enumerate(self._applied) if a[0].t <= t]
+        if not done:
+            return
+        _, _, self._base, self._base_last = self._applied[done[-1]]
+        self._applied = self._applied[done[-1] + 1:]
+        self.log.checkpoint(t)
 
     def _checkpoint(self, t: float) -> None:
         """Every step applied is done (they are all due by ``t``, the time last heard): the state now

@@ -253,10 +253,11 @@ class Painter:
         w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
         epoch, upto = w._keys.page.state_id
         msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None,
-               "state": state_message(w.state, view_message(w)), "picture": picture}
+               "state": state_message(w.state, view_message(w)), "keys": w._keys.page.held_since(),
+               "picture": picture}
         old = w.companion.kernel_state
         if picture is None and old.get("picture") != "pending" and old.get("state") == msg["state"] \
-                and old.get("epoch") == epoch and old.get("upto") == msg["upto"]:
+                and old.get("epoch") == epoch and old.get("upto") == msg["upto"] and old.get("keys") == msg["keys"]:
             return  # unchanged: nothing to send (the picture named before still shows it)
         w.companion.kernel_state = msg
         self.state_at = now
@@ -417,13 +418,14 @@ class Painter:
 
 def level_colors(source, cmap: str = look.LEVEL_COLORMAP, clim=None):
     """Colours of a source's iso levels along the colour map ``cmap``, or None: spread over it by
-    rank (``clim`` None: the data's range, today's look), else each at its value in ``clim``."""
+    rank (``clim`` None: the data's range as known without a full read -- a chunked store's first
+    cut until its background read is done -- today's look), else each at its value in ``clim``."""
     levels = getattr(source, "levels", None)
     if not levels:
         return None
     if clim is not None:
         return look.level_colors(levels, clim[0], clim[1], cmap, by_value=True)
-    lo, hi = getattr(source, "data_range", (min(levels), max(levels)))
+    lo, hi = getattr(source, "known_range", None) or getattr(source, "data_range", (min(levels), max(levels)))
     return look.level_colors(levels, lo, hi, cmap)
 
 

@@ -586,7 +586,6 @@ def _build_three(scene, antialias, display):
         "u_light_color": {"value": [0.62, 0.62, 0.60]},
         "u_light_position": {"value": [-3.0, 4.0, 2.0]},
         "u_specular": {"value": 0.35},
-        "u_shininess": {"value": 40.0},
     }
     scene._materials = {
         "ball": p3.ShaderMaterial(

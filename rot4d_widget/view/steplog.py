@@ -14,6 +14,16 @@ page time ``h`` it has every event stamped before ``h`` (an event dispatched a m
 heartbeat that followed its stamp is the exception: `StepLog.steps` then differs from what was
 applied before, and the caller rebuilds from its checkpoint).
 
+A key's events can come twice, by two ways: ipyevents forwards them, and the companion repeats
+every key event the kernel has not acknowledged with each heartbeat -- the two travel on separate
+comms, which the kernel may handle on separate threads (JupyterLab 4.4+ sends widget messages on a
+subshell, ipykernel routes a comm's messages to the thread it last sent from), so the heartbeat can
+outrun the ipyevents event it follows.  A key's events come in time order by either way, so a press
+no later than the key's last press heard, or a release no later than its last release heard, is one
+heard already (`StepLog.press` and `release` return False).  Presses and releases are compared with
+their own kind: a release stamped a moment before its own press (a page whose clock is coarse or
+jittered) is still that press's release -- a tap -- never taken for an old one, so no key sticks.
+
 `StepLog` is pure bookkeeping: no state, no threads, no widgets.
 """
 
@@ -22,7 +32,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["StepLog", "PageStep", "step_time"]
+__all__ = ["StepLog", "PageStep", "step_time", "SAME_MS", "MAX_EDGES"]
+
+#: Two page times of one event as both ways deliver it: ipyevents' timeStamp goes through seconds
+#: on its way (``t / 1000 * 1000``), a few ulps from the companion's.
+SAME_MS = 1e-6
+#: The keys whose last event is remembered (a key's latest event time); the oldest of keys not held
+#: are forgotten beyond this.
+MAX_EDGES = 512
 
 
 def step_time(down: float, k: int, hold_ms: float, period_ms: float) -> float:
@@ -76,27 +93,46 @@ class StepLog:
         self.heard = -math.inf  # the latest page time the kernel has heard of
         self.checked = -math.inf  # the page time of the last checkpoint
         self._order = 0
+        self._edges: dict[str, list] = {}  # kid -> [page time of its last press, of its last release] heard
+
+    def _heard_already(self, kid: str, t: float, press: bool) -> bool:
+        """An event of ``kid`` at ``t`` heard already: a press no later than the key's last press, a
+        release no later than its last release (module docs)."""
+        last = self._edges.get(kid)
+        return last is not None and t <= last[0 if press else 1] + SAME_MS
+
+    def _note_edge(self, kid: str, t: float, press: bool) -> None:
+        last = self._edges.pop(kid, [-math.inf, -math.inf])
+        last[0 if press else 1] = max(t, last[0 if press else 1])
+        self._edges[kid] = last  # the newest last
+        if len(self._edges) > MAX_EDGES:
+            for old in [k for k in self._edges if self.held_key(k) is None][: len(self._edges) - MAX_EDGES]:
+                del self._edges[old]
 
     # -- events --------------------------------------------------------------------------
     def press(self, kid: str, action, inverted: bool, t: float, repeats: bool) -> bool:
         """Key ``kid`` went down at page time ``t``; False (nothing changes) while it is held already
-        (a second keydown without a keyup: a repeat).  ``repeats``: it steps while held."""
+        (a second keydown without a keyup: a repeat) and for a press heard already (module docs).
+        ``repeats``: it steps while held."""
         held = self.keys.get(kid)
-        if held is not None and held.up is None:
+        if (held is not None and held.up is None) or self._heard_already(kid, t, True):
             return False
         if held is not None:  # pressed again before a checkpoint: the old press keeps its steps
             self.keys[f"{kid}#{held.order}"] = self.keys.pop(kid)
         self._order += 1
         self.keys[kid] = _Key(kid, action, bool(inverted), float(t), self._order, bool(repeats))
+        self._note_edge(kid, float(t), True)
         self.hear(t)
         return True
 
     def release(self, kid: str, t: float) -> bool:
-        """Key ``kid`` went up at page time ``t`` (at least its press); False if it was not held."""
+        """Key ``kid`` went up at page time ``t`` (at least its press); False if it was not held or the
+        release was heard already (module docs)."""
         key = self.keys.get(kid)
-        if key is None or key.up is not None:
+        if key is None or key.up is not None or self._heard_already(kid, t, False):
             return False
         key.up = max(float(t), key.down)
+        self._note_edge(kid, float(t), False)
         self.hear(t)
         return True
 
@@ -113,6 +149,11 @@ class StepLog:
     def held(self) -> tuple:
         """Keys down now, in the order pressed."""
         return tuple(k.kid for k in sorted(self.keys.values(), key=lambda k: k.order) if k.up is None)
+
+    def held_since(self) -> list:
+        """``[[kid, page time pressed], ...]`` of the keys down now, in the order pressed: what the
+        page checks a state of the kernel against (a key it released is not in it)."""
+        return [[k.kid, k.down] for k in sorted(self.keys.values(), key=lambda k: k.order) if k.up is None]
 
     def held_key(self, kid):
         """``(action, inverted)`` of held key ``kid``, or None."""

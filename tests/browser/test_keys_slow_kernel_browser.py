@@ -13,7 +13,9 @@ slow store settled seconds after the last, every intermediate picture drawn.
 
 Every test runs with one core spun by a busy process (the machine has two), on a `Field4D`
 (`moving_sphere`) wrapped in `SlowSource`, which sleeps in every ``slice`` (a slow store).
-Steps are counted in the kernel, from the widget's recording (every applied step, repeats too),
+Steps are counted in the kernel, from the widget's recording (every applied step, repeats too; a
+rebuild from a checkpoint -- the kernel stepped on by its estimate while the page's keyup waited
+behind a busy cell -- is recorded as the checkpoint's matrix set exactly, then the steps again),
 checked against the orientation matrix.  Timing bounds are derived from this run's own tap
 round trips (keydown -> pixels changed, page clock) on the same slow source, as in
 test_widget_browser.py; waits for conditions have generous timeouts.
@@ -78,8 +80,15 @@ def report(w):
     act = lambda e: getattr(e, "action", None)
     xw = [e for e in events if getattr(act(e), "planes", None) == "xw"]
     c0 = [e for e in events if getattr(act(e), "kind", None) == "c0"]
+    net = 0  # net R_xw steps as the recording replays: a rebuild sets the matrix exactly, then steps
+    for e in events:
+        if getattr(act(e), "planes", None) == "xw":
+            net += -1 if e.inverted else 1
+        elif getattr(e, "name", None) == "matrix":  # only R_xw turns here: the set matrix's steps
+            m = np.asarray(e.value)
+            net = round(math.atan2(m[3][0], m[0][0]) / w.state.theta0)
     return dict(
-        xw=sum(-1 if e.inverted else 1 for e in xw), xw_events=len(xw),
+        xw=net, xw_events=len(xw),
         c0_steps=sum((-1 if e.inverted else 1) * act(e).sign for e in c0), c0_events=len(c0),
         m=w.state.matrix.tolist(), theta0=w.state.theta0, c0=w.state.c0, c0_step=w.state.c0_step,
         held=len(w.held_keys), updates=w.stats.updates, stats=w.stats.as_dict(), calls=slow.calls,

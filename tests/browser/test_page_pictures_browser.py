@@ -67,3 +67,34 @@ def test_the_page_s_picture_of_a_state_is_the_kernel_s(jupyter_server, page, art
         assert (diff <= 2).mean() >= 0.995, (name, worst[name])
         assert (kernel != kernel[0]).any(axis=1).sum() > 500, f"{name}: nothing drawn"
     print("page vs kernel, worst channel difference and share within 2/255:", worst)
+
+
+def test_a_star_polychoron_turns_as_balls_and_bars_and_rests_on_the_kernel_s_fills(jupyter_server, page, artifacts):
+    """A star polychoron's fills are the kernel's: while keys are held the page draws the balls and
+    bars of its own state (never fills of another state), at rest the kernel's whole picture."""
+    if jupyter_server.kind != "lab":
+        pytest.skip("JupyterLab only: the same page code in Notebook 7 (the test above runs there)")
+    name = "great grand stellated 120-cell"
+    write_notebook(jupyter_server.root / "page_star.ipynb",
+                   [f"from rot4d_widget import Rot4DWidget\nw = Rot4DWidget({name!r}, width=320, height=260)\nw"])
+    jp = JupyterPage(page, jupyter_server, "page_star.ipynb").open()
+    jp.run_all()
+    sel = _canvas(jp, "w")
+    host = _host(sel)
+    assert jp.wait_for(lambda: jp.kernel_json("w.companion.page_cut.page_draws"), timeout=60), "the page never held it"
+    _hover(jp, sel)
+    jp.page.keyboard.down("4")
+    time.sleep(0.6)
+    assert jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dDrawsOwn()")
+    jp.page.locator(sel).screenshot(path=str(artifacts / "page-star-held.png"))
+    held = jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dCounts()")
+    jp.page.keyboard.up("4")
+    assert jp.wait_for(lambda: jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dDrawsOwn()") is False,
+                       timeout=60)
+    jp.page.mouse.move(2, 2)
+    time.sleep(0.4)
+    rest = jp.page.evaluate(f"() => document.querySelector({host!r}).rot4dCounts()")
+    jp.page.locator(sel).screenshot(path=str(artifacts / "page-star-rest.png"))
+    # held: the page's balls and bars, no fill; at rest: the kernel's picture, its fills too
+    assert held[0] > 0 and held[1] > 0 and held[2] == 0, held
+    assert rest[2] > 1000, rest

@@ -18,7 +18,7 @@ import time
 import numpy as np
 import pytest
 
-from jupyter_page import JupyterPage, write_notebook
+from jupyter_page import _FIND_PANEL, JupyterPage, write_notebook
 from test_widget_browser import _canvas, _hover
 
 pytestmark = pytest.mark.browser
@@ -125,3 +125,43 @@ def _two_keys(jupyter_server, page, var):
     assert same, "the recording does not replay to the view's state"
     steps = jp.kernel(f"print(sum(1 for e in {var}.recording.events if getattr(e, 'key', 0) is None))")
     assert int(steps.strip()) > 10  # both keys repeated
+
+
+#: Start a cell that keeps the kernel's main thread busy for ``s`` seconds, without waiting for it.
+_BUSY = "(s) => { const panel = (" + _FIND_PANEL + ")(); " \
+        "panel.sessionContext.session.kernel.requestExecute({code: `import time; time.sleep(${s})`, " \
+        "store_history: false}); return true; }"
+
+
+def test_a_key_released_while_a_cell_runs_stops_where_the_page_released_it(jupyter_server, page):
+    """A cell keeps the kernel busy as the key comes up: ipyevents' keyup waits for the cell (its
+    comm's messages go to the main thread), the companion's heartbeats do not (JupyterLab sends
+    widget messages on a subshell).  The heartbeats carry the page's key events, so the kernel stops
+    the key when the page did; the page shows no step past its release meanwhile, and the kernel
+    ends on the page's state with the page's steps recorded."""
+    write_notebook(jupyter_server.root / "page_busy.ipynb", CELLS[:1])
+    jp = JupyterPage(page, jupyter_server, "page_busy.ipynb").open()
+    jp.run_all()
+    sel = _canvas(jp, "w")
+    jp.page.locator(sel).scroll_into_view_if_needed()
+    _hover(jp, sel)
+    assert _page(jp, sel) is not None, "the page has no copy of the state"
+    jp.page.keyboard.down("4")
+    time.sleep(1.0)
+    jp.page.evaluate(_BUSY, 2.0)
+    time.sleep(0.3)
+    jp.page.keyboard.up("4")
+    time.sleep(0.1)
+    released = _page(jp, sel)
+    seen = []
+    for _ in range(12):  # while the cell runs: the page shows its release, nothing past it
+        time.sleep(0.1)
+        seen.append(_page(jp, sel)["matrix"])
+    assert not released["held"]
+    for m in seen:
+        np.testing.assert_allclose(m, released["matrix"], rtol=0, atol=1e-12)
+    assert jp.wait_for(lambda: _settled(jp, "w", sel), timeout=60), (_page(jp, sel), _kernel(jp, "w"))
+    kernel, after = _kernel(jp, "w"), _page(jp, sel)
+    np.testing.assert_allclose(kernel["m"], released["matrix"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(after["matrix"], released["matrix"], rtol=0, atol=1e-12)
+    assert jp.kernel_json("bool(((w.recording.replay().matrix == w.state.matrix)).all())")

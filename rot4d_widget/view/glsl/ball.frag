@@ -14,5 +14,5 @@ void main() {
     vec3 hit = (b - sqrt(disc)) * ray;
     vec3 n = (hit - v_centre) / u_ball_radius;
     write_depth(hit);
-    gl_FragColor = vec4(shade(u_ball_color, n, hit), 1.0);
+    gl_FragColor = vec4(shade(u_ball_color, n, hit, ray), 1.0);
 }

@@ -37,5 +37,5 @@ void main() {
         n = (hit - v_a - s * w) / u_bar_radius;
     }
     write_depth(hit);
-    gl_FragColor = vec4(shade(u_bar_color, n, hit), 1.0);
+    gl_FragColor = vec4(shade(u_bar_color, n, hit, ray), 1.0);
 }

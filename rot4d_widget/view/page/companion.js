@@ -56,9 +56,9 @@ import { nextSurfaceVersion, CUBE, likeTexture } from "./uploads.js";
 import { expansions, layerLayout, buildGeometry, makeExpansion, fillExpansion } from "./expand.js";
 import { projections, decodeSkeleton, projectSkeleton } from "./projection.js";
 import { modelId, dataOf, getModel } from "./models.js";
-import { adoptKernel, attachKeys, attachPad, turning } from "./turning.js";
+import { adoptKernel, attachKeys, attachPad, releaseKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
-import { drawsOwn, forceOwn, ownPicture, polytopeArrived } from "./pictures.js";
+import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 import { fieldArrived, freeField, noteContext, wantsTransfer } from "./field.js";
 import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField, quickField } from "./fieldpicture.js";
 
@@ -113,10 +113,15 @@ async function render({ model, el }) {
     cleanups.push(() => clearTimeout(t));
   }
 
-  // 2. focus loss (with the page's time: held keys are released then on both sides)
-  listen(window, "blur", () => send({ event: "focus_lost", reason: "blur", t: performance.now() }));
+  // 2. focus loss (with the page's time: held keys are released then on both sides, one time)
+  const focusLost = (reason) => {
+    const t = performance.now();
+    send({ event: "focus_lost", reason, t });
+    releaseKeys(model, t);
+  };
+  listen(window, "blur", () => focusLost("blur"));
   listen(document, "visibilitychange", () => {
-    if (document.visibilityState === "hidden") send({ event: "focus_lost", reason: "hidden", t: performance.now() });
+    if (document.visibilityState === "hidden") focusLost("hidden");
   });
 
   // 8. the page turns: its own copy of the state, stepped by the keys over this widget's canvases
@@ -178,13 +183,15 @@ async function render({ model, el }) {
     });
   }
   onPageData();
-  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it
-  const pageHook = () => {
+  // the test hook: the page's state, the kernel's id it rests on, the page's steps beyond it, the
+  // pictures it made itself (`rows`: with the last one's rows)
+  const pageHook = (rows = false) => {
     const p = turning(model).prediction;
     if (!p || !p.state) return null;
     const k = p.kernel || {};
     return { matrix: Array.from(p.state.matrix), theta0: p.state.theta0, alpha: p.state.alpha, c0: p.state.c0,
-             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held };
+             epoch: k.epoch, upto: k.upto, pending: p.pending, held: p.held, version: p.version,
+             own: ownPictureReport(model, rows) };
   };
   const hookPage = () => {
     for (const host of canvases()) host.rot4dPage = pageHook;
@@ -258,6 +265,7 @@ async function render({ model, el }) {
       let own = false; // the layers draw the page's own picture (pictures.js), not the kernel's rows
       let fieldOwn = false; // ... of a field (fieldpicture.js): its ray-cast mesh in place of the kernel's
       let drawnVersion = null; // the prediction's version the page's own picture last drawn shows
+      let drawnCounts = []; // the rows each layer drew last (balls, bars, faces): for the test hook
       const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
       const applyTurn = () => {
         const m = own ? IDENTITY : buffer.get("_rot4d_turn");  // the page's rows are in the final frame
@@ -430,6 +438,7 @@ async function render({ model, el }) {
         if (!obj || !obj.array || !(obj.stride > 0)) return;
         const held = Math.floor(obj.array.length / obj.stride);
         const counts = picture ? picture.counts : buffer.get("_rot4d_counts") || [];
+        drawnCounts = Array.from(counts);
         layers.forEach((layer, i) => {
           const inst = layer.model.obj;
           const mesh = layer.mesh && layer.mesh.obj;
@@ -497,8 +506,7 @@ async function render({ model, el }) {
       let ownProj = null; // the state message of the page's own state, made once per state
       const ownProjection = (p) => {
         if (!ownProj || ownProj.version !== p.version) {
-          const c0 = p.state.c0;
-          ownProj = { version: p.version, msg: { matrix: Array.from(p.state.matrix), offsets: [c0], middle: c0 } };
+          ownProj = { version: p.version, msg: ownHyperplanes(model, p.state) };
         }
         return ownProj.msg;
       };
@@ -508,7 +516,7 @@ async function render({ model, el }) {
         const g = projectionShared(lo);
         if (!g) return;
         const sk = buffer.get("_rot4d_skeleton");
-        // the page's own state while it draws its own picture (a single polytope: one hyperplane, c0)
+        // the page's own state while it draws its own picture (c0, or a stack's every cut)
         const mine = own && turning(model).prediction;
         const st = mine && mine.state ? ownProjection(mine) : buffer.get("_rot4d_project");
         if (g.sk !== sk) {
@@ -830,6 +838,7 @@ async function render({ model, el }) {
               return cam ? { world: Array.from(cam.matrixWorld.elements), projection: Array.from(cam.projectionMatrix.elements),
                              scale: DEPTH_SCALE } : { scale: DEPTH_SCALE };
             };
+            host.rot4dCounts = () => drawnCounts.slice();
           }
         }
       };

@@ -15,6 +15,10 @@ export function sameState(a, b) {
   return JSON.stringify(a.view) === JSON.stringify(b.view);
 }
 
+// Two page times of one key event as the kernel heard it (through seconds) and the page made it
+// (rot4d_widget.view.steplog.SAME_MS).
+export const SAME_MS = 1e-6;
+
 export class Prediction {
   // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null
   constructor(config, kernel) {
@@ -32,11 +36,12 @@ export class Prediction {
     if (kernel) this.adopt(kernel);
   }
 
-  // The kernel's state for its id: the page's steps up to `upto` are in it.  The version moves
-  // only if the state predicted is another once the page's later steps are on it again (`advance`):
-  // adopting the kernel's state of what the page already shows draws nothing again.
+  // The kernel's state for its id: the page's steps up to `upto` are in it.  False (not adopted)
+  // when the page's own key events say otherwise (`agrees`).  The version moves only if the state
+  // predicted is another once the page's later steps are on it again (`advance`): adopting the
+  // kernel's state of what the page already shows draws nothing again.
   adopt(kernel) {
-    if (!kernel || !kernel.state) return;
+    if (!kernel || !kernel.state || !this.agrees(kernel)) return false;
     this.kernel = kernel;
     this.log.checkpoint(kernel.upto === null ? -Infinity : kernel.upto);
     this.adopted = { state: this.state, version: this.version };
@@ -44,6 +49,29 @@ export class Prediction {
     this.state = this.base.copy();
     this.applied = [];
     this.version += 1;
+    return true;
+  }
+
+  // Whether the kernel's state can be what the page's keys make by its `upto`: the keys it holds
+  // as held (`keys`: [kid, page time pressed]) are those the page held then.  It is not when the
+  // kernel holds a key the page released by then (it has not heard the release, and went on by
+  // its estimate of a page it did not hear from) or lacks one the page pressed by then (it went
+  // past the press by that estimate): the page's own steps stay until the kernel's state agrees.
+  agrees(kernel) {
+    if (!Array.isArray(kernel.keys) || typeof kernel.upto !== "number") return true;
+    const upto = kernel.upto;
+    const same = (a, b) => Math.abs(a - b) <= SAME_MS;
+    const mine = [...this.log.keys.values()];
+    const theirs = kernel.keys.filter((k) => Array.isArray(k) && typeof k[0] === "string" && typeof k[1] === "number");
+    for (const [kid, down] of theirs) {
+      const key = mine.find((k) => k.kid === kid && same(k.down, down));
+      if (key && key.up !== null && key.up <= upto + SAME_MS) return false;
+    }
+    for (const key of mine) {
+      const heldThen = key.down <= upto + SAME_MS && (key.up === null || key.up > upto + SAME_MS);
+      if (heldThen && !theirs.some(([kid, down]) => kid === key.kid && same(key.down, down))) return false;
+    }
+    return true;
   }
 
   // True for an action the page steps itself (the state's kinds, a field's view kinds and levels).

@@ -14,9 +14,11 @@
 // multiply-adds: turned slices agree to rounding, unturned ones exactly.
 //
 // Polytopes with star faces or non-convex cells (`star`: rot4d_widget.geometry.starslice) are
-// not cut here: `slicePolytope` throws for them.
+// not cut here: `slicePolytope` throws for them; `sliceStarEdges` gives their points and
+// segments (starslicer.js), all the page draws of them.
 
 import { dot3, mod2pi, pairwiseSum } from "./numpyorder.js";
+import { sliceStarUnit } from "./starslicer.js";
 
 // Spacing of the per-polygon sort keys (> 2 pi): section._TWO_PI_PLUS.
 const TWO_PI_PLUS = 8.0;
@@ -76,7 +78,7 @@ export function decodePolytope(msg) {
   const facePtr = offsets(msg, "face_ptr", F);
   const cellVptr = offsets(msg, "cell_vptr", C);
   const cellEptr = offsets(msg, "cell_eptr", C);
-  return {
+  const p = {
     name: String(msg.name), V, E, F, C,
     unit: Number(msg.unit), tol: Number(msg.tol), radius: Number(msg.radius), nudge: Number(msg.nudge),
     convex: Boolean(msg.convex), star: Boolean(msg.star), nGroups: count(msg, "n_groups"),
@@ -93,6 +95,17 @@ export function decodePolytope(msg) {
     cellNormals: typed(msg.cell_normals, Float64Array, 4 * C, "cell_normals"),
     cellCentres: typed(msg.cell_centres, Float64Array, 4 * C, "cell_centres"),
   };
+  if (p.star) {  // the star slicer's tables (starslicer.js)
+    const sides = facePtr[F];
+    p.faceBasis = typed(msg.face_basis, Float64Array, 8 * F, "face_basis");
+    p.faceRho = typed(msg.face_rho, Float64Array, 2 * F, "face_rho");
+    p.slotMate = typed(msg.slot_mate, Int32Array, 2 * sides, "slot_mate");
+    p.slotMate.forEach((v, i) => {
+      if (!(v >= -1 && v < 2 * sides)) throw new Error(`polytope message: slot_mate[${i}] = ${v} is not in [-1, ${2 * sides})`);
+    });
+    p.volumeDefined = Boolean(msg.volume_defined);
+  }
+  return p;
 }
 
 // Row j of the 4-vector a[i..i+3] turned by the row-major `m` (vertices @ m.T), summed k = 0..3.
@@ -119,12 +132,35 @@ export function slicePolytope(p, matrix16, c0) {
   if (p.star) {
     throw new Error(`${p.name} has star faces or non-convex cells: the page does not cut it (the kernel does)`);
   }
+  const { m, x } = turnedVertices(p, matrix16);
+  // cut the unit vertices at c0 / unit (dividing by the power of two is exact, and by 1 changes nothing)
+  return sliceLevel(p, x, m, c0 / p.unit);
+}
+
+// The rotation (row-major Float64Array) and the unit vertices it turns (4 per vertex).
+function turnedVertices(p, matrix16) {
   if (!matrix16 || matrix16.length !== 16) throw new Error("Expected `matrix16` to be 16 numbers (4 x 4, row by row)");
   const m = Float64Array.from(matrix16);
   const x = new Float64Array(4 * p.V);
   for (let i = 0; i < 4 * p.V; i += 4) for (let j = 0; j < 4; j++) x[i + j] = turned(m, j, p.vertices, i);
-  // cut the unit vertices at c0 / unit (dividing by the power of two is exact, and by 1 changes nothing)
-  return sliceLevel(p, x, m, c0 / p.unit);
+  return { m, x };
+}
+
+// What the page draws of a polytope with star faces or non-convex cells (`p.star`) turned by
+// `matrix16` at w = `c0`: the slice's points and segments (starslice.slice_star's vertices before
+// its fill corners, and its edges), as sliceData's fields so that rows.js draws balls and bars
+// (no triangles: the page shows no fill of its own); `volume` as sliceData's (null for a polytope
+// with no inside), `dim` as the Slice's.
+export function sliceStarEdges(p, matrix16, c0) {
+  if (!p.star) throw new Error(`${p.name} has no star faces or non-convex cells: slicePolytope cuts it`);
+  const { m, x } = turnedVertices(p, matrix16);
+  const s = sliceStarUnit(p, x, m, c0 / p.unit);
+  const u = p.unit;
+  const v = p.volumeDefined ? s.volume : null;
+  const volume = v === null || !Number.isFinite(v) || (s.dim === 3 && Math.abs(v) < FLOAT_MIN) ? null : v;
+  return { points: u === 1.0 ? s.vertices : s.vertices.map((c) => c * u), segments: s.edges,
+           triangles: new Int32Array(0), groups: new Int32Array(0), cornerOnly: null, volume, dim: s.dim,
+           convex: p.convex };
 }
 
 // section.slice_level: the tolerance, then exact signs, then (never seen) H moved by a hair.
