@@ -14,7 +14,8 @@ Renderer with the widget's settings (600 x 500, no multisampling) -- and
 Issue 22's cases ``proj120`` (the 120-cell with ``projection=True``), ``sstel120`` and ``gicos120``
 (the small stellated and great icosahedral 120-cells): judged as the 600- and 120-cell are.
 
-Issue 21's cases ``blob64-surface``, ``blob64-volume``, ``blob64-mip``: a 64^4 field (a Gaussian
+Issue 21's cases ``blob64-surface``, ``blob64-volume``, ``blob64-mip`` (and issue 36's ``blob64-sections``,
+every rendering): a 64^4 field (a Gaussian
 blob travelling along x as w grows, the array of benchmarks/volume_step.py) in each rendering,
 with a table of held fps, its ratio to the same run's baseline (target >= 0.6x for volume and
 mip) and bytes per update; ``--volume-step S`` sets the ray's sample spacing (a diagnosis).
@@ -189,7 +190,7 @@ BLOB64 = (
 )
 #: The widget's ``rendering`` per case (the fields above draw "surface").
 FIELD_RENDERING = {}
-for _r in ("surface", "volume", "mip"):
+for _r in ("surface", "volume", "mip", "sections"):
     FIELD_CASES[f"blob64-{_r}"] = BLOB64
     FIELD_RENDERING[f"blob64-{_r}"] = _r
 #: Issue 21's speed target: volume and mip held keys at >= 0.6x the baseline's held frame rate
@@ -1476,7 +1477,7 @@ def main(argv=None) -> int:
     ap.add_argument("--hold", type=float, default=2.0, help="seconds to hold '4' (default 2)")
     ap.add_argument("--cases", default=",".join(POLYCHORA), help="comma-separated polychora (default: all six), "
                          "fields (sphere64, waves128, allen-cahn, "
-                         "blob64-surface, blob64-volume, blob64-mip) or "
+                         "blob64-surface, blob64-volume, blob64-mip, blob64-sections) or "
                          "parallel slices (oval24, oval600) or the largest uniform polychoron (omni120) or "
                          "issue 22's projection and star polychora (proj120, sstel120, gicos120)")
     ap.add_argument("--tap", default="60-120",
