@@ -38,7 +38,7 @@ _LAZY = {
     "Rot4DWidget": "view.widget",
     "Field4D": "sources.fields",
     "StackSource": "sources.tomography",
-    "arrangement_layout": "sources.tomography",
+    "arrangement_layout": "sources.arrangements",
     "slice_field": "sources.fields",
     "FieldSlice": "sources.fields",
     "FieldSliceData": "sources.fields",

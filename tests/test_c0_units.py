@@ -104,10 +104,10 @@ def test_a_polytope_s_c0_is_unchanged(make):
 
 
 def test_stack_cuts_and_labels_are_in_the_data_s_time():
-    src = StackSource(_field(), slices=3, spacing=0.2)
+    src = StackSource(_field(), slices=3, spacing=1.0)  # in the data's w units, as c0 (issue 37)
     assert w_frame(src) == (25.0, WPU)
     cuts = src.cuts_at(26.0)
-    np.testing.assert_allclose(cuts, [25.0, 26.0, 27.0])  # 0.2 slice units = 1 s apart
+    np.testing.assert_allclose(cuts, [25.0, 26.0, 27.0])  # 1 s apart
     data = src.slice(np.eye(4), 26.0)
     for k, t in enumerate(cuts):
         assert np.abs(_radii(data.extra["slices"][k]) - radius(t)).max() < 0.02
@@ -159,7 +159,7 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
     assert w.c0 == pytest.approx(25.0 + WPU * (-0.4 + 0.05))  # 23.25 s
     assert w.state.c0_step == WPU * 0.05
     new = rec.for_source(f)
-    assert new.initial["format"] == 2 and new.initial["c0"] == 26.0 and new.initial["initial"]["c0"] == 26.0
+    assert new.initial["format"] == 3 and new.initial["c0"] == 26.0 and new.initial["initial"]["c0"] == 26.0
     assert rec.for_source(make("5-cell").source) is rec  # a polytope's frame (0, 1): nothing to convert
 
 
@@ -170,7 +170,7 @@ def test_a_rendered_picture_names_c0_and_the_slices_in_seconds():
     fig = render_state(st, _field(resolution=16), annotate=True, size=(300, 250), dpi=50)
     text = " ".join(t.get_text() for ax in fig.axes for t in ax.texts)
     assert "c0 = +26 s" in text
-    fig = render_state(st, _field(resolution=16), slices=3, spacing=0.2, annotate=True, size=(300, 250), dpi=50)
+    fig = render_state(st, _field(resolution=16), slices=3, spacing=1.0, annotate=True, size=(300, 250), dpi=50)
     text = " ".join(t.get_text() for t in fig.axes[0].texts)
     assert "3 slices w = +25 \u2026 +27 s, \u0394 = 1 s" in text
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]

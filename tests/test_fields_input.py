@@ -151,9 +151,12 @@ def test_an_array_without_axes_is_refused_naming_the_choices_and_repr_names_the_
 
 def test_from_xarray_names_its_dims_in_repr_and_readout():
     xr = pytest.importorskip("xarray")
+    from rot4d_widget.sources.fields import UnitsWarning
+
     da = xr.DataArray(tzyx_array(), dims=("time", "z", "y", "x"), name="T")
     with warnings.catch_warnings():
         warnings.simplefilter("error", category=UserWarning)
+        warnings.simplefilter("ignore", category=UnitsWarning)  # it has none: said (issue 37)
         field = Field4D.from_xarray(da)
     assert "T[time, z, y, x] as [w, z, y, x]" in repr(field)
     assert dict(field.slice(np.eye(4), 0.0).readout)["axes"].startswith("T[time, z, y, x] as [w, z, y, x]")

@@ -176,7 +176,7 @@ def test_animation_frames_are_render_states_pictures(source):
     box = figures.union_extent(boxes)
     for k, (t, st, s) in enumerate(animation_states(rec, None, src)):
         fig = figures.render_state(st, s if s is not None else src, size=(240, 200), dpi=40, frame=box,
-                                   title=f"frame {k}", annotate=f"t = {t:.2f} s, frame {k + 1}/{len(frames)}")
+                                   title=f"frame {k}", annotate=f"frame {k + 1}/{len(frames)}")
         canvas = FigureCanvasAgg(fig)
         canvas.draw()
         want = np.asarray(canvas.buffer_rgba())[..., :3].astype(int)

@@ -33,7 +33,8 @@ from test_widget_scene import companion_says, drawn, run_ticker
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.catalogue import polytope
 from rot4d_widget.sources.protocol import PolytopeSource
-from rot4d_widget.sources.tomography import ARRANGEMENTS, StackSource
+from rot4d_widget.sources.arrangements import ARRANGEMENTS
+from rot4d_widget.sources.tomography import StackSource
 from rot4d_widget.view.pagecut import page_cuttable, polytope_transfer, stack_config
 from rot4d_widget.view.projection import state_message
 

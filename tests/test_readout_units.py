@@ -37,7 +37,7 @@ def test_the_volume_readout_is_the_slice_s_volume_in_cubic_metres(make):
 
 
 def test_parallel_slices_are_labelled_in_seconds(make):
-    w = make(ball(), slices=3, spacing=1.0)
+    w = make(ball(), slices=3, spacing=15.0)  # in seconds, as c0 (issue 37)
     legend = re.search(r"colours</td><td>(.*?)</td>", w.readout.value).group(1)
     labels = [t.strip() for t in re.findall(r"&nbsp;([^<]*)", legend)]
     assert labels == ["w 15 s", "w 30 s", "w 45 s"]

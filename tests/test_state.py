@@ -316,7 +316,7 @@ def test_to_dict_round_trips_exactly_through_json():
     assert (back.theta0, back.alpha, back.c0, back.c0_step) == (st.theta0, st.alpha, st.c0, st.c0_step)
     assert list(back.keymap.items()) == list(st.keymap.items())  # same bindings, same order
     assert back.keymap["o"].kind == "custom" and back.keymap["o"].text == "raise the level"
-    assert d["keymap"]["4"] == "xw" and d["keymap"]["l"] == "c0+" and d["format"] == 2
+    assert d["keymap"]["4"] == "xw" and d["keymap"]["l"] == "c0+" and d["format"] == 3
     # the loaded state steps like the original
     st.press("y"), back.press("y")
     assert np.array_equal(back.matrix, st.matrix)

@@ -18,13 +18,10 @@ from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.keep.figures import render_tomography
 from rot4d_widget.core.rotation import simple_rotation
 from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.arrangements import ARRANGEMENTS, GAP, OVAL_PARABOLA, arrangement_layout
 from rot4d_widget.sources.tomography import (
-    ARRANGEMENTS,
-    GAP,
-    OVAL_PARABOLA,
     SPACING_FACTOR,
     StackSource,
-    arrangement_layout,
     highlighted_index,
     stack_levels,
 )
@@ -421,9 +418,10 @@ def test_render_tomography_writes_files(tmp_path, ext, magic):
     fig = render_tomography("24-cell", random_rotation(3), 0.0, 5, None, "oval", path, dpi=40)
     assert path.read_bytes()[:5].startswith(magic)
     texts = [t.get_text() for t in fig.axes[0].texts]
-    assert sorted(t for t in texts if t.startswith("w = ")) == sorted(f"w = {w:.3g}" for w in (-1.6, -0.8, 0, 0.8, 1.6))
+    # each slice's w as the readout and the page write it (issue 37: `data_w_text`)
+    assert sorted(t for t in texts if t.startswith("w ")) == sorted(["w -1.6", "w -0.8", "w +0", "w +0.8", "w +1.6"])
     bold = [t.get_text() for t in fig.axes[0].texts if t.get_fontweight() == "bold"]
-    assert bold == ["w = 0"]
+    assert bold == ["w +0"]
     rings = [p for p in fig.axes[0].patches if p.get_gid() == "highlight-ring"]
     assert len(rings) == 1
 

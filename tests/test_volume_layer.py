@@ -8,6 +8,8 @@ reading of the grid (a loop over nodes, matplotlib's own colour map, the field's
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -230,8 +232,10 @@ def test_a_single_field_labels_its_box_with_data_coordinates(make):
     f = blob()
     w = make(f, rendering="mip")
     labels = w.scene._buffer._rot4d_labels
-    g = f.sample(w.state.matrix, w.c0)
-    want = box_labels(f, w.state.matrix, w.c0, g)
+    # the data's extent (the box's cut), not the ray-cast grid's padding (issue 37)
+    pts, _ = f.sample(w.state.matrix, w.c0).outline
+    box = SimpleNamespace(origin=pts.min(axis=0), extent=tuple(zip(pts.min(axis=0), pts.max(axis=0))))
+    want = box_labels(f, w.state.matrix, w.c0, box)
     assert [lab["text"] for lab in labels] == [t for _, t in want] and len(labels) == 4
     np.testing.assert_allclose([lab["p"] for lab in labels], [w.scene.scale * np.asarray(p) for p, _ in want])
     w.press("4")  # x and w mix: the edge labels name both

@@ -105,7 +105,7 @@ def constant_field(value=1.0):
     return Field4D(np.full((9, 9, 9, 5), value), axes="xyzw", extent=BOX)
 
 
-@pytest.mark.parametrize("pixels_per_ray", [1, None])
+@pytest.mark.parametrize("pixels_per_ray", [1, "auto"])
 def test_a_constant_fields_mip_is_its_colour_inside_the_silhouette(pixels_per_ray):
     grid = sample_field(constant_field(1.0), np.eye(4), 0.0, 16)
     scale = 0.8
@@ -213,3 +213,27 @@ def test_the_default_clim_is_robust_to_outliers():
     assert 0.0 <= lo < 0.2 and 9.8 < hi <= 10.0
     assert default_clim(np.full(5, 3.0)) == (1.5, 4.5)
     assert default_clim(np.full(5, np.nan)) == (0.0, 1.0)
+
+
+@pytest.mark.parametrize("rendering", ["mip", "volume", "sections"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_compiled_caster_draws_numpys_picture(rendering, seed):
+    """The numba kernel (ray by ray) against numpy's passes (every ray at once), on turned cuts with
+    holes of NaN: the same pixels, within the opacity at which a volume ray stops (1e-4)."""
+    from matplotlib import colormaps
+
+    from rot4d_widget.keep import volume
+
+    pytest.importorskip("numba")
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(0.0, 1.0, (9, 8, 10, 7))
+    a[2:4, 3:5, 1:3, :] = np.nan  # a hole the rays must see through
+    f = Field4D(a, axes="xyzw", extent=BOX)
+    m = random_rotation(rng)
+    g = sample_field(f, m, 0.1, 20)
+    args = (g, rendering, colormaps["magma"], (0.2, 0.8), (90, 70), camera_limits((90, 70)), 1.3,
+            np.array([0.1, -0.2, 0.3]), D, 4.0, 0.5, np.array([0.3, 0.5, 0.7]))
+    compiled = volume._cast(*args)
+    plain = volume._cast(*args, compiled=False)
+    assert (plain[..., 3] > 0).sum() > 500
+    np.testing.assert_allclose(compiled, plain, atol=1e-4 if rendering == "volume" else 1e-12)

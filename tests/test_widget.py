@@ -39,6 +39,10 @@ pytestmark = pytest.mark.usefixtures("recording_comms")
 # --------------------------------------------------------------------- fakes
 class FakeCamera(traitlets.HasTraits):
     position = traitlets.Tuple((0.0, 0.0, 5.0))
+    quaternion = traitlets.Tuple((0.0, 0.0, 0.0, 1.0))
+
+    def hold_sync(self):
+        return self.hold_trait_notifications()
 
 
 def _register(cbs, cb, remove):
@@ -60,6 +64,7 @@ class FakeScene:
         self.canvas._view_count = 0
         self.canvas_class = "rot4d-canvas-fake"
         self.camera = FakeCamera()
+        self.canvas.camera = self.camera  # as the Renderer's
         self.shown = []  # the slices passed to show()
         self.single = []  # their single_rgb
         self.turns = []  # the 3-D turns passed to turn()

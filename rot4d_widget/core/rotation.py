@@ -29,6 +29,7 @@ __all__ = [
     "double_rotation",
     "as_rotation_matrix",
     "reorthonormalize",
+    "quaternion_xyzw",
 ]
 
 AXES = "xyzw"
@@ -163,6 +164,27 @@ def reorthonormalize(matrix: np.ndarray) -> np.ndarray:
     however many steps are taken (without it the error grows like sqrt(steps)).
     """
     return 1.5 * matrix - 0.5 * (matrix @ (matrix.T @ matrix))
+
+
+def quaternion_xyzw(r) -> tuple:
+    """(x, y, z, w) floats: the unit quaternion of the 3-D rotation matrix ``r`` (3, 3), as
+    three.js reads ``Object3D.quaternion`` (Shepperd's method: the largest square first).
+
+    >>> quaternion_xyzw(np.eye(3))
+    (0.0, 0.0, 0.0, 1.0)
+    """
+    r = np.asarray(r, dtype=np.float64).reshape(3, 3)
+    t = float(np.trace(r))
+    if t > 0:
+        s = 2.0 * float(np.sqrt(t + 1.0))
+        q = [(r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, 0.25 * s]
+    else:
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * float(np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k]))
+        q = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
+        q[i], q[j], q[k] = 0.25 * s, (r[j, i] + r[i, j]) / s, (r[k, i] + r[i, k]) / s
+    return tuple(float(v) for v in q)
 
 
 def random_rotation(rng=None) -> np.ndarray:

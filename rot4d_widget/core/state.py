@@ -61,6 +61,7 @@ __all__ = [
     "THETA0_MAX",
     "ALPHA_MAX",
     "STATE_FORMAT",
+    "spacing_factor",
     "action_to_data",
     "action_from_data",
     "keymap_to_dict",
@@ -70,8 +71,10 @@ __all__ = [
 
 #: The version of `RotationState.to_dict`'s layout (``d["format"]``).  2: c0 and its step are in
 #: the source's w units (a field's data w, `rot4d_widget.sources.protocol.w_frame`); 1 had them in the drawn
-#: (slice) units -- `RotationState.from_dict` converts them given the source's ``w_frame``.
-STATE_FORMAT = 2
+#: (slice) units -- `RotationState.from_dict` converts them given the source's ``w_frame``.  3: the same
+#: state, and the spacing of parallel slices saved beside it (a state file's settings, a recording's
+#: source settings) is in those w units too; up to 2 it was in the drawn units (`spacing_factor`).
+STATE_FORMAT = 3
 #: A loaded orientation this close to orthogonal (max |M M^T - I|) is taken as it is;
 #: further off, up to `rotation.ORTHOGONALITY_TOLERANCE`, it is re-orthonormalised.
 _EXACT_ENOUGH = tol_.ORTHOGONAL_TO_ROUNDING
@@ -341,7 +344,7 @@ class RotationState:
     def to_dict(self, *, initial: bool = False) -> dict:
         """The state as JSON-able data (lists, floats, strings); `from_dict` reads it back exactly.
 
-        ``{"format": 2, "orientation": 4 x 4 list (rows), "theta0", "alpha", "c0", "c0_step",
+        ``{"format": 3, "orientation": 4 x 4 list (rows), "theta0", "alpha", "c0", "c0_step",
         "keymap": {key: action}}``; an action is its name as `Action.parse` reads it
         (``"xw"``, ``"xz,yw"``, ``"c0+"`` ...) or, for a source's own action, a dict of the
         `Action` fields.  ``initial=True`` adds ``"initial"``: the state `reset` returns to
@@ -350,7 +353,7 @@ class RotationState:
 
         >>> d = RotationState(theta0=0.1, c0=0.5).to_dict()
         >>> d["format"], d["theta0"], d["c0"], d["keymap"]["4"], d["orientation"][0]
-        (2, 0.1, 0.5, 'xw', [1.0, 0.0, 0.0, 0.0])
+        (3, 0.1, 0.5, 'xw', [1.0, 0.0, 0.0, 0.0])
         >>> RotationState.from_dict(d).c0
         0.5
         """
@@ -439,6 +442,19 @@ class RotationState:
 
 
 # ----------------------------------------------------------------------------- data helpers
+def spacing_factor(fmt, w_frame) -> float:
+    """What a parallel-slice spacing saved beside a state of format ``fmt`` is multiplied by to be
+    in today's units, the source's w units (format 3): its ``per_unit`` (`w_frame`) for format 1
+    or 2 (spacing in the drawn units then), else 1.
+
+    >>> spacing_factor(2, (30.0, 12.5)), spacing_factor(3, (30.0, 12.5)), spacing_factor(2, None)
+    (12.5, 1.0, 1.0)
+    """
+    if isinstance(fmt, bool) or not isinstance(fmt, int) or fmt >= 3 or w_frame is None:
+        return 1.0
+    return _old_units(1, w_frame)[1]
+
+
 def _old_units(fmt: int, w_frame) -> tuple:
     """(origin, per_unit) that turn a format-``fmt`` c0 into today's: identity for format 2."""
     if fmt >= 2 or w_frame is None:

@@ -24,7 +24,7 @@ import numpy as np
 from ..core.progress import progress as make_progress
 from ..core.state import RotationState
 from ..geometry.polytopes import pentachoron
-from ..sources.protocol import PolytopeSource, as_source
+from ..sources.protocol import PolytopeSource, as_source, note_matrix
 from .recorder import (
     SOURCE_SETTINGS,
     VIEW_SETTINGS,
@@ -77,7 +77,9 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
 
     def set_source(name, value):  # the copy is ours: replace it where the widget would
         nonlocal src
+        note_matrix(src, state.matrix)  # as the widget tells its source: a default spacing along today's w
         src = _with_source_setting(src, name, value)
+        note_matrix(src, state.matrix)
 
     setter = None if src is None else set_source
     if src is not None:
@@ -154,7 +156,8 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     bounding boxes of all frames' slices (`figures.frame_extent`), which fills 90 % of the
     picture's width or height -- the slices are computed once for this, in a first pass, and
     kept for drawing (up to 256 MB); ``"camera"`` or a box as `render_state`.  ``annotate``
-    (default True): each frame carries "t = ... s, frame k/n", θ0, c0 and what the source tells
+    (default True): each frame carries "frame k/n", θ0, c0 in the data's units, the turn
+    (`figures.turn_text`: how far the cut is turned from the data's own w) and what the source tells
     of itself (`figures.annotation`), and a legend; False for a bare picture.
     """
     for f in _frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames, titles=titles,
@@ -189,8 +192,10 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
     canvas = figures._FrameCanvas()  # one figure for every frame
     if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
         boxes, kept = [], 0
-        for _t, state, src, _view in _steps(recording, initial_state, source, per=per, fps=fps):
-            _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep)
+        for _t, state, src, view in _steps(recording, initial_state, source, per=per, fps=fps):
+            _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep,
+                                               rendering={**start_view, **view}.get("rendering", "surface"),
+                                               eye=settings.get("eye"))
             boxes.append(box)
             kept += _data_bytes(data)
             cache.append(data if kept <= _SLICE_CACHE_BYTES else None)
@@ -198,11 +203,13 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         frame = "camera" if box is None else box
     for k, (t, state, src, view) in enumerate(_steps(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
-        note = f"t = {t:.2f} s, frame {k + 1}/{n}" if annotate else False
+        note = f"frame {k + 1}/{n}" if annotate else False  # c0 and the turn follow (`figures.annotation`)
         drawn = src if src is not None else "5-cell"
         extra = {}
         if k < len(cache) and cache[k] is not None:
-            extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep)
+            extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep,
+                                                  rendering={**start_view, **view}.get("rendering", "surface"),
+                                                  eye=settings.get("eye"))
             cache[k] = None  # drawn once: let it go
         look_now = {**start_view, **{n: v for n, v in view.items() if n in takes}}
         fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,

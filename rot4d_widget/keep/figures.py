@@ -41,7 +41,7 @@ from .drawing import (
 )
 from .drawing import TITLE_HEIGHT as TITLE_HEIGHT
 from .drawing import _slice_collection as _slice_collection
-from .framing import FIT_FILL, annotation, colorbar_width, frame_extent, union_extent
+from .framing import FIT_FILL, annotation, colorbar_width, frame_extent, turn_text, union_extent
 from .framing import _level_colors as _level_colors
 from .paper import panel_style, paper_figure_3, paper_figure_4, render_key_sequence, render_slice
 from .picture import _prepare as _prepare
@@ -70,6 +70,7 @@ __all__ = [
     "frame_extent",
     "union_extent",
     "annotation",
+    "turn_text",
     "colorbar_width",
     "RENDERINGS",
     "render_grid",

@@ -21,7 +21,7 @@ from ..core.look import REFERENCE_RADIUS
 from ..core.state import RotationState
 from ..geometry.slicing import Slice
 from ..sources.field_labels import box_labels
-from ..sources.protocol import apply_setting, as_source, inner_source, settings_of
+from ..sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
 from ..sources.tomography import StackSource
 from .canvas import LiteralTextFigure
 from .drawing import (
@@ -43,13 +43,17 @@ from .framing import (
     _draw_colorbar,
     _frame_limits,
     annotation,
+    annotation_boxes,
+    below_notes,
     colorbar_width,
     frame_extent,
     level_rgb,
+    room_for_labels,
+    seen_from,
     small_font,
     value_label,
 )
-from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume
+from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume, view_rotation
 
 
 def render_tomography(
@@ -85,6 +89,7 @@ def render_tomography(
     colorbar: bool = True,
     axis_labels: bool = True,
     progress=True,
+    eye=None,
     _data=None,
     _theta0=None,
     _canvas=None,
@@ -131,6 +136,10 @@ def render_tomography(
     surfaces' colours (surface rendering).  ``axis_labels``: a single cut's box labelled with its
     data coordinates (`rot4d_widget.sources.field_labels.box_labels`: the origin corner's, and
     what changes along each edge leaving it), so the picture says which way time runs.
+    ``eye``: where the camera is (displayed units; it looks at the origin, +y up, as the live view's
+    OrbitControls do; only its direction counts, the distance is the live view's 5); None: the
+    live view's default for ``rendering`` (`look.default_eye`: for "sections" above, right of and in
+    front of the cut, so that no plane is edge-on).
     """
     # a source that wraps another is parallel slices already (the protocol's ``wraps``)
     src = source if getattr(source, "wraps", None) is not None else None
@@ -162,6 +171,9 @@ def render_tomography(
     data = src.slice(matrix, c0) if _data is None else _data
     # a volume rendering's cuts, sampled once (drawn, and the box labelled); no `sample`: a TypeError here
     grids = cut_grids(src, data, matrix) if volume else None
+    view = view_rotation(look.default_eye(rendering) if eye is None else eye)
+    cut = data  # the slice in the scene's coordinates (labels, grids); `data` as the camera sees it
+    data = seen_from(data, view)
     ex = data.extra
     n = src.slices
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
@@ -192,6 +204,27 @@ def render_tomography(
     else:
         box = _as_box(frame)
     (x0, x1), (y0, y1) = _frame_limits(box, aspect)
+    notes = None  # the annotation's lines and legend, and where they go (pixels, y down)
+    if annotate:
+        lines, legend = annotation(src, cut, c0, theta0=_theta0, cmap=cmap, clim=clim, matrix=matrix)
+        if volume:
+            legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
+            name = getattr(inner, "name", None) or "the value"  # no level drawn: say what is
+            lines = [look.RENDERING_TEXT[rendering].format(name=name) if ln.startswith(("level ", "levels ")) else ln
+                     for ln in lines]
+        if isinstance(annotate, str):
+            lines = [annotate, *lines]
+        notes = (lines, legend, annotation_boxes(lines, legend, height, dpi, (width * dpi, height * dpi)))
+        if box is not None:  # a fitted frame: the picture moves down, out from under the text
+            (x0, x1), (y0, y1) = below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
+    box_text = None  # a single field's box labels: ``(labels, extent)`` of the data's extent
+    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
+        extent = _slice_box(cut, data.extra["point_offsets"], data.extra["segment_offsets"])
+        if extent is not None:  # the data's extent, never the padded sampling grid
+            box_text = (box_labels(inner, matrix, c0, extent), extent.corners)
+    if box_text is not None and box is not None:  # a fitted frame: out until every label has room
+        (x0, x1), (y0, y1) = room_for_labels((x0, x1), (y0, y1), box_text, scale, small_font(height) - 0.5,
+                                              height, dpi, notes[2] if notes else (), view)
     limit = 0.5 * (y1 - y0)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
@@ -210,7 +243,8 @@ def render_tomography(
         bar = look.default_bar_radius(ball) if bar_radius is None else bar_radius
         if poly is not None:
             s = ex["slices"][k]
-            placed = Slice(np.asarray(s.vertices) * scales[k] + centres[k] / scale if n > 1 else np.asarray(s.vertices),
+            vertices = np.asarray(s.vertices) * scales[k] + np.asarray(cut.extra["centres"][k]) if n > 1 else s.vertices
+            placed = Slice(np.asarray(vertices, dtype=np.float64) @ view.T if data is not cut else vertices,
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
                            s.volume, s.dim, n_fill=int(getattr(s, "n_fill", 0)))
             if palette is not None:
@@ -239,7 +273,8 @@ def render_tomography(
                           src.source, face_alpha, z_shift, bar_width, show_faces=show_faces and not volume,
                           cmap=cmap, clim=clim)
         if labels:
-            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, cuts[k], k == hi, z_shift))
+            jobs.append((centres[k], scales[k] * REFERENCE_RADIUS, data_w_text(src, float(cuts[k]), matrix), k == hi,
+                         z_shift))
     # labels that would overlap one already placed are left out: the highlighted slice's first,
     # then the nearer (bigger) slices' (far, small slices of the oval crowd together)
     placed: list = []
@@ -250,24 +285,18 @@ def render_tomography(
     ax.set_ylim(y0, y1)
     used = None
     if volume:
-        image = draw_volume(ax, src, data, matrix, rendering, size=(round(width * dpi), round(height * dpi)),
-                            cmap=cmap, clim=clim, sections=sections, grids=grids, progress=progress)
+        image = draw_volume(ax, src, cut, matrix, rendering, size=(round(width * dpi), round(height * dpi)),
+                            cmap=cmap, clim=clim, sections=sections, grids=grids, progress=progress, view=view)
         used = image.get_clim() if image is not None else None
     if right:
         _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
-    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
-        grid = grids[0] if grids else _slice_box(data, offs, soff)
-        if grid is not None:
-            labels = box_labels(inner, matrix, c0, grid)
-            centre = np.asarray(grid.origin) + 0.5 * np.diff(np.asarray(grid.extent), axis=1).ravel()
-            _draw_box_labels(ax, labels, scale, centre, small_font(height) - 0.5, height)
-    if annotate:
-        lines, legend = annotation(src, data, c0, theta0=_theta0, cmap=cmap, clim=clim)
-        if volume:
-            legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
-        if isinstance(annotate, str):
-            lines = [annotate, *lines]
-        _draw_annotation(ax, lines, legend, height, _canvas)
+    taken = []  # what the box labels keep clear of besides the data: the annotation
+    if notes is not None:
+        _draw_annotation(ax, notes[0], notes[1], height, _canvas)
+        taken = notes[2]
+    if box_text is not None:
+        _draw_box_labels(ax, box_text[0], scale, box_text[1], small_font(height) - 0.5, height, placed=taken,
+                         view=view)
     if title:
         name = getattr(src.source, "name", None) or type(src.source).__name__
         text = title if isinstance(title, str) else (
@@ -313,25 +342,27 @@ def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top
 
 def _slice_box(data, offs, soff):
     """The bounding box of a single cut's box edges (the slice's segments) as what `box_labels`
-    reads of a grid (``origin``, ``extent``); None when the cut is empty."""
+    reads of a grid (``origin``, ``extent``), with the points they join (``corners``: the data's
+    extent in slice coordinates); None when the cut is empty."""
     seg = np.asarray(data.segments[soff[0]:soff[1]])
     if not len(seg):
         return None
     pts = np.asarray(data.points[offs[0]:offs[1]], dtype=np.float64)[np.unique(seg) - offs[0]]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)))
+    return SimpleNamespace(origin=lo, extent=tuple((float(a), float(b)) for a, b in zip(lo, hi)), corners=pts)
 
 
-def _label_slice(ax, centre, radius, w, highlighted, z_shift, *, point=None, placed=None):
-    """'w = ...' at the upper left of a slice's projected bounding circle (inside its square, like a
-    CT film's corner text), painted with its slice (nearer slices cover it); the highlighted slice
-    ringed, its label bold.  With ``point`` (data units per point) and ``placed`` (boxes of the
-    labels drawn so far), a label overlapping one of them is left out (not the highlighted one)."""
+def _label_slice(ax, centre, radius, text, highlighted, z_shift, *, point=None, placed=None):
+    """``text`` (the slice's w in the data's units, `data_w_text`: "time 0.0025 s", "(outside the
+    data)" for a slice that misses it) at the upper left of a slice's projected bounding circle
+    (inside its square, like a CT film's corner text), painted with its slice (nearer slices
+    cover it); the highlighted slice ringed, its label bold.  With ``point`` (data units per point)
+    and ``placed`` (boxes of the labels drawn so far), a label overlapping one of them is left out
+    (not the highlighted one)."""
     (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
     r = radius * f
     fs = max(5.0, min(9.0, 30.0 * r))
     z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
-    text = f"w = {w:.3g}"
     x0, y1 = xy[0] - 0.98 * r, xy[1] + 0.98 * r
     if point is not None and placed is not None:
         # the upper left corner of the slice's square, else its upper right, else just above it
@@ -506,7 +537,7 @@ def render_state(
     show_faces: bool = True,
     size=(600, 500),
     dpi: float = 100,
-    labels: bool = False,
+    labels=None,
     title: str | None = None,
     frame="fit",
     annotate=False,
@@ -518,6 +549,7 @@ def render_state(
     colorbar: bool = True,
     axis_labels: bool = True,
     progress=True,
+    eye=None,
     _prepared=None,
     _canvas=None,
 ) -> Figure:
@@ -533,11 +565,14 @@ def render_state(
     ``show_balls`` / ``show_bars`` / ``show_faces``.
 
     The scene is the live view's: every source scaled to the displayed circumradius
-    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z with the vertical
+    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z (``eye``: elsewhere,
+    looking at the origin; None: `look.default_eye` of ``rendering``, the live view's default camera
+    -- for "sections" an oblique one) with the vertical
     field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
     widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
     `look.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
-    camera the user dragged.  ``labels`` writes each parallel slice's w; ``title`` goes above.
+    camera the user dragged.  ``labels`` writes each parallel slice's w in the data's units (None, the
+    default: when there are several, so every slice of the view carries its time); ``title`` goes above.
 
     ``frame="fit"`` (the default) keeps that eye and perspective but zooms so that the projected
     bounding box of what is drawn fills `FIT_FILL` (90 %) of the picture's width or height;
@@ -581,30 +616,34 @@ def render_state(
         face_color = look.as_rgb(color_by, "color_by")
     if _prepared is None:
         _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
-                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps)
+                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps,
+                             rendering=rendering, eye=eye)
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
     return render_tomography(
         stack, state.matrix, state.c0, path=path, width=w_px / dpi, height=h_px / dpi,
-        dpi=dpi, title=title if title else None, labels=labels, face_alpha=face_opacity, ball_radius=ball_radius,
+        dpi=dpi, title=title if title else None, labels=stack.slices > 1 if labels is None else labels,
+        face_alpha=face_opacity, ball_radius=ball_radius,
         bar_radius=bar_radius, show_balls=show_balls, show_bars=show_bars, show_faces=show_faces,
         face_color=face_color, group_colors=group_colors, background=background, frame=frame,
         annotate=annotate, rendering=rendering, cmap=cmap, clim=clim, sections=sections, colorbar=colorbar,
-        axis_labels=axis_labels, progress=progress, _data=data, _theta0=state.theta0, _canvas=_canvas,
+        axis_labels=axis_labels, progress=progress, eye=eye, _data=data, _theta0=state.theta0, _canvas=_canvas,
     )
 
 
 def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
-             show_balls=True, data=None, inside=None, caps=None, **_ignored):
+             show_balls=True, data=None, inside=None, caps=None, rendering="surface", eye=None, **_ignored):
     """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
     source with the settings applied (`state_source`), its slice at ``state``, the ball radius
     in displayed units (None: the stack's default) and the projected bounding box of the
     drawing (`frame_extent`; None when empty).  ``data``: the slice, computed before.  An
     animation takes the boxes of all its frames first to frame them alike, and draws each frame
-    from the slice computed then."""
+    from the slice computed then.  ``rendering`` and ``eye``: where the camera is (`render_state`'s:
+    the box as it sees the slice)."""
     stack = state_source(source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
                          inside=inside, caps=caps)
+    note_matrix(stack, state.matrix)  # a default spacing not spread yet: along this picture's w
     if ball_radius is None:
         edge = getattr(stack, "edge_length", None)
         if edge:
@@ -615,4 +654,5 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
         ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
     else:
         ball = 0.0
-    return stack, data, ball_radius, frame_extent(data, stack, ball_radius=ball)
+    seen = seen_from(data, view_rotation(look.default_eye(rendering) if eye is None else eye))
+    return stack, data, ball_radius, frame_extent(seen, stack, ball_radius=ball)

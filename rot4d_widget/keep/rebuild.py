@@ -19,6 +19,7 @@ from typing import Mapping
 import numpy as np
 
 from ..geometry.polytopes import Polytope, polytope
+from ..sources.field_checks import UnitsWarning
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
 
@@ -161,6 +162,7 @@ def _open_origin(origin, base):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", category=RuntimeWarning)  # zarr: no consolidated metadata
+            warnings.simplefilter("ignore", category=UnitsWarning)  # said when the field was first made
             field = Field4D.open(path, variable, engine=engine, chunks=chunks,
                                  isel=_selection_from_json(origin.get("isel"), "isel"),
                                  sel=_selection_from_json(origin.get("sel"), "sel"),

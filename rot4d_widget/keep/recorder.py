@@ -52,9 +52,10 @@ import numpy as np
 from ..core import look
 from ..core.keymap import Action
 from ..core.rotation import as_rotation_matrix
-from ..core.state import RotationState, action_from_data, action_to_data
-from ..sources.protocol import apply_setting, inner_source, settings_of, w_frame
-from ..sources.tomography import ARRANGEMENTS, StackSource
+from ..core.state import STATE_FORMAT, RotationState, action_from_data, action_to_data, spacing_factor
+from ..sources.arrangements import ARRANGEMENTS
+from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of, w_frame
+from ..sources.tomography import StackSource
 from .jsonfile import read_json
 from .rebuild import _jsonable
 
@@ -335,6 +336,7 @@ def _apply(state: RotationState, event, source=None, set_source=None, set_view=N
             return True
         if source is None:
             return False
+        note_matrix(source, state.matrix)  # as the widget tells it: a default spacing along today's w
         _set_on_source(source, event.name, event.value)
         return True
     if isinstance(event, Setting):
@@ -345,6 +347,7 @@ def _apply(state: RotationState, event, source=None, set_source=None, set_view=N
         sa = _source_action(source, action.name) if source is not None else None
         if sa is None:
             return False
+        note_matrix(source, state.matrix)
         sa.run(-1 if event.inverted else 1)
         return True
     state.apply(action, event.inverted)
@@ -390,17 +393,20 @@ class Recording:
         return RotationState.from_dict(self._initial, keymap=keymap)
 
     def for_source(self, source) -> "Recording":
-        """This recording with c0 in ``source``'s w units: a recording made before c0 followed
-        the data's units (its starting state of format 1) has its c0, initial c0, c0 step and
-        every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
-        (`rot4d_widget.sources.protocol.w_frame`: c0 -> origin + per_unit c0); any other recording, or a
-        source whose frame is (0, 1) (a polytope), gives ``self``."""
-        if source is None or self._initial.get("format", 2) >= 2:
+        """This recording with c0 and the slices' spacing in ``source``'s w units: a recording made
+        before c0 followed the data's units (its starting state of format 1) has its c0, initial c0,
+        c0 step and every recorded ``c0`` / ``c0_step`` setting converted by the source's ``w_frame``
+        (`rot4d_widget.sources.protocol.w_frame`: c0 -> origin + per_unit c0), and one made before the
+        spacing did (format 1 or 2) its recorded and starting ``spacing`` (times per_unit); any
+        other recording, or a source whose frame is (0, 1) (a polytope), gives ``self``."""
+        fmt = self._initial.get("format", STATE_FORMAT)
+        if source is None or fmt >= STATE_FORMAT:
             return self
         frame = w_frame(source)
         if frame == (0.0, 1.0):
             return self
-        origin, per = frame
+        origin, per = frame if fmt < 2 else (0.0, 1.0)  # c0 in the drawn units up to format 1
+        spread = spacing_factor(fmt, frame)  # and the spacing up to format 2
         initial = RotationState.from_dict(self._initial, w_frame=frame).to_dict(initial=True)
 
         def converted(e):
@@ -408,10 +414,15 @@ class Recording:
                 return Setting(e.t, "c0", origin + per * float(e.value))
             if isinstance(e, Setting) and e.name == "c0_step":
                 return Setting(e.t, "c0_step", per * float(e.value))
+            if isinstance(e, SourceSetting) and e.name == "spacing" and e.value is not None:
+                return SourceSetting(e.t, "spacing", spread * float(e.value))
             return e
 
+        start = dict(self._initial_source or {})
+        if start.get("spacing") is not None:
+            start["spacing"] = spread * float(start["spacing"])
         return Recording(initial, [converted(e) for e in self.events], dropped=self.dropped,
-                         initial_source=self._initial_source, initial_view=self._initial_view)
+                         initial_source=start or None, initial_view=self._initial_view)
 
     @property
     def duration(self) -> float:
@@ -497,7 +508,7 @@ class Recording:
         for name, f in (("set_source", set_source), ("set_view", set_view)):
             if f is not None and not callable(f):
                 raise TypeError(f"Expected `{name}` to be a callable (name, value), got {type(f).__name__}")
-        if source is not None and self._initial.get("format", 2) < 2:
+        if source is not None and self._initial.get("format", STATE_FORMAT) < STATE_FORMAT:
             return self.for_source(source).replay(state, source, restart=restart, set_source=set_source,
                                                   set_view=set_view)
         if set_source is None and source is not None:

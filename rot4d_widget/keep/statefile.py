@@ -39,7 +39,7 @@ import warnings
 from typing import Mapping, NamedTuple
 
 from .. import __version__
-from ..core.state import RotationState
+from ..core.state import RotationState, spacing_factor
 from ..sources.protocol import as_source
 from .jsonfile import read_json
 from .rebuild import (
@@ -128,6 +128,21 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     text = json.dumps(doc, indent=1, allow_nan=False)
     _write_atomically(os.fspath(path), text + "\n")
     return doc
+
+
+def _convert_spacing(doc, factor: float) -> None:
+    """Multiply the parallel slices' spacing a state file holds (its settings', its stacks') by
+    ``factor`` (`spacing_factor`: drawn units -> the source's w units), in place."""
+    if factor == 1.0:
+        return
+    settings = doc["settings"]
+    if isinstance(settings.get("spacing"), (int, float)) and not isinstance(settings["spacing"], bool):
+        settings["spacing"] = float(settings["spacing"]) * factor
+    d = doc.get("source")
+    while isinstance(d, Mapping) and d.get("kind") == "stack":
+        if isinstance(d.get("spacing"), (int, float)) and not isinstance(d["spacing"], bool):
+            d["spacing"] = float(d["spacing"]) * factor
+        d = d.get("source")
 
 
 def _fields_in(d):
@@ -223,13 +238,17 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     missing = [k for k in ("state", "source", "settings") if k not in doc]
     if missing:
         raise ValueError(f"{path!r} lacks {', '.join(map(repr, missing))}")
+    frame = _described_w_frame(doc.get("source"))
     try:  # a state from before c0 followed the data's units: converted by the file's own source
-        state = RotationState.from_dict(doc["state"], w_frame=_described_w_frame(doc.get("source")))
+        state = RotationState.from_dict(doc["state"], w_frame=frame)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{path!r}: bad state: {exc}") from None
     settings = doc["settings"]
     if not isinstance(settings, dict):
         raise ValueError(f"{path!r}: expected 'settings' to be a dict, got {type(settings).__name__}")
+    # a spacing from before it followed the data's w units (state format 1 or 2): converted likewise
+    _convert_spacing(doc, spacing_factor(doc["state"].get("format") if isinstance(doc["state"], dict) else None,
+                                         frame))
     for name in VIEW_SETTINGS:  # checked here, so that nothing is set from a bad file
         if name in settings:
             try:

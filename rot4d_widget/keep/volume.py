@@ -48,15 +48,16 @@ import numpy as np
 from scipy.ndimage import map_coordinates
 
 from ..core import look
-from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering
+from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering, view_rotation
 from ..core.progress import progress as make_progress
+from . import volume_kernels
 
 #: How far the live view's camera is from the centre (`rot4d_widget.keep.drawing.CAMERA_DISTANCE`,
 #: the same number: that module imports matplotlib, which the widget's import does not need)
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
 __all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
-           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
+           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids", "view_rotation"]
 
 # RENDERINGS (what `render_state` draws for a field) and check_rendering are core.look's, named here too.
 #: The renderings ray-cast here.
@@ -139,10 +140,10 @@ def _trilinear(flat, shape, x, y, z):
 
 
 def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
-    """Pixels per ray side: ``pixels_per_ray``, or (None) the most that keeps two rays per grid
+    """Pixels per ray side: ``pixels_per_ray``, or ("auto") the most that keeps two rays per grid
     spacing where the grid is nearest the eye (a ray per pixel for a small picture)."""
-    if pixels_per_ray is not None:
-        return max(1, int(pixels_per_ray))
+    if pixels_per_ray != "auto":
+        return _check_pitch(pixels_per_ray)
     w_px = int(size[0])
     (x0, x1), _ = limits
     near = float(shift[2]) + scale * (float(grid.origin[2]) + grid.spacing * (grid.values.shape[2] - 1))
@@ -150,6 +151,12 @@ def _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance):
         return 1
     voxel_px = scale * grid.spacing * distance / (distance - near) * w_px / (x1 - x0)
     return max(1, int(voxel_px // 2))
+
+
+def _check_pitch(pixels_per_ray) -> int:
+    if isinstance(pixels_per_ray, bool) or not isinstance(pixels_per_ray, (int, np.integer)) or pixels_per_ray < 1:
+        raise ValueError(f"Expected `pixels_per_ray` to be an int >= 1 or 'auto', got {pixels_per_ray!r}")
+    return int(pixels_per_ray)
 
 
 def _progress_sink(progress, description: str):
@@ -167,7 +174,8 @@ def _progress_sink(progress, description: str):
 
 def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None, scale: float = 1.0,
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
-                step: float = 0.5, pixels_per_ray=None, sections=DEFAULT_SECTIONS, progress=True) -> np.ndarray:
+                step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True,
+                view=None) -> np.ndarray:
     """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
     ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
@@ -176,10 +184,14 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     optical depth across the grid's longest side at the top of the ramp; ``step``: samples every
     ``step`` spacings along a ray; ``sections``: (fx, fy, fz), the planes' places as fractions of
     the grid's extent.  ``pixels_per_ray``: one ray for every p x p pixels, the picture between
-    the rays' pixels bilinear in premultiplied colour (1: a ray through every pixel's centre);
-    None: two rays per grid spacing where the grid is nearest, at most one per pixel (sections:
-    always one per pixel).  ``progress``: True a progress bar once the casting took a second
-    (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1)."""
+    the rays' pixels bilinear in premultiplied colour (1, the default: a ray through every pixel's
+    centre, the full resolution); "auto": two rays per grid spacing where the grid is nearest, at
+    most one per pixel (sections: always one per pixel).  The rays are cast by a compiled kernel
+    (`rot4d_widget.keep.volume_kernels`) when numba is installed, else in numpy: the same picture.
+    ``progress``: True a progress bar once the casting took a second
+    (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1).
+    ``view``: (3, 3) the camera's rotation (`view_rotation` of its position; None: the identity,
+    the eye on +z): the rays are turned back into the scene, so the grid is seen from there."""
     # matplotlib's colour map registry: the keep wing's, looked up by name
     from matplotlib import colormaps
 
@@ -198,11 +210,12 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     tick, close = _progress_sink(progress, f"ray casting ({rendering})")
     try:
         if rendering == "sections":
-            pitch = 1 if pixels_per_ray is None else max(1, int(pixels_per_ray))
+            pitch = 1 if pixels_per_ray == "auto" else _check_pitch(pixels_per_ray)
         else:
             pitch = _ray_pitch(pixels_per_ray, grid, size, limits, scale, shift, distance)
         args = (grid, rendering, colormap, clim)
-        rest = (scale, shift, distance, density, step, fractions, tick)
+        view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
+        rest = (scale, shift, distance, density, step, fractions, tick, view)
         if pitch == 1:
             out = _cast(*args, (w_px, h_px), limits, *rest)
             tick(1.0)
@@ -241,8 +254,18 @@ def _box_entry(eye, dirs, lo_box, hi_box):
 
 
 def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
-          tick=lambda f: None):
-    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes."""
+          tick=lambda f: None, view=None, *, compiled: bool = True):
+    """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes; ``view``
+    the camera's rotation (None: the identity).  The compiled kernel's picture
+    (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
+    numpy's (every ray at once, a step at a time)."""
+    view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
+    if compiled:
+        out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
+                                  step, fractions, tick, view, cells=_cell_flags(np.asarray(grid.values)),
+                                  opaque=_OPAQUE)
+        if out is not None:
+            return out
     vals = np.asarray(grid.values)
     spacing = float(grid.spacing)
     w_px, h_px = size
@@ -252,6 +275,8 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
     hi_box = lo_box + scale * spacing * (np.asarray(shape) - 1)
     eye, dirs = pixel_rays(size, limits, distance)
     dirs = dirs.reshape(-1, 3)
+    if not np.array_equal(view, np.eye(3)):  # the rays back into the scene: p_scene = view.T p_camera
+        eye, dirs = view.T @ eye, dirs @ view
     t_in, t_out = _box_entry(eye, dirs, lo_box, hi_box)
     hit = np.flatnonzero(t_out > t_in)
     if not len(hit):
@@ -375,7 +400,7 @@ def grids_clim(grids) -> tuple:
 
 
 def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis", clim=None,
-                density: float = DEFAULT_DENSITY, sections=DEFAULT_SECTIONS, grids=None, progress=True):
+                density: float = DEFAULT_DENSITY, sections=DEFAULT_SECTIONS, grids=None, progress=True, view=None):
     """Paint the cut(s) of ``stack``'s field (a `StackSource` whose inner source has ``sample``,
     like `Field4D.sample`) on ``ax`` as ``rendering`` ("mip", "volume" or "sections"): every slice
     of ``data`` (the stack's slice at ``matrix``) sampled at its cut (``grids``: sampled before,
@@ -398,7 +423,8 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
         scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
         limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
-        order = np.argsort(centres[:, 2], kind="stable") if n > 1 else np.arange(n)
+        depth = centres[:, 2] if view is None else (centres @ np.asarray(view, dtype=np.float64).reshape(3, 3).T)[:, 2]
+        order = np.argsort(depth, kind="stable") if n > 1 else np.arange(n)
         images = []
         for rank, k in enumerate(order):
             if grids[k].empty:
@@ -406,7 +432,7 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
             shift = scale * centres[k] if n > 1 else np.zeros(3)
             sc = scale * scales[k] if n > 1 else scale
             images.append(render_grid(grids[k], rendering, size=size, limits=limits, cmap=cmap, clim=clim, scale=sc,
-                                      shift=shift, density=density, sections=sections,
+                                      shift=shift, density=density, sections=sections, view=view,
                                       progress=lambda f, r=rank: tick((1.0 + r + f) / (n + 1))))
     finally:
         close()

@@ -42,7 +42,7 @@ class CoarseCopy:
     """The coarse copy of ``field`` (`copy` once built; `get` builds it or waits for the build) and,
     when the field is chunked or lazy and fits its memory budget, the whole array (`loaded`).
 
-    ``counted((n +inf, n -inf, None))`` receives the +-inf counts of a chunk-by-chunk build of a
+    ``counted((n +inf, n -inf, None, NaN per w step))`` receives the non-finite counts of a chunk-by-chunk build of a
     chunked array not loaded (a loaded one, or one in memory, is counted by the field itself);
     ``progress``: (chunks done, chunks in all) of that build once it started; ``counter``: the
     `Progress` of the background read (`prepare`); ``error``: what made it fail."""
@@ -194,6 +194,8 @@ class CoarseCopy:
         out = np.zeros(target, dtype=np.float64)
         floating = np.dtype(vals.dtype).kind == "f"
         npos = nneg = 0
+        w_axis = f.axis_of[3]
+        nan_w = np.zeros(nshape[w_axis], dtype=np.int64)  # NaN per w step: blocks of missing data
         total = math.prod(nch)
         chunk_bytes = math.prod(int(np.diff(b).max()) for b in rd.bounds) * rd.dtype.itemsize
         batch = max(1, min(CHUNK_BATCH, (64 * 1024**2) // max(1, chunk_bytes)))
@@ -209,6 +211,10 @@ class CoarseCopy:
                     into[rd.chunk_slices(idx)] = x
                 if coarse:
                     if floating:
+                        nan = np.isnan(x)
+                        if nan.any():
+                            nan_w[rd.chunk_slices(idx)[w_axis]] += nan.sum(
+                                axis=tuple(ax for ax in range(nan.ndim) if ax != w_axis))
                         inf = np.isinf(x)
                         if inf.any():
                             p = int(np.count_nonzero(inf & (x > 0)))
@@ -224,7 +230,7 @@ class CoarseCopy:
         if not coarse:
             return None
         if report:
-            self._counted((npos, nneg, None) if floating else (0, 0, None))
+            self._counted((npos, nneg, None, nan_w))
         x = out.astype(np.float32) if np.dtype(vals.dtype) == np.float32 else out
         x.flags.writeable = False
         coords = list(f.coords)

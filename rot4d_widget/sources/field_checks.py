@@ -24,7 +24,12 @@ class AxesWarning(UserWarning):
 
 
 class NonFiniteWarning(RuntimeWarning):
-    """The data hold +inf or -inf samples (reported once per field; NaN is allowed and silent)."""
+    """The data hold NaN or +-inf samples: how many, and where in w (reported once per field)."""
+
+
+class UnitsWarning(UserWarning):
+    """Data read from xarray name no units for their values or coordinates: which, and the attribute
+    to set (once per field)."""
 
 
 def _axes_text(axes: str) -> str:

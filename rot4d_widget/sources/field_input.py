@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core._arrays import sealed as _sealed
 from .chunks import _array_kind
-from .field_checks import _AXES
+from .field_checks import _AXES, UnitsWarning
 
 
 def _dataset_error(ds) -> TypeError:
@@ -396,13 +396,16 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
             "a DataArray does not say which file it came from (xarray's netCDF4 and h5netcdf engines write it "
             "into its encoding; scipy, which xarray uses when netCDF4 is not installed, and zarr do not)"))
     flips, coords, extent = {}, [None] * 4, []
+    epoch = None
     for d_i, k in enumerate(_AXES):
         dim = chosen[k]
         n = int(da.sizes[dim])
         if dim in da.coords:
             c = np.asarray(da.coords[dim].values)
+            if k == "w" and np.issubdtype(c.dtype, np.datetime64):  # seconds from the first; shown as dates
+                epoch = c.min()
             if np.issubdtype(c.dtype, np.datetime64) or np.issubdtype(c.dtype, np.timedelta64):
-                c = (c - c[0]) / np.timedelta64(1, "s")
+                c = (c - c.min()) / np.timedelta64(1, "s")
             try:
                 c = np.asarray(c, dtype=np.float64)
             except (TypeError, ValueError):
@@ -434,7 +437,36 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
     space_units = kwargs.pop("space_units", space.pop() if len(space) == 1 else None)
     args = dict(axes=axes, extent=extent, name=kwargs.pop("name", da.name), units=kwargs.pop("units", units),
                 w_per_unit=w_per_unit, w_units=w_units, _coords=coords, space_units=space_units)
+    if epoch is not None:
+        args["_w_epoch"] = epoch
+    _warn_missing_units(args, chosen, da)
     return values, args, dims, meta_range, origin, _long_name(getattr(da, "attrs", None))
+
+
+def _warn_missing_units(args, chosen, da) -> None:
+    """One `UnitsWarning` naming what has no units -- the values, x, y, z (or their disagreeing
+    units), w -- and the xarray attribute (or keyword) that gives them: the readout, the labels and
+    the exports would show bare numbers.  (A state file reopening the data says it no more:
+    `rot4d_widget.keep.rebuild`.)"""
+    name = repr(str(da.name)) if da.name is not None else "the DataArray"
+    fixes = []
+    if args["units"] is None:
+        fixes.append("the values (set da.attrs['units'], e.g. 'K', or pass units=...)")
+    if args["space_units"] is None:
+        dims = [chosen[k] for k in "xyz"]
+        found = {d: (da.coords[d].attrs.get("units") if d in da.coords else None) for d in dims}
+        if len({u for u in found.values() if u is not None}) > 1:
+            fixes.append(f"x, y and z together (their units disagree: {found}; pass space_units=...)")
+        else:
+            lacking = [d for d, u in found.items() if u is None]
+            fixes.append(f"{', '.join(lacking)} (set " + ", ".join(f"da[{d!r}].attrs['units']" for d in lacking)
+                         + " to one unit, e.g. 'm', or pass space_units=...)")
+    if args["w_units"] is None:
+        fixes.append(f"w, {chosen['w']} (set da[{chosen['w']!r}].attrs['units'], e.g. 's', or pass w_units=...)")
+    if fixes:
+        warnings.warn(f"Field4D.from_xarray: {name} has no units for " + "; for ".join(fixes)
+                      + ". Until they are given, the readout, the box labels and the exports show bare numbers.",
+                      UnitsWarning, stacklevel=4)
 
 
 def _long_name(attrs):

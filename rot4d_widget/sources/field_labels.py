@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.look import number_text
 
-__all__ = ["box_labels", "axis_names", "axis_units"]
+__all__ = ["box_labels", "axis_names", "axis_units", "coordinate_text", "date_time_text"]
 
 #: A data coordinate changing by less than this fraction of the box's span along it is unchanged.
 _CHANGE = 1e-6
@@ -35,6 +35,31 @@ def axis_units(field) -> tuple:
     it names none)."""
     space, w = getattr(field, "space_units", None), getattr(field, "w_units", None)
     return (space, space, space, w)
+
+
+def date_time_text(epoch, seconds: float, step: float) -> str:
+    """``epoch`` (a numpy datetime64) plus ``seconds``, as a date and time to the resolution of
+    ``step`` (the data's time step, s: whole seconds for a step of a second or more, else ms or µs).
+
+    >>> date_time_text(np.datetime64("2021-03-04T12:00:00"), 330.0, 60.0)
+    '2021-03-04 12:05:30'
+    """
+    unit = "s" if step >= 1.0 else "ms" if step >= 1e-3 else "us"
+    t = np.datetime64(epoch, "us") + np.timedelta64(int(round(float(seconds) * 1e6)), "us")
+    return str(np.datetime_as_string(t, unit=unit)).replace("T", " ")
+
+
+def coordinate_text(field, c: int, value: float, span: float, digits: int = 3) -> str:
+    """Data coordinate ``c`` (0 ... 3: x, y, z, w) of ``field`` at ``value`` as a label writes it:
+    a number for people (`number_text`, rounding noise next to ``span`` shown as 0) and its unit, or
+    -- w of a field whose times were datetime64 (``w_epoch``: c0 counts seconds from it) -- the date
+    and time."""
+    epoch = getattr(field, "w_epoch", None) if c == 3 else None
+    if epoch is not None:
+        lo, hi = (float(v) for v in field.extent[3])
+        return date_time_text(epoch, value, (hi - lo) / max(int(field.shape[3]) - 1, 1))
+    unit = axis_units(field)[c]
+    return number_text(value, span, digits) + (f" {unit}" if unit else "")
 
 
 def box_labels(field, matrix, c0, grid) -> tuple:
@@ -69,12 +94,16 @@ def box_labels(field, matrix, c0, grid) -> tuple:
     def unit(c):
         return f" {units[c]}" if units[c] else ""
 
-    corner = ", ".join(f"{names[c]} {number_text(data[0, c], span[c], 3)}{unit(c)}" for c in range(4))
+    def change(c, a, b):  # "0.01 → 0.05 m", or two date-times
+        if c == 3 and getattr(field, "w_epoch", None) is not None:
+            return f"{coordinate_text(field, c, a, span[c])} \u2192 {coordinate_text(field, c, b, span[c])}"
+        return f"{number_text(a, span[c], 3)} \u2192 {number_text(b, span[c], 3)}{unit(c)}"
+
+    corner = ", ".join(f"{names[c]} {coordinate_text(field, c, data[0, c], span[c])}" for c in range(4))
     out = [(points[0].copy(), corner)]
     for a in range(3):
         moved = [c for c in range(4) if abs(data[a + 1, c] - data[0, c]) > _CHANGE * span[c]]
         moved.sort(key=lambda c: -abs(data[a + 1, c] - data[0, c]) / span[c])  # the main change first
-        text = ", ".join(f"{names[c]} {number_text(data[0, c], span[c], 3)} \u2192 "
-                         f"{number_text(data[a + 1, c], span[c], 3)}{unit(c)}" for c in moved)
+        text = ", ".join(f"{names[c]} {change(c, data[0, c], data[a + 1, c])}" for c in moved)
         out.append((points[a + 1].copy(), text))
     return tuple(out)

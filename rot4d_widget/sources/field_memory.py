@@ -19,9 +19,10 @@ __all__ = ["FieldMemory"]
 
 
 class FieldMemory:
-    """What `Field4D` takes from here: the coarse copy, the array read whole, the memory budget and
-    the background read.  The field provides ``_values``, ``_kind``, ``_coarse_copy`` (its
-    `rot4d_widget.sources.coarse.CoarseCopy`) and ``_reader`` (its chunk reader, or None)."""
+    """What `Field4D` takes from here: the coarse copy, the array read whole, the memory budget, the
+    background read and what it found missing (`missing`).  The field provides ``_values``,
+    ``_kind``, ``_coarse_copy`` (its `rot4d_widget.sources.coarse.CoarseCopy`), ``_stat`` (its
+    `rot4d_widget.sources.field_stats.FieldStatistics`) and ``_reader`` (its chunk reader, or None)."""
 
     @property
     def memory_budget(self) -> int:
@@ -97,3 +98,13 @@ class FieldMemory:
         readout) and the data range and default level come from the chunks read so far ("first
         cut"); `coarse` waits for the read."""
         return self._coarse_copy.prepare(progress)
+
+    @property
+    def missing(self):
+        """Where the data are missing, for the readout: "NaN in time 0.0021 … 0.0026 s (8 of 60
+        steps), 12.5 % of the samples" -- steps of w holding NaN beyond 1 % of their samples more
+        than the step with fewest (a block: a failed write, a gap; `NonFiniteWarning` says it once)
+        -- or None.  Counted over an array in memory at first need; a chunked or lazy one's by its
+        background read (None until that read ends)."""
+        self._stat.count_nonfinite()
+        return self._stat.nan_text()

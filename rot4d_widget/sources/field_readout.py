@@ -10,16 +10,13 @@ import numpy as np
 
 from .field_checks import _axes_text
 from .field_input import _LazyXarray
+from .protocol import w_span_text
 
 
 def _readout(field, m, c0, slices, box, coarse) -> tuple:
     """The readout rows of a field's slice (`Field4D.slice`): what, its axes, the levels and
     the data range, the volumes, the w the box's cut spans, the resolution of a coarse step."""
-    rows = []
-    label = field.name or "field"
-    rows.append(("field", f"{label}" + (f" [{field.units}]" if field.units else "")))
-    if field.kind != "function":
-        rows.append(("axes", f"{_order_text(field)}, shape {tuple(int(n) for n in field.values.shape)}"))
+    rows = list(_what_rows(field))
     lo, hi = field.data_range
     parts = []
     for s in slices:
@@ -41,19 +38,49 @@ def _readout(field, m, c0, slices, box, coarse) -> tuple:
                      + ("" if field.caps else ", open on the box's faces (no volume)")))
     if len(slices) > 1:
         rows.append(("volumes", ", ".join(f"{s.volume:.4g}" for s in slices)))
+    rows += _cut_rows(field, m, c0, box)
+    if coarse:
+        rows.append(("resolution", f"{field.coarse_resolution} (coarse copy)"))
+    return tuple(rows)
+
+
+def _what_rows(field) -> tuple:
+    """The rows naming the field: its name and units, the order of its axes and its shape."""
+    rows = [("field", f"{field.name or 'field'}" + (f" [{field.units}]" if field.units else ""))]
+    if field.kind != "function":
+        rows.append(("axes", f"{_order_text(field)}, shape {tuple(int(n) for n in field.values.shape)}"))
+        missing = field.missing
+        if missing is not None:
+            rows.append(("missing", missing))
+    return tuple(rows)
+
+
+def _cut_rows(field, m, c0, box) -> tuple:
+    """The rows of the cut itself, whatever draws it: the w its box spans and how much w one unit
+    of space is."""
+    rows = []
     wu = f" {field.w_units}" if field.w_units else ""
     if len(box.vertices):
         p = np.column_stack([np.asarray(box.vertices), np.full(len(box.vertices), c0)])
         w = (p @ m)[:, 3] * field.w_per_unit + field.centre[3]
-        rows.append(("w cut", f"{w.min():.4g} \u2026 {w.max():.4g}{wu} (data {field.extent[3][0]:.4g} \u2026 "
-                              f"{field.extent[3][1]:.4g})"))
+        if field.w_epoch is not None:  # dates and times
+            rows.append(("w cut", f"{w_span_text(field, w.min(), w.max())} "
+                                  f"(data {w_span_text(field, *field.extent[3])})"))
+        else:
+            rows.append(("w cut", f"{w.min():.4g} \u2026 {w.max():.4g}{wu} (data {field.extent[3][0]:.4g} \u2026 "
+                                  f"{field.extent[3][1]:.4g})"))
     else:
         rows.append(("w cut", "none (w = c0 misses the data)"))
     per = field.space_units if field.space_units else "unit of space"
     rows.append(("w per unit", f"{field.w_per_unit:.4g}{wu} per {per}"))
-    if coarse:
-        rows.append(("resolution", f"{field.coarse_resolution} (coarse copy)"))
     return tuple(rows)
+
+
+def _outline_readout(field, m, d, box) -> tuple:
+    """The readout rows of a field's cut without its surfaces (`Field4D.outline`): what it is and
+    the cut (``d`` the offset in slice units, as `_readout` takes it)."""
+    return _what_rows(field) + _cut_rows(field, m, d, box)
+
 
 def _order_text(field) -> str:
     """Which of x, y, z, w each array axis is: 'f[w, z, y, x]', with the dim names from xarray

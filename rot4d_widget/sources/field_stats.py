@@ -16,19 +16,35 @@ import numpy as np
 from ..geometry.polytopes import _power_of_two_unit
 from .field_checks import NonFiniteWarning, _axes_text, _call
 from .field_slicing import _sample_raw
+from .protocol import w_span_text, w_value_text
 
 #: Nodes per axis of the grid a function field is sampled on for its range.
 _FUNCTION_PROBE = 21
 
 
-def _count_infinite(a, block_bytes: int = 64 * 1024**2):
-    """(n +inf, n -inf, first index as a tuple or None) of an array in memory, read in blocks
-    along its first axis (at most ``block_bytes`` of booleans at a time)."""
+#: A step of w (a time step) whose samples are NaN beyond this fraction, more than in the step with
+#: fewest, is reported (`FieldStatistics.report_nonfinite`): a block of missing data (a failed write,
+#: a gap), not a mask that every step shares nor a stray NaN.
+NAN_BLOCK_FRACTION = 0.01
+
+
+def _count_nonfinite(a, w_axis: int, block_bytes: int = 64 * 1024**2):
+    """(n +inf, n -inf, first +-inf index as a tuple or None, NaN per w step (nw,) int64) of an
+    array in memory, read in blocks along its first axis (at most ``block_bytes`` of booleans at a
+    time); ``w_axis``: the array axis that is w."""
     npos = nneg = 0
     first = None
+    nan_w = np.zeros(int(a.shape[w_axis]), dtype=np.int64)
     per = max(1, int(block_bytes // max(1, math.prod(int(n) for n in a.shape[1:]))))
     for i in range(0, int(a.shape[0]), per):
         b = np.asarray(a[i:i + per])
+        nan = np.isnan(b)
+        if nan.any():
+            counts = nan.sum(axis=tuple(ax for ax in range(nan.ndim) if ax != w_axis))
+            if w_axis == 0:
+                nan_w[i:i + len(counts)] += counts
+            else:
+                nan_w += counts
         inf = np.isinf(b)
         if not inf.any():
             continue
@@ -38,7 +54,18 @@ def _count_infinite(a, block_bytes: int = 64 * 1024**2):
         if first is None:
             j = np.unravel_index(int(np.flatnonzero(inf.ravel())[0]), inf.shape)
             first = (i + int(j[0]),) + tuple(int(v) for v in j[1:])
-    return npos, nneg, first
+    return npos, nneg, first, nan_w
+
+
+def _runs(idx) -> list:
+    """Runs of consecutive integers in the sorted ``idx``: [(first, last), ...]."""
+    out = []
+    for i in (int(v) for v in idx):
+        if out and i == out[-1][1] + 1:
+            out[-1] = (out[-1][0], i)
+        else:
+            out.append((i, i))
+    return out
 
 
 def _finite_range(a, block_bytes: int = 64 * 1024**2) -> tuple:
@@ -59,9 +86,9 @@ class FieldStatistics:
     """The data range, K and the +-inf report of one `Field4D` (``field``), each found once.
 
     ``meta_range``: (lo, hi, where) from the data's metadata, or None; ``infinite``: (n +inf,
-    n -inf, first index or None) once counted (the coarse copy's pass counts them for a chunked
-    array: `counted`); ``infinite_reported``: the warning was given (or is the original
-    field's, for a coarse copy)."""
+    n -inf, first index or None, NaN per w step) once counted (the coarse copy's pass counts them
+    for a chunked array: `counted`); ``infinite_reported``: the warning was given (or is the
+    original field's, for a coarse copy)."""
 
     def __init__(self, field, meta_range=None):
         self._field = field
@@ -74,8 +101,11 @@ class FieldStatistics:
         self.infinite_reported = False
 
     def counted(self, infinite) -> None:
-        """The coarse copy's pass counted the +-inf samples: ``(n +inf, n -inf, None)``."""
+        """The coarse copy's pass (the background read of a chunked or lazy array) counted the
+        non-finite samples: ``(n +inf, n -inf, None, NaN per w step)``; reported at once
+        (`report_nonfinite`: a warning and the readout's "missing" row) when there are any."""
         self.infinite = infinite
+        self.report_nonfinite()
 
     def forget_k(self) -> None:
         """K is per slice unit: forgotten when `Field4D.w_per_unit` changes."""
@@ -119,11 +149,11 @@ class FieldStatistics:
                 rng = (float(a[finite].min()), float(a[finite].max())) if finite.any() else (math.nan, math.nan)
                 self._range = (rng, "probe grid")
             elif f.resident is not None:  # in memory: given so, or read whole (`Field4D.prepare`)
-                self.report_infinite()
+                self.report_nonfinite()
                 self._range = (_finite_range(f.resident), "data")
             else:  # chunked or lazy: one pass over the data (read whole when it fits the budget)
                 c = f.coarse()
-                self.report_infinite()
+                self.report_nonfinite()
                 self._range = ((_finite_range(f.resident), "data") if f.resident is not None
                                else (c.data_range, "coarse copy"))
         return self._range
@@ -203,26 +233,80 @@ class FieldStatistics:
         return max(span, abs(rng[1]) if math.isfinite(rng[1]) else 0.0, 1.0) / (2 * f.size)
 
     def report_infinite(self) -> None:
-        """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf: how many, and where
-        (the first, for an array in memory).  Counted over the whole array: in blocks for numpy,
-        alongside the coarse copy's pass for chunked and lazy arrays."""
+        """The old name of `report_nonfinite`."""
+        self.report_nonfinite()
+
+    def count_nonfinite(self) -> tuple | None:
+        """(n +inf, n -inf, first index or None, NaN per w step): counted once over the whole array
+        in memory (in blocks), or by the background read of a chunked or lazy one (None until then);
+        a function's: None."""
+        f = self._field
+        if self.infinite is None and f.kind != "function" and (f.resident is not None or f.kind == "numpy"):
+            a = f.resident if f.resident is not None else f.values
+            w_axis = f.axis_of[3]
+            self.infinite = (_count_nonfinite(a, w_axis) if np.dtype(a.dtype).kind == "f"
+                             else (0, 0, None, np.zeros(int(a.shape[w_axis]), dtype=np.int64)))
+        return self.infinite
+
+    def nan_blocks(self) -> tuple:
+        """``(steps, fraction)``: the w steps that hold NaN beyond `NAN_BLOCK_FRACTION` of their
+        samples more than the step with fewest (indices, sorted), and the fraction of all samples
+        that are NaN -- ``((), 0.0)`` when none (or not counted yet)."""
+        census = self.infinite
+        if census is None or len(census) < 4:
+            return (), 0.0
+        nan_w = np.asarray(census[3], dtype=np.int64)
+        shape = self._field.values.shape
+        per_step = math.prod(int(n) for n in shape) / max(len(nan_w), 1)
+        if not len(nan_w) or not nan_w.any():
+            return (), 0.0
+        steps = np.flatnonzero(nan_w - nan_w.min() > NAN_BLOCK_FRACTION * per_step)
+        return tuple(int(i) for i in steps), float(nan_w.sum()) / (per_step * len(nan_w))
+
+    def nan_text(self) -> str | None:
+        """The readout's "missing" text ("NaN in time 0.0021 … 0.0026 s (8 of 60 steps), 12.5 % of the
+        samples"), or None when no block of NaN was found (`nan_blocks`)."""
+        steps, fraction = self.nan_blocks()
+        if not steps:
+            return None
+        f = self._field
+        n_w = int(f.values.shape[f.axis_of[3]])
+        lo, hi = f.extent[3]
+        at = (np.asarray(f.coords[3]) if f.coords[3] is not None else np.linspace(lo, hi, n_w))
+        blocks = _runs(steps)
+        runs = ", ".join(w_value_text(f, at[a]) if a == b else w_span_text(f, at[a], at[b])
+                         for a, b in blocks[:3]) + (" \u2026" if len(blocks) > 3 else "")
+        name = f.dims[f.axes.index("w")] if f.dims is not None else "w"
+        return (f"NaN in {name} {runs} ({len(steps)} of {n_w} steps), {100 * fraction:.3g} % of the samples")
+
+    def report_nonfinite(self) -> None:
+        """Warn once (`NonFiniteWarning`) when the data hold +inf or -inf -- how many, and where (the
+        first, for an array in memory) -- or blocks of NaN in w (`nan_blocks`: a failed write, a gap;
+        which steps and what fraction).  Counted over the whole array: in blocks for numpy, alongside
+        the coarse copy's pass for chunked and lazy arrays (reported when that pass ends)."""
         if self.infinite_reported:
+            return
+        census = self.count_nonfinite()
+        if census is None:
             return
         self.infinite_reported = True
         f = self._field
-        if self.infinite is None:
-            a = f.resident if f.resident is not None else f.values
-            self.infinite = _count_infinite(a) if np.dtype(a.dtype).kind == "f" else (0, 0, None)
-        npos, nneg, first = self.infinite
-        if npos == 0 and nneg == 0:
-            return
-        what = " and ".join(t for t in (f"{npos} +inf" if npos else "", f"{nneg} -inf" if nneg else "") if t)
-        where = f" (the first at index {first} of {_axes_text(f.axes)})" if first is not None else ""
-        warnings.warn(
-            f"Field4D{' ' + repr(f.name) if f.name else ''}: the data hold {what} of "
-            f"{math.prod(int(n) for n in f.values.shape)} samples{where}. They are kept: +inf lies above "
-            f"and -inf below every level, the data range ignores them, and a point interpolated in a cell "
-            f"that holds one is +-inf, or NaN (below every level) where two meet or its weight is 0. "
-            f"To draw them otherwise, mask or clip first, "
-            f"e.g. np.where(np.isfinite(a), a, np.nan) or np.clip(a, lo, hi)",
-            NonFiniteWarning, stacklevel=4)
+        npos, nneg, first = census[:3]
+        parts = []
+        if npos or nneg:
+            what = " and ".join(t for t in (f"{npos} +inf" if npos else "", f"{nneg} -inf" if nneg else "") if t)
+            where = f" (the first at index {first} of {_axes_text(f.axes)})" if first is not None else ""
+            parts.append(
+                f"the data hold {what} of {math.prod(int(n) for n in f.values.shape)} samples{where}. They are kept: "
+                f"+inf lies above and -inf below every level, the data range ignores them, and a point "
+                f"interpolated in a cell that holds one is +-inf, or NaN (below every level) where two meet or its "
+                f"weight is 0. To draw them otherwise, mask or clip first, "
+                f"e.g. np.where(np.isfinite(a), a, np.nan) or np.clip(a, lo, hi)")
+        nan = self.nan_text()
+        if nan is not None:
+            parts.append(f"{nan} -- a block of missing data (a failed write, a gap?). NaN lies below every "
+                         f"level and is no value in the ray-cast renderings: those steps show nothing. Fill them, "
+                         f"or select the steps around them (da.isel(...)); the readout's row \"missing\" says it too")
+        if parts:
+            warnings.warn(f"Field4D{' ' + repr(f.name) if f.name else ''}: " + "; ".join(parts),
+                          NonFiniteWarning, stacklevel=4)

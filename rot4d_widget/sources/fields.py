@@ -71,6 +71,7 @@ from .field_checks import (
     MAX_SAMPLE_BYTES,
     AxesWarning,
     NonFiniteWarning,
+    UnitsWarning,
     _as_levels,
     _check_extent,
     _check_positive,
@@ -92,13 +93,13 @@ from .field_input import (  # noqa: F401,E402  (export reads them)
 from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
 from .field_levels import FieldLevels
 from .field_memory import FieldMemory
-from .field_readout import _describe, _order_text, _readout
+from .field_readout import _describe, _order_text, _outline_readout, _readout
 from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
 from .field_stats import FieldStatistics
 from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
 
 __all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
-           "NonFiniteWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
+           "NonFiniteWarning", "UnitsWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
 
 _REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
                _resample_affine, _sample_raw, _surface)
@@ -173,7 +174,7 @@ class Field4D(FieldLevels, FieldMemory):
     def __init__(self, values, *, axes=None, extent=None, name=None, units=None,
                  w_per_unit=None, w_units=None, space_units=None, resolution: int = 64, coarse_resolution=None,
                  levels=None, chunk_cache_bytes: int = 128 * 1024**2, inside: str = "above", caps: bool = True,
-                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None):
+                 memory_budget: int = MEMORY_BUDGET, _coords=None, _function=None, _copy_of=None, _w_epoch=None):
         self._function = _function
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
@@ -200,6 +201,7 @@ class Field4D(FieldLevels, FieldMemory):
             wpu = 1.0 if w_per_unit is None else w_per_unit
             self.w_units = None if w_units is None else str(w_units)
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
+        self.w_epoch = None if _w_epoch is None else np.datetime64(_w_epoch)  #: w = 0's date, from datetime64
         self.name = None if name is None else str(name)
         self.units = None if units is None else str(units)
         self.space_units = None if space_units is None else str(space_units)
@@ -428,14 +430,14 @@ class Field4D(FieldLevels, FieldMemory):
         return FieldSliceData.assemble(slices, box, readout, frame)
 
     def outline(self, matrix, c0) -> "FieldSliceData":
-        """The slice's bars without its surface: the cut of the data's box at w = ``c0`` after
-        ``matrix``, read from nothing (the source protocol's ``outline``: what the widget sizes its
-        buffers and ball radius from, so that building a view reads no chunk but its first cut's)."""
-        m = as_rotation_matrix(matrix)
-        d = self.offset(c0)
+        """The slice's bars without its surface, and the readout rows that do not depend on it: the
+        cut of the data's box at w = ``c0`` after ``matrix``, read from nothing (the source protocol's
+        ``outline``: the widget sizes its buffers and ball radius from it, reading no chunk)."""
+        m, d = as_rotation_matrix(matrix), self.offset(c0)
         frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
                  "unit": _sealed(self._unit.copy())}
-        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), _box_slice(self, m, d), (), frame)
+        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box := _box_slice(self, m, d),
+                                       _outline_readout(self, m, d, box), frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)

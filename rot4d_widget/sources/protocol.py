@@ -93,6 +93,7 @@ from ..core.look import number_text
 from ..geometry.polytopes import POLYTOPE_NAMES, Polytope
 from ..geometry.polytopes import polytope as get_polytope
 from ..geometry.slicing import slice_polytope
+from .field_labels import axis_names, coordinate_text
 
 __all__ = [
     "Source",
@@ -103,6 +104,10 @@ __all__ = [
     "check_slice",
     "BadSlice",
     "data_w_text",
+    "note_matrix",
+    "w_value_text",
+    "c0_text",
+    "w_span_text",
     "w_frame",
     "inner_source",
     "settings_of",
@@ -294,6 +299,15 @@ def outline_of(source, matrix, c0):
     return source.slice(matrix, c0) if outline is None else outline(matrix, c0)
 
 
+def note_matrix(source, matrix) -> None:
+    """Tell ``source`` the orientation the view shows now (its optional ``note_matrix``: a stack
+    spreads its default spacing along that w when N next changes); nothing for a source without one.
+    Whoever runs a source's action or changes its settings (the widget, a replay) tells it first."""
+    note = getattr(source, "note_matrix", None)
+    if note is not None:
+        note(matrix)
+
+
 def prepare_in_background(source, progress: bool = True):
     """Start ``source``'s background work (its ``prepare``: a field's read into memory and coarse
     copy) and return what counts it, a `rot4d_widget.core.progress.Progress`, or None (a source
@@ -304,17 +318,55 @@ def prepare_in_background(source, progress: bool = True):
 
 
 def data_w_text(source, w: float, matrix=None) -> str:
-    """A cut's label in the source's own w, c0's units: ``"w 30 s"`` for a field (its time, in its
-    ``w_units``), ``"w +0.5"`` for a polytope.  ``w`` is a c0 (`w_frame`); ``matrix`` is unused
-    (kept for callers of the older form)."""
+    """A cut's label in the source's own w, c0's units: ``"time 30 s"`` for a field (w's name -- its
+    dim's, "w" without one -- and its time in its ``w_units``), ``"w +0.5"`` for a polytope.  ``w``
+    is a c0 (`w_frame`).  With ``matrix``, a field's cut that misses its data (``w`` outside
+    ``w_range(matrix)``: before or after the record along that w) says so: ``"time 0.5 s (outside
+    the data)"``."""
     inner = getattr(source, "source", source)
     extent = getattr(inner, "extent", None)
     if extent is None:
         text = number_text(w, getattr(source, "size", 1.0), 3)
         return f"w {'+' if not text.startswith('-') else ''}{text}"
-    lo, hi = float(extent[3][0]), float(extent[3][1])
+    text = f"{axis_names(inner)[3]} {w_value_text(inner, w)}"
+    if matrix is not None and callable(getattr(inner, "w_range", None)):
+        lo, hi = (float(v) for v in inner.w_range(matrix))
+        slack = 1e-9 * max(abs(lo), abs(hi), hi - lo)
+        if not lo - slack <= float(w) <= hi + slack:
+            text += " (outside the data)"
+    return text
+
+
+def w_value_text(source, w: float) -> str:
+    """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits -- or, for times
+    that were datetime64 (``w_epoch``), the date and time."""
+    inner = getattr(source, "source", source)
+    lo, hi = (float(v) for v in inner.extent[3])
+    if getattr(inner, "w_epoch", None) is not None:
+        return coordinate_text(inner, 3, float(w), max(abs(lo), abs(hi)))
     unit = getattr(inner, "w_units", None)
-    return f"w {number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+    return f"{number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
+
+
+def c0_text(source, c0: float):
+    """How c0 reads for ``source`` when a number with its unit would not do: the date and time for a
+    field whose times were datetime64 (``w_epoch``; c0 counts seconds from it), with those seconds
+    -- "2021-03-04 12:05:00 (c0 = 300 s)" -- else None."""
+    inner = getattr(source, "source", source)
+    if getattr(inner, "w_epoch", None) is None:
+        return None
+    return f"{w_value_text(inner, c0)} (c0 = {number_text(float(c0), 0.0, 6)} s)"
+
+
+def w_span_text(source, a: float, b: float) -> str:
+    """Two of a field's w as a range: "0.0021 … 0.0026 s" (the unit once), or two date-times."""
+    inner = getattr(source, "source", source)
+    if getattr(inner, "w_epoch", None) is not None:
+        return f"{w_value_text(inner, a)} \u2026 {w_value_text(inner, b)}"
+    lo, hi = (float(v) for v in inner.extent[3])
+    unit = getattr(inner, "w_units", None)
+    big = max(abs(lo), abs(hi))
+    return f"{number_text(float(a), big, 4)} \u2026 {number_text(float(b), big, 4)}{' ' + unit if unit else ''}"
 
 
 class BadSlice(ValueError):
@@ -499,6 +551,23 @@ class PolytopeSource:
         return f"PolytopeSource({self.polytope.name!r})"
 
 
+def _data_hint(obj) -> str:
+    """What to write instead when ``obj`` is data rather than a source: an xarray DataArray or
+    Dataset, or an array (numpy, dask, zarr) -- "" for anything else."""
+    kind = type(obj)
+    module = (kind.__module__ or "").split(".")[0]
+    if module == "xarray" and kind.__name__ == "DataArray":
+        return ("; an xarray.DataArray is a field: Rot4DWidget(Field4D.from_xarray(da)) (dims found by name, "
+                "or named: Field4D.from_xarray(da, w='time'))")
+    if module == "xarray" and kind.__name__ == "Dataset":
+        return ("; an xarray.Dataset holds fields: Rot4DWidget(Field4D.from_xarray(ds, 'T')) with the "
+                "variable's name (a state file can then reopen its file)")
+    if isinstance(obj, np.ndarray) or module in ("dask", "zarr"):
+        return ("; a 4-D array is a field: Rot4DWidget(Field4D(a, axes='wzyx')) (axes: which of x, y, z, w "
+                "each array axis is), or Field4D.from_xarray for a DataArray")
+    return ""
+
+
 def as_source(obj):
     """A polytope name, a `Polytope` or any `Source` -> a source.
 
@@ -511,6 +580,7 @@ def as_source(obj):
         raise TypeError(
             "Expected a polytope name (e.g. '24-cell'), a rot4d_widget.Polytope or a source with "
             f"slice(matrix, c0), size, n_groups and describe(); {type(obj).__name__} lacks {', '.join(missing)}"
+            + _data_hint(obj)
         )
     if not callable(obj.slice) or not callable(obj.describe):
         raise TypeError("Expected `source.slice` and `source.describe` to be methods")

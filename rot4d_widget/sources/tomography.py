@@ -5,41 +5,13 @@
 
     w_k = c0 + (k - (N - 1) / 2) Δ,        k = 0 ... N - 1,
 
-all under one orientation, and returns ONE `SliceData` in which slice k is moved and shrunk to
-its place in the arrangement: a point p of it is drawn at ``centre_k + scale_k * p`` (its
-normals unchanged), so every slice keeps the same x, y, z orientation.  The widget shows it
+(c0 and Δ in the source's w units: a field's time) all under one orientation, and returns ONE
+`SliceData` in which slice k is moved and shrunk to its place in the arrangement: a point p of
+it is drawn at ``centre_k + scale_k * p`` (its normals unchanged), so every slice keeps the
+same x, y, z orientation.  The widget shows it
 like any source and stays unaware of stacks; ``slices=1`` is the single slice, point for point.
 
-Arrangements (`arrangement_layout`, designed in displayed units -- the object's circumradius
-`look.REFERENCE_RADIUS`, the eye at (0, 0, 5) looking down -z, vertical fov 40 degrees, the
-default canvas aspect 600 / 500 -- and scaled to the source's units):
-
-``"oval"``
-    Kageyama's follow-up (J. Visualization 2016): the slice centres lie on the parabola
-    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, |u| <= 2.0 and Y0
-    chosen for each N so that the picture is centred in the frame (the slices' bounding spheres
-    reach as far above the frame's middle as below it: -0.05 for N = 5, -0.49 for N = 12, -0.95
-    for N = 64): it opens away from the eye and rises with depth, so its perspective image is
-    an oval (the points at infinity would close it at the horizon y' = 5 C / B = 2).  The
-    central slice (w = c0) sits at the vertex P(0) = (0, Y0, 0), nearest the eye and
-    lowest; slices of higher w go right, lower w left.  World scales are
-    ``s0 (1 - 0.4 tau^2) / max``, tau = (k - (N-1)/2) / ((N-1)/2), on top of perspective.
-    Slices are laid along the parabola from the vertex at arc-length steps proportional to
-    their sizes (touching spheres at scale 0.6 plus a 5 % gap) until the arc |u| <= 2 is
-    used up; then the steps shrink.  ``s0`` is the largest scale, at most 0.6, for which
-    every pair of bounding spheres (radius ``radius * scale``) is disjoint with a 5 % gap
-    and every sphere's image lies in the 600 x 500 camera frame with a 3 % margin.  Why these
-    numbers: A, B, C make the oval's image span |x'| <= 1.68 and -0.65 ... 1.22 in y' (the
-    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0, with Y0 = -0.65); u = 2 is past the widest point
-    u* = sqrt(5 / B) = 1.29, so the ends curl back towards each other (an oval, not a U)
-    while the farthest slice, 12 units deep, is still drawn at 29 % of its size.  With
-    N = 16 every slice gets scale 0.56, with 64 about 0.2.
-``"grid"``
-    Small multiples like a CT film: ``ceil(sqrt(N))`` columns, rows from top to bottom,
-    slice 0 (lowest w) top left, all at z = 0 and one scale, the largest (at most 1) for
-    which the grid of bounding spheres, 5 % apart, fits the frame with a 3 % margin.
-``"stack"``
-    One row along x at z = 0, lowest w on the left, one scale chosen the same way.
+Where the N slices sit in the view: `rot4d_widget.sources.arrangements` (oval, grid, stack).
 
 N = 1 is the identity in every arrangement (centre 0, scale 1).  The *highlighted* slice is
 the one at w = c0 (k = (N - 1) / 2 for odd N; for even N no slice is at c0 and k = N / 2,
@@ -67,6 +39,7 @@ import numpy as np
 from ..core import look
 from ..core.rotation import as_rotation_matrix
 from ..geometry.slicing import slice_polytope
+from .arrangements import arrangement_layout, check_arrangement
 from .protocol import (
     PolytopeSource,
     SliceData,
@@ -81,39 +54,23 @@ from .protocol import (
     settings_of,
     takes_coarse,
     w_frame,
+    w_value_text,
 )
 
 __all__ = [
-    "ARRANGEMENTS",
     "MAX_SLICES",
-    "OVAL_PARABOLA",
     "StackSource",
     "StackSliceData",
-    "arrangement_layout",
     "stack_levels",
     "stack_offsets",
     "default_spacing",
     "highlighted_index",
 ]
 
-#: The arrangements, in the order the docs list them.
-ARRANGEMENTS = ("oval", "grid", "stack")
 #: Most slices in a stack.
 MAX_SLICES = 64
 COLOR_BY = ("w", "cell")
 
-#: The oval's parabola P(u) = (A u, Y0 + C u^2, -B u^2), |u| <= U_MAX, in displayed units; Y0 is
-#: where the layout starts: it is then shifted so that the picture is centred in the frame.
-OVAL_PARABOLA = {"A": 2.6, "B": 3.0, "C": 1.2, "Y0": -0.65, "U_MAX": 2.0}
-#: Largest world scale of an oval slice; relative shrink of the end slices (1 - 0.4 tau^2).
-OVAL_MAX_SCALE = 0.6
-OVAL_SHRINK = 0.4
-#: Gap between neighbouring bounding spheres, relative to the sum of their radii.
-GAP = 0.05
-#: Fraction of the camera frame the layout may fill.
-FRAME_MARGIN = 0.97
-#: The widget's default canvas, width / height (600 x 500).
-VIEW_ASPECT = 600.0 / 500.0
 #: g / f multiply / divide the spacing by this (Shift inverts).
 SPACING_FACTOR = 2.0 ** 0.25
 #: Δ stays within [SPACING_MIN, SPACING_MAX] times the source's size: g / f refuse a step
@@ -122,8 +79,6 @@ SPACING_FACTOR = 2.0 ** 0.25
 SPACING_MIN = 2.0 ** -12
 SPACING_MAX = 4.0
 
-_D = float(look.CAMERA_POSITION[2])
-_HALF_H = _D * math.tan(math.radians(look.CAMERA_FOV) / 2.0)  # frame half-height at z = 0
 
 
 # ------------------------------------------------------------------ validation
@@ -141,12 +96,6 @@ def _check_spacing(d):
     return float(d)
 
 
-def _check_arrangement(a) -> str:
-    if a not in ARRANGEMENTS:
-        raise ValueError(f"Expected `arrangement` to be one of {', '.join(map(repr, ARRANGEMENTS))}, got {a!r}")
-    return a
-
-
 def _check_color_by(c) -> str:
     if c not in COLOR_BY:
         raise ValueError(f"Expected `color_by` to be one of {', '.join(map(repr, COLOR_BY))}, got {c!r}")
@@ -154,9 +103,29 @@ def _check_color_by(c) -> str:
 
 
 # ------------------------------------------------------------------ levels and layouts
-def default_spacing(size: float, n: int) -> float:
-    """The default Δ = 2 size / N: N slices spread over the object's extent."""
-    return 2.0 * float(size) / _check_slices(n)
+def default_spacing(source, n: int, matrix=None) -> float:
+    """The default Δ, in ``source``'s w units.  A record (a source with an ``extent``: a field): its
+    extent along the current w -- the c0 at which the hyperplane w = c0 after ``matrix`` (default
+    the identity) first and last touches the data, its ``w_range`` -- over N, so that N slices
+    about the middle of it each take one N-th of it.  Any other source (a polytope): 2 size / N, as
+    before there were records (times its w per unit of space)."""
+    n = _check_slices(n)
+    if getattr(source, "extent", None) is not None:
+        lo, hi = _w_range(source, np.eye(4) if matrix is None else as_rotation_matrix(matrix))
+        if math.isfinite(lo) and math.isfinite(hi) and hi > lo:
+            return (hi - lo) / n
+    return 2.0 * float(source.size) * w_frame(source)[1] / n
+
+
+def _w_range(source, matrix) -> tuple:
+    """``source.w_range(matrix)``, or (-size, size) for a source without one (a polytope's own w)."""
+    f = getattr(source, "w_range", None)
+    return tuple(float(v) for v in f(matrix)) if f is not None else (-float(source.size), float(source.size))
+
+
+def _w_units(source):
+    """The unit of ``source``'s w (a field's ``w_units``), or None."""
+    return getattr(source, "w_units", None)
 
 
 def stack_offsets(n: int, spacing: float) -> np.ndarray:
@@ -178,95 +147,6 @@ def stack_levels(c0: float, n: int, spacing: float) -> np.ndarray:
 def highlighted_index(n: int) -> int:
     """The slice at w = c0 (odd n), else the first above c0: ``n // 2``."""
     return _check_slices(n) // 2
-
-
-def _frame_fit(cx, cy, cz, r):
-    """Largest factor for radii ``r`` (n,) so that the spheres' images lie in the camera frame."""
-    f = _D / (_D - cz)
-    lim_y = FRAME_MARGIN * _HALF_H
-    lim_x = VIEW_ASPECT * lim_y
-    return min(float(((lim_x - np.abs(cx * f)) / (r * f)).min()), float(((lim_y - np.abs(cy * f)) / (r * f)).min()))
-
-
-def _oval(n: int):
-    R = look.REFERENCE_RADIUS
-    A, B, C, Y0, UM = (OVAL_PARABOLA[k] for k in ("A", "B", "C", "Y0", "U_MAX"))
-    tau = (np.arange(n) - (n - 1) / 2.0) / ((n - 1) / 2.0)
-    g = 1.0 - OVAL_SHRINK * tau * tau
-    g /= g.max()
-    uu = np.linspace(0.0, UM, 2001)
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(A, np.hypot(2 * C * (uu[1:] + uu[:-1]) / 2,
-                                                                  2 * B * (uu[1:] + uu[:-1]) / 2)) * np.diff(uu))])
-    cum = np.concatenate([[0.0], np.cumsum((g[:-1] + g[1:]) / 2.0)])
-    cum -= cum[-1] / 2.0  # symmetric about the vertex, in units of one step
-    step = min(2.0 * R * OVAL_MAX_SCALE * (1.0 + GAP), arc[-1] / np.abs(cum).max())
-    a = cum * step
-    u = np.sign(a) * np.interp(np.abs(a), arc, uu)
-    centres = np.stack([A * u, Y0 + C * u * u, -B * u * u], axis=1)
-    diff = np.linalg.norm(centres[:, None, :] - centres[None, :, :], axis=2)
-    iu = np.triu_indices(n, 1)
-    s_sep = float((diff[iu] / (R * (g[:, None] + g[None, :])[iu] * (1.0 + GAP))).min())
-    # centred in the frame (few slices use only the bottom of the oval), then fitted to it
-    centres[:, 1] += _vertical_centring(centres, R * min(OVAL_MAX_SCALE, s_sep) * g)
-    s_fit = _frame_fit(centres[:, 0], centres[:, 1], centres[:, 2], R * g)
-    scales = min(OVAL_MAX_SCALE, s_sep, s_fit) * g
-    centres[:, 1] += _vertical_centring(centres, R * scales)
-    s_fit = _frame_fit(centres[:, 0], centres[:, 1], centres[:, 2], R * g)
-    return centres, np.minimum(scales, s_fit * g)
-
-
-def _vertical_centring(centres, radii) -> float:
-    """The world-y shift after which the spheres' images reach as far above the frame's middle
-    as below it (their top and bottom, ``(y +- r) D / (D - z)``, balance)."""
-    f = _D / (_D - centres[:, 2])
-    y, r = centres[:, 1], radii
-
-    def imbalance(dy):
-        return float(((y + dy + r) * f).max() + ((y + dy - r) * f).min())
-
-    lo, hi = -20.0, 20.0  # imbalance rises with dy
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if imbalance(mid) < 0 else (lo, mid)
-    return 0.5 * (lo + hi)
-
-
-def _rows(n: int, cols: int):
-    R = look.REFERENCE_RADIUS
-    rows = -(-n // cols)
-    lim_y = FRAME_MARGIN * _HALF_H
-    lim_x = VIEW_ASPECT * lim_y
-    s = min(1.0, lim_x / (R * ((cols - 1) * (1.0 + GAP) + 1.0)), lim_y / (R * ((rows - 1) * (1.0 + GAP) + 1.0)))
-    pitch = 2.0 * R * s * (1.0 + GAP)
-    k = np.arange(n)
-    r, c = k // cols, k % cols
-    centres = np.stack([(c - (cols - 1) / 2.0) * pitch, ((rows - 1) / 2.0 - r) * pitch, np.zeros(n)], axis=1)
-    return centres, np.full(n, s)
-
-
-def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS):
-    """Where each of ``n`` slices goes: ``(centres (n, 3) float64, scales (n,) float64)``.
-
-    Slice k of an object of circumradius ``radius`` is drawn at ``centres[k] + scales[k] * p``.
-    Designed for ``radius = look.REFERENCE_RADIUS`` (what the widget shows) and the camera of
-    `rot4d_widget.core.look`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
-    picture is the same once the widget scales the source to its displayed size.  See the
-    module docstring for each arrangement's constants.  ``n = 1``: centre 0, scale 1.
-    """
-    _check_arrangement(name)
-    n = _check_slices(n)
-    if (isinstance(radius, (bool, np.bool_)) or not isinstance(radius, Real)
-            or not (math.isfinite(radius) and radius > 0)):
-        raise ValueError(f"Expected `radius` to be a finite number > 0, got {radius!r}")
-    if n == 1:
-        return np.zeros((1, 3)), np.ones(1)
-    if name == "oval":
-        centres, scales = _oval(n)
-    elif name == "grid":
-        centres, scales = _rows(n, math.ceil(math.sqrt(n)))
-    else:
-        centres, scales = _rows(n, n)
-    return centres * (float(radius) / look.REFERENCE_RADIUS), scales
 
 
 # ------------------------------------------------------------------ the slice data
@@ -318,7 +198,10 @@ class StackSource:
     ----------
     source : a polytope name, a `Polytope` or any source (`rot4d_widget.Source`)
     slices : int in 1 ... 64 -- N
-    spacing : float > 0 or None -- Δ, in the source's units; None: ``2 size / N`` (follows N)
+    spacing : float > 0 or None -- Δ, in the source's w units (c0's: a field's time); None: the
+        default, the record's extent along the current w over N (`default_spacing`), spread when the
+        stack is made and whenever N changes, for the orientation noted last (`note_matrix`)
+    matrix : (4, 4) rotation or None -- the orientation the default is spread for at first
     arrangement : "oval", "grid" or "stack" (see the module docstring)
     color_by : "w" (a colormap over the N levels) or "cell" (the inner source's groups)
 
@@ -327,8 +210,11 @@ class StackSource:
     c0)`` takes ``coarse=`` exactly when the inner source's slice does.
     """
 
-    def __init__(self, source, slices: int = 5, spacing=None, arrangement: str = "oval", color_by: str = "w"):
+    def __init__(self, source, slices: int = 5, spacing=None, arrangement: str = "oval", color_by: str = "w",
+                 matrix=None):
         self.source = as_source(source)
+        self._matrix = np.eye(4) if matrix is None else as_rotation_matrix(matrix)
+        self._default = None  # the default Δ once spread (`_spread`); None: to be spread at the next need
         self.slices = slices
         self.spacing = spacing
         self.arrangement = arrangement
@@ -346,11 +232,13 @@ class StackSource:
     @slices.setter
     def slices(self, value) -> None:
         self._slices = _check_slices(value)
+        self._default = None  # a new N: the default is spread again
 
     @property
     def spacing(self) -> float:
-        """Δ in the source's units (the default ``2 size / N`` unless set; setting None restores it)."""
-        return self._spacing if self._spacing is not None else default_spacing(self.size, self._slices)
+        """Δ in the source's w units, c0's (a field's time): the one set, else the default spread over
+        the record (`default_spacing`; setting None restores it)."""
+        return self._spacing if self._spacing is not None else self._spread()
 
     @spacing.setter
     def spacing(self, value) -> None:
@@ -358,14 +246,32 @@ class StackSource:
         if d is not None:
             lo, hi = self.spacing_range
             if not lo <= d <= hi:
-                raise ValueError(f"Expected `spacing` in [{lo:.4g}, {hi:.4g}] ({SPACING_MIN:g} \u2026 {SPACING_MAX:g} "
-                                 f"times the source's size {self.size:.4g}) or None, got {d!r}")
+                unit = f" {_w_units(self.source)}" if _w_units(self.source) else ""
+                raise ValueError(f"Expected `spacing` in [{lo:.4g}, {hi:.4g}]{unit} ({SPACING_MIN:g} \u2026 "
+                                 f"{SPACING_MAX:g} times the source's size {self.size:.4g}, in its w units) or "
+                                 f"None, got {d!r}")
+        else:
+            self._default = None
         self._spacing = d
 
     @property
     def spacing_range(self) -> tuple:
-        """(lowest, highest) Δ allowed: `SPACING_MIN` and `SPACING_MAX` times the source's size."""
-        return SPACING_MIN * self.size, SPACING_MAX * self.size
+        """(lowest, highest) Δ allowed, in the source's w units: `SPACING_MIN` and `SPACING_MAX`
+        times the source's size (times its w per unit of space, `w_frame`)."""
+        per = w_frame(self.source)[1]
+        return SPACING_MIN * self.size * per, SPACING_MAX * self.size * per
+
+    def note_matrix(self, matrix) -> None:
+        """The orientation the view shows now (the source protocol's ``note_matrix``, told before an
+        action or a setting changes N): a default spacing spread from now on is spread along its w.
+        A turn alone never moves the slices: the default is spread only when the stack is made, when N
+        changes and when the spacing is set back to None."""
+        self._matrix = as_rotation_matrix(matrix)
+
+    def _spread(self) -> float:
+        if self._default is None:
+            self._default = default_spacing(self.source, self._slices, self._matrix)
+        return self._default
 
     @property
     def spacing_is_default(self) -> bool:
@@ -377,7 +283,7 @@ class StackSource:
 
     @arrangement.setter
     def arrangement(self, value) -> None:
-        self._arrangement = _check_arrangement(value)
+        self._arrangement = check_arrangement(value)
 
     @property
     def color_by(self) -> str:
@@ -418,8 +324,7 @@ class StackSource:
         return float(e) * float(self.layout()[1].max())
 
     def w_range(self, matrix) -> tuple:
-        f = getattr(self.source, "w_range", None)
-        return tuple(f(matrix)) if f is not None else (-self.size, self.size)
+        return _w_range(self.source, matrix)
 
     @property
     def wraps(self):
@@ -446,20 +351,23 @@ class StackSource:
             apply_setting(self.source, name, value)
 
     def __copy__(self) -> "StackSource":
-        """A stack around a copy of the inner source (replaying its actions changes the copy only)."""
-        return StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
-                           arrangement=self._arrangement, color_by=self._color_by)
+        """A stack around a copy of the inner source (replaying its actions changes the copy only),
+        its default spacing as spread here."""
+        new = StackSource(copy.copy(self.source), slices=self._slices, spacing=self._spacing,
+                          arrangement=self._arrangement, color_by=self._color_by, matrix=self._matrix)
+        new._default = self._default
+        return new
 
     @property
     def w_frame(self) -> tuple:
-        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0 and the
-        cuts are in its w units, Δ in the drawn units (a cut is Δ * per_unit from the next)."""
+        """The inner source's ``(origin, per_unit)`` (`rot4d_widget.sources.protocol.w_frame`): c0, Δ
+        and the cuts are in its w units."""
         return w_frame(self.source)
 
     def cut_offsets(self) -> np.ndarray:
-        """(N,) float64: each cut's offset from c0, in c0's units, ``(k - (N - 1)/2) Δ per_unit``
+        """(N,) float64: each cut's offset from c0, in c0's units (Δ's), ``(k - (N - 1)/2) Δ``
         (`stack_offsets`)."""
-        return stack_offsets(self._slices, self.spacing * w_frame(self.source)[1])
+        return stack_offsets(self._slices, self.spacing)
 
     def cuts_at(self, c0: float) -> np.ndarray:
         """The stack's cuts for the plane w = ``c0``: the w of each of the N slices, in c0's units,
@@ -505,7 +413,7 @@ class StackSource:
         n = self._slices + (1 if sign > 0 else -1)
         if not 1 <= n <= MAX_SLICES:
             return False
-        self._slices = n
+        self.slices = n  # a default spacing is spread again for N (never one the user set)
         return n
 
     def step_spacing(self, sign: int):
@@ -590,10 +498,9 @@ class StackSource:
         time, `data_w_text`), its census (polytopes) and volume (the source's own units)."""
         n = len(cuts)
         how = "colour by w (viridis, low w dark)" if self._color_by == "w" else "colour by cell"
-        wpu = getattr(self.source, "w_per_unit", None)
-        unit = getattr(self.source, "w_units", None)
-        delta = look.number_text(self.spacing * (wpu if wpu is not None else 1.0))
-        delta += f" {unit}" if wpu is not None and unit else ""
+        unit = _w_units(self.source)
+        delta = look.number_text(self.spacing) + (f" {unit}" if unit else "")
+        delta += "" if self._spacing is not None else " (spread over the record)"
         rows = [("stack", f"{n} slices, \u0394 = {delta}, {self._arrangement}, {how}")]
         polytope = self._polytope is not None
         if n <= 12:
@@ -602,14 +509,16 @@ class StackSource:
                 parts = []
                 if polytope:
                     parts.append(_short_census(piece.slice))
-                if v is not None:
+                if v is not None and not label.endswith("(outside the data)"):
                     space = getattr(self.source, "space_units", None)
                     parts.append(f"vol {look.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
-            rows.append(("w", f"{data_w_text(self.source, cuts[0], m)[2:]} \u2026 "
-                              f"{data_w_text(self.source, cuts[-1], m)[2:]} "
-                              f"(\u25b8 {data_w_text(self.source, cuts[hi], m)[2:]})"))
+            if getattr(self.source, "extent", None) is None:  # a polytope's own w
+                ends = [data_w_text(self.source, cuts[i])[2:] for i in (0, -1, hi)]
+            else:
+                ends = [w_value_text(self.source, cuts[i]) for i in (0, -1, hi)]
+            rows.append(("w", f"{ends[0]} \u2026 {ends[1]} (\u25b8 {ends[2]})"))
             if any(v is not None for v in volumes):
                 rows.append(("volumes", " ".join("\u2014" if v is None else f"{v:.3g}" for v in volumes)))
         if polytope:  # a hemi or non-orientable polytope: its slices have no volume, and why

@@ -8,14 +8,16 @@ no isosurface is computed for a single field, so a held key costs a coarse sampl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..sources.field_labels import box_labels
-from ..sources.protocol import SliceData, inner_source
+from ..core.look import RENDERING_TEXT, number_text
+from ..sources.field_labels import axis_names, axis_units, box_labels
+from ..sources.protocol import SliceData, data_w_text, inner_source, outline_of, settings_of
 
-__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "STACK_NODES"]
+__all__ = ["GridCut", "grid_cut", "can_sample", "cut_labels", "CutLabels", "NO_LABELS", "data_extent", "rendering_rows",
+           "STACK_NODES"]
 
 #: A stack's slices share this many grid nodes in all (each sampled more coarsely as they multiply).
 STACK_NODES = 4 * 64 ** 3
@@ -61,7 +63,10 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
         if inner is source:
             grid = _sample(inner, matrix, c0, None, coarse)
             pts, segs = grid.outline
-            data = SliceData.build(pts, segs, show_points=False, readout=_readout(grid))
+            rows = tuple(outline_of(inner, matrix, c0).readout)
+            n = sum(1 for k, _ in rows if k in ("field", "axes"))  # the level where the surfaces' readout has it
+            rows = rows[:n] + _level_row(inner, grid) + rows[n:] + _readout(grid)
+            data = SliceData.build(pts, segs, show_points=False, readout=rows)
             return GridCut(data, (_part(grid, np.zeros(3), scale),), (grid,))
         sliced = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
         ex = sliced.extra
@@ -77,8 +82,37 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
     return GridCut(data, parts, grids)
 
 
+@dataclass(frozen=True)
+class CutLabels:
+    """What the page needs to label a picture of a cut, whichever picture it is (the kernel's or the
+    page's own): ``labels``, ``(point (3,), text, kind)`` in slice coordinates (the source's units)
+    -- kind ``"corner"`` (the box's origin corner, every data coordinate there), ``"edge"`` (the far
+    end of an edge leaving it, what changes along it) or ``"slice"`` (a stack's slice, its w) --
+    and ``extent`` (n, 3) float64, the corners of the data's extent (the box's cut) that the box
+    labels keep clear of where they project.  False when there is no label."""
+
+    labels: tuple = ()
+    extent: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    def __bool__(self) -> bool:
+        return bool(self.labels)
+
+    def traits(self, scale: float) -> tuple:
+        """``(labels, extent)`` as the scene's buffer holds them (``_rot4d_labels``: ``{"p": [x, y,
+        z], "text", "kind"}``; ``_rot4d_label_extent``: ``[x, y, z]`` rows), in displayed units
+        (``scale`` times the source's); no extent without a label."""
+        pinned = [{"p": [float(v) * scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t),
+                   "kind": str(kind)} for p, t, kind in self.labels]
+        extent = np.asarray(self.extent, dtype=np.float64).reshape(-1, 3) * scale
+        return pinned, [[float(v) for v in row] for row in extent] if pinned else []
+
+
+#: A picture without labels.
+NO_LABELS = CutLabels()
+
+
 class _Box:
-    """The bounding box of a slice's points in the shape `box_labels` reads (``origin``, ``extent``)."""
+    """The bounding box of points in the shape `box_labels` reads (``origin``, ``extent``)."""
 
     def __init__(self, points):
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -87,19 +121,48 @@ class _Box:
         self.values = None
 
 
-def cut_labels(source, matrix, c0, data, grid=None) -> tuple:
-    """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels`): its box's
-    origin corner and the far ends of the three edges leaving it, with the data coordinates there,
-    in slice coordinates; ``grid`` the cut's `FieldGrid` (ray-cast renderings) or None (the
-    bounding box of ``data``'s points, the box's cut).  () for a stack, a source that maps no
-    slice point to its data (no ``to_data``) or an empty cut."""
-    if inner_source(source) is not source or not callable(getattr(source, "to_data", None)):
-        return ()
-    if grid is None:
-        if not len(data.points):
-            return ()
-        grid = _Box(data.points)
-    return box_labels(source, matrix, c0, grid)
+def data_extent(data) -> np.ndarray:
+    """(n, 3) float64: the corners of a single cut's data extent -- the points its bars (the box's
+    cut, ``data.segments``) join; the padded sampling grid of a ray-cast picture is never counted."""
+    seg = np.asarray(data.segments, dtype=np.intp).reshape(-1, 2)
+    if not len(seg):
+        return np.zeros((0, 3))
+    return np.asarray(data.points, dtype=np.float64).reshape(-1, 3)[np.unique(seg)]
+
+
+def cut_labels(source, matrix, c0, data) -> CutLabels:
+    """The labels of a single field's cut (`rot4d_widget.sources.field_labels.box_labels` of the
+    data's extent: the bounding box of the box's cut, ``data``'s bars, in every rendering): its
+    origin corner with every data coordinate there, the far ends of the three edges leaving it
+    with what changes along each, and the extent's corners.  A stack's: each slice's w under it
+    (`_slice_labels`).  An empty `CutLabels` for a source that maps no slice point to its data (no
+    ``to_data``) or a cut that misses the data."""
+    if inner_source(source) is not source:
+        return _slice_labels(source, matrix, c0, data)
+    if not callable(getattr(source, "to_data", None)):
+        return CutLabels()
+    extent = data_extent(data)
+    if not len(extent):
+        return CutLabels()
+    pairs = box_labels(source, matrix, c0, _Box(extent))
+    kinds = ("corner",) + ("edge",) * (len(pairs) - 1)
+    return CutLabels(tuple((p, t, k) for (p, t), k in zip(pairs, kinds)), extent)
+
+
+def _slice_labels(stack, matrix, c0, data) -> CutLabels:
+    """A stack's labels: under each slice (its centre and scale, ``data.extra``), the w it cuts at in
+    the data's own units (`data_w_text`: "time 0.0025 s", "(outside the data)" for a slice that
+    misses it), kind "slice" -- every slice carries its w, an empty one too."""
+    ex = data.extra
+    cuts = np.asarray(ex["cuts"], dtype=np.float64)
+    centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
+    scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+    if len(cuts) < 2:
+        return CutLabels()
+    radius = float(inner_source(stack).size)
+    labels = tuple((centres[k] + np.array([0.0, -1.02 * scales[k] * radius, 0.0]),
+                    data_w_text(stack, float(w), matrix), "slice") for k, w in enumerate(cuts))
+    return CutLabels(labels)
 
 
 def _sample(inner, matrix, c0, resolution, coarse):
@@ -109,6 +172,49 @@ def _sample(inner, matrix, c0, resolution, coarse):
         res = resolution if resolution is not None else getattr(inner, "coarse_resolution", None)
         return inner.sample(matrix, c0, res)
     return inner.sample(matrix, c0, resolution, coarse=coarse)
+
+
+def _level_row(source, grid) -> tuple:
+    """The iso level(s) in a ray-cast picture: named, and said not to be drawn (the surface
+    rendering draws them), so that no row reads as if the picture showed them."""
+    levels = settings_of(source).get("levels") or ()
+    if not levels:
+        return ()
+    units = f" {grid.units}" if grid.units else ""
+    return (("level" if len(levels) == 1 else "levels",
+             f"{', '.join(f'{v:.4g}' for v in levels)}{units}: the surface rendering's (v), not drawn here"),)
+
+
+def rendering_rows(source, matrix, c0, rendering: str, sections, grid) -> tuple:
+    """Readout rows saying what a ray-cast picture of a single field's cut shows: the rendering,
+    and for "sections" where its planes are, in the data's own coordinates -- for each plane (keys
+    a, s, d: the picture's x, y, z), the data coordinates that change across it, at the point where
+    it crosses the middle of the cut ("time 0.0025 s" after a turn into time; "(outside the data)"
+    for a plane in the grid's padding, past the data's box)."""
+    name = grid.name or "the value"
+    rows = [("rendering", RENDERING_TEXT[rendering].format(name=name))]
+    if rendering != "sections" or grid.empty or inner_source(source) is not source:
+        return tuple(rows)
+    ext = np.asarray(grid.extent, dtype=np.float64).reshape(3, 2)
+    mid = ext.mean(axis=1)
+    span = np.abs(np.diff(np.asarray(source.extent, dtype=np.float64).reshape(4, 2), axis=1)).ravel()
+    names, units = axis_names(source), axis_units(source)
+    planes = []
+    for a in range(3):
+        p = mid.copy()
+        p[a] = ext[a, 0] + float(sections[a]) * (ext[a, 1] - ext[a, 0])
+        q = p.copy()
+        q[a] += ext[a, 1] - ext[a, 0]
+        data = np.asarray(source.to_data(np.vstack([p, q]), matrix, c0), dtype=np.float64).reshape(2, 4)
+        moved = [c for c in range(4) if abs(data[1, c] - data[0, c]) > 1e-6 * max(span[c], 1e-300)]
+        moved.sort(key=lambda c: -abs(data[1, c] - data[0, c]) / max(span[c], 1e-300))
+        text = ", ".join(f"{names[c]} {number_text(data[0, c], span[c], 3)}" + (f" {units[c]}" if units[c] else "")
+                         for c in moved)
+        lo, hi = np.asarray(source.extent, dtype=np.float64).reshape(4, 2).T
+        outside = np.any((data[0] < lo - 1e-9 * span) | (data[0] > hi + 1e-9 * span))
+        planes.append(text + (" (outside the data)" if outside else ""))
+    rows.append(("planes a / s / d", "; ".join(planes)))
+    return tuple(rows)
 
 
 def _readout(grid) -> tuple:

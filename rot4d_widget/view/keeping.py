@@ -16,7 +16,7 @@ from ..core.state import without_source_keys
 from ..keep.export import SETTING_NAMES, load_state, save_state, slice_mesh
 from ..keep.export import settings_of as widget_settings
 from ..keep.recording import VIEW_DEFAULTS, VIEW_SETTINGS, Recorder, Recording, check_view_setting, render_animation
-from ..sources.protocol import apply_setting, inner_source, settings_of
+from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of
 
 __all__ = ["Keeper", "view_settings"]
 
@@ -155,6 +155,8 @@ class Keeper:
         with w._pump.lock:
             state = w.state.copy()
             kwargs = {**_taken_by_render_state(widget_settings(w)), **options}
+            if kwargs.get("slices") is not None and "spacing" not in options:
+                kwargs["spacing"] = w.spacing  # the slices the view shows, its default spread where it was
         size = (w.scene.width, w.scene.height) if size is None else size
         from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
 
@@ -223,6 +225,10 @@ class Keeper:
                 value = tuple(value)
             if getattr(w, name) != value:
                 setattr(w, name, value)
+        if w._stacking.is_stack and settings.get("spacing") is None:  # made now: spread along the loaded w
+            with w._pump.lock, w._source_lock:
+                note_matrix(w.source, w.state.matrix)
+                apply_setting(w.source, "spacing", None)
         w.refresh()
         with w._pump.lock:
             self.restart()

@@ -17,6 +17,7 @@ import math
 from collections.abc import Mapping
 
 from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
+from ..sources.protocol import note_matrix
 from . import markup
 from .fieldkeys import FieldKeys, level_actions
 from .pagestate import page_config
@@ -300,6 +301,7 @@ class KeyPath:
             if run is None:
                 return False
             with w._source_lock:
+                note_matrix(w.source, w.state.matrix)  # n: a default spacing spread along today's w
                 result = run[0](-1 if inverted else 1)
             if result is False:  # refused (at a bound): nothing changed, nothing recorded
                 return False

@@ -96,10 +96,11 @@ def _unit(unit) -> str:
 
 
 # ----------------------------------------------------------------------------- readout pieces
-def gauge_html(c0: float, lo: float, hi: float, unit: str | None = None) -> Markup:
+def gauge_html(c0: float, lo: float, hi: float, unit: str | None = None, text: str | None = None) -> Markup:
     """c0 with a small bar: where w = c0 lies between ``lo`` and ``hi`` (clamped, marked outside).
     ``unit``: c0's unit (a field's ``w_units``), written after the number; the number has four
-    decimals within 1000 of zero (a polytope's w), else four significant digits (a time in s).
+    decimals between 1 and 1000 from zero (a polytope's w), else four significant digits (a time
+    in s, or in ms of a run).  ``text``: what c0 is written as instead (a date and time), no unit.
 
     >>> print(gauge_html(0.5, 0.0, 1.0, "<b>"))
     0.5000 &lt;b&gt;<span class='rot4d-gauge' title='w from 0 to 1 &lt;b&gt;'><i style='left:50%'></i></span>
@@ -110,12 +111,17 @@ def gauge_html(c0: float, lo: float, hi: float, unit: str | None = None) -> Mark
     pos = min(max(frac, 0.0), 1.0) * 100.0
     note = f" ({where} the object)" if where else ""
     big = max(abs(lo), abs(hi), abs(c0))
-    text = f"{c0:.4f}" if big < 1000 else number_text(c0, big, 6)
+    u = _unit(unit)
+    if text is not None:
+        u = ""
+    elif 1.0 <= big < 1000:
+        text = f"{c0:.4f}"
+    else:
+        text = number_text(c0, big, 6 if big >= 1000 else 4)
     if text.lstrip("-").strip("0.") == "":  # no "-0.0000"
         text = text.lstrip("-")
-    u = _unit(unit)
     return Markup("{}{}<span class='rot4d-gauge' title='w from {:.4g} to {:.4g}{}'>"
-                  "<i style='left:{:.0f}%'></i></span>{}").format(text, u, lo, hi, u, pos, note)
+                  "<i style='left:{:.0f}%'></i></span>{}").format(text, u, lo, hi, _unit(unit), pos, note)
 
 
 def colourbar_html(stops, lo: float, hi: float, label: str, units: str | None = None, marks=(),

@@ -14,10 +14,10 @@ import numpy as np
 
 from ..core import look
 from ..keep.volume import default_clim
-from ..sources.protocol import BadSlice, check_slice, data_w_text, inner_source, outline_of
+from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, outline_of
 from . import markup as ro
 from .buffers import check_update_size
-from .cuts import can_sample, cut_labels, grid_cut
+from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
 from .fieldview import field_config, view_message
 from .pagefield import page_field
 from .pagestate import state_message
@@ -188,7 +188,7 @@ class Painter:
                 self.grid_cache = (m, c0, version, coarse_, cut)
             clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
-            labels = cut_labels(w.source, m, c0, cut.data, cut.grids[0] if len(cut.grids) == 1 else None)
+            labels = cut_labels(w.source, m, c0, cut.data)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
                 self.labelled = bool(labels)
                 sent = scene.update_id
@@ -282,6 +282,20 @@ class Painter:
         message = self.w._projection.message(key.matrix, key.c0, key.version)
         return {} if message is None else {"projection": message}
 
+    def data_read(self) -> None:
+        """The source's background read is over (`ViewBar.follow`): draw again from the data now in
+        memory, the readout with what the read found (a field's blocks of NaN: its "missing" row)."""
+        w = self.w
+        try:
+            with w._pump.lock:
+                if w._closed:
+                    return
+                w._source_version += 1  # the same source, read: slice it again
+                w._pump.mark_dirty()
+                w._pump.flush()
+        except Exception as exc:
+            w._report_error(exc)
+
     def eye_moved(self, eye) -> None:
         """Scene: the camera moved (a mouse orbit ended): send the faces in the order for the new eye."""
         w = self.w
@@ -346,19 +360,29 @@ class Painter:
             ("\u03b80", ro.angle_text(st.theta0)),
             ("\u03b1", ro.angle_text(st.alpha)),
             ("\u03b2", ro.angle_text(st.beta)),
-            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None))),
+            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None),
+                                 text=c0_text(inner_source(source), st.c0))),
             ("last", last),
         ]
         rows += [(k, str(v)) for k, v in getattr(data, "readout", ())]
+        cast = self.cast_shown
+        single = inner_source(source) is source
+        if cast and single and self.labelled:  # what the ray-cast picture shows, and where its planes are
+            cut = self.grid_cache[4] if self.grid_cache is not None else None
+            if cut is not None and len(cut.grids) == 1:
+                rows += rendering_rows(source, self.shown.matrix, self.shown.c0, w.rendering, w.sections,
+                                       cut.grids[0])
         colors, labels = self.colours()
-        if labels is not None and w.color_by == "group":  # the legend: what each colour is
-            rows.append(("colours", ro.legend_html(labels, colors)))
-        bar = self.colourbar(colors if labels is not None and inner_source(source) is source else None)
+        if labels is not None and w.color_by == "group" and not cast:  # the legend: what each colour is
+            rows.append(("colours", ro.legend_html(labels, colors)))  # (a ray-cast picture: the bar says)
+        bar = self.colourbar(colors if labels is not None and single else None)
         if bar:
             rows.append(("colour", bar))
         volume = getattr(data, "volume", None)
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
+        elif cast and single and getattr(inner_source(source), "levels", None):
+            rows.append(("volume", "\u2014 (inside the level: the surface rendering's)"))
         turning = self.turning_text()
         if turning is not None:
             rows.append(("turning", turning))
@@ -368,6 +392,11 @@ class Painter:
         if views is not None:
             rows.insert(0, views)
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
+
+    @property
+    def cast_shown(self) -> bool:
+        """True while the scene shows a ray-cast picture (volume, mip, sections), not surfaces."""
+        return self.shown is not None and self.shown.scale[2:3] not in ((), ("surface",))
 
     def colourbar(self, level_rgb=None) -> ro.Markup | str:
         """The colour bar of a field's values (`markup.colourbar_html`): ``cmap`` over ``clim`` (or
@@ -381,7 +410,7 @@ class Painter:
         levels = getattr(inner, "levels", None)
         if not levels:
             return ""
-        cast = self.shown is not None and self.shown.scale[2:3] not in ((), ("surface",))
+        cast = self.cast_shown
         if cast and self.cast_clim is not None:  # a ray-cast picture: the limits its colours used
             lo, hi = self.cast_clim
         else:

@@ -10,6 +10,8 @@ it while the work runs, whatever cell is running meanwhile, and hides it when th
 
 from __future__ import annotations
 
+import threading
+
 import ipywidgets
 from IPython.display import display
 
@@ -49,16 +51,20 @@ class ViewBar:
         self.label = ipywidgets.Label()
         self.box = ipywidgets.VBox([self.label, self.bar], layout=ipywidgets.Layout(display="none"))
         self.box.add_class("rot4d-progress")
+        self._on_done = None  # called when the work followed is done (`follow`)
 
     @property
     def visible(self) -> bool:
         return self.box.layout.display != "none"
 
-    def follow(self, source):
+    def follow(self, source, on_done=None):
         """Start ``source``'s background work (`rot4d_widget.sources.protocol.prepare_in_background`: a
         field's read into memory, or its coarse copy) and show its progress here until it is over; a
-        live widget does this for its source when it is made.  Returns the
+        live widget does this for its source when it is made.  ``on_done()``: called, on a thread of
+        its own (no lock of the count held), once the work is done -- the widget redraws, so the
+        readout says what the read found (a block of NaN).  Returns the
         `rot4d_widget.core.progress.Progress`, or None when there is nothing to do."""
+        self._on_done = on_done
         counter = prepare_in_background(source, progress=False)
         if counter is not None:
             counter.attach(self)
@@ -73,6 +79,8 @@ class ViewBar:
 
     def close(self, done: bool) -> None:
         self.box.layout.display = "none"
+        if done and self._on_done is not None:
+            threading.Thread(target=self._on_done, name="rot4d-read-done", daemon=True).start()
 
     @property
     def widgets(self) -> tuple:

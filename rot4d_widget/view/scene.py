@@ -71,6 +71,7 @@ from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
+from .cuts import NO_LABELS, CutLabels
 from .field_layer import FieldLayer
 from .keypad import close_quietly
 from .traits import check_flag as _flag
@@ -115,9 +116,10 @@ class _RowBuffer(p3.InstancedInterleavedBuffer):
     _rot4d_surface = Dict().tag(sync=True)
     #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
     _rot4d_volume = Dict().tag(sync=True)
-    #: Texts pinned to points of the view ({"p": [x, y, z] displayed units, "text": str}): the
-    #: companion draws them over the canvas where the points project, turned with the view.
+    #: Texts pinned to points of the view, turned with it, and the data's extent the box labels keep
+    #: clear of ([x, y, z] displayed units; `rot4d_widget.view.cuts.CutLabels.traits`).
     _rot4d_labels = List(Dict()).tag(sync=True)
+    _rot4d_label_extent = List(List(CFloat())).tag(sync=True)
     #: The projection's skeleton, sent once per source (`projection.skeleton_message`).  {} = none.
     _rot4d_skeleton = Dict().tag(sync=True)
     #: The projection's state, with every update while it is shown (`projection.state_message`).
@@ -381,8 +383,8 @@ class Scene:
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
-    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None, labels=(),
-             projection=None) -> bool:
+    def show(self, data, *, single_rgb=None, group_rgb=None, force=False, volume=None,
+             labels: CutLabels = NO_LABELS, projection=None) -> bool:
         """Show a slice (`rot4d_widget.sources.protocol.SliceData`); True if an update was sent.
 
         Normally one message: a new (capacity, 20) float32 array for the shared
@@ -393,8 +395,8 @@ class Scene:
         travel quantised in the same message (``_rot4d_surface``, coloured by
         ``group_rgb`` if given), the rows carry its points' bars.  ``volume``: a ray-cast
         rendering of the cut (`volume_layer.volume_message`) sent in the same message, in place
-        of any surface (None: no volume; one shown before is hidden).  ``labels``: ``(point (3,)
-        in the source's units, text)`` pairs drawn over the canvas where the points project.
+        of any surface (None: no volume; one shown before is hidden).  ``labels``: a `CutLabels`
+        (in the source's units) drawn over the canvas where its points project.
         ``projection``: what the projection view draws of this state (`ProjectionView.message`:
         ``{"state": ..., "skeleton": ...}``, the skeleton only when new), in the same message.
         """
@@ -413,9 +415,8 @@ class Scene:
             surface = {}
         if volume is None and self._volume_shown:
             volume = {}
-        pinned = [{"p": [float(v) * self.scale for v in np.asarray(p, dtype=np.float64).reshape(3)], "text": str(t)}
-                  for p, t in labels]
-        pinned = None if pinned == self._buffer._rot4d_labels else pinned
+        pinned = labels.traits(self.scale)
+        pinned = None if pinned == (self._buffer._rot4d_labels, self._buffer._rot4d_label_extent) else pinned
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -508,7 +509,7 @@ class Scene:
             if projection is not None:
                 _put_projection(self._buffer, projection)
             if labels is not None:
-                buf._rot4d_labels = labels
+                buf._rot4d_label_extent, buf._rot4d_labels = labels[1], labels[0]
             if surface is not None:
                 buf._rot4d_surface = surface
                 self._surface_shown = bool(surface)

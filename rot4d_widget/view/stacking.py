@@ -19,9 +19,10 @@ def is_stack(source) -> bool:
     return inner_source(source) is not source
 
 
-def make_stack(source, slices, spacing=None, arrangement="oval"):
-    """``slices`` parallel slices of ``source`` (raises before anything changes if not allowed)."""
-    return StackSource(source, slices=slices, spacing=spacing, arrangement=arrangement)
+def make_stack(source, slices, spacing=None, arrangement="oval", matrix=None):
+    """``slices`` parallel slices of ``source`` (raises before anything changes if not allowed), a
+    default spacing spread along the w of ``matrix`` (the view's orientation; None: the identity)."""
+    return StackSource(source, slices=slices, spacing=spacing, arrangement=arrangement, matrix=matrix)
 
 
 class Stacking:
@@ -41,7 +42,7 @@ class Stacking:
         keymap and the help.  Raises before any change if ``slices`` is not allowed.
         """
         w = self.w
-        stack = make_stack(w.source, slices)
+        stack = make_stack(w.source, slices, matrix=w.state.matrix)
         # the stack brings the inner source's keys too: rebind them from the reserved ones
         w._keys.use_keymap(without_source_keys(w.state.keymap), stack)
         with w._source_lock:

@@ -9,7 +9,7 @@ protocol (`settings_of`, `inner_source`), never from its class.
 
 from __future__ import annotations
 
-from ..sources.protocol import inner_source
+from ..sources.protocol import inner_source, note_matrix
 from .painter import title
 
 __all__ = ["TraitSync", "STATE_TRAITS", "DISPLAY_TRAITS", "FIELD_TRAITS", "STACK_TRAITS", "COLOUR_TRAITS"]
@@ -92,6 +92,7 @@ class TraitSync:
                 if target is None:
                     raise TypeError(why_not)
                 with w._source_lock:
+                    note_matrix(w.source, w.state.matrix)  # `slices`: a default spacing spread along today's w
                     setattr(target, change["name"], change["new"])
             except Exception:
                 self.set_quietly(change["name"], change["old"])

@@ -52,8 +52,8 @@ from ipyevents import Event
 from ..core import look
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
+from ..sources.arrangements import ARRANGEMENTS
 from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
-from ..sources.tomography import ARRANGEMENTS
 from . import markup
 from . import progress as _progress  # registers the kernel's progress bar with the core; the widget's own
 from . import traits as t
@@ -135,9 +135,9 @@ class Rot4DWidget(widgets.HBox):
     slices, spacing, arrangement : int, float, str, optional
         Parallel slices at w = c0 + (k - (N - 1)/2) * spacing (4-D tomography,
         `rot4d_widget.sources.tomography.StackSource`), placed "oval" (on a parabola, the slice at
-        c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the
-        spacing (default 2 * size / N).  Also traits: setting `slices` (or pressing n) on a
-        single view turns it into parallel slices (oval, default spacing).
+        c0 nearest the eye), "grid" or "stack"; keys n / b and g / f change N and the spacing (in
+        the source's w units, like c0; default: the record's extent along w over N, spread when
+        made and on n / b).  Also traits: `slices` (or n) on a single view makes parallel slices.
     levels : float or sequence of floats, optional
         Iso levels of a field source (`Field4D`); also the `levels` trait, and keys
         o / i move them.  Several are drawn as nested translucent surfaces.
@@ -186,7 +186,7 @@ class Rot4DWidget(widgets.HBox):
                                               "(False); None for sources without one")
     slices = t.Count(None, low=1, high=64, allow_none=True,
                      help="parallel slices shown; None for a single view until set (or n pressed)")
-    spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's units")
+    spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's w units")
     arrangement = t.Choice(None, ARRANGEMENTS, allow_none=True, help="where the parallel slices are placed")
     cmap = t.Cmap(look.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
     clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
@@ -526,7 +526,7 @@ def _wire(w, keypad) -> None:
     # readout; its first picture above read only the chunks the cut touches.  Only with the
     # ticker running (a live widget): scripts and tests stay deterministic.
     if w._pump.autotick:
-        w.progress_bar.follow(inner_source(w.source))
+        w.progress_bar.follow(inner_source(w.source), on_done=w._painter.data_read)
 
 
 def _unwire(w) -> None:

@@ -24,7 +24,7 @@ field = Field4D.from_xarray(da, w="time", levels=0.0)
 w = Rot4DWidget(field, width=420, height=360)
 w''',
     '''\
-s = Rot4DWidget(Field4D.from_xarray(da, w="time", levels=0.0), slices=3, spacing=1.0, arrangement="grid",
+s = Rot4DWidget(Field4D.from_xarray(da, w="time", levels=0.0), slices=3, spacing=30.0, arrangement="grid",
                 width=420, height=360)
 s''',
 ]
@@ -45,8 +45,8 @@ def test_a_field_s_readout_and_stack_labels_are_in_the_data_s_units(jupyter_serv
             assert "m\u00b3" in text and "phi [m2]" in text and "s per m" in text, text
             assert "30.0000 s" in text, text  # c0 is the data's time: the middle, 30 s
         else:
-            # 30 s per unit of space (5 s per time step over 1/6 m per grid step): Δ = 1 is 30 s
-            for label in ("w 0 s", "w 30 s", "w 60 s", "\u0394 = 30 s", "vol 11.35 m\u00b3"):
+            # the spacing in seconds, like c0 (issue 37); each slice named by its dim, time
+            for label in ("time 0 s", "time 30 s", "time 60 s", "\u0394 = 30 s", "vol 11.35 m\u00b3"):
                 assert label in text, text
         box, sbox = jp.page.locator(sel).bounding_box(), side.bounding_box()
         clip = {"x": box["x"], "y": min(box["y"], sbox["y"]), "width": sbox["x"] + sbox["width"] - box["x"],

@@ -23,7 +23,7 @@ import numpy as np
 from PIL import Image
 from rot4d_widget import Field4D, Rot4DWidget
 from rot4d_widget.core import look
-from rot4d_widget.keep.volume import render_grid
+from rot4d_widget.keep.volume import render_grid, view_rotation
 
 # an off-centre blob in x, y, z, t and a second, weaker one: where the values are high and low
 x = np.linspace(-1.0, 1.0, 25)
@@ -44,7 +44,8 @@ def compare(png, rendering):
     half_w = half_h * W / H
     opts = dict(sections=tuple(w.sections)) if rendering == "sections" else {}
     rgba = render_grid(g, rendering, size=(W, H), limits=((-half_w, half_w), (-half_h, half_h)), cmap=w.cmap,
-                       clim=w.clim, scale=w.scene.scale, pixels_per_ray=1, **opts)
+                       clim=w.clim, scale=w.scene.scale, pixels_per_ray=1,
+                       view=view_rotation(w.scene.eye), **opts)
     static = rgba[..., :3] * rgba[..., 3:] + (1.0 - rgba[..., 3:])  # over the white background
     Image.fromarray(np.round(static * 255).astype(np.uint8)).save(f"volume-{rendering}-static.png")
     ink = lambda a: (1.0 - a).sum(axis=2)  # how far from white

@@ -61,6 +61,7 @@ import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer
 import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
 import { fieldArrived, freeField, noteContext, wantsTransfer } from "./field.js";
 import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField, quickField } from "./fieldpicture.js";
+import { drawLabels } from "./labels.js";
 
 export { decodeSkeleton, projectSkeleton };
 
@@ -639,17 +640,19 @@ async function render({ model, el }) {
       };
       const watched = { array: note("array"), _rot4d_seq: note("seq"), _rot4d_counts: note("counts"), _rot4d_turn: note("turn"),
                         _rot4d_surface: note("surface"), _rot4d_volume: note("volume"),
-                        _rot4d_labels: note("labels"), _rot4d_project: note("project"),
+                        _rot4d_labels: note("labels"), _rot4d_label_extent: note("labels"), _rot4d_project: note("project"),
                         _rot4d_skeleton: note("project") };
       let guardsAt = -Infinity;
       // Labels pinned to points of the view (`_rot4d_labels`: a field's box corners with their data
-      // coordinates): an overlay over each canvas of this scene, each text where its point projects
-      // through the camera of the frame just drawn, turned with the meshes.  Rewritten only when a
-      // position or a text changed.
+      // coordinates, a stack's slices with their w): an overlay over each canvas of this scene, each
+      // text placed from where its point projects through the camera of the frame just drawn, turned
+      // with the meshes, clear of where the data's extent (`_rot4d_label_extent`) projects
+      // (labels.js).  Rewritten only when a position or a text changed.
       const overlays = new Map(); // canvas host element -> {div, key}
       cleanups.push(() => overlays.forEach((o) => o.div.remove()));
       const placeLabels = (camera) => {
         const labels = fieldOwn ? [] : buffer.get("_rot4d_labels") || [];  // the kernel's: not while the page draws
+        const extent = labels.length ? buffer.get("_rot4d_label_extent") || [] : [];
         const cls = model.get("canvas_class");
         if (!cls || !camera || !camera.projectionMatrix) return;
         const turn = meshes.length && meshes[0].obj ? meshes[0].obj.matrixWorld : null;
@@ -658,13 +661,15 @@ async function render({ model, el }) {
           const canvas = host.localName === "canvas" ? host : host.querySelector("canvas");
           if (!canvas || !canvas.isConnected) continue;
           const w = canvas.clientWidth, h = canvas.clientHeight;
-          const spots = labels.map((l) => {
-            const v = new V(l.p[0], l.p[1], l.p[2]);
+          const at = (p) => {
+            const v = new V(p[0], p[1], p[2]);
             if (turn) v.applyMatrix4(turn);
             v.project(camera);
-            return { x: Math.round(((v.x + 1) / 2) * w), y: Math.round(((1 - v.y) / 2) * h), text: String(l.text || "") };
-          });
-          const key = JSON.stringify(spots);
+            return { x: Math.round(((v.x + 1) / 2) * w), y: Math.round(((1 - v.y) / 2) * h) };
+          };
+          const spots = labels.map((l) => ({ ...at(l.p), text: String(l.text || ""), kind: String(l.kind || "edge") }));
+          const box = extent.map(at);
+          const key = JSON.stringify([spots, box, w, h]);
           let o = overlays.get(host);
           if (o && o.key === key && o.div.isConnected) continue;
           if (!o || !o.div.isConnected) {
@@ -677,24 +682,7 @@ async function render({ model, el }) {
             overlays.set(host, o);
           }
           o.key = key;
-          // a dot at each point, its text beside it away from the labels' middle (the box's),
-          // kept inside the canvas
-          const mid = spots.reduce((a, s) => a + s.x, 0) / Math.max(spots.length, 1);
-          const shown = spots.filter((s) => s.text);
-          o.div.replaceChildren(...shown.map((s) => {
-            const span = document.createElement("span");
-            span.className = "rot4d-label";
-            span.textContent = s.x <= mid ? s.text + " \u25cf" : "\u25cf " + s.text;
-            span.style.cssText = `position:absolute;left:${s.x}px;top:${s.y}px;font:10px sans-serif;color:#333;` +
-              "background:rgba(255,255,255,0.72);padding:0 2px;white-space:nowrap;transform:translate(0,-50%)";
-            return span;
-          }));
-          Array.from(o.div.children).forEach((span, i) => {
-            const s = shown[i];
-            const width = span.offsetWidth;
-            const x0 = s.x <= mid ? s.x - width + 5 : s.x - 5;
-            span.style.left = `${Math.max(0, Math.min(w - width, x0))}px`;
-          });
+          drawLabels(o.div, spots, box, w, h);
         }
       };
       const onRendered = (_scene, _renderer, camera) => {
