@@ -134,8 +134,11 @@ def test_no_directional_light_and_shaders_do_the_lighting(scenes):
     objects = list(walk(sc.canvas.scene))
     assert not any(isinstance(o, p3.DirectionalLight) for o in objects)
     parts = [o for o in objects if isinstance(o, p3.Mesh)]
-    assert [m.name for m in parts] == ["balls", "bars", "faces", "surface", "volume"]
+    assert [m.name for m in parts] == ["balls", "bars", "faces", "surface", "volume", "field"]
     assert parts[4].visible is False  # the ray-cast layer (emission, not lit) waits for a field's volume
+    assert parts[5].visible is False  # the page's own field picture: shown by the page alone (issue 36)
+    field = parts[5].material  # its isosurfaces lit as the surface layer's
+    assert "vec3 shade(" in field.fragmentShader and {"u_ambient", "u_light_position"} <= set(field.uniforms)
     for m in parts[:4]:
         assert m.frustumCulled is False
         assert isinstance(m.material, p3.ShaderMaterial)
@@ -176,7 +179,7 @@ def test_faces_facing_away_from_the_camera_come_first(scenes, name):
 
 def test_meshes_share_one_buffer_through_the_documented_columns(scenes):
     sc, _ = scenes("24-cell")
-    geos = [m.geometry for name, m in meshes(sc).items() if name not in ("surface", "volume")]
+    geos = [m.geometry for name, m in meshes(sc).items() if name not in ("surface", "volume", "field")]
     buffers = set()
     for g in geos:
         assert isinstance(g, p3.InstancedBufferGeometry)
@@ -214,7 +217,7 @@ def test_shader_attributes_match_the_columns(scenes):
     sc, _ = scenes("5-cell")
     decl = {}
     for name_, m in meshes(sc).items():
-        if name_ in ("surface", "volume"):  # their own geometries (test_surface_*, test_volume_layer.py)
+        if name_ in ("surface", "volume", "field"):  # their own geometries (test_surface_*, test_volume_layer.py)
             continue
         for typ, name in re.findall(r"attribute (vec[234]|float) (\w+);", m.material.vertexShader):
             decl[name] = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}[typ]
@@ -349,7 +352,7 @@ def test_growth_keeps_every_intermediate_state_whole(scenes, log):
     big = src.slice(random_rotation(np.random.default_rng(0)), 0.0)
     sc.show(big)
     assert live_widgets() == widgets_before
-    geo_ids = {m.geometry.model_id for name, m in meshes(sc).items() if name not in ("surface", "volume")}
+    geo_ids = {m.geometry.model_id for name, m in meshes(sc).items() if name not in ("surface", "volume", "field")}
     assert len(geo_ids) == 3
     kinds = [("buffer" if cid == sc.buffer_model_id else "geometry" if cid in geo_ids else cid) for cid, *_ in log]
     assert kinds == ["buffer", "geometry", "geometry", "geometry", "buffer"]

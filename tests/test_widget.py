@@ -27,6 +27,7 @@ from rot4d_widget.core.keymap import RESERVED_KINDS
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import DEFAULT_THETA0
 from rot4d_widget.view.pagecut import PageCut
+from rot4d_widget.view.pagefield import PageField
 from rot4d_widget.view.transfer import Transfers
 from rot4d_widget.view.widget import Rot4DWidget
 
@@ -138,8 +139,10 @@ class FakeCompanion(ipywidgets.DOMWidget):
         self.config = {}  # as `Companion`: what the page steps its state by, and the kernel's state
         self.kernel_state = {}
         self.page_data, self.draw_config = {}, {}  # what the page holds and how it draws its own pictures
+        self.field_config = {}
         self.transfers = Transfers(self)
         self.page_cut = PageCut(self)
+        self.page_field = PageField(self)
         self.last_draw_time = None  # as `Companion`: the page's time for the last update it drew
 
     def on_drawn(self, callback, remove=False):
@@ -157,6 +160,9 @@ class FakeCompanion(ipywidgets.DOMWidget):
 
     def on_screenshot(self, callback, remove=False):
         pass  # screenshots: tests/test_widget_screenshot.py, with the real companion
+
+    def on_holds(self, callback, remove=False):
+        pass  # the page's copies: tests/test_page_field.py, with the real companion
 
     def request_screenshot(self, request_id):
         pass

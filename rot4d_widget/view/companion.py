@@ -81,6 +81,7 @@ from traitlets import Dict, List, Unicode
 
 from .bundle import page_module
 from .pagecut import PageCut
+from .pagefield import PageField
 from .transfer import Transfers
 
 __all__ = ["Companion", "MAX_CLOCK_EDGES"]
@@ -126,6 +127,9 @@ class Companion(anywidget.AnyWidget):
     #: how the page draws its own pictures of a polytope it cuts (`pagecut.PageCut`): the scale, the
     #: group colours packed as the row buffer holds them, one colour for all faces or None
     draw_config = Dict().tag(sync=True)
+    #: how the page draws its own pictures of a field it holds (`fieldview.field_config`): the field's
+    #: box and frame, the layout of the slices, the rendering's fixed settings and colours
+    field_config = Dict().tag(sync=True)
 
     def __init__(self, scene=None, **kwargs):
         if scene is not None:
@@ -144,8 +148,10 @@ class Companion(anywidget.AnyWidget):
         self._focus_handlers = CallbackDispatcher()
         self._screenshot_handlers = CallbackDispatcher()
         self._clock_handlers = CallbackDispatcher()
+        self._holds_handlers = CallbackDispatcher()
         self.transfers = Transfers(self)
         self.page_cut = PageCut(self)
+        self.page_field = PageField(self)
         self.last_drawn = None  # the last "drawn" id a page sent, awaited or not
         self.last_draw_time = None  # its seconds from the update's arrival to that "drawn", if said
         self.on_msg(self._handle_message)
@@ -168,6 +174,10 @@ class Companion(anywidget.AnyWidget):
         and the page's key events the kernel has not acknowledged (as the page sent them, at most
         `MAX_CLOCK_EDGES`: `rot4d_widget.view.keys.KeyPath.heartbeat` checks each)."""
         self._clock_handlers.register_callback(callback, remove=remove)
+
+    def on_holds(self, callback, remove=False):
+        """Call ``callback(name)`` when a page says it holds the one-time transfer ``name``."""
+        self._holds_handlers.register_callback(callback, remove=remove)
 
     def on_focus_lost(self, callback, remove=False):
         """Call ``callback(reason, t_ms)`` (``"blur"`` or ``"hidden"``; the page's time, or None) when
@@ -197,10 +207,17 @@ class Companion(anywidget.AnyWidget):
             reason, t = content.get("reason"), content.get("t")
             ok = isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t)
             self._focus_handlers(reason if isinstance(reason, str) else "", float(t) if ok else None)
-        elif event in ("want", "holds"):
+        elif event in ("want", "holds", "got"):
             name, key = content.get("name"), content.get("key")
             if isinstance(name, str) and isinstance(key, str):
-                (self.transfers.want if event == "want" else self.page_cut.holds)(name, key)
+                if event == "want":
+                    self.transfers.want(name, key)
+                elif event == "got":
+                    self.transfers.got(name, key, content.get("part"))
+                else:
+                    self.page_cut.holds(name, key)
+                    self.page_field.holds(name, key)
+                    self._holds_handlers(name)
         elif event == "clock":
             t, edges = content.get("t"), content.get("edges")
             if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):

@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from ..core.keymap import REPEATING_KINDS, RESERVED_KINDS, SHIFT_KINDS, Action, Keymap
 from ..sources.protocol import note_matrix
 from . import markup
+from .fieldkeys import FieldKeys, level_actions
 from .pagestate import page_config
 from .pagesteps import HEARTBEAT_STALE, PREDICTED_KINDS, LastStep, PageSteps
 
@@ -39,7 +40,7 @@ class KeyPath:
         """Take the page's keys by their timestamps from now on (`PageSteps`)."""
         rep = self.w._repeater
         self.page = PageSteps(self.w.state, recorder, self.last, hold_delay=rep.hold_delay,
-                              tick_rate=rep.tick_rate, clock=clock)
+                              tick_rate=rep.tick_rate, clock=clock, view=FieldKeys(self.w))
 
     @property
     def held(self) -> tuple:
@@ -92,8 +93,9 @@ class KeyPath:
         if action.kind == "help":
             w.help_visible = not w.help_visible
             return
-        if action.kind in PREDICTED_KINDS and when is not None:  # the page's schedule
-            self.page.press(kid, action, inverted, 1000.0 * when, action.kind in REPEATING_KINDS)
+        if (action.kind in PREDICTED_KINDS or self.page.view.steps(action)) and when is not None:  # the page's
+            repeats = action.kind in REPEATING_KINDS or (action.kind == "custom" and w._custom[action.name][1])
+            self.page.press(kid, action, inverted, 1000.0 * when, repeats)
             self.advance()
             w._pump.flush()
             return
@@ -161,8 +163,11 @@ class KeyPath:
         """The page's steps heard of and not applied yet (lock held): applied, recorded, the picture
         dirty and the traits synced once."""
         w = self.w
-        if self.page.advance().changed:
+        applied = self.page.advance()
+        if applied.changed:
             w._pump.mark_dirty()
+            if any(a.kind == "custom" for a in applied.actions):  # a field's levels (the source changed)
+                w._sync.source_traits()
             w._sync.state_traits()
             # the page learns the kernel answers; the picture of this state is owed (the pump sends it)
             w._painter.send_state("pending", throttle=bool(self.page.held))
@@ -242,8 +247,14 @@ class KeyPath:
         """The key table and rules the page steps its copy of the state by (`pagestate.page_config`)."""
         w = self.w
         rep = w._repeater
-        w.companion.config = page_config(w.state.keymap, hold_delay=rep.hold_delay, tick_rate=rep.tick_rate,
-                                         max_lag=rep.max_steps * rep.period, predicted=PREDICTED_KINDS)
+        predicted = PREDICTED_KINDS | self.page.view.kinds()
+        levels = level_actions(w.source)
+        actions = {name: {"rule": "levels", "sign": sign, "repeat": bool(w._custom[name][1])}
+                   for name, sign in levels.items() if name in w._custom}
+        config = page_config(w.state.keymap, hold_delay=rep.hold_delay, tick_rate=rep.tick_rate,
+                             max_lag=rep.max_steps * rep.period, predicted=predicted, predicted_actions=actions)
+        if config != w.companion.config:
+            w.companion.config = config
 
     # -- steps -----------------------------------------------------------------------------
     def tick(self, now: float) -> None:

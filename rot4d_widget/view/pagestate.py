@@ -22,17 +22,21 @@ def action_message(action) -> dict:
     return {"kind": action.kind, "planes": action.planes, "sign": int(action.sign), "name": action.name}
 
 
-def page_config(keymap: Keymap, *, hold_delay: float, tick_rate: float, max_lag: float, predicted=()) -> dict:
+def page_config(keymap: Keymap, *, hold_delay: float, tick_rate: float, max_lag: float, predicted=(),
+                predicted_actions=None) -> dict:
     """The page's key table and rules: ``keymap`` (key name -> action), which kinds Shift inverts
     and which repeat while held, the state's bounds, the hold delay and tick rate (s, Hz) that give
     a held key's steps (`rot4d_widget.view.keyhold.steps_for`), the kernel's catch-up window
-    ``max_lag``, and the action kinds the page steps itself (``predicted``: the state's kinds;
-    a source's own actions run Python code and are the kernel's alone)."""
+    ``max_lag``, and the action kinds the page steps itself (``predicted``: the state's kinds, a
+    field's view kinds; a source's own actions run Python code and are the kernel's alone, but for
+    those ``predicted_actions`` names -- a field's levels, ``{name: {"rule": "levels", "sign",
+    "repeat"}}``: `rot4d_widget.view.fieldkeys`)."""
     return {
         "keymap": {k: action_message(a) for k, a in keymap.items()},
         "shift_kinds": sorted(SHIFT_KINDS),
         "repeating_kinds": sorted(REPEATING_KINDS),
         "predicted_kinds": sorted(predicted),
+        "predicted_actions": dict(predicted_actions or {}),
         "bounds": {
             "theta0_min": st.THETA0_MIN,
             "theta0_max": st.THETA0_MAX,
@@ -50,12 +54,13 @@ def _matrix(m) -> list:
     return [float(x) for x in m.reshape(16)]
 
 
-def state_message(state: st.RotationState) -> dict:
+def state_message(state: st.RotationState, view: dict | None = None) -> dict:
     """``state`` as the page adopts it: the matrix (16 numbers, row by row), theta0, alpha, c0 and
-    its step, the c0 range and the reset point."""
+    its step, the c0 range and the reset point; with ``view``, a field's view settings
+    (`rot4d_widget.view.fieldview.view_message`)."""
     t, a, c, m = state.reset_point
     limit = state.c0_limit
-    return {
+    msg = {
         "matrix": _matrix(state.matrix),
         "theta0": state.theta0,
         "alpha": state.alpha,
@@ -65,3 +70,6 @@ def state_message(state: st.RotationState) -> dict:
         "c0_origin": state.c0_origin,
         "initial": {"matrix": _matrix(m), "theta0": t, "alpha": a, "c0": c},
     }
+    if view is not None:
+        msg["view"] = view
+    return msg

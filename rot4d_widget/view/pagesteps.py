@@ -18,6 +18,10 @@ prediction with server reconciliation); a change from the kernel is placed at ``
 A checkpoint is taken when no key is held (the state becomes the base) and before a change that
 starts in the kernel (`sync_external` notices one by the state no longer being what the last
 step made, and starts a new epoch from it).
+
+Besides the state, a field's view settings are stepped the same way (issue 36: its rendering,
+section planes and levels; ``view``, a `rot4d_widget.view.fieldkeys.FieldKeys`): their steps are
+the kernel's own (recorded as those are), their snapshot part of the checkpoint.
 """
 
 from __future__ import annotations
@@ -77,20 +81,23 @@ class PageSteps:
     """One widget's page-timed steps (the lock of its pump held by every caller).
 
     Collaborators: ``state`` (`RotationState`, the authority), ``recorder`` (the widget's
-    `rot4d_widget.keep.recorder.Recorder`), ``last`` (`LastStep`), ``clock`` (the pump's, seconds).
+    `rot4d_widget.keep.recorder.Recorder`), ``last`` (`LastStep`), ``clock`` (the pump's, seconds),
+    ``view`` (the field's view settings, `FieldKeys`: ``steps(action)``, ``snapshot()``,
+    ``restore(snap)``, ``apply(action, inverted)``).
     """
 
-    def __init__(self, state, recorder, last: LastStep, *, hold_delay: float, tick_rate: float, clock):
+    def __init__(self, state, recorder, last: LastStep, *, hold_delay: float, tick_rate: float, clock, view):
         self.state = state
+        self.view = view
         self.recorder = recorder
         self.last = last
         self.clock = clock
         self.log = StepLog(hold_delay, tick_rate)
         self.epoch = 0
         self.upto = -math.inf  # page ms: the state has every step due by then
-        #: since the checkpoint: (step, it changed the state, the state and last step after it)
+        #: since the checkpoint: (step, it changed the state, the state and view, and last step after it)
         self._applied: list[tuple[PageStep, bool, tuple, tuple]] = []
-        self._base = state.snapshot()
+        self._base = self._snapshot()
         self._base_last = last.snapshot()
         self._made = self._base  # the state as the last step left it (a change since: the kernel's)
         self._offset = -math.inf  # page ms minus kernel ms: at least this (the latest page time heard, sent)
@@ -163,10 +170,13 @@ class PageSteps:
         return (self.epoch, self.upto)
 
     # -- applying -----------------------------------------------------------------------
+    def _snapshot(self) -> tuple:
+        return (self.state.snapshot(), self.view.snapshot())
+
     def sync_external(self) -> bool:
         """If the state changed since the last step (a trait, code, a replay, a source's key ...):
         a checkpoint there and a new epoch.  True if it had."""
-        if _same(self.state.snapshot(), self._made):
+        if _same(self._snapshot(), self._made):
             return False
         self._checkpoint(self.upto)
         self.epoch += 1
@@ -180,7 +190,8 @@ class PageSteps:
         done = [a[0] for a in self._applied]
         rebuilt = done != steps[: len(done)]
         if rebuilt:
-            self.state.restore_snapshot(self._base)
+            self.state.restore_snapshot(self._base[0])
+            self.view.restore(self._base[1])
             self.last.restore(self._base_last)
             self._record_restore()
             todo, self._applied = steps, []
@@ -190,14 +201,18 @@ class PageSteps:
             self.epoch += 1  # a step older than the state last named (a late event): a new name
         actions = []
         for step in todo:
-            changed = self.state.apply(step.action, step.inverted)
+            if self.view.steps(step.action):  # a field's key: the kernel's own step, recorded there
+                changed = self.view.apply(step.action, step.inverted)
+            else:
+                changed = self.state.apply(step.action, step.inverted)
+                if changed:
+                    self.recorder.record(None, False, step.action, step.inverted, t=self._stamp(step.t))
             if changed:
                 self.last.note(step.action.label(step.inverted))
-                self.recorder.record(None, False, step.action, step.inverted, t=self._stamp(step.t))
                 actions.append(step.action)
-            self._applied.append((step, changed, self.state.snapshot(), self.last.snapshot()))
+            self._applied.append((step, changed, self._snapshot(), self.last.snapshot()))
         self.upto = max(self.upto, self.log.heard)
-        self._made = self.state.snapshot()
+        self._made = self._snapshot()
         if not self.log.held and self.log.keys:
             self._checkpoint(self.upto)
         elif len(self._applied) > ROLL_STEPS:  # only steps the page said it made, long enough ago
@@ -220,12 +235,12 @@ class PageSteps:
         is the base a rebuild starts from."""
         self.log.checkpoint(t)
         self._applied = []
-        self._base = self._made = self.state.snapshot()
+        self._base = self._made = self._snapshot()
         self._base_last = self.last.snapshot()
 
     def _record_restore(self) -> None:
         """A rebuild in the recording: the checkpoint's values, set exactly (the steps follow)."""
-        matrix, theta0, alpha, c0 = self._base
+        matrix, theta0, alpha, c0 = self._base[0]
         for name, value in (("matrix", matrix), ("theta0", theta0), ("alpha", alpha), ("c0", c0)):
             self.recorder.record_set(name, value)
 
@@ -237,5 +252,6 @@ class PageSteps:
 
 
 def _same(a: tuple, b: tuple) -> bool:
-    """Two state snapshots equal (the matrices by value)."""
-    return a[1:] == b[1:] and (a[0] is b[0] or bool((a[0] == b[0]).all()))
+    """Two snapshots ``(state's, view's)`` equal (the matrices by value)."""
+    (sa, va), (sb, vb) = a, b
+    return va == vb and sa[1:] == sb[1:] and (sa[0] is sb[0] or bool((sa[0] == sb[0]).all()))

@@ -18,6 +18,8 @@ from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inne
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
+from .fieldview import field_config, view_message
+from .pagefield import page_field
 from .pagestate import state_message
 from .volume_layer import volume_message
 
@@ -150,7 +152,8 @@ class Painter:
         single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
         cut = w.companion.page_cut
         cut.sync(w.source, self.group_colors(), w._scale, single)
-        if held and cut.page_draws:  # the page draws the pictures of the keys held: no work here
+        self.sync_field()
+        if held and (cut.page_draws or w.companion.page_field.page_draws):  # the page draws them: no work here
             self.send_state("pending")
             self.readout_stale = True  # at rest the picture and the readout follow (`KeyPath.settle`)
             return None
@@ -225,6 +228,7 @@ class Painter:
         # the state and its id, and which picture shows it: this one, if it is of the state now (keys
         # may have changed it while the picture was made), else one is owed
         now_shown = key.matrix is w.state.matrix and key.c0 == w.state.c0
+        self.sync_field()  # the colour limits this picture used (the page's while it draws)
         self.send_state(picture=(sent if now_shown else "pending") if sent is not None else
                         (None if now_shown else "pending"))
         w._shots.send_owed()  # screenshots asked meanwhile: of this picture
@@ -248,14 +252,29 @@ class Painter:
             return
         w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
         epoch, upto = w._keys.page.state_id
-        msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": state_message(w.state),
-               "keys": w._keys.page.held_since(), "picture": picture}
+        msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None,
+               "state": state_message(w.state, view_message(w)), "keys": w._keys.page.held_since(),
+               "picture": picture}
         old = w.companion.kernel_state
         if picture is None and old.get("picture") != "pending" and old.get("state") == msg["state"] \
                 and old.get("epoch") == epoch and old.get("upto") == msg["upto"] and old.get("keys") == msg["keys"]:
             return  # unchanged: nothing to send (the picture named before still shows it)
         w.companion.kernel_state = msg
         self.state_at = now
+
+    def sync_field(self) -> None:
+        """Offer the page the field's copy once it is in memory (`pagefield.PageField`) and say how
+        it draws it (`fieldview.field_config`, sent when it changed)."""
+        w = self.w
+        pf = w.companion.page_field
+        pf.sync(w.source)
+        w._keys.send_config()  # a field's levels are predicted once its range is known without a read
+        field = page_field(w.source)
+        if field is None or not pf.offered:
+            return
+        cfg = field_config(w, field, pf.clim, pf.texture_side, self.colours())
+        if cfg != w.companion.field_config:
+            w.companion.field_config = cfg
 
     def projection(self, key: ViewKey) -> dict:
         """The projection view's part of the update showing ``key`` (`ProjectionView.message`), as the
@@ -287,6 +306,38 @@ class Painter:
                     w._pump.flush()
         except Exception as exc:
             w._report_error(exc)
+
+    def page_holds(self, name) -> None:
+        """Companion: the page holds a one-time transfer: the readout says who draws while turning."""
+        w = self.w
+        try:
+            with w._pump.lock:
+                if not w._closed and name in ("field", "field_box"):
+                    ro.show(w.readout, self.readout_html())
+        except Exception as exc:
+            w._report_error(exc)
+
+    def turning_text(self):
+        """Who draws a field's pictures while keys are held (the readout's "turning" row), or None
+        for a source that is not a field."""
+        w = self.w
+        if not can_sample(w.source):
+            return None
+        pf = w.companion.page_field
+        if page_field(w.source) is None:
+            return "the kernel draws every picture (the page holds no copy of a function or of unevenly spaced data)"
+        if pf.page_draws:
+            shape = " \u00d7 ".join(str(n) for n in pf.shape)
+            what = "the data" if pf.which == "data" else "the coarse copy"
+            return f"the page draws while keys are held, from its copy of {what} ({shape}); the kernel at rest"
+        sending = w.companion.transfers.sending("field")
+        if sending is not None:
+            return (f"the kernel draws while keys are held: the page's copy is on its way "
+                    f"({sending[0]}/{sending[1]} parts)")
+        if pf.offered:
+            return ("the kernel draws while keys are held until the page has its copy (a page without WebGL2 "
+                    "never takes one)")
+        return "the kernel draws while keys are held until the page has its copy (after the background read)"
 
     # -- the readout ------------------------------------------------------------------------
     def set_note(self, text: str) -> None:
@@ -332,6 +383,9 @@ class Painter:
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
         elif cast and single and getattr(inner_source(source), "levels", None):
             rows.append(("volume", "\u2014 (inside the level: the surface rendering's)"))
+        turning = self.turning_text()
+        if turning is not None:
+            rows.append(("turning", turning))
         if self.note:
             rows.append(("picture", self.note))
         views = w._projection.readout_row()  # which view is which, with the projection shown

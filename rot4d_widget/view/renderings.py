@@ -16,12 +16,10 @@ from __future__ import annotations
 from ..core import look
 from ..core.rotation import quaternion_xyzw
 from .cuts import can_sample
+from .fieldkeys import SECTION_STEP
 from .painter import title
 
 __all__ = ["Renderings", "SECTION_STEP"]
-
-#: One key step of a section plane, as a fraction of the cut's extent.
-SECTION_STEP = 1.0 / 32.0
 
 
 class Renderings:
@@ -88,6 +86,12 @@ class Renderings:
         pos[axis] = moved
         self._set("sections", tuple(pos))
         return True
+
+    def set_quietly(self, name, value) -> None:
+        """Set ``rendering`` or ``sections`` without the observer's redraw (the caller marks the picture
+        dirty; the keeper records the trait); nothing when it holds that value."""
+        if getattr(self.w, name) != value:
+            self._set(name, value)
 
     def _set(self, name, value) -> None:
         """Set the trait from a key (the pump's lock is held: the observer's redraw waits for it)."""

@@ -67,12 +67,13 @@ import uuid
 
 import numpy as np
 import pythreejs as p3
-from traitlets import CFloat, CInt, Dict, List
 
 from ..core import look
 from . import buffers as bf
 from .cuts import NO_LABELS, CutLabels
+from .field_layer import FieldLayer
 from .keypad import close_quietly
+from .rowbuffer import NO_TURN, RowBuffer
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
@@ -89,41 +90,6 @@ def shader_source(name: str) -> str:
     """The GLSL of ``rot4d_widget/view/glsl/<name>`` with its ``// @include FILE`` lines expanded."""
     text = (_GLSL / name).read_text()
     return _INCLUDE.sub(lambda m: shader_source(m.group(1)), text)
-
-
-_IDENTITY4 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
-
-
-class _RowBuffer(p3.InstancedInterleavedBuffer):
-    """The shared buffer.  What travels in the same message as the array (or alone, for a turn):
-
-    ``_rot4d_seq`` the update's id; ``_rot4d_counts`` the rows each layer draws
-    (balls, bars, faces: the companion sets the geometries' drawn count as it
-    applies the message); ``_rot4d_turn`` a 3-D turn of the whole view as a
-    column-major 4x4 (the companion sets it on the meshes); ``_rot4d_surface``
-    a smooth surface's quantised arrays (the companion uploads them); ``_rot4d_volume`` a
-    field's cut(s) on grids for the ray-cast renderings (`rot4d_widget.view.volume_layer`);
-    ``_rot4d_skeleton`` and ``_rot4d_project`` what the projection view draws (the companion
-    projects the skeleton in the page, `rot4d_widget.view.projection`).
-    """
-
-    _rot4d_seq = CInt(0).tag(sync=True)
-    _rot4d_counts = List(CInt(), default_value=[0, 0, 0]).tag(sync=True)
-    _rot4d_turn = List(CFloat(), default_value=_IDENTITY4).tag(sync=True)
-    #: A smooth surface (`buffers.surface_arrays`, arrays as bytes): the companion uploads it
-    #: into the surface mesh as it applies the same message as the rows.  {} = none.
-    _rot4d_surface = Dict().tag(sync=True)
-    #: The cut(s) as an atlas, boxes and colour table (`volume_layer.volume_message`).  {} = none.
-    _rot4d_volume = Dict().tag(sync=True)
-    #: Texts pinned to points of the view, turned with it, and the data's extent the box labels keep
-    #: clear of ([x, y, z] displayed units; `rot4d_widget.view.cuts.CutLabels.traits`).
-    _rot4d_labels = List(Dict()).tag(sync=True)
-    _rot4d_label_extent = List(List(CFloat())).tag(sync=True)
-    #: The projection's skeleton, sent once per source (`projection.skeleton_message`).  {} = none.
-    _rot4d_skeleton = Dict().tag(sync=True)
-    #: The projection's state, with every update while it is shown (`projection.state_message`).
-    _rot4d_project = Dict().tag(sync=True)
-    version = CInt(0).tag(sync=True, echo_update=False)
 
 
 # -- option validation -------------------------------------------------------
@@ -275,13 +241,14 @@ class Scene:
 
     @property
     def mesh_model_ids(self) -> list:
-        """Model ids of the ball, bar, face, surface and volume meshes (the companion turns them)."""
-        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume")]
+        """Model ids of the ball, bar, face, surface, volume and field meshes (the companion turns them)."""
+        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume", "field")]
 
     @property
     def texture_model_ids(self) -> list:
-        """Model ids of the volume layer's atlas and colour-table textures (the companion fills them)."""
-        return self._volume.texture_model_ids
+        """Model ids of the volume layer's atlas and colour-table textures (the companion fills them) and
+        the field layer's placeholder 3-D texture (the page takes its class)."""
+        return [*self._volume.texture_model_ids, self._field.texture_model_id]
 
     @property
     def scene_model_id(self) -> str:
@@ -425,7 +392,7 @@ class Scene:
         projection = _projection_news(self._buffer, projection)
         if (not force and not self._unsent and surface is None and volume is None and pinned is None
                 and projection is None and np.array_equal(rows, self._rows)
-                and self._buffer._rot4d_turn == _IDENTITY4):
+                and self._buffer._rot4d_turn == NO_TURN):
             return False
         self.update_id += 1
         counts = [bf.ball_count(data), len(data.segments), len(data.triangles)]
@@ -499,7 +466,7 @@ class Scene:
     @property
     def turned(self) -> bool:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
-        return self._buffer._rot4d_turn != _IDENTITY4
+        return self._buffer._rot4d_turn != NO_TURN
 
     def _assign(self, rows, seq, counts=None, surface=None, volume=None, labels=None, projection=None):
         buf = self._buffer
@@ -518,8 +485,8 @@ class Scene:
             buf._rot4d_seq = seq
             if counts is not None:
                 buf._rot4d_counts = [int(c) for c in counts]
-            if buf._rot4d_turn != _IDENTITY4:
-                buf._rot4d_turn = list(_IDENTITY4)
+            if buf._rot4d_turn != NO_TURN:
+                buf._rot4d_turn = list(NO_TURN)
         self._rows = rows
 
     def _grow(self, capacity):
@@ -557,7 +524,7 @@ def _build_three(scene, antialias, display):
     """The pythreejs objects of ``scene``: one row buffer read by balls, bars and faces, the smooth
     surface, camera, controls, renderer (built once; updates assign new arrays)."""
     scene._rows = np.zeros((scene.capacity, bf.ROW_FLOATS), dtype=np.float32)
-    scene._buffer = _RowBuffer(array=scene._rows, meshPerAttribute=1)
+    scene._buffer = RowBuffer(array=scene._rows, meshPerAttribute=1)
     attrs = {
         name: p3.InterleavedBufferAttribute(data=scene._buffer, itemSize=size, offset=col)
         for name, (col, size) in bf.COLUMNS.items()
@@ -641,6 +608,8 @@ def _build_three(scene, antialias, display):
     )
     scene._volume = VolumeLayer()  # a field's cut ray-cast: hidden until a volume arrives
     scene._meshes["volume"] = scene._volume.build(shader_source)
+    scene._field = FieldLayer(scene._light)  # the page's own picture of a field (issue 36): hidden
+    scene._meshes["field"] = scene._field.build(shader_source)
     scene._camera = p3.PerspectiveCamera(
         position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=scene.width / scene.height,
         near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
@@ -668,6 +637,7 @@ def _build_three(scene, antialias, display):
         *(a for t in templates.values() for a in t.values()),
         scene._surface_geometry, *scene._surface_attrs.values(), scene._surface_index,
         *(w for w in scene._volume.widgets if w is not scene._meshes["volume"]),
+        *(w for w in scene._field.widgets if w is not scene._meshes["field"]),
     ]  # fmt: skip
     scene._surface_shown = False
     scene._volume_shown = False

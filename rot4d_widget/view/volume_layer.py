@@ -1,14 +1,18 @@
 """The page's volume layer: a field's cut drawn by ray casting in a shader ("volume", "mip",
 "sections"), from the cut's values sampled on a grid by the kernel.
 
-Why a 2-D atlas and not a 3-D texture: three.js r97 has ``DataTexture3D`` only for a WebGL2
-context, and pythreejs's `Renderer` asks for a WebGL1 one.  So each cut's grid travels as a 2-D
-texture whose tiles are its z layers (``LuminanceAlpha``, 8 bits each: the value quantised over
-the colour limits, and 255 where the node is finite, 0 where it is not); the shader interpolates
-within a tile bilinearly (the texture's filter) and between two tiles linearly: trilinear.  A
-sample counts only where both layers' alpha is 1, i.e. where its cell's nodes are finite: the
-static renders' rule (`rot4d_widget.keep.volume`), whose camera, step, colour table and optical
-depth the shader repeats, so the page and ``w.render`` agree.
+The kernel's picture of a cut: its grid travels as a 2-D texture whose tiles are its z layers
+(``LuminanceAlpha``, 8 bits each: the value quantised over the colour limits, and 255 where the
+node is finite, 0 where it is not); the shader interpolates within a tile bilinearly (the
+texture's filter) and between two tiles linearly: trilinear.  A sample counts only where both
+layers' alpha is 1, i.e. where its cell's nodes are finite: the static renders' rule
+(`rot4d_widget.keep.volume`), whose camera, step, colour table and optical depth the shader
+repeats, so the page and ``w.render`` agree.  The context is WebGL2 wherever the browser has it
+(pythreejs's `Renderer` asks for it; measured in Chromium on SwiftShader:
+``tests/browser/test_webgl_probe_browser.py``, docs/fields.md "The page's WebGL"), and the atlas
+needs nothing of WebGL2: the kernel's pictures draw on a WebGL1 context too.  The page's own copy
+of the 4-D field (a 3-D texture, `rot4d_widget.view.pagefield`) needs WebGL2; without it the page
+never asks for the copy and every picture is the kernel's.
 
 One update is still one message: `volume_message` is a dict put on the scene's row buffer in the
 same ``hold_sync`` as the rows (the box's outline as bars); the companion uploads the atlas and
@@ -39,7 +43,7 @@ __all__ = ["VolumeLayer", "volume_message", "pack_atlas", "colour_table", "MODES
 
 #: The renderings the layer draws, by the shader's mode number.
 MODES = {"volume": 0, "mip": 1, "sections": 2}
-#: The atlas's widest side, in texels (every WebGL1 implementation takes 4096).
+#: The atlas's widest side, in texels (every WebGL1 and WebGL2 implementation takes 4096).
 ATLAS_MAX = 4096
 #: Samples every this many grid spacings along a ray (the static renders' default).
 STEP = 0.5

@@ -508,6 +508,8 @@ def _wire(w, keypad) -> None:
     w.companion.on_focus_lost(w._keys.focus_lost)
     w.companion.on_clock(w._keys.heartbeat)
     w.companion.on_screenshot(w._shots.answer)
+    w.companion.on_holds(w._painter.page_holds)
+    w.companion.transfers.bar = w.progress_bar  # a field's copy on its way to the page: counted there
     w.scene.on_view_count(w._keys.view_count)
     w.scene.on_eye_moved(w._painter.eye_moved)
     w._sync.observe()
@@ -537,6 +539,7 @@ def _unwire(w) -> None:
         companion.on_focus_lost(w._keys.focus_lost, remove=True)
         companion.on_clock(w._keys.heartbeat, remove=True)
         companion.on_screenshot(w._shots.answer, remove=True)
+        companion.on_holds(w._painter.page_holds, remove=True)
     if scene is not None:
         scene.on_view_count(w._keys.view_count, remove=True)
         scene.on_eye_moved(w._painter.eye_moved, remove=True)

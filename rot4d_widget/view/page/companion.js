@@ -59,6 +59,8 @@ import { modelId, dataOf, getModel } from "./models.js";
 import { adoptKernel, attachKeys, attachPad, releaseKeys, turning } from "./turning.js";
 import { askForTransfers, receiveChunk, transferStore, unpack } from "./transfer.js";
 import { drawsOwn, forceOwn, ownHyperplanes, ownPicture, ownPictureReport, polytopeArrived } from "./pictures.js";
+import { fieldArrived, freeField, noteContext, wantsTransfer } from "./field.js";
+import { DEPTH_SCALE, FieldPicture, fieldDrawsOwn, forceOwnField, quickField } from "./fieldpicture.js";
 import { drawLabels } from "./labels.js";
 
 export { decodeSkeleton, projectSkeleton };
@@ -162,16 +164,23 @@ async function render({ model, el }) {
   cleanups.push(() => shared0.listeners.delete(sideMark));
 
   // 9. one-time transfers (transfer.js): asked for when offered and not held, put together here
-  const onPageData = () => askForTransfers(model);
+  const onPageData = () => askForTransfers(model, (name) => wantsTransfer(model, name));
   const onTransfer = (msg, buffers) => {
-    if (receiveChunk(model, msg, buffers && buffers[0]) && msg.name === "polytope") polytopeArrived(model);
+    if (!receiveChunk(model, msg, buffers && buffers[0])) return;
+    if (msg.name === "polytope") polytopeArrived(model);
+    if (msg.name === "field" || msg.name === "field_box") fieldArrived(model);
   };
+  const onClose = () => freeField(model);  // the widget closed: its field's copy goes
   if (typeof model.on === "function") {
     model.on("change:page_data", onPageData);
+    model.on("change:field_config", onPageData);
     model.on("msg:custom", onTransfer);
+    model.on("destroy", onClose);
     cleanups.push(() => {
       model.off("change:page_data", onPageData);
+      model.off("change:field_config", onPageData);
       model.off("msg:custom", onTransfer);
+      model.off("destroy", onClose);
     });
   }
   onPageData();
@@ -255,6 +264,8 @@ async function render({ model, el }) {
       };
       // The whole view turned in 3-D (keys that leave w alone): one rotation for every mesh.
       let own = false; // the layers draw the page's own picture (pictures.js), not the kernel's rows
+      let fieldOwn = false; // ... of a field (fieldpicture.js): its ray-cast mesh in place of the kernel's
+      let drawnVersion = null; // the prediction's version the page's own picture last drawn shows
       let drawnCounts = []; // the rows each layer drew last (balls, bars, faces): for the test hook
       const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
       const applyTurn = () => {
@@ -348,8 +359,8 @@ async function render({ model, el }) {
         // class, format, type and filters): pythreejs writes its model's data back into its own
         // texture whenever the model is synced (and refuses other dimensions), so ours are not
         // its objects.  A texture set as a new uniform value needs the material set up again.
-        if (u && !ownTextures && textures.length === 2 && textures[0].obj && textures[1].obj) {
-          ownTextures = textures.map((m) => likeTexture(m.obj));
+        if (u && !ownTextures && textures.length >= 2 && textures[0].obj && textures[1].obj) {
+          ownTextures = textures.slice(0, 2).map((m) => likeTexture(m.obj));
           cleanups.push(() => ownTextures.forEach((t) => t.dispose && t.dispose()));
         }
         if (u && ownTextures && (!u.u_atlas || u.u_atlas.value !== ownTextures[0] || !u.u_lut || u.u_lut.value !== ownTextures[1])) {
@@ -640,7 +651,7 @@ async function render({ model, el }) {
       const overlays = new Map(); // canvas host element -> {div, key}
       cleanups.push(() => overlays.forEach((o) => o.div.remove()));
       const placeLabels = (camera) => {
-        const labels = buffer.get("_rot4d_labels") || [];
+        const labels = fieldOwn ? [] : buffer.get("_rot4d_labels") || [];  // the kernel's: not while the page draws
         const extent = labels.length ? buffer.get("_rot4d_label_extent") || [] : [];
         const cls = model.get("canvas_class");
         if (!cls || !camera || !camera.projectionMatrix) return;
@@ -681,11 +692,11 @@ async function render({ model, el }) {
         } catch (e) {
           console.warn("rot4d_widget companion: labels not placed", e);
         }
-        if (surfaceLost()) {
+        if (!fieldOwn && surfaceLost()) {
           applySurface();
           scene.trigger("rerender", scene, {});
         }
-        if (volumeLost()) {
+        if (!fieldOwn && volumeLost()) {
           applyVolume();
           if (volumeApplied) scene.trigger("rerender", scene, {});
         }
@@ -736,7 +747,8 @@ async function render({ model, el }) {
           ratioRenderer = renderer;
           baseRatio = renderer.getPixelRatio();
         }
-        const want = v.n_boxes > 0 && v.held ? baseRatio / 2 : baseRatio;
+        const half = (v.n_boxes > 0 && v.held) || (fieldOwn && quickField(model));
+        const want = half ? baseRatio / 2 : baseRatio;
         if (renderer.getPixelRatio() !== want) renderer.setPixelRatio(want);
       };
       cleanups.push(() => {
@@ -744,21 +756,48 @@ async function render({ model, el }) {
           ratioRenderer.setPixelRatio(baseRatio);
         }
       });
+      // 10. the page's own picture of a field (fieldpicture.js): its mesh "field" in place of the
+      // kernel's surface and volume meshes while the page draws, given back after
+      const fieldMesh = meshes.find((m) => m.obj && m.obj.name === "field");
+      const fieldPic = fieldMesh && textures.length >= 3 && textures[2].obj && textures[1].obj
+        ? new FieldPicture(fieldMesh, textures[2].obj.constructor, textures[1].obj) : null;
+      const kernelMeshes = () => meshes.filter((m) => m.obj && (m.obj.name === "surface" || m.obj.name === "volume"));
+      const setFieldOwn = (on) => {
+        fieldOwn = on;
+        if (on) {
+          for (const m of kernelMeshes()) m.obj.visible = false;
+          return;
+        }
+        fieldPic.hide();
+        for (const m of kernelMeshes()) if (m.obj.name === "surface") m.obj.visible = !!m.get("visible");
+        applySurface();
+        applyVolume();
+      };
       const beforeRender = (_scene, renderer, camera) => {
         settle();
+        if (noteContext(renderer)) onPageData();  // now the page knows whether it can hold a field
         const p = turning(model).prediction;
-        const mine = polytopeArrived(model) !== null && drawsOwn(model, p, buffer.get("_rot4d_seq"));
-        if (mine !== own) {
-          own = mine;
+        const seq = buffer.get("_rot4d_seq");
+        const mine = polytopeArrived(model) !== null && drawsOwn(model, p, seq);
+        const mineField = !mine && fieldPic !== null && fieldDrawsOwn(model, p, seq);
+        const fieldRows = mineField ? fieldPic.draw(model, p) : null;
+        if (!!fieldRows !== fieldOwn) setFieldOwn(!!fieldRows);
+        if ((mine || !!fieldRows) !== own) {
+          own = mine || !!fieldRows;
           applyTurn();
         }
         const eye = camera && camera.position ? [camera.position.x, camera.position.y, camera.position.z] : null;
-        expand(own ? ownPicture(model, p, eye) : null);
+        expand(mine ? ownPicture(model, p, eye) : fieldRows);
+        drawnVersion = own && p ? p.version : null;
         applyRatio(renderer);
       };
-      // the page's own picture changes with its state: draw again
+      // the page's own picture changes with its state: draw again (not for a state already drawn:
+      // the kernel's state of what the page shows, adopted, keeps its version)
       const redraw = () => {
-        if (own || drawsOwn(model, turning(model).prediction, buffer.get("_rot4d_seq"))) {
+        const p = turning(model).prediction;
+        const seq = buffer.get("_rot4d_seq");
+        const want = drawsOwn(model, p, seq) || (fieldPic !== null && fieldDrawsOwn(model, p, seq));
+        if (want !== own || (want && (!p || p.version !== drawnVersion))) {
           scene.trigger("rerender", scene, {});
           projectionRerender();
         }
@@ -773,9 +812,20 @@ async function render({ model, el }) {
           for (const host of document.getElementsByClassName(cls)) {
             host.rot4dForceOwn = (on) => {
               forceOwn(model, on);
+              forceOwnField(model, on);
               scene.trigger("rerender", scene, {});
             };
             host.rot4dDrawsOwn = () => own;
+            // the page's field picture as each pixel's first surface hit's distance (field.frag
+            // u_output), with the camera it was drawn with: read the canvas after a frame
+            host.rot4dFieldDepth = (on) => {
+              if (!fieldPic) return null;
+              fieldPic.setOutput(on);
+              scene.trigger("rerender", scene, {});
+              const cam = scene.obj && scene.obj.children.find((c) => c.isCamera);
+              return cam ? { world: Array.from(cam.matrixWorld.elements), projection: Array.from(cam.projectionMatrix.elements),
+                             scale: DEPTH_SCALE } : { scale: DEPTH_SCALE };
+            };
             host.rot4dCounts = () => drawnCounts.slice();
           }
         }

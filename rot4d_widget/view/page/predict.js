@@ -8,6 +8,13 @@ import { KeyLog } from "./keys.js";
 import { PageKeymap } from "./keymap.js";
 import { PageState } from "./state.js";
 
+// Two predicted states the same (every number a picture is made from).
+export function sameState(a, b) {
+  if (!a || !b || a.theta0 !== b.theta0 || a.alpha !== b.alpha || a.c0 !== b.c0) return false;
+  for (let i = 0; i < 16; i++) if (a.matrix[i] !== b.matrix[i]) return false;
+  return JSON.stringify(a.view) === JSON.stringify(b.view);
+}
+
 // Two page times of one key event as the kernel heard it (through seconds) and the page made it
 // (rot4d_widget.view.steplog.SAME_MS).
 export const SAME_MS = 1e-6;
@@ -18,6 +25,8 @@ export class Prediction {
     this.config = config;
     this.keymap = new PageKeymap(config.keymap, config.shift_kinds);
     this.predicted = new Set(config.predicted_kinds || []);
+    // a source's own actions the page steps too (a field's levels): name -> {rule, sign, repeat}
+    this.actions = new Map(Object.entries(config.predicted_actions || {}));
     this.repeating = new Set(config.repeating_kinds || []);
     this.log = new KeyLog(config.hold_delay, config.tick_rate);
     this.kernel = null;
@@ -28,11 +37,14 @@ export class Prediction {
   }
 
   // The kernel's state for its id: the page's steps up to `upto` are in it.  False (not adopted)
-  // when the page's own key events say otherwise (`agrees`).
+  // when the page's own key events say otherwise (`agrees`).  The version moves only if the state
+  // predicted is another once the page's later steps are on it again (`advance`): adopting the
+  // kernel's state of what the page already shows draws nothing again.
   adopt(kernel) {
     if (!kernel || !kernel.state || !this.agrees(kernel)) return false;
     this.kernel = kernel;
     this.log.checkpoint(kernel.upto === null ? -Infinity : kernel.upto);
+    this.adopted = { state: this.state, version: this.version };
     this.base = new PageState(kernel.state, this.config.bounds);
     this.state = this.base.copy();
     this.applied = [];
@@ -62,15 +74,21 @@ export class Prediction {
     return true;
   }
 
+  // True for an action the page steps itself (the state's kinds, a field's view kinds and levels).
+  steps(action) {
+    return this.predicted.has(action.kind) || (action.kind === "custom" && this.actions.has(action.name));
+  }
+
   // A key event the page steps itself: {action, inverted, kid} or null (not ours: the kernel's).
   ours(event, kid) {
     const found = this.keymap.lookup(event);
-    if (!found || !kid || !this.predicted.has(found.action.kind)) return null;
+    if (!found || !kid || !this.steps(found.action)) return null;
     return { ...found, kid };
   }
 
   press(kid, action, inverted, t) {
-    return this.log.press(kid, action, inverted, t, this.repeating.has(action.kind));
+    const repeats = action.kind === "custom" ? !!this.actions.get(action.name).repeat : this.repeating.has(action.kind);
+    return this.log.press(kid, action, inverted, t, repeats);
   }
 
   release(kid, t) {
@@ -102,10 +120,16 @@ export class Prediction {
     }
     let changed = !same;
     for (const s of todo) {
-      changed = this.state.apply(s.action, s.inverted) || changed;
+      changed = this.state.apply(s.action, s.inverted, this.actions.get(s.action.name)) || changed;
       this.applied.push(s);
     }
     if (changed) this.version += 1;
+    const before = this.adopted;
+    this.adopted = null;
+    if (before && sameState(before.state, this.state)) {
+      this.version = before.version;  // the kernel's state with the page's steps on it: what was shown
+      return false;
+    }
     return changed;
   }
 

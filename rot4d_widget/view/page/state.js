@@ -4,6 +4,8 @@
 
 import { doubleRotation, matmul4, reorthonormalize, simpleRotation } from "./rotation.js";
 
+const copyView = (v) => ({ ...v, sections: v.sections.slice(), levels: v.levels.slice() });
+
 const finiteOr = (v, dflt) => (typeof v === "number" && Number.isFinite(v) ? v : dflt);
 
 export class PageState {
@@ -24,12 +26,15 @@ export class PageState {
     this.c0Origin = msg.c0_origin;
     const init = msg.initial;
     this.initial = { matrix: Float64Array.from(init.matrix), theta0: init.theta0, alpha: init.alpha, c0: init.c0 };
+    // a field's view settings (rot4d_widget.view.fieldview.view_message), or null
+    this.view = msg.view ? copyView(msg.view) : null;
     return this;
   }
 
   copy() {
     const c = Object.create(PageState.prototype);
-    Object.assign(c, this, { matrix: Float64Array.from(this.matrix), initial: { ...this.initial } });
+    Object.assign(c, this, { matrix: Float64Array.from(this.matrix), initial: { ...this.initial },
+                             view: this.view ? copyView(this.view) : null });
     return c;
   }
 
@@ -43,8 +48,10 @@ export class PageState {
     return simpleRotation(action.planes, sign * this.theta0);
   }
 
-  // One step of `action` ({kind, planes, sign}); true if the state changed (RotationState.apply).
-  apply(action, inverted = false) {
+  // One step of `action` ({kind, planes, sign}); true if the state changed (RotationState.apply;
+  // a field's view keys as rot4d_widget.view.fieldkeys steps them: `rule` for a source action the
+  // page steps, {rule: "levels", sign}).
+  apply(action, inverted = false, rule = null) {
     const b = this.bounds;
     switch (action.kind) {
       case "rotate":
@@ -79,8 +86,56 @@ export class PageState {
         this.alpha = this.initial.alpha;
         this.c0 = this.initial.c0;
         return true;
-      default:  // help, the view's and the source's keys: not the state's
+      case "rendering":
+        return this.view !== null && this.stepRendering(action, inverted);
+      case "section":
+        return this.view !== null && this.stepSection(action, inverted);
+      case "custom":
+        return this.view !== null && !!rule && rule.rule === "levels" && this.stepLevels(rule.sign * (inverted ? -1 : 1));
+      default:  // help, the view's other keys and the source's own: not the page's
         return false;
     }
   }
+
+  // v / Shift+v: the next rendering in the kernel's order (rot4d_widget.view.renderings.Renderings.step)
+  stepRendering(action, inverted) {
+    const order = this.view.renderings;
+    const direction = (inverted ? -1 : 1) * action.sign;
+    const n = order.length;
+    this.view.rendering = order[(((order.indexOf(this.view.rendering) + direction) % n) + n) % n];
+    return true;
+  }
+
+  // a / s / d (Shift back): the section plane by one step, rounded to 1/1024, refused at 0 and 1
+  stepSection(action, inverted) {
+    const axis = "xyz".indexOf(action.name);
+    const pos = this.view.sections;
+    const direction = (inverted ? -1 : 1) * action.sign;
+    const moved = Math.min(1, Math.max(0, roundHalfEven((pos[axis] + direction * this.view.section_step) * 1024) / 1024));
+    if (moved === pos[axis]) return false;
+    pos[axis] = moved;
+    return true;
+  }
+
+  // o / i: every level by one step (FieldLevels.step_levels), refused beyond the range widened by one
+  stepLevels(sign) {
+    const v = this.view;
+    if (!Number.isFinite(v.level_step)) return false;
+    const step = v.level_step;
+    const [lo, hi] = v.level_range;
+    const next = v.levels.map((x) => x + (sign > 0 ? 1 : -1) * step);
+    if (!next.every(Number.isFinite)) return false;
+    if (Number.isFinite(lo) && Number.isFinite(hi)) {
+      const outside = (x) => Math.max(lo - step - x, x - hi - step, 0.0);
+      if (v.levels.some((u, i) => outside(next[i]) > 0 && outside(next[i]) >= outside(u))) return false;
+    }
+    v.levels = next;
+    return true;
+  }
+}
+
+// Python's round(): halves to the even neighbour.
+function roundHalfEven(x) {
+  const r = Math.round(x);
+  return Math.abs(x % 1) === 0.5 && r % 2 !== 0 ? r - 1 : r;
 }

@@ -1,6 +1,7 @@
 // One-time transfers from the kernel (rot4d_widget.view.transfer): data the page keeps -- a
-// polytope to cut -- offered by name and key in the companion's `page_data`, asked for once per
-// page when not held, sent in chunks, put together here and unpacked into typed arrays.  The
+// polytope to cut, a field's data to ray-cast -- offered by name and key in the companion's
+// `page_data`, asked for once per page when not held, sent in chunks (each acknowledged: a paced
+// transfer sends the next ones then), put together here and unpacked into typed arrays.  The
 // store is per widget (its companion model) and shared by its views.
 
 const TYPES = { float64: Float64Array, float32: Float32Array, int32: Int32Array, uint32: Uint32Array,
@@ -31,13 +32,14 @@ export function transferStore(model) {
   return s;
 }
 
-// Ask for every transfer the kernel offers that this page does not hold (once per key).
-export function askForTransfers(model) {
+// Ask for every transfer the kernel offers that this page does not hold (once per key) and
+// `accept(name)` takes (default: all).
+export function askForTransfers(model, accept = () => true) {
   const s = transferStore(model);
   const offered = model.get("page_data") || {};
   for (const [name, key] of Object.entries(offered)) {
     const have = s.done.get(name);
-    if ((have && have.key === key) || s.asked.get(name) === key) continue;
+    if ((have && have.key === key) || s.asked.get(name) === key || !accept(name)) continue;
     s.asked.set(name, key);
     model.send({ event: "want", name, key });
   }
@@ -61,6 +63,7 @@ export function receiveChunk(model, msg, buffer) {
   p.bytes.set(chunk, p.filled);
   p.filled += chunk.byteLength;
   p.next += 1;
+  model.send({ event: "got", name: msg.name, key: msg.key, part: msg.part });  // a paced transfer sends on
   if (p.next < msg.parts) return false;
   s.partial.delete(id);
   s.done.set(msg.name, { key: msg.key, meta: p.meta, bytes: p.bytes });

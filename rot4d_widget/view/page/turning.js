@@ -155,7 +155,7 @@ export function attachPad(model, { listen, canvasClass }) {
     const p = s.prediction;
     if (!b || !p || s.silent || (event.type === "mousedown" && event.button !== 0)) return;
     const found = p.keymap.resolve(b.key, b.shift);
-    if (!found || !p.predicted.has(found.action.kind)) return;
+    if (!found || !p.steps(found.action)) return;
     if (!p.held.length) s.lastKernel = Math.max(s.lastKernel, event.timeStamp);
     const kid = `pad:${b.key}${b.shift ? "+shift" : ""}`;
     if (!p.press(kid, found.action, found.inverted, event.timeStamp)) return;

@@ -1,0 +1,100 @@
+"""What the page needs to draw its own picture of a field it holds (issue 36), besides the data
+(`rot4d_widget.view.pagefield`) and the state it predicts.
+
+* `view_message`: the field's view settings that keys change -- the rendering, the section planes,
+  the iso levels -- and the rules the page steps them by (`rot4d_widget.view.fieldkeys.view_rules`),
+  carried in the kernel's state (`rot4d_widget.view.pagestate.state_message`) so the page adopts
+  them with the state.
+* `field_config`: everything else, the companion's synced ``field_config``: the field's box (half
+  widths, slice units) and w frame, the view's scale, where each cut lies and is placed (a stack's
+  offsets, centres and scales), the kernel's grid resolutions and ray steps (held and at rest),
+  the colour table of ``cmap`` and the colour limits the kernel's pictures use (``clim``, else the
+  limits of the last ray-cast picture, else the 1st-99th percentile of the page's copy), the
+  density, which side is inside and the caps, the colours of the levels (or of a stack's cuts, or
+  one colour) and the surfaces' opacity, the copy's texture side (a page whose WebGL cannot hold it
+  does not ask).  Numbers as JSON; the colour table as 1024 integers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core import look
+from ..keep.volume import DEFAULT_DENSITY, default_clim
+from ..sources.protocol import inner_source, w_frame
+from ..sources.tomography import StackSource
+from .cuts import STACK_NODES, can_sample
+from .fieldkeys import view_rules
+from .volume_layer import HELD_STEP, MAX_STEPS, STEP, colour_table
+
+__all__ = ["view_message", "field_config", "copy_clim", "MARCH", "HELD_MARCH"]
+
+#: The page's surfaces are marched every this many kernel grid spacings at rest (and refined by
+#: bisection), and while keys are held every this many spacings of the coarse grid.
+MARCH = 0.5
+HELD_MARCH = 1.0
+
+
+def view_message(widget):
+    """``{"rendering", "sections", "levels"}`` of a field's view (None for a source without renderings)."""
+    w = widget
+    if not can_sample(w.source):
+        return None
+    inner = inner_source(w.source)
+    return {"rendering": w.rendering, "sections": [float(s) for s in w.sections],
+            "levels": [float(v) for v in inner.levels], **view_rules(w.source)}
+
+
+def _rgb(colours) -> list:
+    """Colours as the surface layer quantises them (uint8), back in [0, 1]."""
+    c = np.rint(np.clip(np.asarray(colours, dtype=np.float64).reshape(-1, 3), 0.0, 1.0) * 255.0) / 255.0
+    return [[float(x) for x in row] for row in c]
+
+
+def copy_clim(values) -> list:
+    """The 1st and 99th percentiles of a copy's values (every 7th: the same to a few codes, quickly):
+    the page's colour limits when neither ``clim`` nor a ray-cast picture of the kernel's gives any."""
+    v = np.asarray(values).reshape(-1)[::7]
+    return [float(x) for x in default_clim(v)]
+
+
+def field_config(widget, field, default_clim_: list, texture_side: int, colours) -> dict:
+    """The page's ``field_config`` for ``field`` (the `Field4D` the page holds) shown by ``widget``;
+    ``default_clim_`` the copy's `copy_clim`, ``texture_side`` the copy's longest texture side,
+    ``colours`` the painter's ``(rgb, labels)`` (`Painter.colours`)."""
+    w = widget
+    src = w.source
+    origin, per = w_frame(src)
+    if isinstance(src, StackSource) and src.slices > 1:
+        dc = np.asarray(src.cuts_at(0.0), dtype=np.float64)
+        centres, scales = src.layout()
+        slices = [{"dc": float(dc[k]), "centre": [float(x) for x in centres[k]], "scale": float(scales[k])}
+                  for k in range(len(dc))]
+    else:
+        slices = [{"dc": 0.0, "centre": [0.0, 0.0, 0.0], "scale": 1.0}]
+    painter = w._painter
+    clim = w.clim if w.clim is not None else painter.cast_clim
+    if clim is None:
+        clim = default_clim_
+    rgb, labels = colours
+    single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+    by_slice = labels is not None and inner_source(src) is not src  # a stack coloured by w
+    return {
+        "hw": [float(h) for h in field.half_widths],
+        "origin": float(origin), "per_unit": float(per), "scale": float(w._scale),
+        "slices": slices,
+        "resolution": int(field.resolution), "coarse_resolution": int(field.coarse_resolution),
+        "stack_nodes": int(STACK_NODES),
+        "step": float(STEP), "held_step": float(HELD_STEP), "max_steps": int(MAX_STEPS),
+        "march": float(MARCH), "held_march": float(HELD_MARCH),
+        "lut": [int(b) for b in colour_table(w.cmap).reshape(-1)],
+        "clim": [float(clim[0]), float(clim[1])],
+        "density": float(DEFAULT_DENSITY),
+        "inside": field.inside, "caps": bool(field.caps),
+        "level_rgb": _rgb(rgb) if not by_slice else [],
+        "level_by_value": w.clim is not None and single is None and not by_slice,
+        "box_rgb": _rgb(rgb) if by_slice and single is None else None,
+        "single_rgb": None if single is None else _rgb([single])[0],
+        "surface_opacity": float(look.SURFACE_OPACITY),
+        "texture_side": int(texture_side),
+    }
