@@ -256,3 +256,23 @@ def test_each_block_range_holds_every_node_of_its_cells():
     bad[4, 0, 0, 0] = True  # a node two blocks share along w
     lo, hi = pf.block_ranges(codes, bad)
     assert (lo[:, 0, 0, 0] == 0).all() and (hi[:, 0, 0, 0] == pf.CODES).all() and hi[0, 1, 1, 1] < pf.CODES + 1
+
+
+def test_a_stack_coloured_by_w_gives_every_level_a_colour(make):
+    """A field stack coloured by w sends no level colours (its boxes carry them): the page must
+    still give each level one, or the shader's uniforms fail on every frame (CI: a TypeError from
+    FieldPicture.uniforms for a 3-slice stack with its projection)."""
+    from rot4d_widget.view.fieldview import field_config
+
+    field = Field4D(_blob(), axes="xyzw", extent=[(-1, 1)] * 4, levels=[0.2, 0.5])
+    w = make(field, slices=3)
+    cfg = field_config(w, field, [0.0, 1.0], 64, w._painter.colours())
+    assert cfg["level_rgb"] == [] and cfg["box_rgb"]
+    got = run_page(LEVEL_COLOURS, {"cfg": cfg, "levels": [0.2, 0.5]})
+    assert len(got) == 2 and all(len(c) == 3 and all(isinstance(x, (int, float)) for x in c) for c in got)
+
+
+LEVEL_COLOURS = """
+import { levelColours } from "page:fieldpicture.js";
+console.log(JSON.stringify(levelColours(INPUT.cfg, INPUT.levels)));
+"""

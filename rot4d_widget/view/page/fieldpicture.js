@@ -59,9 +59,13 @@ export function lutRgb(lut, x) {
 
 // Each level's colour: the kernel's (by rank: they do not change as the page steps the levels) or,
 // with colour limits, the table's colour at the level's place in them.
+// A stack coloured by w has no level colours (its boxes carry them, `box_rgb`): black, unused.
 export function levelColours(cfg, levels) {
   if (cfg.single_rgb) return levels.map(() => cfg.single_rgb);
-  if (!cfg.level_by_value) return levels.map((_, i) => cfg.level_rgb[i] || cfg.level_rgb[cfg.level_rgb.length - 1]);
+  if (!cfg.level_by_value) {
+    const table = cfg.level_rgb || [];
+    return levels.map((_, i) => table[i] || table[table.length - 1] || [0, 0, 0]);
+  }
   const [lo, hi] = cfg.clim;
   return levels.map((v) => lutRgb(cfg.lut, (v - lo) / (hi - lo)));
 }
