@@ -105,6 +105,7 @@ __all__ = [
     "BadSlice",
     "data_w_text",
     "note_matrix",
+    "known_range",
     "w_value_text",
     "c0_text",
     "w_span_text",
@@ -306,6 +307,17 @@ def note_matrix(source, matrix) -> None:
     note = getattr(source, "note_matrix", None)
     if note is not None:
         note(matrix)
+
+
+def known_range(source, default) -> tuple:
+    """``(lo, hi)`` of ``source``'s data as far as it is known without reading all of it: its
+    optional ``known_range`` (a chunked field's first cut until its background read is done), else
+    its ``data_range``, else ``default``.  What a view asks for colours: never a whole read."""
+    for name in ("known_range", "data_range"):
+        rng = getattr(source, name, None)
+        if rng is not None:
+            return rng
+    return default
 
 
 def prepare_in_background(source, progress: bool = True):

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core import look
 from ..keep.volume import default_clim
-from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, outline_of
+from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, known_range, outline_of
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
@@ -454,7 +454,7 @@ def level_colors(source, cmap: str = look.LEVEL_COLORMAP, clim=None):
         return None
     if clim is not None:
         return look.level_colors(levels, clim[0], clim[1], cmap, by_value=True)
-    lo, hi = getattr(source, "known_range", None) or getattr(source, "data_range", (min(levels), max(levels)))
+    lo, hi = known_range(source, (min(levels), max(levels)))
     return look.level_colors(levels, lo, hi, cmap)
 
 
