@@ -316,3 +316,35 @@ def test_the_page_keeps_its_own_steps_over_a_kernel_state_its_keys_say_is_wrong(
     assert np.allclose(matrices[2], ref.matrix, atol=1e-12)  # its own steps, not the kernel's 40-odd
     assert not np.allclose(np.array(ahead["state"]["matrix"]).reshape(4, 4), ref.matrix, atol=1e-6)
     assert np.array_equal(matrices[3], ref.matrix)  # the kernel's, adopted: exact
+
+
+REMADE = """
+import { Prediction } from "page:predict.js";
+const first = new Prediction(INPUT.config, INPUT.start);
+const mine = first.ours({ key: "4", code: "Digit4", shiftKey: false }, "Digit4");
+first.press("Digit4", mine.action, mine.inverted, 1000.0);
+first.advance(1300.0);
+// the key table changes while "4" is held (a field's keys become the page's when it holds its copy)
+const next = new Prediction(INPUT.changed, INPUT.start, first);
+next.advance(1600.0);
+console.log(JSON.stringify({ held: next.held, matrix: Array.from(next.state.matrix) }));
+"""
+
+
+def test_a_key_held_when_the_page_s_key_table_changes_goes_on_stepping(make, clock):
+    """The page remakes its prediction when the key table changes -- a field's view keys become
+    the page's once it holds its copy, often while a key is held (the user turned as soon as the
+    picture showed).  The keys held go on: the page's "4" steps to 1600 ms as the kernel's does.
+    Before, the new prediction forgot them, the page stopped stepping and drew only the kernel's
+    states as they arrived (a 2 GB store: 5 pictures a second instead of 15,
+    benchmarks/store_timeline.py)."""
+    from page_node import run_page
+
+    w = make("24-cell")
+    start = dict(w.companion.kernel_state)
+    config = w.companion.config
+    changed = dict(config, predicted_kinds=sorted(set(config["predicted_kinds"]) | {"rendering"}))
+    page = run_page(REMADE, {"config": config, "changed": changed, "start": start})
+    assert page["held"] == ["Digit4"]
+    ref = reference(w, [("4", False, 1000.0, 1600.0)])
+    assert np.allclose(np.array(page["matrix"]).reshape(4, 4), ref.matrix, atol=1e-12)

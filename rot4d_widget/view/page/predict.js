@@ -20,15 +20,20 @@ export function sameState(a, b) {
 export const SAME_MS = 1e-6;
 
 export class Prediction {
-  // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null
-  constructor(config, kernel) {
+  // `config`: rot4d_widget.view.pagestate.page_config; `kernel`: {epoch, upto, state} or null;
+  // `previous`: the prediction this one replaces when the key table changes (a field's keys become
+  // the page's once it holds its copy) -- the keys held then stay held, with the actions they were
+  // pressed with, if the hold's schedule is the same
+  constructor(config, kernel, previous = null) {
     this.config = config;
     this.keymap = new PageKeymap(config.keymap, config.shift_kinds);
     this.predicted = new Set(config.predicted_kinds || []);
     // a source's own actions the page steps too (a field's levels): name -> {rule, sign, repeat}
     this.actions = new Map(Object.entries(config.predicted_actions || {}));
     this.repeating = new Set(config.repeating_kinds || []);
-    this.log = new KeyLog(config.hold_delay, config.tick_rate);
+    const log = new KeyLog(config.hold_delay, config.tick_rate);
+    const same = previous && previous.log.holdMs === log.holdMs && previous.log.periodMs === log.periodMs;
+    this.log = same ? previous.log : log;
     this.kernel = null;
     this.state = null;
     this.applied = [];

@@ -29,7 +29,8 @@ const shared = new WeakMap();
 // The key events kept for the kernel until it has them (a state of its that has them adopted).
 export const MAX_EDGES = 256;
 
-// The widget's prediction (made on first use, remade when the key table changes), and a way to
+// The widget's prediction (made on first use, remade when the key table changes, its held keys
+// kept), and a way to
 // be told when the predicted state changes: `subscribe(f)` -> unsubscribe.
 export function turning(model) {
   let s = shared.get(model);
@@ -41,7 +42,7 @@ export function turning(model) {
   const config = model.get("config");
   if (config && config.keymap && s.configSeen !== config) {
     s.configSeen = config;
-    s.prediction = new Prediction(config, model.get("kernel_state"));
+    s.prediction = new Prediction(config, model.get("kernel_state"), s.prediction);
   }
   return s;
 }
