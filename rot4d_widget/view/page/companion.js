@@ -418,7 +418,7 @@ async function render({ model, el }) {
         set("u_density", Number(v.density) || 0);
         set("u_step", Number(v.step) || 0.5);
         obj.material.uniformsNeedUpdate = true;
-        obj.visible = true;
+        obj.visible = !fieldOwn;  // while the page draws its own field picture the kernel's stays hidden
         volumeApplied = { geometry: g, position: arrays.position, atlas, image: atlas.image };
       };
       // 6. rows drawn without instancing: geometries[i] is meshes[i]'s (balls, bars, faces)
@@ -782,6 +782,10 @@ async function render({ model, el }) {
         const mineField = !mine && fieldPic !== null && fieldDrawsOwn(model, p, seq);
         const fieldRows = mineField ? fieldPic.draw(model, p) : null;
         if (!!fieldRows !== fieldOwn) setFieldOwn(!!fieldRows);
+        // a kernel's picture that arrives while the page draws its own (sent before the page took
+        // over: keys held from before the page had its copy) must not show beside it: two ray
+        // casts a frame, the kernel's of an older state
+        if (fieldOwn) for (const m of kernelMeshes()) m.obj.visible = false;
         if ((mine || !!fieldRows) !== own) {
           own = mine || !!fieldRows;
           applyTurn();
@@ -816,6 +820,9 @@ async function render({ model, el }) {
               scene.trigger("rerender", scene, {});
             };
             host.rot4dDrawsOwn = () => own;
+            // which of the kernel's field meshes (surface, volume) are drawn, and whether the page
+            // draws its own field picture now
+            host.rot4dFieldMeshes = () => ({ own: fieldOwn, kernel: kernelMeshes().filter((m) => m.obj.visible).map((m) => m.obj.name) });
             // the page's field picture as each pixel's first surface hit's distance (field.frag
             // u_output), with the camera it was drawn with: read the canvas after a frame
             host.rot4dFieldDepth = (on) => {
