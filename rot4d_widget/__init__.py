@@ -13,7 +13,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 
-__version__ = "0.1.0"
+from .core.version import __version__ as __version__
 
 #: public name -> the submodule that defines it.  A new public name is one line here.
 #: An entry whose module does not exist (yet) does not break ``import rot4d_widget``:

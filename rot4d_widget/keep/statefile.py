@@ -38,8 +38,8 @@ import stat
 import warnings
 from typing import Mapping, NamedTuple
 
-from .. import __version__
 from ..core.state import RotationState, spacing_factor
+from ..core.version import __version__
 from ..sources.protocol import as_source
 from .jsonfile import read_json
 from .rebuild import (
