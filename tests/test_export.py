@@ -11,7 +11,8 @@ import pytest
 
 trimesh = pytest.importorskip("trimesh")
 
-from rot4d_widget import Field4D, RotationState, look  # noqa: E402
+from rot4d_widget import Field4D, RotationState  # noqa: E402
+from rot4d_widget.core import look
 from rot4d_widget.keep.export import (  # noqa: E402
     CodeNotAllowed,
     SourceNotRebuildable,

@@ -8,7 +8,8 @@ import uuid
 import numpy as np
 import pytest
 
-from rot4d_widget import RotationState, export
+from rot4d_widget import RotationState
+from rot4d_widget.keep import export
 from rot4d_widget.keep.export import load_state
 from rot4d_widget.geometry.offfile import read_off
 from rot4d_widget.keep.recording import Recording

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull, cKDTree
 
-from rot4d_widget import uniform
+from rot4d_widget.geometry import uniform
 from rot4d_widget.geometry.polytopes import Polytope, polytope
 
 PUBLISHED = {
