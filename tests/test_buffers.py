@@ -17,7 +17,7 @@ import pytest
 
 from rot4d_widget.view import buffers as bf
 from rot4d_widget import polytope
-from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 
 

@@ -24,7 +24,8 @@ from rot4d_widget.keep.export import (  # noqa: E402
     slice_mesh,
 )
 from rot4d_widget.sources.fields import slice_field  # noqa: E402
-from rot4d_widget.geometry.polytopes import pentachoron, polytope  # noqa: E402
+from rot4d_widget.geometry.catalogue import polytope
+from rot4d_widget.geometry.regular import pentachoron  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402

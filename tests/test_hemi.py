@@ -31,7 +31,7 @@ from reference_geometry import random_rotation
 from test_star_cells import edge_crossings, parity_in_faces, plane_frame, same_points, shoelace
 
 from rot4d_widget import Polytope, slice_polytope
-from rot4d_widget.geometry.polytopes import MeshError
+from rot4d_widget.geometry.meshcheck import MeshError
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.tomography import StackSource
 

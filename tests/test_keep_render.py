@@ -134,7 +134,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
 
     from rot4d_widget.core import look
     from rot4d_widget.keep import figures
-    from rot4d_widget.geometry.polytopes import polytope
+    from rot4d_widget.geometry.catalogue import polytope
     from rot4d_widget.core.rotation import random_rotation
     from rot4d_widget.geometry.slicing import slice_polytope
 

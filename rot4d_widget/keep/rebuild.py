@@ -18,7 +18,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ..geometry.polytopes import Polytope, polytope
+from ..geometry.catalogue import polytope
+from ..geometry.mesh import Polytope
 from ..sources.field_checks import UnitsWarning
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
@@ -46,7 +47,7 @@ OLD_MODULES = {
     "rot4d_widget.look": "rot4d_widget.core.look",
     "rot4d_widget._arrays": "rot4d_widget.core._arrays",
     "rot4d_widget.progress": "rot4d_widget.core.progress",
-    "rot4d_widget.polytopes": "rot4d_widget.geometry.polytopes",
+    "rot4d_widget.polytopes": "rot4d_widget.geometry.catalogue",
     "rot4d_widget.uniform": "rot4d_widget.geometry.uniform",
     "rot4d_widget.slicing": "rot4d_widget.geometry.slicing",
     "rot4d_widget.offfile": "rot4d_widget.geometry.offfile",

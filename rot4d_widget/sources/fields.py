@@ -45,7 +45,7 @@ Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
 
 Scale: the box's half widths (slice units) and the ends of ``extent`` must lie
-in `rot4d_widget.geometry.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
+in `rot4d_widget.geometry.mesh.COORDINATE_RANGE` (1e-150 to 1e150; else a
 ValueError naming it).  Within it a field scaled by ``s`` (extent times s, the
 same samples) slices as the unscaled one at ``c0 / s`` (extent's w scaled too), its surfaces scaled by
 s: the box cut is the exact slicer's (normalised), the resampling works in
@@ -62,7 +62,7 @@ import numpy as np
 
 from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
-from ..geometry.polytopes import check_scale
+from ..geometry.mesh import check_scale
 from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
 from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
 from .field_checks import (
