@@ -4,8 +4,7 @@
 needs and ``"rebuild"``: True or why it cannot be rebuilt), a stack's inner source described the
 same way; `rebuild_source` makes the source again from the kinds it knows (a polytope, a stack, a
 field from a module-level function or the file it was opened from).  A description is data:
-rebuilding imports nothing it names unless the caller allows it (`CodeNotAllowed`).  Part of
-`rot4d_widget.keep.export`, which re-exports every public name.
+rebuilding imports nothing it names unless the caller allows it (`CodeNotAllowed`).
 """
 
 from __future__ import annotations
@@ -55,7 +54,7 @@ OLD_MODULES = {
     "rot4d_widget.fields": "rot4d_widget.sources.fields",
     "rot4d_widget.tomography": "rot4d_widget.sources.tomography",
     "rot4d_widget.datasets": "rot4d_widget.sources.datasets",
-    "rot4d_widget.export": "rot4d_widget.keep.export",
+    "rot4d_widget.export": "rot4d_widget.keep.statefile",
     "rot4d_widget.recording": "rot4d_widget.keep.recording",
     "rot4d_widget.figures": "rot4d_widget.keep.figures",
     "rot4d_widget.widget": "rot4d_widget.view.widget",

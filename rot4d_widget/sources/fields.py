@@ -278,7 +278,7 @@ class Field4D(FieldLevels, FieldMemory):
              isel=None, sel=None, load: bool = False, **kwargs) -> "Field4D":
         """`from_xarray` of ``variable`` in the netCDF file or zarr store at ``path``, remembering
         where it came from (``field.origin``), so that a state file reopens it
-        (`rot4d_widget.keep.export.save_state`, `Rot4DWidget.save_state` / ``from_state``).
+        (`rot4d_widget.keep.statefile.save_state`, `Rot4DWidget.save_state` / ``from_state``).
 
         ``variable`` may be omitted when the file has one data variable.  ``engine`` goes to
         ``xarray.open_dataset`` (None: xarray's guess; a directory opens with ``"zarr"``).
