@@ -73,7 +73,7 @@ def _timed(owner, name, part, spent, when=lambda args, kwargs: True):
 
 def _time_parts(spent: dict) -> None:
     """Time the parts of the new code's render_animation (see --parts)."""
-    from rot4d_widget import figures, recording
+    from rot4d_widget.keep import figures, recording
 
     _timed(figures, "_prepare", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
     _timed(figures, "render_state", "building", spent)
@@ -86,7 +86,7 @@ def worker(case: str, ext: str, repeats: int, new: bool, parts: bool = False) ->
     per render, its total and `PARTS`)."""
     import inspect
 
-    from rot4d_widget import datasets
+    from rot4d_widget.sources import datasets
     from rot4d_widget.keep.recording import render_animation
 
     quiet = {"progress": False} if "progress" in inspect.signature(render_animation).parameters else {}

@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 from rot4d_widget import Field4D  # noqa: E402
-from rot4d_widget import fields as F  # noqa: E402
+from rot4d_widget.sources import fields as F  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 
 

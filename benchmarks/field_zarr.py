@@ -204,7 +204,7 @@ def fetched_text(f, n_chunks):
 
 def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chunk_mb: float, disk: int):
     """The phases for one way of opening: (rows, notes)."""
-    from rot4d_widget import fields as F
+    from rot4d_widget.sources import fields as F
     from rot4d_widget.core.rotation import random_rotation, simple_rotation
 
     rows, notes = [], []

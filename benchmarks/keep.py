@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from rot4d_widget import Field4D, RotationState
-from rot4d_widget.keep.export import slice_mesh
+from rot4d_widget.keep.meshes import slice_mesh
 from rot4d_widget.keep.figures import render_state
 from rot4d_widget.keep.recording import paper_animation
 from rot4d_widget.core.rotation import random_rotation

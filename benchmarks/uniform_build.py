@@ -29,7 +29,7 @@ CHILD = r"""
 import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
-from rot4d_widget import uniform
+from rot4d_widget.geometry import uniform
 from rot4d_widget.geometry.slicing import slice_polytope
 t1 = time.perf_counter()
 name, steps = sys.argv[1], int(sys.argv[2])
@@ -54,7 +54,7 @@ print(json.dumps({"import": t1 - t0, "build": t2 - t1, "first_slice": t3 - t2,
 
 
 def names(which: str) -> list:
-    from rot4d_widget import uniform
+    from rot4d_widget.geometry import uniform
 
     fams = uniform.polytope_names()
     non_prismatic = [n for f, ns in fams.items() if not f.startswith(("prisms", "duoprisms", "antiprismatic"))
@@ -90,7 +90,7 @@ def main() -> None:
     print("| polychoron | Dynkin | V, E, F, C | build (s) | + first slice, tables (s) | cold total (s) "
           "| slice (ms) | slice polygons |")
     print("|---|---|---|---:|---:|---:|---:|---:|")
-    from rot4d_widget import uniform
+    from rot4d_widget.geometry import uniform
 
     for name in names(args.names):
         r = measure(name, args.steps, args.repeats)

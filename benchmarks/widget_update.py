@@ -32,7 +32,7 @@ import time
 import numpy as np
 from scipy.stats import special_ortho_group
 
-from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.geometry.star_regular import SPECS
 from rot4d_widget.view.widget import Rot4DWidget
 

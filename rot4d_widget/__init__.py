@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import sys as _sys
 
-__version__ = "0.1.0"
+from .core.version import __version__ as __version__
 
 #: public name -> the submodule that defines it.  A new public name is one line here.
 #: An entry whose module does not exist (yet) does not break ``import rot4d_widget``:
@@ -22,10 +23,10 @@ _LAZY = {
     "Action": "core.keymap",
     "DEFAULT_KEYMAP": "core.keymap",
     "Keymap": "core.keymap",
-    "Polytope": "geometry.polytopes",
-    "MeshError": "geometry.polytopes",
-    "pentachoron": "geometry.polytopes",
-    "polytope": "geometry.polytopes",
+    "Polytope": "geometry.mesh",
+    "MeshError": "geometry.meshcheck",
+    "pentachoron": "geometry.regular",
+    "polytope": "geometry.catalogue",
     "double_rotation": "core.rotation",
     "simple_rotation": "core.rotation",
     "Slice": "geometry.slicing",
@@ -43,76 +44,13 @@ _LAZY = {
     "FieldSlice": "sources.fields",
     "FieldSliceData": "sources.fields",
     "polytope_names": "geometry.catalogue",
-    "slice_mesh": "keep.export",
-    "save_state": "keep.export",
-    "load_state": "keep.export",
+    "slice_mesh": "keep.meshes",
+    "save_state": "keep.statefile",
+    "load_state": "keep.statefile",
     "Recording": "keep.recording",
     "Recorder": "keep.recording",
     "render_state": "keep.figures",
 }
-
-#: the wings (subpackages, docs/design.md): rot4d_widget.core ... rot4d_widget.view
-_WINGS = ("core", "geometry", "sources", "keep", "view")
-
-#: module paths from before the wings (``rot4d_widget.fields`` ...) -> where the module is now.
-#: They keep working, as attributes and in import statements (`_OldPaths`), and are the same
-#: module objects as the new paths; CHANGELOG lists them.
-_MOVED = {
-    "rotation": "core.rotation",
-    "keymap": "core.keymap",
-    "state": "core.state",
-    "look": "core.look",
-    "_arrays": "core._arrays",
-    "polytopes": "geometry.polytopes",
-    "uniform": "geometry.uniform",
-    "slicing": "geometry.slicing",
-    "offfile": "geometry.offfile",
-    "source": "sources.protocol",
-    "fields": "sources.fields",
-    "tomography": "sources.tomography",
-    "datasets": "sources.datasets",
-    "export": "keep.export",
-    "recording": "keep.recording",
-    "figures": "keep.figures",
-    "widget": "view.widget",
-    "scene": "view.scene",
-    "buffers": "view.buffers",
-    "companion": "view.companion",
-    "pump": "view.pump",
-    "keyhold": "view.keyhold",
-    "readout": "view.markup",
-    "progress": "core.progress",
-}
-
-#: submodules reachable as attributes (``rot4d_widget.slicing.TOLERANCE``) without an import
-#: statement, as they were when this ``__init__`` imported the core eagerly.
-_SUBMODULES = tuple(_MOVED) + _WINGS
-
-
-class _OldPaths:
-    """A meta path finder: ``import rot4d_widget.fields`` (a path from before the wings) imports
-    ``rot4d_widget.sources.fields`` and binds the old name to that same module object."""
-
-    @staticmethod
-    def find_spec(fullname, path=None, target=None):
-        prefix, _, old = fullname.partition(".")
-        if prefix != __name__ or old not in _MOVED:
-            return None
-        return importlib.util.spec_from_loader(fullname, _OldPaths)
-
-    @staticmethod
-    def create_module(spec):
-        return importlib.import_module(f"{__name__}.{_MOVED[spec.name.partition('.')[2]]}")
-
-    @staticmethod
-    def exec_module(module):
-        pass  # already executed under its new name
-
-
-import sys as _sys  # noqa: E402 - the finder goes in once, after its class
-
-if not any(f is _OldPaths for f in _sys.meta_path):
-    _sys.meta_path.append(_OldPaths)
 
 
 def _exists(module: str) -> bool:
@@ -124,18 +62,18 @@ __all__ = sorted(name for name, module in _LAZY.items() if _exists(module))
 
 def __getattr__(name: str):
     module = _LAZY.get(name)
-    if module is None and name not in _SUBMODULES:
+    if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     try:
-        mod = importlib.import_module(f".{module or _MOVED.get(name, name)}", __name__)
+        mod = importlib.import_module(f".{module}", __name__)
     except ModuleNotFoundError as exc:
         # only the submodule itself missing means "no such attribute"; a missing
         # dependency inside it (pythreejs for Rot4DWidget, say) must be seen as it is
-        if exc.name != f"{__name__}.{module or name}":
+        if exc.name != f"{__name__}.{module}":
             raise
         raise AttributeError(f"module {__name__!r} has no attribute {name!r} "
-                             f"(there is no module {__name__}.{module or name})") from None
-    value = mod if module is None else getattr(mod, name)
+                             f"(there is no module {__name__}.{module})") from None
+    value = getattr(mod, name)
     globals()[name] = value  # resolved once
     _kernel_bar()
     return value

@@ -11,7 +11,9 @@ import pytest
 from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
-from rot4d_widget import datasets, figures, look
+from rot4d_widget.core import look
+from rot4d_widget.keep import figures
+from rot4d_widget.sources import datasets
 from rot4d_widget.keep.recording import Recorder, render_frames
 from rot4d_widget.core.state import RotationState
 

@@ -15,9 +15,9 @@ import numpy as np
 from rot4d_widget.core.rotation import random_rotation
 import pytest
 
-from rot4d_widget import buffers as bf
+from rot4d_widget.view import buffers as bf
 from rot4d_widget import polytope
-from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 
 

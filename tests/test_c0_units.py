@@ -129,7 +129,8 @@ def _old_state_file(tmp_path, source_desc, c0_slice, c0_step_slice):
 
 
 def test_a_state_file_from_before_loads_with_c0_converted(tmp_path, make):
-    from rot4d_widget.keep.export import describe_source, load_state
+    from rot4d_widget.keep.rebuild import describe_source
+    from rot4d_widget.keep.statefile import load_state
 
     f = _field()
     desc = describe_source(f)

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from rot4d_widget import datasets
+from rot4d_widget.sources import datasets
 from rot4d_widget.sources.datasets import default_cache_dir, moving_sphere, phase_separation, phase_separation_key
 from rot4d_widget.sources.fields import Field4D, slice_field
 from rot4d_widget.core.rotation import simple_rotation

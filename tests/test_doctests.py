@@ -16,7 +16,7 @@ import pytest
 PKG = pathlib.Path(__file__).resolve().parent.parent / "rot4d_widget"
 CORE = sorted(f"rot4d_widget.core.{p.stem}" for p in (PKG / "core").glob("*.py") if p.stem != "__init__")
 #: geometry modules with examples (each is listed so that one losing its examples is noticed)
-GEOMETRY = ["rot4d_widget.geometry._ragged", "rot4d_widget.geometry.catalogue", "rot4d_widget.geometry.polytopes",
+GEOMETRY = ["rot4d_widget.geometry._ragged", "rot4d_widget.geometry.catalogue",
             "rot4d_widget.geometry.regular", "rot4d_widget.geometry.star_regular", "rot4d_widget.geometry.uniform",
             "rot4d_widget.geometry.wythoff"]
 #: the core's public functions that must carry an example

@@ -1,4 +1,4 @@
-"""Issue 12: the slice as a mesh (trimesh) and the state as a JSON file (rot4d_widget.keep.export)."""
+"""Issue 12: the slice as a mesh (trimesh) and the state as a JSON file (rot4d_widget.keep.meshes, .statefile)."""
 
 import json
 import math
@@ -11,19 +11,14 @@ import pytest
 
 trimesh = pytest.importorskip("trimesh")
 
-from rot4d_widget import Field4D, RotationState, look  # noqa: E402
-from rot4d_widget.keep.export import (  # noqa: E402
-    CodeNotAllowed,
-    SourceNotRebuildable,
-    describe_source,
-    face_colors,
-    load_mesh,
-    load_state,
-    save_state,
-    slice_mesh,
-)
+from rot4d_widget import Field4D, RotationState  # noqa: E402
+from rot4d_widget.core import look
+from rot4d_widget.keep.meshes import face_colors, load_mesh, slice_mesh
+from rot4d_widget.keep.rebuild import CodeNotAllowed, SourceNotRebuildable, describe_source
+from rot4d_widget.keep.statefile import load_state, save_state
 from rot4d_widget.sources.fields import slice_field  # noqa: E402
-from rot4d_widget.geometry.polytopes import pentachoron, polytope  # noqa: E402
+from rot4d_widget.geometry.catalogue import polytope
+from rot4d_widget.geometry.regular import pentachoron  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402
@@ -282,7 +277,7 @@ def test_function_field_state_file_rebuilds_the_field(tmp_path):
 
 def test_file_field_state_file_reopens_the_file(tmp_path):
     xarray = pytest.importorskip("xarray")
-    from rot4d_widget.keep.export import open_field
+    from rot4d_widget.keep.rebuild import open_field
 
     g = np.linspace(-1, 1, 9)
     t = np.linspace(0, 1, 6)
@@ -385,7 +380,7 @@ def test_bare_slices_from_the_slicers(field_data):
 
 def test_a_widget_settings_go_to_a_state_file_and_a_picture(tmp_path):
     from rot4d_widget import Rot4DWidget
-    from rot4d_widget.keep.export import settings_of
+    from rot4d_widget.keep.statefile import settings_of
     from rot4d_widget.keep.figures import render_state
 
     w = Rot4DWidget("24-cell", slices=3, arrangement="grid", show_balls=False)

@@ -24,7 +24,8 @@ import warnings
 import numpy as np
 import pytest
 
-from rot4d_widget.keep.export import SourceNotRebuildable, load_state, save_state
+from rot4d_widget.keep.rebuild import SourceNotRebuildable
+from rot4d_widget.keep.statefile import load_state, save_state
 from rot4d_widget.sources.fields import COARSE_SAMPLES, Field4D
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState

@@ -11,7 +11,7 @@ from matplotlib.image import imread
 from matplotlib.patches import Circle
 
 from rot4d_widget import RotationState, double_rotation, pentachoron, simple_rotation, slice_polytope
-from rot4d_widget import figures
+from rot4d_widget.keep import figures
 from rot4d_widget.keep.figures import (
     CAMERA_DISTANCE,
     FIG4_ALPHA,
@@ -383,7 +383,7 @@ def test_panel_style_keeps_dense_polytopes_readable():
 def _ndc_pixel(p3, size):
     """Where the live view's three.js camera (look: eye (0, 0, 5), vertical fov 40 deg, aspect
     w / h) puts the displayed point p3: pixel (column, row) of a w x h image, written out here."""
-    from rot4d_widget import look
+    from rot4d_widget.core import look
 
     w, h = size
     d = look.CAMERA_POSITION[2]
@@ -396,7 +396,8 @@ def _ndc_pixel(p3, size):
 
 @pytest.mark.parametrize("size", [(600, 500), (320, 400)])
 def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path, size):
-    from rot4d_widget import look, polytope
+    from rot4d_widget import polytope
+    from rot4d_widget.core import look
     from rot4d_widget.keep.figures import render_state
     from rot4d_widget.core.rotation import random_rotation
 
@@ -425,7 +426,7 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
 
 
 def test_render_state_display_options_and_colours(tmp_path):
-    from rot4d_widget import look
+    from rot4d_widget.core import look
     from rot4d_widget.keep.figures import render_state
 
     st = RotationState()
@@ -457,7 +458,8 @@ def test_render_state_display_options_and_colours(tmp_path):
 
 
 def test_render_state_field_levels_and_stack(tmp_path):
-    from rot4d_widget import Field4D, look
+    from rot4d_widget import Field4D
+    from rot4d_widget.core import look
     from rot4d_widget.keep.figures import render_state, state_source
     from rot4d_widget.sources.tomography import StackSource
 

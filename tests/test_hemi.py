@@ -31,7 +31,7 @@ from reference_geometry import random_rotation
 from test_star_cells import edge_crossings, parity_in_faces, plane_frame, same_points, shoelace
 
 from rot4d_widget import Polytope, slice_polytope
-from rot4d_widget.geometry.polytopes import MeshError
+from rot4d_widget.geometry.meshcheck import MeshError
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.tomography import StackSource
 
@@ -186,7 +186,7 @@ def test_no_volume_reads_none_everywhere(hemi, tmp_path):
         assert data.volume is None and all(v is None for v in data.extra["volumes"])
         assert ("volume", f"none ({why})") in data.readout
         assert not any("None" in str(v) for _, v in data.readout)
-    from rot4d_widget.keep.export import slice_mesh
+    from rot4d_widget.keep.meshes import slice_mesh
 
     pytest.importorskip("trimesh")
     for data in (d, slice_polytope(p, m, 0.3), StackSource(p, slices=3, spacing=0.2).slice(m, 0.3)):

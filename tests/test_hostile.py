@@ -483,7 +483,7 @@ def test_a_second_keydown_without_repeat_during_a_tap_is_a_repeat_not_a_step(mak
 def test_a_state_file_whose_c0_its_step_cannot_move_is_refused(make, tmp_path):
     import json
 
-    from rot4d_widget.keep.export import load_state
+    from rot4d_widget.keep.statefile import load_state
 
     w = make()
     path = tmp_path / "view.json"
@@ -501,7 +501,7 @@ def test_a_state_file_whose_c0_its_step_cannot_move_is_refused(make, tmp_path):
 
 @pytest.mark.parametrize("what", ["state", "recording"])
 def test_a_deeply_nested_json_file_is_a_value_error(tmp_path, what):
-    from rot4d_widget.keep.export import load_state
+    from rot4d_widget.keep.statefile import load_state
     from rot4d_widget.keep.recording import Recording
 
     path = tmp_path / "deep.json"

@@ -55,7 +55,7 @@ def test_animation_frames_fill_the_picture_and_keep_one_frame(tmp_path):
 
 
 def test_annotation_is_written_when_asked(tmp_path):
-    from rot4d_widget import datasets
+    from rot4d_widget.sources import datasets
     from rot4d_widget.keep.figures import render_state
 
     st = RotationState(theta0=np.pi / 16, c0=0.25)
@@ -132,8 +132,9 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     order matplotlib would paint draw_slice's patches (by zorder, ties in the order added)."""
     from matplotlib.figure import Figure
 
-    from rot4d_widget import figures, look
-    from rot4d_widget.geometry.polytopes import polytope
+    from rot4d_widget.core import look
+    from rot4d_widget.keep import figures
+    from rot4d_widget.geometry.catalogue import polytope
     from rot4d_widget.core.rotation import random_rotation
     from rot4d_widget.geometry.slicing import slice_polytope
 
@@ -165,7 +166,8 @@ def test_animation_frames_are_render_states_pictures(source):
     framing and annotation (text is blended from cached pictures: equal up to rounding)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from rot4d_widget import datasets, figures
+    from rot4d_widget.keep import figures
+    from rot4d_widget.sources import datasets
     from rot4d_widget.keep.recording import animation_states
 
     rec = _held_4(4)
@@ -187,7 +189,7 @@ def test_animation_frames_are_render_states_pictures(source):
 def test_an_error_while_drawing_leaves_no_gif_and_no_encoder(tmp_path, monkeypatch):
     import threading
 
-    from rot4d_widget import figures
+    from rot4d_widget.keep import figures
 
     real, calls = figures.render_state, []
 

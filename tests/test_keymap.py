@@ -143,7 +143,7 @@ def test_labels():
 
 # -- keys the next issues add (issue 7) ------------------------------------------
 
-from rot4d_widget import keymap as keymap_module  # noqa: E402
+from rot4d_widget.core import keymap as keymap_module  # noqa: E402
 
 RESERVED = {
     "o": ("level", 1, "raise the iso level (fields)"),

@@ -1,28 +1,51 @@
-"""The package's imports run one way (issue 20): core <- geometry <- sources <- keep <- view.
+"""The package's import rules (issue 38): contracts for import-linter, and what it cannot see.
 
-Parsed from the source (nothing imported): every ``import`` / ``from ... import`` of a
-rot4d_widget module anywhere in a module (at its top or inside a function) is an edge.  The test
-fails on an edge from a lower wing to a higher one, on a cycle between modules, on a widget
-library imported outside the view, and on a module or class larger than the issue allows.
+The rules live in ``pyproject.toml`` (``[tool.importlinter]``) and `test_the_import_contracts_hold`
+runs ``lint-imports`` on them:
 
-Imports sit at module tops: one inside a function says why (a comment on its line or the line
-above its group), and it names neither a standard-library module nor a module of the package,
-except a package module in `HEAVY_MODULES` and the modules in `LAZY_MODULES`.
+``wings``
+    core <- geometry <- sources <- keep <- view: a lower wing never imports a higher one;
+``widget-libraries``
+    only the view imports ipywidgets, pythreejs, ipyevents, traitlets, anywidget or IPython;
+``no-root``
+    no module of the package imports the root package: its ``__init__`` is the table of public
+    names (and, in a kernel, registers the view's progress bar), so importing it from a wing is
+    a way round the wings;
+``no-cycles``
+    no import cycle between the modules (or subpackages) of one package.
+
+Each contract is seen failing here on a copy of the package with a violation written into it
+(`test_each_contract_fails_on_a_violation`).  Sizes are not checked: modules and classes are as
+large as what they hold.
+
+What import-linter cannot see is checked by hand below:
+
+* imports inside functions: one says why (a comment on its line or the line above its group), and
+  names neither a standard-library module nor a module of the package, except a package module in
+  `HEAVY_MODULES` and the modules in `LAZY_MODULES`;
+* modules loaded by name (``importlib.import_module``, ``__import__``): only where `LOADS_BY_NAME`
+  says why, since an edge made from a string is invisible to the contracts.
 """
 
 from __future__ import annotations
 
 import ast
+import os
 import pathlib
+import shutil
+import subprocess
 import sys
 
 import pytest
 
-PKG = pathlib.Path(__file__).resolve().parent.parent / "rot4d_widget"
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+PKG = ROOT / "rot4d_widget"
 WINGS = ("core", "geometry", "sources", "keep", "view")
-WIDGET_LIBRARIES = ("ipywidgets", "pythreejs", "ipyevents", "traitlets", "anywidget", "IPython")
-MAX_MODULE_LINES = 700
-MAX_CLASS_LINES = 400
 #: package modules that may be imported inside a function: what importing them pulls in
 HEAVY_MODULES = {
     "rot4d_widget.keep.figures": "matplotlib and Pillow (~0.5 s)",
@@ -35,6 +58,15 @@ LAZY_MODULES = {
     "rot4d_widget": "resolves every public name on first use; a Jupyter server imports it at start",
     "rot4d_widget._server": "the server extension, loaded by every Jupyter server at start",
 }
+#: the modules that load modules by name, and what they load
+LOADS_BY_NAME = {
+    "rot4d_widget": "its public names (the table `_LAZY`) and, in a kernel, view.progress: the root is above "
+                    "every wing, and no package module imports it (contract no-root)",
+    "rot4d_widget.keep.rebuild": "the function a state file names (``module:qualname``), only when the caller "
+                                 "allows code: a user's module, not an edge of the package",
+}
+#: the contracts pyproject.toml must declare (a contract taken out is noticed)
+CONTRACTS = {"wings", "widget-libraries", "no-root", "no-cycles"}
 
 
 def _modules():
@@ -68,94 +100,68 @@ def _resolve(module: str, is_package: bool, node: ast.ImportFrom | ast.Import, k
     return out
 
 
-def _edges():
-    mods = _modules()
-    edges = []  # (importer, imported, line, at top)
-    for name, path in mods.items():
-        tree = ast.parse(path.read_text(), str(path))
-        top = {id(n) for n in tree.body}
-        for node in ast.walk(tree):
-            if isinstance(node, (ast.Import, ast.ImportFrom)):
-                for target in _resolve(name, path.name == "__init__.py", node, mods):
-                    if target != name:
-                        edges.append((name, target, node.lineno, id(node) in top))
-    return mods, edges
+def _resolve(module: str, is_package: bool, node: ast.ImportFrom | ast.Import, known) -> list:
+    """The rot4d_widget modules an import statement of ``module`` names."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names if a.name.split(".")[0] == "rot4d_widget"]
+    base = module.split(".") if is_package else module.split(".")[:-1]
+    if node.level:
+        base = base[: len(base) - (node.level - 1)]
+        target = ".".join(base + ([node.module] if node.module else []))
+    else:
+        target = node.module or ""
+    if target.split(".")[0] != "rot4d_widget":
+        return []
+    out = []
+    for alias in node.names:  # `from .pkg import module` names a module
+        sub = f"{target}.{alias.name}"
+        out.append(sub if sub in known else target)
+    return out
 
 
-def _wing(module: str):
-    parts = module.split(".")
-    return parts[1] if len(parts) > 2 and parts[1] in WINGS else None
+def _lint_imports(root: pathlib.Path, config: pathlib.Path) -> subprocess.CompletedProcess:
+    """``lint-imports`` on the package under ``root`` (first on its path), with the contracts of ``config``."""
+    code = ("import importlib.util, pathlib, sys; "
+            "origin = pathlib.Path(importlib.util.find_spec('rot4d_widget').origin); "
+            f"assert origin.is_relative_to({str(root)!r}), origin; "
+            "from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
+    return subprocess.run([sys.executable, "-c", code, "--no-cache", "--no-logo", str(config)], cwd=root, env=env,
+                          capture_output=True, text=True, timeout=300)
 
 
-def test_imports_run_one_way_between_the_wings():
-    mods, edges = _edges()
-    assert {_wing(m) for m in mods} >= set(WINGS)
-    upward = []
-    for a, b, line, _ in edges:
-        wa, wb = _wing(a), _wing(b)
-        if wa is not None and wb is not None and WINGS.index(wb) > WINGS.index(wa):
-            upward.append(f"{a} (line {line}) imports {b}: {wa} may not import {wb}")
-    assert not upward, "\n".join(upward)
+def test_pyproject_declares_the_contracts():
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
+    contracts = {c["id"]: c for c in config["contracts"]}
+    assert set(contracts) == CONTRACTS
+    assert config["root_package"] == "rot4d_widget"
+    assert contracts["wings"]["layers"] == list(reversed(WINGS))
+    assert {m.split(".")[1] for m in contracts["widget-libraries"]["source_modules"]} >= set(WINGS) - {"view"}
 
 
-def test_no_import_cycle_between_modules():
-    mods, edges = _edges()
-    graph = {m: set() for m in mods}
-    for a, b, _, _ in edges:
-        if b in graph and not (b.count(".") < a.count(".") and a.startswith(b + ".")):  # a package's own init
-            graph[a].add(b)
-    # the package's __init__ and the wings' __init__s resolve names lazily: not part of a cycle
-    for m in list(graph):
-        if m == "rot4d_widget" or (m.count(".") == 1 and m.split(".")[1] in WINGS):
-            graph[m] = set()
-    seen, stack, cycles = {}, [], []
-
-    def visit(m):
-        seen[m] = 1
-        stack.append(m)
-        for n in sorted(graph[m]):
-            if seen.get(n) == 1:
-                cycles.append(" -> ".join(stack[stack.index(n):] + [n]))
-            elif n not in seen:
-                visit(n)
-        stack.pop()
-        seen[m] = 2
-
-    for m in sorted(graph):
-        if m not in seen:
-            visit(m)
-    assert not cycles, "\n".join(cycles)
+def test_the_import_contracts_hold():
+    out = _lint_imports(ROOT, ROOT / "pyproject.toml")
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert f"Contracts: {len(CONTRACTS)} kept, 0 broken." in out.stdout, out.stdout
 
 
-def test_only_the_view_imports_widget_libraries():
-    mods = _modules()
-    bad = []
-    for name, path in mods.items():
-        if _wing(name) == "view" or name.count(".") == 0:
-            continue
-        tree = ast.parse(path.read_text(), str(path))
-        for node in ast.walk(tree):
-            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
-                     else [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
-            for n in names:
-                if n.split(".")[0] in WIDGET_LIBRARIES:
-                    bad.append(f"{name} (line {node.lineno}) imports {n}")
-    assert not bad, "\n".join(bad)
-
-
-def test_no_module_over_700_lines_and_no_class_over_400():
-    big = []
-    for name, path in _modules().items():
-        text = path.read_text()
-        n = text.count("\n")
-        if n > MAX_MODULE_LINES:
-            big.append(f"{name}: {n} lines")
-        for node in ast.walk(ast.parse(text)):
-            if isinstance(node, ast.ClassDef):
-                size = node.end_lineno - node.lineno + 1
-                if size > MAX_CLASS_LINES:
-                    big.append(f"{name}.{node.name}: class of {size} lines")
-    assert not big, "\n".join(big)
+@pytest.mark.parametrize("module, line, contract", [
+    ("core/state.py", "from ..view import widget", "The wings import one way"),
+    ("keep/meshes.py", "import ipywidgets", "Only the view imports a widget library"),
+    ("keep/statefile.py", "from .. import __version__", "No module of the package imports the root package"),
+    ("view/markup.py", "import rot4d_widget", "No module of the package imports the root package"),
+    ("core/rotation.py", "from . import state", "No import cycle"),
+])
+def test_each_contract_fails_on_a_violation(tmp_path, module, line, contract):
+    """A copy of the package with ``line`` added to ``module``: ``lint-imports`` names the contract broken."""
+    shutil.copytree(PKG, tmp_path / "rot4d_widget", ignore=lambda d, names: [
+        n for n in names if not (n.endswith(".py") or (pathlib.Path(d) / n).is_dir()) or n == "__pycache__"])
+    target = tmp_path / "rot4d_widget" / module
+    target.write_text(target.read_text() + f"\n{line}  # a violation, on purpose\n")
+    out = _lint_imports(tmp_path, ROOT / "pyproject.toml")
+    assert out.returncode == 1, out.stdout + out.stderr
+    broken = out.stdout.split("Broken contracts", 1)[-1]
+    assert contract in broken, out.stdout  # (an upward import between wings is a cycle of wings too)
 
 
 def _inner_imports(tree):
@@ -234,15 +240,42 @@ def test_the_inner_import_check_sees_a_light_or_silent_import(body, problem):
         assert any(problem in f for f in found), found
 
 
-@pytest.mark.parametrize("bad, why", [
-    ("from ..view import widget", "imports rot4d_widget.view.widget: core may not import view"),
-])
-def test_the_layer_check_sees_an_upward_import(tmp_path, bad, why):
-    """The checker itself: an upward import written into a core module is reported."""
-    tree = ast.parse(bad)
-    node = tree.body[0]
+def _loads_by_name(tree) -> list:
+    """The calls ``importlib.import_module(...)``, ``import_module(...)`` and ``__import__(...)``."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else None
+            if name in ("import_module", "__import__"):
+                out.append(node)
+    return out
+
+
+def _by_name_problems(name: str, text: str) -> list:
+    if name in LOADS_BY_NAME:
+        return []
+    return [f"{name} (line {node.lineno}) `{ast.unparse(node)}`: loads a module by name, an import the contracts "
+            "cannot see; import it at the top (or say in LOADS_BY_NAME why it must be loaded by name)"
+            for node in _loads_by_name(ast.parse(text))]
+
+
+def test_modules_are_loaded_by_name_only_where_it_is_said_why():
     mods = _modules()
-    targets = _resolve("rot4d_widget.core.state", False, node, mods)
-    assert targets == ["rot4d_widget.view.widget"]
-    wa, wb = _wing("rot4d_widget.core.state"), _wing(targets[0])
-    assert WINGS.index(wb) > WINGS.index(wa)
+    problems = []
+    for name, path in mods.items():
+        problems += _by_name_problems(name, path.read_text())
+    assert not problems, "\n".join(problems)
+    for name in LOADS_BY_NAME:  # each entry still loads something (a stale entry is noticed)
+        assert _loads_by_name(ast.parse(mods[name].read_text())), f"{name} loads nothing by name any more"
+
+
+@pytest.mark.parametrize("body", [
+    "importlib.import_module('rot4d_widget.view.widget')",
+    "import_module('..view.widget', __package__)",
+    "__import__('rot4d_widget.view.widget')",
+])
+def test_the_by_name_check_sees_a_load(body):
+    """The checker itself, on a made-up module of the core."""
+    found = _by_name_problems("rot4d_widget.core.state", f"import importlib\n\n\ndef f():\n    return {body}\n")
+    assert len(found) == 1 and "loads a module by name" in found[0], found

@@ -11,7 +11,10 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from rot4d_widget import buffers, figures, look, pentachoron, polytope, slice_polytope
+from rot4d_widget import pentachoron, polytope, slice_polytope
+from rot4d_widget.core import look
+from rot4d_widget.keep import figures
+from rot4d_widget.view import buffers
 from rot4d_widget.keep.figures import draw_slice, panel_style, render_slice
 
 

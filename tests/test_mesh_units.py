@@ -12,7 +12,7 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 
 from rot4d_widget import Field4D  # noqa: E402
-from rot4d_widget.keep.export import load_mesh, slice_mesh  # noqa: E402
+from rot4d_widget.keep.meshes import load_mesh, slice_mesh  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402

@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import connected_components
 from mesh_shapes import SHAPES, stellated_tesseract_mesh, tesseract_union, tesseract_union_mesh
 from reference_geometry import random_rotation, rotation_with_w_row
 from rot4d_widget import Polytope, slice_polytope
-from rot4d_widget.geometry.polytopes import MeshError
+from rot4d_widget.geometry.meshcheck import MeshError
 
 PROPS = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 seeds = st.integers(0, 2**32 - 1)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget.geometry.offfile import MAX_LINE_CHARS, read_off
-from rot4d_widget.geometry.polytopes import polytope
+from rot4d_widget.geometry.catalogue import polytope
 
 MB = 1 << 20
 TESSERACT = polytope("8-cell").to_off()

@@ -9,7 +9,7 @@ from mesh_shapes import duoprism, duoprism_mesh, prism_mesh, tesseract_union, te
 from reference_geometry import random_rotation
 from rot4d_widget import Polytope, polytope, slice_polytope
 from rot4d_widget.geometry.offfile import read_off
-from rot4d_widget.geometry.polytopes import MeshError
+from rot4d_widget.geometry.meshcheck import MeshError
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 

@@ -327,7 +327,7 @@ def test_a_single_view_given_stack_settings_is_refused_before_any_change():
         r.replay(state, field)
     assert field.levels == before and np.array_equal(state.matrix, np.eye(4))
     with pytest.raises(ValueError, match="sets 'levels'.*iso levels"):
-        r.replay(None, __import__("rot4d_widget.sources.tomography").tomography.StackSource("5-cell", slices=2))
+        r.replay(None, __import__("rot4d_widget").StackSource("5-cell", slices=2))
     assert np.array_equal(r.replay().matrix, r.replay(None, None).matrix)  # skipped without a source
 
 
@@ -349,7 +349,7 @@ def test_animations_follow_the_source_settings_on_their_copy():
 
 def test_render_frames_follow_the_source_settings(monkeypatch):
     """Each frame is drawn with the settings recorded up to it; the keywords given are the start."""
-    from rot4d_widget import figures
+    from rot4d_widget.keep import figures
     from rot4d_widget.keep.recording import render_frames
 
     drawn = []

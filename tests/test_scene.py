@@ -22,10 +22,11 @@ import pythreejs as p3
 from ipywidgets.widgets import widget as ipywidget_module
 
 import rot4d_widget
-from rot4d_widget import buffers as bf
-from rot4d_widget import look, polytope
+from rot4d_widget.view import buffers as bf
+from rot4d_widget import polytope
+from rot4d_widget.core import look
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.view.scene import Scene, shader_source
 

@@ -104,11 +104,25 @@ def test_public_names_resolve_lazily_from_their_modules():
     for name in rot4d_widget.__all__:
         module = importlib.import_module(f"rot4d_widget.{rot4d_widget._LAZY[name]}")
         assert getattr(rot4d_widget, name) is getattr(module, name), name
-    from rot4d_widget import Polytope, polytope, slicing  # names and submodules, as before
+    from rot4d_widget import Polytope, polytope
+    from rot4d_widget.geometry import slicing
 
     assert isinstance(polytope("5-cell"), Polytope) and slicing.TOLERANCE > 0
     with pytest.raises(AttributeError, match="no attribute 'nonesuch'"):
         rot4d_widget.nonesuch
+
+
+@pytest.mark.parametrize("old", ["fields", "slicing", "widget", "readout"])
+def test_the_module_paths_from_before_the_wings_are_gone(old):
+    """No import hook and no submodule attributes before 1.0 (issue 38): a module is imported by
+    its path in its wing (CHANGELOG lists where each went)."""
+    import rot4d_widget
+
+    assert old not in rot4d_widget.__all__ and old not in dir(rot4d_widget)
+    with pytest.raises(AttributeError, match=f"no attribute '{old}'"):
+        getattr(rot4d_widget, old)
+    with pytest.raises(ModuleNotFoundError, match=f"rot4d_widget.{old}"):
+        importlib.import_module(f"rot4d_widget.{old}")
 
 
 def test_a_table_entry_for_a_missing_module_breaks_nothing(monkeypatch):

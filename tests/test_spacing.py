@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from test_labels import flame, turned
 
-from rot4d_widget.keep.export import load_state
+from rot4d_widget.keep.statefile import load_state
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

@@ -13,7 +13,8 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from reference_geometry import random_rotation
-from rot4d_widget import look, polytope, slice_polytope
+from rot4d_widget import polytope, slice_polytope
+from rot4d_widget.core import look
 from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.keep.figures import render_tomography
 from rot4d_widget.core.rotation import simple_rotation

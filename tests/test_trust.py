@@ -8,14 +8,13 @@ import uuid
 import numpy as np
 import pytest
 
-from rot4d_widget import RotationState, export
-from rot4d_widget.keep.export import load_state
+from rot4d_widget import RotationState
+from rot4d_widget.keep.statefile import load_state
 from rot4d_widget.geometry.offfile import read_off
 from rot4d_widget.keep.recording import Recording
 from rot4d_widget.core.rotation import random_rotation
 
-#: (looked up so that the tests also run, and fail for the right reason, on a version without it)
-CodeNotAllowed = getattr(export, "CodeNotAllowed", ValueError)
+from rot4d_widget.keep.rebuild import CodeNotAllowed
 EXTENT = [[-1.2, 1.2], [-1.2, 1.2], [-1.2, 1.2], [-1.0, 1.0]]
 
 

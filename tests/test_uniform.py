@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull, cKDTree
 
-from rot4d_widget import uniform
-from rot4d_widget.geometry.polytopes import Polytope, polytope
+from rot4d_widget.geometry import uniform
+from rot4d_widget.geometry.catalogue import polytope
+from rot4d_widget.geometry.mesh import Polytope
 
 PUBLISHED = {
     # A4

@@ -17,7 +17,7 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.export import SETTING_NAMES, load_state, save_state
+from rot4d_widget.keep.statefile import SETTING_NAMES, load_state, save_state
 from rot4d_widget.keep.figures import render_state
 from rot4d_widget.keep.recording import (
     RECORDING_VERSION,

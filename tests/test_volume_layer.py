@@ -110,7 +110,7 @@ def test_back_to_surface_hides_the_volume_in_the_same_message(make):
 
 
 def test_default_clim_is_the_cuts_1st_to_99th_percentile(make):
-    from rot4d_widget.keep.volume import default_clim
+    from rot4d_widget.core.look import default_clim
 
     f = blob()
     w = make(f, rendering="mip")

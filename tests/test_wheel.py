@@ -70,8 +70,8 @@ def test_names_and_version(dists):
     sdist, wheel = dists
     assert sdist.name == f"{NAME}-{VERSION}.tar.gz"
     assert wheel.name == f"{NAME}-{VERSION}-py3-none-any.whl"  # pure Python: installs anywhere, no compiler
-    init = (ROOT / "rot4d_widget" / "__init__.py").read_text()
-    assert f'__version__ = "{VERSION}"' in init, "rot4d_widget.__version__ differs from pyproject's version"
+    home = (ROOT / "rot4d_widget" / "core" / "version.py").read_text()
+    assert f'__version__ = "{VERSION}"' in home, "rot4d_widget.__version__ differs from pyproject's version"
 
 
 def test_wheel_carries_the_package_its_javascript_and_glsl(wheel_names):

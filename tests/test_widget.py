@@ -22,7 +22,7 @@ from ipywidgets.widgets import widget as ipywidget_module
 from widget_time import service
 
 from rot4d_widget import polytope, simple_rotation, slice_polytope
-from rot4d_widget import widget as wmod
+from rot4d_widget.view import widget as wmod
 from rot4d_widget.core.keymap import RESERVED_KINDS
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import DEFAULT_THETA0
@@ -104,7 +104,7 @@ class FakeScene:
 
     @staticmethod
     def palette(n_groups):
-        from rot4d_widget import look
+        from rot4d_widget.core import look
 
         return look.group_palette(max(int(n_groups), 1))
 

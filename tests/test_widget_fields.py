@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from rot4d_widget import look
+from rot4d_widget.core import look
 from rot4d_widget.sources.fields import Field4D
 from test_widget import down, up
 from test_widget_scene import drawn, run_ticker
@@ -156,7 +156,7 @@ def test_levels_do_not_apply_to_polytopes(make):
 
 
 def test_surface_quantisation_is_within_half_a_step():
-    from rot4d_widget import buffers as bf
+    from rot4d_widget.view import buffers as bf
 
     f = ball_field()
     data = f.slice(np.eye(4), 0.0)
@@ -187,7 +187,7 @@ def test_an_empty_surface_clears_the_layer(make, clock):
 
 def test_the_rows_carry_only_the_box_so_an_update_stays_small(make):
     """The row table is sized for the box's bars, not the surface's triangles (they travel quantised)."""
-    from rot4d_widget import buffers as bf
+    from rot4d_widget.view import buffers as bf
 
     f = ball_field()
     w = make(f)

@@ -22,9 +22,10 @@ from rot4d_widget.core.rotation import random_rotation
 import pytest
 from ipywidgets.widgets import widget as ipywidget_module
 
-from rot4d_widget import buffers as bf
-from rot4d_widget import look, polytope
-from rot4d_widget.geometry.polytopes import POLYTOPE_NAMES
+from rot4d_widget.view import buffers as bf
+from rot4d_widget import polytope
+from rot4d_widget.core import look
+from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.view.widget import Rot4DWidget
 from test_widget import down, up, xw_steps
 from widget_time import service

@@ -102,7 +102,7 @@ def test_a_held_3d_turn_reslices_each_slice_instead_of_turning_the_whole_layout(
 def test_colours_by_w_reach_the_rows_and_the_legend(make):
     w = make("24-cell", slices=3, spacing=0.5, arrangement="stack")
     colors = w.source.group_colors()
-    from rot4d_widget import buffers as bf
+    from rot4d_widget.view import buffers as bf
 
     packed = set(bf.pack_rgb(colors).tolist())
     used = w.scene.rows[: w.scene.counts[2], 19]

@@ -59,6 +59,8 @@ __all__ = [
     "check_clim",
     "RENDERINGS",
     "DEFAULT_SECTIONS",
+    "DEFAULT_DENSITY",
+    "default_clim",
     "check_rendering",
     "check_sections",
     "level_colors",
@@ -262,12 +264,35 @@ RENDERINGS = ("surface", "volume", "mip", "sections")
 #: Where the three planes of ``"sections"`` cross the cut's grid: a fraction of its extent along
 #: each of x, y, z (0 the first node, 1 the last).
 DEFAULT_SECTIONS = (0.5, 0.5, 0.5)
+#: ``"volume"``: the optical depth across the cut grid's longest side of a medium at the top of
+#: the opacity ramp (the live view's shader and a static picture's ray caster alike).
+DEFAULT_DENSITY = 4.0
 #: What each ray-cast rendering shows, for readouts and annotations ({name}: the field's name).
 RENDERING_TEXT = {
     "mip": "maximum intensity: the highest {name} along each line of sight",
     "volume": "volume: {name} glows and absorbs, the more the higher it is (colour bar)",
     "sections": "sections: {name} on three planes of the cut",
 }
+
+
+def default_clim(values) -> tuple:
+    """(lo, hi): the 1st and 99th percentiles of the finite ``values`` (robust to a few outliers),
+    the colour range of a ray-cast rendering whose ``clim`` is not set (live view and picture).
+    A constant gives (v - 1/2 |v|, v + 1/2 |v|) (1/2 around 0), so it takes the middle of the
+    colour map; no finite value gives (0, 1).
+
+    >>> default_clim(np.r_[np.arange(101.0), np.nan, 1e9])
+    (1.01, 99.99)
+    """
+    v = np.asarray(values, dtype=np.float64).ravel()
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return 0.0, 1.0
+    lo, hi = (float(x) for x in np.percentile(v, [1.0, 99.0]))
+    if not hi > lo:
+        half = 0.5 * abs(lo) if lo != 0 else 0.5
+        lo, hi = lo - half, lo + half
+    return lo, hi
 
 
 def check_projection(value, name: str = "projection") -> bool:

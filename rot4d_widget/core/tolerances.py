@@ -7,7 +7,7 @@ Use the module as the tolerance object (like trimesh's ``constants.tol``)::
 
 Each constant says what it is relative to.  The older names stay where they were
 (`rot4d_widget.geometry.slicing.TOLERANCE`, `rot4d_widget.core.rotation.ORTHOGONALITY_TOLERANCE`,
-`rot4d_widget.geometry.polytopes.MESH_TOLERANCE`) and are these same numbers.
+`rot4d_widget.geometry.mesh.MESH_TOLERANCE`) and are these same numbers.
 
 >>> ON_HYPERPLANE, ORTHOGONALITY, MESH
 (1e-09, 1e-06, 1e-06)

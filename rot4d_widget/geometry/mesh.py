@@ -55,7 +55,7 @@ def check_scale(scale: float, what: str) -> None:
         shown = f"{scale:.3g}"  # with every digit where three would look like a bound (1.0000000000000002e+150)
         shown = repr(float(scale)) if float(shown) in (lo, hi) else shown
         raise ValueError(f"{what} is {shown}; expected {lo:g} to {hi:g} "
-                         f"(rot4d_widget.geometry.polytopes.COORDINATE_RANGE: "
+                         f"(rot4d_widget.geometry.mesh.COORDINATE_RANGE: "
                          f"squares of coordinates must stay normal float64 numbers; rescale the data, e.g. to "
                          f"other units)")
 

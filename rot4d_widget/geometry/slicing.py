@@ -76,7 +76,7 @@ Scale: the slicer cuts the polytope's *unit vertices* (its vertices divided by
 a power of two, so the largest |coordinate| is in [1, 2); exact) at
 ``c0 / unit`` and multiplies the slice's vertices by ``unit`` (exact) and its
 volume by ``unit**3``: a polytope scaled by ``s`` (any scale in
-`rot4d_widget.geometry.polytopes.COORDINATE_RANGE`, 1e-150 to 1e150) has the slices
+`rot4d_widget.geometry.mesh.COORDINATE_RANGE`, 1e-150 to 1e150) has the slices
 of the unscaled one at ``c0 / s``, scaled by ``s``.  Only the volume can leave
 float64's range (coordinates beyond about 5e102 give ``inf``, below about
 2e-103 it underflows towards 0; ``dim`` still says the slice is solid).
@@ -100,13 +100,10 @@ import numpy as np
 from ..core import tolerances as tol_
 from ..core.rotation import as_rotation_matrix
 from ..core.validate import is_real
-from ._ragged import _owner
 from .catalogue import polytope as _get_polytope
-from .mesh import Polytope
-from .multislice import _NoCrossing, _nonzero2, _slice_generic, _slice_many
-from .section import _TWO_PI_PLUS, _faces_in_h, _slice, _touching
+from .multislice import _slice_many
 from .section import slice_level as _slice_level
-from .slicetables import _TABLES, Slice, _fan, _Inconsistent, _inplane_axes, _padded, _scaled, _scaled_volume, _Tables
+from .slicetables import Slice
 from .slicetables import tables as _tables
 from .starslice import slice_star
 
@@ -115,11 +112,6 @@ __all__ = ["Slice", "slice_polytope", "TOLERANCE"]
 #: The one tolerance for "on H", relative to the polytope's circumradius
 #: (`rot4d_widget.core.tolerances.ON_HYPERPLANE`).
 TOLERANCE = tol_.ON_HYPERPLANE
-
-#: the private names this module had before it was split, still importable from it
-_MOVED = (_owner, Polytope, _NoCrossing, _nonzero2, _slice_generic, _TWO_PI_PLUS, _faces_in_h,
-          _slice, _touching, _TABLES, _fan, _Inconsistent, _inplane_axes, _padded, _scaled, _scaled_volume, _Tables)
-
 
 def slice_polytope(polytope, matrix, c0=0.0):
     """Cut ``polytope`` (a `Polytope` or a name), rotated by ``matrix``, with w = ``c0``.

@@ -10,7 +10,7 @@ What is here
   the p-antiprismatic prisms for 3 <= p, q <= 32.
 
 Every one has edge length 2 and is centred on the origin, like the regular six of
-:mod:`rot4d_widget.geometry.polytopes` — and the regular six *are* those objects: ``build("x3o3o3o")``
+:mod:`rot4d_widget.geometry.regular` — and the regular six *are* those objects: ``build("x3o3o3o")``
 returns ``polytope("5-cell")`` itself (its vertex array unchanged).
 
 Combinatorics from the group, not from the geometry
@@ -291,7 +291,7 @@ def _built(canon: str):
 
 
 def build(name):
-    """The polychoron called ``name`` as a `rot4d_widget.geometry.polytopes.Polytope` (edge 2, centred).
+    """The polychoron called ``name`` as a `rot4d_widget.geometry.mesh.Polytope` (edge 2, centred).
 
     ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see the module
     docstring; `polytope_names` lists the canonical names).  The regular six are the core's own

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..core.progress import progress as make_progress
 from ..core.state import RotationState
-from ..geometry.polytopes import pentachoron
+from ..geometry.regular import pentachoron
 from ..sources.protocol import PolytopeSource, as_source, note_matrix
 from .recorder import (
     SOURCE_SETTINGS,

@@ -40,8 +40,8 @@ from matplotlib.patches import Circle, Polygon
 from ..core import look
 from ..core.look import REFERENCE_RADIUS
 from ..core.state import PAPER_ALPHA_RATIO
-from ..geometry.polytopes import Polytope
-from ..geometry.polytopes import polytope as _named_polytope
+from ..geometry.catalogue import polytope as _named_polytope
+from ..geometry.mesh import Polytope
 from ..geometry.slicing import Slice
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).

@@ -11,8 +11,6 @@ slice index when coloured by w) and its colour (``mesh.visual.face_colors``, the
 palette from `rot4d_widget.core.look`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
 extension (trimesh's own writers); what each keeps is listed in `MESH_FORMATS`.
 `load_mesh(path)` reads one back with the groups a PLY file carries.
-
-Part of `rot4d_widget.keep.export`, which re-exports every public name.
 """
 
 from __future__ import annotations

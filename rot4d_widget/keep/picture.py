@@ -557,7 +557,7 @@ def render_state(
 
     ``state`` is a `RotationState` (its matrix and c0 are used); ``source`` a polytope name, a
     Polytope, a `Field4D`, a `StackSource` or any source.  The keywords are the widget's
-    settings, by the names of its traits (`rot4d_widget.keep.export.save_state` stores them so):
+    settings, by the names of its traits (`rot4d_widget.keep.statefile.save_state` stores them so):
     ``levels`` (a field's iso levels), ``slices``, ``spacing``, ``arrangement`` (parallel
     slices: `state_source`), ``color_by`` (``"group"`` or one colour), ``group_colors``,
     ``face_opacity``, ``ball_radius`` / ``bar_radius`` (displayed units; default as the widget

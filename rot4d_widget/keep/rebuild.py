@@ -4,8 +4,7 @@
 needs and ``"rebuild"``: True or why it cannot be rebuilt), a stack's inner source described the
 same way; `rebuild_source` makes the source again from the kinds it knows (a polytope, a stack, a
 field from a module-level function or the file it was opened from).  A description is data:
-rebuilding imports nothing it names unless the caller allows it (`CodeNotAllowed`).  Part of
-`rot4d_widget.keep.export`, which re-exports every public name.
+rebuilding imports nothing it names unless the caller allows it (`CodeNotAllowed`).
 """
 
 from __future__ import annotations
@@ -18,7 +17,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ..geometry.polytopes import Polytope, polytope
+from ..geometry.catalogue import polytope
+from ..geometry.mesh import Polytope
 from ..sources.field_checks import UnitsWarning
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
@@ -33,6 +33,51 @@ class CodeNotAllowed(ValueError):
     """A state file names code (a field's ``"module:qualname"`` function) and the caller did not
     allow importing it: pass ``allow_code=True`` (a file you trust), the function
     (``function=f``) or the source (``source=...``)."""
+
+
+#: Module paths of the package from before the wings (issue 20) -> where that code is now.  A
+#: state file names a field's function by ``"module:qualname"``; one written before the wings can
+#: name package code by an old path, which the package no longer imports (issue 38: no import
+#: hook before 1.0), so the loader translates it with this table -- data, nothing imported.
+OLD_MODULES = {
+    "rot4d_widget.rotation": "rot4d_widget.core.rotation",
+    "rot4d_widget.keymap": "rot4d_widget.core.keymap",
+    "rot4d_widget.state": "rot4d_widget.core.state",
+    "rot4d_widget.look": "rot4d_widget.core.look",
+    "rot4d_widget._arrays": "rot4d_widget.core._arrays",
+    "rot4d_widget.progress": "rot4d_widget.core.progress",
+    "rot4d_widget.polytopes": "rot4d_widget.geometry.catalogue",
+    "rot4d_widget.uniform": "rot4d_widget.geometry.uniform",
+    "rot4d_widget.slicing": "rot4d_widget.geometry.slicing",
+    "rot4d_widget.offfile": "rot4d_widget.geometry.offfile",
+    "rot4d_widget.source": "rot4d_widget.sources.protocol",
+    "rot4d_widget.fields": "rot4d_widget.sources.fields",
+    "rot4d_widget.tomography": "rot4d_widget.sources.tomography",
+    "rot4d_widget.datasets": "rot4d_widget.sources.datasets",
+    "rot4d_widget.export": "rot4d_widget.keep.statefile",
+    "rot4d_widget.recording": "rot4d_widget.keep.recording",
+    "rot4d_widget.figures": "rot4d_widget.keep.figures",
+    "rot4d_widget.widget": "rot4d_widget.view.widget",
+    "rot4d_widget.scene": "rot4d_widget.view.scene",
+    "rot4d_widget.buffers": "rot4d_widget.view.buffers",
+    "rot4d_widget.companion": "rot4d_widget.view.companion",
+    "rot4d_widget.pump": "rot4d_widget.view.pump",
+    "rot4d_widget.keyhold": "rot4d_widget.view.keyhold",
+    "rot4d_widget.readout": "rot4d_widget.view.markup",
+}
+
+
+def module_now(module: str) -> str:
+    """Where the module a state file names is now: `OLD_MODULES`'s entry for an old path of the
+    package (or of a module under it), else ``module`` itself.
+
+    >>> module_now("rot4d_widget.fields"), module_now("mylab.fields")
+    ('rot4d_widget.sources.fields', 'mylab.fields')
+    """
+    for old, new in OLD_MODULES.items():
+        if module == old or module.startswith(old + "."):
+            return new + module[len(old):]
+    return module
 
 
 class _CannotRebuild(ValueError):
@@ -204,7 +249,7 @@ def _rebuild_field(d, allow_code=False, function=None, base=None):
                 "load_state(path, function=f), or the source, load_state(path, source=...)")
         module, _, qual = spec.partition(":")
         try:
-            obj = importlib.import_module(module)
+            obj = importlib.import_module(module_now(module))
             for part in qual.split("."):
                 obj = getattr(obj, part)
         except (ImportError, AttributeError, ValueError) as exc:

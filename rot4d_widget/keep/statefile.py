@@ -25,8 +25,6 @@ names.  A field made from a function is described by the function's name
 saying how to allow it) unless asked: ``load_state(path, allow_code=True)`` for a file you
 trust, ``load_state(path, function=f)`` to give the function yourself, or
 ``load_state(path, source=field)``.
-
-Part of `rot4d_widget.keep.export`, which re-exports every public name.
 """
 
 from __future__ import annotations
@@ -38,8 +36,8 @@ import stat
 import warnings
 from typing import Mapping, NamedTuple
 
-from .. import __version__
 from ..core.state import RotationState, spacing_factor
+from ..core.version import __version__
 from ..sources.protocol import as_source
 from .jsonfile import read_json
 from .rebuild import (

@@ -48,7 +48,15 @@ import numpy as np
 from scipy.ndimage import map_coordinates
 
 from ..core import look
-from ..core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, RENDERINGS, check_rendering, view_rotation
+from ..core.look import (
+    DEFAULT_DENSITY,
+    DEFAULT_SECTIONS,
+    REFERENCE_RADIUS,
+    RENDERINGS,
+    check_rendering,
+    default_clim,
+    view_rotation,
+)
 from ..core.progress import progress as make_progress
 from . import volume_kernels
 
@@ -59,34 +67,14 @@ CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 __all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
            "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids", "view_rotation"]
 
-# RENDERINGS (what `render_state` draws for a field) and check_rendering are core.look's, named here too.
+# RENDERINGS (what `render_state` draws for a field), check_rendering and the defaults DEFAULT_DENSITY,
+# DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too), named here too.
 #: The renderings ray-cast here.
 VOLUME_RENDERINGS = ("volume", "mip", "sections")
-#: Optical depth across the grid's longest side of a medium at the top of the opacity ramp.
-DEFAULT_DENSITY = 4.0
 #: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).
 _BATCH_POINTS = 400_000
 #: A ray this transparent no longer changes a pixel (front-to-back compositing stops for it).
 _OPAQUE = 1e-4
-
-
-def default_clim(values) -> tuple:
-    """(lo, hi): the 1st and 99th percentiles of the finite ``values`` (robust to a few outliers).
-    A constant gives (v - 1/2 |v|, v + 1/2 |v|) (1/2 around 0), so it takes the middle of the
-    colour map; no finite value gives (0, 1).
-
-    >>> default_clim(np.r_[np.arange(101.0), np.nan, 1e9])
-    (1.01, 99.99)
-    """
-    v = np.asarray(values, dtype=np.float64).ravel()
-    v = v[np.isfinite(v)]
-    if not len(v):
-        return 0.0, 1.0
-    lo, hi = (float(x) for x in np.percentile(v, [1.0, 99.0]))
-    if not hi > lo:
-        half = 0.5 * abs(lo) if lo != 0 else 0.5
-        lo, hi = lo - half, lo + half
-    return lo, hi
 
 
 def pixel_rays(size, limits, distance: float = CAMERA_DISTANCE):

@@ -8,7 +8,7 @@ import numbers
 
 import numpy as np
 
-from ..geometry.polytopes import COORDINATE_RANGE, check_scale
+from ..geometry.mesh import COORDINATE_RANGE, check_scale
 
 __all__ = ["AxesWarning", "NonFiniteWarning", "MAX_SAMPLE_BYTES", "BYTES_PER_SAMPLE"]
 
@@ -102,7 +102,7 @@ def _check_extent(extent) -> tuple:
         end = float(np.abs(e[d]).max())
         if end > hi:
             raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
-                             f"{lo:g} to {hi:g} (rot4d_widget.geometry.polytopes.COORDINATE_RANGE; "
+                             f"{lo:g} to {hi:g} (rot4d_widget.geometry.mesh.COORDINATE_RANGE; "
                              f"rescale the coordinates, "
                              f"e.g. to other units)")
         check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")

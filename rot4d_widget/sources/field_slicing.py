@@ -17,7 +17,7 @@ import itertools
 
 import numpy as np
 
-from ..geometry.polytopes import Polytope
+from ..geometry.mesh import Polytope
 from ..geometry.slicing import slice_polytope
 from .field_checks import _AXES, _call
 from .field_kernels import _resample_affine

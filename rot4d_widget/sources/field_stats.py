@@ -13,7 +13,7 @@ import warnings
 
 import numpy as np
 
-from ..geometry.polytopes import _power_of_two_unit
+from ..geometry.mesh import _power_of_two_unit
 from .field_checks import NonFiniteWarning, _axes_text, _call
 from .field_slicing import _sample_raw
 from .protocol import w_span_text, w_value_text

@@ -45,7 +45,7 @@ Shapes: vertices (n, 3) float64, triangles (k, 3) intp, normals (n, 3)
 float64; everything returned is read-only.
 
 Scale: the box's half widths (slice units) and the ends of ``extent`` must lie
-in `rot4d_widget.geometry.polytopes.COORDINATE_RANGE` (1e-150 to 1e150; else a
+in `rot4d_widget.geometry.mesh.COORDINATE_RANGE` (1e-150 to 1e150; else a
 ValueError naming it).  Within it a field scaled by ``s`` (extent times s, the
 same samples) slices as the unscaled one at ``c0 / s`` (extent's w scaled too), its surfaces scaled by
 s: the box cut is the exact slicer's (normalised), the resampling works in
@@ -62,7 +62,7 @@ import numpy as np
 
 from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
-from ..geometry.polytopes import check_scale
+from ..geometry.mesh import check_scale
 from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
 from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
 from .field_checks import (
@@ -278,7 +278,7 @@ class Field4D(FieldLevels, FieldMemory):
              isel=None, sel=None, load: bool = False, **kwargs) -> "Field4D":
         """`from_xarray` of ``variable`` in the netCDF file or zarr store at ``path``, remembering
         where it came from (``field.origin``), so that a state file reopens it
-        (`rot4d_widget.keep.export.save_state`, `Rot4DWidget.save_state` / ``from_state``).
+        (`rot4d_widget.keep.statefile.save_state`, `Rot4DWidget.save_state` / ``from_state``).
 
         ``variable`` may be omitted when the file has one data variable.  ``engine`` goes to
         ``xarray.open_dataset`` (None: xarray's guess; a directory opens with ``"zarr"``).

@@ -90,8 +90,9 @@ from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 import numpy as np
 
 from ..core.look import number_text
-from ..geometry.polytopes import POLYTOPE_NAMES, Polytope
-from ..geometry.polytopes import polytope as get_polytope
+from ..geometry.catalogue import polytope as get_polytope
+from ..geometry.mesh import Polytope
+from ..geometry.regular import POLYTOPE_NAMES
 from ..geometry.slicing import slice_polytope
 from .field_labels import axis_names, coordinate_text
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import look
-from ..keep.volume import DEFAULT_DENSITY, default_clim
 from ..sources.protocol import inner_source, w_frame
 from ..sources.tomography import StackSource
 from .cuts import STACK_NODES, can_sample
@@ -55,7 +54,7 @@ def copy_clim(values) -> list:
     """The 1st and 99th percentiles of a copy's values (every 7th: the same to a few codes, quickly):
     the page's colour limits when neither ``clim`` nor a ray-cast picture of the kernel's gives any."""
     v = np.asarray(values).reshape(-1)[::7]
-    return [float(x) for x in default_clim(v)]
+    return [float(x) for x in look.default_clim(v)]
 
 
 def field_config(widget, field, default_clim_: list, texture_side: int, colours) -> dict:
@@ -89,7 +88,7 @@ def field_config(widget, field, default_clim_: list, texture_side: int, colours)
         "march": float(MARCH), "held_march": float(HELD_MARCH),
         "lut": [int(b) for b in colour_table(w.cmap).reshape(-1)],
         "clim": [float(clim[0]), float(clim[1])],
-        "density": float(DEFAULT_DENSITY),
+        "density": float(look.DEFAULT_DENSITY),
         "inside": field.inside, "caps": bool(field.caps),
         "level_rgb": _rgb(rgb) if not by_slice else [],
         "level_by_value": w.clim is not None and single is None and not by_slice,

@@ -13,16 +13,17 @@ import inspect
 import os
 
 from ..core.state import without_source_keys
-from ..keep.export import SETTING_NAMES, load_state, save_state, slice_mesh
-from ..keep.export import settings_of as widget_settings
+from ..keep.meshes import slice_mesh
 from ..keep.recording import VIEW_DEFAULTS, VIEW_SETTINGS, Recorder, Recording, check_view_setting, render_animation
+from ..keep.statefile import SETTING_NAMES, load_state, save_state
+from ..keep.statefile import settings_of as widget_settings
 from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of
 
 __all__ = ["Keeper", "view_settings"]
 
 
 def view_settings(widget) -> dict:
-    """What a state file keeps of the widget's settings (`keep.export.settings_of`: its
+    """What a state file keeps of the widget's settings (`keep.statefile.settings_of`: its
     `SETTING_NAMES`, the view settings among them; a tuple as a list)."""
     return widget_settings(widget)
 

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core import look
-from ..keep.volume import default_clim
 from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, known_range, outline_of
 from . import markup as ro
 from .buffers import check_update_size
@@ -186,7 +185,7 @@ class Painter:
                     w._pump.mark_dirty()
                     return None
                 self.grid_cache = (m, c0, version, coarse_, cut)
-            clim = w.clim if w.clim is not None else default_clim(cut.finite_values)
+            clim = w.clim if w.clim is not None else look.default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
             labels = cut_labels(w.source, m, c0, cut.data)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):

@@ -37,7 +37,6 @@ import numpy as np
 import pythreejs as p3
 
 from ..core import look
-from ..keep.volume import DEFAULT_DENSITY
 
 __all__ = ["VolumeLayer", "volume_message", "pack_atlas", "colour_table", "MODES", "ATLAS_MAX"]
 
@@ -117,7 +116,7 @@ def pack_atlas(grids, clim):
     return atlas, places
 
 
-def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = DEFAULT_DENSITY, *,
+def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = look.DEFAULT_DENSITY, *,
                    held: bool = False) -> dict:
     """The synced dict of one volume update.
 
@@ -183,7 +182,7 @@ class VolumeLayer:
                 # ShaderMaterial): placeholders, so that the names are in the material's uniforms
                 "u_atlas": {"value": None}, "u_lut": {"value": None},
                 "u_atlas_size": {"value": [1.0, 1.0]}, "u_mode": {"value": 0.0},
-                "u_sections": {"value": list(look.DEFAULT_SECTIONS)}, "u_density": {"value": DEFAULT_DENSITY},
+                "u_sections": {"value": list(look.DEFAULT_SECTIONS)}, "u_density": {"value": look.DEFAULT_DENSITY},
                 "u_step": {"value": STEP},
             },
             side="BackSide", transparent=True, depthWrite=False,

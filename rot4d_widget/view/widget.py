@@ -398,12 +398,12 @@ class Rot4DWidget(widgets.HBox):
         field, all slices of a stack, placed as shown), in the source's own units, with each
         face's group (cell / level / slice) in ``mesh.face_attributes["group"]`` and the
         view's colours.  ``.export("slice.ply")`` writes OBJ, PLY, STL or GLB by extension.
-        See `rot4d_widget.keep.export.slice_mesh` for ``options``."""
+        See `rot4d_widget.keep.meshes.slice_mesh` for ``options``."""
         return self._keeper.slice_mesh(**options)
 
     def save_state(self, path) -> dict:
         """Write the state (orientation, θ0, α, c0, c0 step, key bindings), what the source is
-        and the widget's settings to the JSON file ``path`` (`rot4d_widget.keep.export.save_state`).
+        and the widget's settings to the JSON file ``path`` (`rot4d_widget.keep.statefile.save_state`).
         A source that cannot be rebuilt from the file (an in-memory array) is described with a
         warning; `load_state` into a widget showing it still works.  Returns the dict written."""
         return self._keeper.save_state(path)

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from jupyter_page import JupyterPage
-from rot4d_widget import look, simple_rotation
+from rot4d_widget import simple_rotation
+from rot4d_widget.core import look
 from test_widget_browser import TAP_KEYS, _bad_console, _canvas, _hover, _state, _timing_bound
 
 #: Screenshots to look at (not test artifacts: the issue asks for them here).

@@ -20,7 +20,8 @@ from test_widget_browser import _bad_console, _canvas, _hover
 CELL = """\
 import itertools
 import numpy as np
-from rot4d_widget import Rot4DWidget, look
+from rot4d_widget import Rot4DWidget
+from rot4d_widget.core import look
 w = Rot4DWidget('24-cell', slices=5, spacing=0.3, arrangement='oval')
 
 def slice_boxes():
