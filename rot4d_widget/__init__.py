@@ -47,9 +47,9 @@ _LAZY = {
     "slice_mesh": "keep.meshes",
     "save_state": "keep.statefile",
     "load_state": "keep.statefile",
-    "Recording": "keep.recording",
-    "Recorder": "keep.recording",
-    "render_state": "keep.figures",
+    "Recording": "keep.recorder",
+    "Recorder": "keep.recorder",
+    "render_state": "keep.picture",
 }
 
 

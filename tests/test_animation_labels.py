@@ -17,9 +17,10 @@ from test_labels import flame
 
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep import figures
+from rot4d_widget.keep import picture
 from rot4d_widget.keep.drawing import perspective
-from rot4d_widget.keep.recording import Recorder, render_frames
+from rot4d_widget.keep.recorder import Recorder
+from rot4d_widget.keep.animation import render_frames
 from rot4d_widget.keep.volume import render_grid
 
 
@@ -37,7 +38,7 @@ def _frames(rendering, monkeypatch):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     seen = []
-    real = figures.render_state
+    real = picture.render_state
 
     def caught(state, source, *args, **kwargs):
         fig = real(state, source, *args, **kwargs)
@@ -52,7 +53,7 @@ def _frames(rendering, monkeypatch):
                      state.copy(), images, (ax.get_xlim(), ax.get_ylim())))
         return fig
 
-    monkeypatch.setattr(figures, "render_state", caught)
+    monkeypatch.setattr(picture, "render_state", caught)
     f = flame()
     frames = list(render_frames(_recording(), None, f, rendering=rendering, size=(300, 250), dpi=100))
     return f, frames, seen

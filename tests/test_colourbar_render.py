@@ -16,7 +16,7 @@ from rot4d_widget.core import look
 from rot4d_widget.core import progress as core_progress
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep import volume
-from rot4d_widget.keep.figures import render_state
+from rot4d_widget.keep.picture import render_state
 from rot4d_widget.keep.volume import default_clim, render_grid
 from rot4d_widget.sources.fields import Field4D, sample_field
 

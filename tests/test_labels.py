@@ -18,7 +18,7 @@ import pytest
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.drawing import perspective
-from rot4d_widget.keep.figures import render_state
+from rot4d_widget.keep.picture import render_state
 from rot4d_widget.sources.fields import Field4D
 
 pytestmark = pytest.mark.usefixtures("recording_comms")

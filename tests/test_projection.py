@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.keep.recording import ViewSetting
+from rot4d_widget.keep.recorder import ViewSetting
 from rot4d_widget.sources.fields import Field4D
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.tomography import StackSource

@@ -15,7 +15,7 @@ import pytest
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.figures import render_state
+from rot4d_widget.keep.picture import render_state
 from rot4d_widget.keep.volume import RENDERINGS, VOLUME_RENDERINGS, render_grid
 from rot4d_widget.sources.fields import Field4D, sample_field
 

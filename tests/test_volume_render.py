@@ -19,7 +19,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from rot4d_widget.core.look import CAMERA_FOV, REFERENCE_RADIUS
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.figures import render_state
+from rot4d_widget.keep.picture import render_state
 from rot4d_widget.keep.volume import default_clim, render_grid
 from rot4d_widget.sources.fields import Field4D, sample_field
 

@@ -20,8 +20,7 @@ face's centroid), so nearer things cover farther ones.
 * translucent faces (slice polygons), coloured by the 4-D cell they are cut from
   (``look.group_palette``, the live view's palette).
 
-Also the validators and the saving helper the other figure modules share.  Part of
-`rot4d_widget.keep.figures`, which re-exports every public name.
+Also the validators and the saving helper the other picture modules share.
 """
 
 from __future__ import annotations

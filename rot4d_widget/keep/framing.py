@@ -2,7 +2,7 @@
 
 `frame_extent` / `union_extent`: the projected bounding box of a slice (or of an animation's
 frames) that ``frame="fit"`` fills `FIT_FILL` of the picture with; `annotation`: the corner text
-and legend of a picture.  Part of `rot4d_widget.keep.figures`, which re-exports every public name.
+and legend of a picture.
 """
 
 from __future__ import annotations

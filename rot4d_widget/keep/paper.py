@@ -2,7 +2,6 @@
 
 ``render_key_sequence(key, n_panels)`` shows what holding a key does: panel k is drawn after k
 presses; :func:`paper_figure_3` and :func:`paper_figure_4` reproduce the paper's figures.
-Part of `rot4d_widget.keep.figures`, which re-exports every public name.
 """
 
 from __future__ import annotations

@@ -2,8 +2,7 @@
 
 :func:`render_state` draws a `RotationState` and any source (polytope, field, stack, a user's
 own) with the widget's display settings at a chosen size in pixels; :func:`render_tomography`
-draws N parallel slices as the live view lays them out.  Part of `rot4d_widget.keep.figures`,
-which re-exports every public name.
+draws N parallel slices as the live view lays them out.
 """
 
 from __future__ import annotations

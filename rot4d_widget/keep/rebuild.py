@@ -39,6 +39,9 @@ class CodeNotAllowed(ValueError):
 #: state file names a field's function by ``"module:qualname"``; one written before the wings can
 #: name package code by an old path, which the package no longer imports (issue 38: no import
 #: hook before 1.0), so the loader translates it with this table -- data, nothing imported.
+#: A file can name only a module that defined a field's function (its ``__module__``), so modules
+#: that defined none have no entry: ``rot4d_widget.recording`` and ``rot4d_widget.figures`` (the
+#: recordings and the static pictures, split since over several modules of keep).
 OLD_MODULES = {
     "rot4d_widget.rotation": "rot4d_widget.core.rotation",
     "rot4d_widget.keymap": "rot4d_widget.core.keymap",
@@ -55,8 +58,6 @@ OLD_MODULES = {
     "rot4d_widget.tomography": "rot4d_widget.sources.tomography",
     "rot4d_widget.datasets": "rot4d_widget.sources.datasets",
     "rot4d_widget.export": "rot4d_widget.keep.statefile",
-    "rot4d_widget.recording": "rot4d_widget.keep.recording",
-    "rot4d_widget.figures": "rot4d_widget.keep.figures",
     "rot4d_widget.widget": "rot4d_widget.view.widget",
     "rot4d_widget.scene": "rot4d_widget.view.scene",
     "rot4d_widget.buffers": "rot4d_widget.view.buffers",
