@@ -49,7 +49,7 @@ _LAZY = {
     "load_state": "keep.statefile",
     "Recording": "keep.recorder",
     "Recorder": "keep.recorder",
-    "render_state": "keep.picture",
+    "render_state": "keep.pictures.state_picture",
 }
 
 

@@ -12,8 +12,8 @@ from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
 from rot4d_widget.core import look
-from rot4d_widget.keep import drawing, framing, picture
-from rot4d_widget.keep.canvas import _FrameCanvas, _glyph_caching_renderer
+from rot4d_widget.keep.pictures import framing, slice_drawing, state_picture
+from rot4d_widget.keep.pictures.canvas import _FrameCanvas, _glyph_caching_renderer
 from rot4d_widget.sources import datasets
 from rot4d_widget.keep.recorder import Recorder
 from rot4d_widget.keep.animation import render_frames
@@ -98,9 +98,9 @@ def test_animation_frames_with_and_without_kept_glyphs_are_identical(monkeypatch
 
 
 def _surface_collection(state, source):
-    stack, data, _, box = picture._prepare(state, source)
+    stack, data, _, box = state_picture._prepare(state, source)
     canvas = _FrameCanvas()
-    picture.render_state(state, stack, frame=box, _canvas=canvas, _prepared=(stack, data, None, box))
+    state_picture.render_state(state, stack, frame=box, _canvas=canvas, _prepared=(stack, data, None, box))
     (coll,) = [c for c in canvas.ax.collections if c.get_gid() == "surface"]
     return stack, data, coll
 
@@ -125,7 +125,7 @@ def test_surface_shading_and_order_are_the_mean_formulas_bit_for_bit(levels):
     light = np.array([-0.35, 0.45, 0.82])
     rgb = np.clip(rgb * (0.45 + 0.55 * np.abs(n @ (light / np.linalg.norm(light))))[:, None], 0.0, 1.0)
     order = np.argsort(pts[tri].mean(axis=1)[:, 2], kind="stable")
-    xy, _ = drawing.perspective(pts)
+    xy, _ = slice_drawing.perspective(pts)
     assert len(tri) > 100
     np.testing.assert_array_equal(coll._tri_verts, xy[tri[order]])
     np.testing.assert_array_equal(coll._tri_rgba[:, :3], rgb[order])

@@ -165,7 +165,7 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
 
 
 def test_a_rendered_picture_names_c0_and_the_slices_in_seconds():
-    from rot4d_widget.keep.picture import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     st = RotationState(c0=26.0)
     fig = render_state(st, _field(resolution=16), annotate=True, size=(300, 250), dpi=50)

@@ -381,7 +381,7 @@ def test_bare_slices_from_the_slicers(field_data):
 def test_a_widget_settings_go_to_a_state_file_and_a_picture(tmp_path):
     from rot4d_widget import Rot4DWidget
     from rot4d_widget.keep.statefile import settings_of
-    from rot4d_widget.keep.picture import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     w = Rot4DWidget("24-cell", slices=3, arrangement="grid", show_balls=False)
     try:

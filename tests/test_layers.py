@@ -48,10 +48,10 @@ PKG = ROOT / "rot4d_widget"
 WINGS = ("core", "geometry", "sources", "keep", "view")
 #: package modules that may be imported inside a function: what importing them pulls in
 HEAVY_MODULES = {
-    "rot4d_widget.keep.picture": "matplotlib and Pillow (~0.5 s: it draws with every other picture module)",
-    "rot4d_widget.keep.canvas": "matplotlib's Figure and Text (the animation's reused figure)",
-    "rot4d_widget.keep.framing": "matplotlib, through keep.drawing",
-    "rot4d_widget.keep.drawing": "matplotlib (~0.35 s; keep.volume draws with it, the widget imports keep.volume)",
+    "rot4d_widget.keep.pictures.state_picture": "matplotlib and Pillow (~0.5 s: it draws with every other picture module)",
+    "rot4d_widget.keep.pictures.canvas": "matplotlib's Figure and Text (the animation's reused figure)",
+    "rot4d_widget.keep.pictures.framing": "matplotlib, through keep.pictures.slice_drawing",
+    "rot4d_widget.keep.pictures.slice_drawing": "matplotlib (~0.35 s; keep.pictures.ray_caster draws with it, the widget imports keep.pictures.ray_caster)",
     "rot4d_widget.sources.fields": "numba and scikit-image (~0.5 s)",
     "rot4d_widget.view.scene": "pythreejs (~0.3 s)",
 }

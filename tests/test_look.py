@@ -13,10 +13,10 @@ from matplotlib.figure import Figure
 
 from rot4d_widget import pentachoron, polytope, slice_polytope
 from rot4d_widget.core import look
-from rot4d_widget.keep import drawing, paper
+from rot4d_widget.keep.pictures import panels, slice_drawing
 from rot4d_widget.view import buffers
-from rot4d_widget.keep.drawing import draw_slice
-from rot4d_widget.keep.paper import panel_style, render_slice
+from rot4d_widget.keep.pictures.slice_drawing import draw_slice
+from rot4d_widget.keep.pictures.panels import panel_style, render_slice
 
 
 def _projected_corners(slice_, k, scale):
@@ -97,7 +97,7 @@ def test_colours_are_valid_and_drawn_by_default(tmp_path):
     drawing = draw_slice(Figure().add_subplot(), s)
     assert drawing.balls[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BALL_COLOR))
     assert drawing.bars[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BAR_COLOR))
-    fig = paper.paper_figure_3(tmp_path / "f.png", dpi=20)
+    fig = panels.paper_figure_3(tmp_path / "f.png", dpi=20)
     assert fig.get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BACKGROUND))
 
 
@@ -175,11 +175,11 @@ def test_figure_projects_like_the_live_camera(size):
 
 
 def test_panels_of_a_grid_share_the_live_cameras_frame():
-    fig = paper.render_key_sequence("4", 2, ncols=2)
+    fig = panels.render_key_sequence("4", 2, ncols=2)
     half = look.CAMERA_POSITION[2] * math.tan(math.radians(look.CAMERA_FOV) / 2)
     for ax in fig.axes:
         assert ax.get_xlim() == pytest.approx((-half, half)) and ax.get_ylim() == pytest.approx((-half, half))
-    assert drawing.CAMERA_DISTANCE == look.CAMERA_POSITION[2] and drawing.CAMERA_FOV == look.CAMERA_FOV
+    assert slice_drawing.CAMERA_DISTANCE == look.CAMERA_POSITION[2] and slice_drawing.CAMERA_FOV == look.CAMERA_FOV
     assert look.CAMERA_POSITION == (0.0, 0.0, 5.0)
     assert (look.CAMERA_FOV, look.CAMERA_NEAR, look.CAMERA_FAR) == (40.0, 0.1, 100.0)
 

@@ -15,8 +15,8 @@ import pytest
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.picture import render_state
-from rot4d_widget.keep.volume import RENDERINGS, VOLUME_RENDERINGS, render_grid
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.keep.pictures.ray_caster import RENDERINGS, VOLUME_RENDERINGS, render_grid
 from rot4d_widget.sources.fields import Field4D, sample_field
 
 D = 5.0

@@ -1,6 +1,6 @@
 """Volume renderings of a field's cut without a browser: numpy ray casting through a `FieldGrid`.
 
-The camera is the static renders' and the live view's (`rot4d_widget.keep.drawing`): the eye at
+The camera is the static renders' and the live view's (`rot4d_widget.keep.pictures.slice_drawing`): the eye at
 (0, 0, ``distance``) looking down -z, the picture plane z = 0 with its limits ``(x0, x1)``,
 ``(y0, y1)`` (what `render_state` sets on its axes).  Pixel (row r, column c) of an H x W picture
 looks along the ray from the eye through its centre,
@@ -47,8 +47,8 @@ import math
 import numpy as np
 from scipy.ndimage import map_coordinates
 
-from ..core import look
-from ..core.look import (
+from ...core import look
+from ...core.look import (
     DEFAULT_DENSITY,
     DEFAULT_SECTIONS,
     REFERENCE_RADIUS,
@@ -57,10 +57,10 @@ from ..core.look import (
     default_clim,
     view_rotation,
 )
-from ..core.progress import progress as make_progress
-from . import volume_kernels
+from ...core.progress import progress as make_progress
+from . import ray_caster_kernels
 
-#: How far the live view's camera is from the centre (`rot4d_widget.keep.drawing.CAMERA_DISTANCE`,
+#: How far the live view's camera is from the centre (`rot4d_widget.keep.pictures.slice_drawing.CAMERA_DISTANCE`,
 #: the same number: that module imports matplotlib, which the widget's import does not need)
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
@@ -175,7 +175,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     the rays' pixels bilinear in premultiplied colour (1, the default: a ray through every pixel's
     centre, the full resolution); "auto": two rays per grid spacing where the grid is nearest, at
     most one per pixel (sections: always one per pixel).  The rays are cast by a compiled kernel
-    (`rot4d_widget.keep.volume_kernels`) when numba is installed, else in numpy: the same picture.
+    (`rot4d_widget.keep.pictures.ray_caster_kernels`) when numba is installed, else in numpy: the same picture.
     ``progress``: True a progress bar once the casting took a second
     (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1).
     ``view``: (3, 3) the camera's rotation (`view_rotation` of its position; None: the identity,
@@ -245,11 +245,11 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
           tick=lambda f: None, view=None, *, compiled: bool = True):
     """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes; ``view``
     the camera's rotation (None: the identity).  The compiled kernel's picture
-    (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
+    (`rot4d_widget.keep.pictures.ray_caster_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
     numpy's (every ray at once, a step at a time)."""
     view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
     if compiled:
-        out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
+        out = ray_caster_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
                                   step, fractions, tick, view, cells=_cell_flags(np.asarray(grid.values)),
                                   opaque=_OPAQUE)
         if out is not None:
@@ -426,7 +426,7 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         close()
     if not images:
         return None
-    from .drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
+    from .slice_drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
 
     (x0, x1), (y0, y1) = limits
     image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",

@@ -12,11 +12,11 @@ import math
 
 import numpy as np
 
-from ..core import look
-from ..core.look import REFERENCE_RADIUS
-from ..sources.field_labels import axis_names
-from ..sources.protocol import c0_text
-from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
+from ...core import look
+from ...core.look import REFERENCE_RADIUS
+from ...sources.field_labels import axis_names
+from ...sources.protocol import c0_text
+from .slice_drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
 #: With ``frame="fit"`` the bounding box of what is drawn spans this fraction of the picture's
