@@ -26,7 +26,7 @@ import numpy as np
 import rot4d_widget
 t1 = time.perf_counter()
 from rot4d_widget import Polytope, polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 p0 = polytope("600-cell")
 v, f, c = p0.vertices.copy(), [x.tolist() for x in p0.faces], [list(x) for x in p0.cells]
 t2 = time.perf_counter()

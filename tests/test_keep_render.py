@@ -137,7 +137,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     from rot4d_widget.keep.pictures import panels, slice_drawing
     from rot4d_widget.geometry.catalogue import polytope
     from rot4d_widget.core.rotation import random_rotation
-    from rot4d_widget.geometry.slicing import slice_polytope
+    from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 
     p = polytope("24-cell")
     s = slice_polytope(p, random_rotation(np.random.default_rng(3)), 0.1)

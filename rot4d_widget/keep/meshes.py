@@ -22,7 +22,7 @@ from typing import Mapping
 import numpy as np
 
 from ..core import look
-from ..geometry.slicing import Slice
+from ..geometry.slicing.tables import Slice
 from ..sources.protocol import SliceData
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as

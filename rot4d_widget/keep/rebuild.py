@@ -51,7 +51,7 @@ OLD_MODULES = {
     "rot4d_widget.progress": "rot4d_widget.core.progress",
     "rot4d_widget.polytopes": "rot4d_widget.geometry.catalogue",
     "rot4d_widget.uniform": "rot4d_widget.geometry.uniform",
-    "rot4d_widget.slicing": "rot4d_widget.geometry.slicing",
+    "rot4d_widget.slicing": "rot4d_widget.geometry.slicing.polytope_slice",
     "rot4d_widget.offfile": "rot4d_widget.geometry.offfile",
     "rot4d_widget.source": "rot4d_widget.sources.protocol",
     "rot4d_widget.fields": "rot4d_widget.sources.fields",

@@ -18,7 +18,7 @@ import itertools
 import numpy as np
 
 from ..geometry.mesh import Polytope
-from ..geometry.slicing import slice_polytope
+from ..geometry.slicing.polytope_slice import slice_polytope
 from .field_checks import _AXES, _call
 from .field_kernels import _resample_affine
 from .field_surface import _empty_slice, _surface

@@ -93,7 +93,7 @@ from ..core.look import number_text
 from ..geometry.catalogue import polytope as get_polytope
 from ..geometry.mesh import Polytope
 from ..geometry.regular import POLYTOPE_NAMES
-from ..geometry.slicing import slice_polytope
+from ..geometry.slicing.polytope_slice import slice_polytope
 from .field_labels import axis_names, coordinate_text
 
 __all__ = [

@@ -17,7 +17,7 @@ from ...core.look import REFERENCE_RADIUS
 from ...core.state import RotationState
 from ...geometry.mesh import Polytope
 from ...geometry.regular import pentachoron
-from ...geometry.slicing import slice_polytope
+from ...geometry.slicing.polytope_slice import slice_polytope
 from .canvas import LiteralTextFigure
 from .slice_drawing import (
     FIG3_THETA0,

@@ -41,7 +41,7 @@ from ...core.look import REFERENCE_RADIUS
 from ...core.state import PAPER_ALPHA_RATIO
 from ...geometry.catalogue import polytope as _named_polytope
 from ...geometry.mesh import Polytope
-from ...geometry.slicing import Slice
+from ...geometry.slicing.tables import Slice
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])

@@ -18,7 +18,7 @@ from matplotlib.patches import Circle
 from ...core import look
 from ...core.look import REFERENCE_RADIUS
 from ...core.state import RotationState
-from ...geometry.slicing import Slice
+from ...geometry.slicing.tables import Slice
 from ...sources.field_labels import box_labels
 from ...sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
 from ...sources.tomography import StackSource
