@@ -141,7 +141,7 @@ def flame_worker(npy: str, rendering: str, repeats: int, per_pixel: bool) -> dic
     from rot4d_widget.keep.pictures import ray_caster
     from rot4d_widget.keep.recorder import Recorder
     from rot4d_widget.keep.animation import render_animation
-    from rot4d_widget.sources.fields import Field4D
+    from rot4d_widget.sources.field.container import Field4D
 
     if per_pixel:
         ray_caster.render_grid = functools.partial(ray_caster.render_grid, pixels_per_ray=1)

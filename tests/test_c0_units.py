@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget import Field4D, RotationState
-from rot4d_widget.sources.fields import slice_field
+from rot4d_widget.sources.field.container import slice_field
 from rot4d_widget.keep.recorder import Recording, Setting, Step
 from rot4d_widget.sources.protocol import data_w_text, w_frame
 from rot4d_widget.sources.tomography import StackSource

@@ -16,7 +16,7 @@ from rot4d_widget.core import look
 from rot4d_widget.keep.meshes import face_colors, load_mesh, slice_mesh
 from rot4d_widget.keep.rebuild import CodeNotAllowed, SourceNotRebuildable, describe_source
 from rot4d_widget.keep.statefile import load_state, save_state
-from rot4d_widget.sources.fields import slice_field  # noqa: E402
+from rot4d_widget.sources.field.container import slice_field  # noqa: E402
 from rot4d_widget.geometry.catalogue import polytope
 from rot4d_widget.geometry.regular import pentachoron  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402

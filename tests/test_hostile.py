@@ -19,7 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rot4d_widget import Rot4DWidget, SliceData
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.view.keyhold import steps_for
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP
 from rot4d_widget.core.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState

@@ -19,7 +19,7 @@ from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures.slice_drawing import perspective
 from rot4d_widget.keep.pictures.state_picture import render_state
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

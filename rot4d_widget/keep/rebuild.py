@@ -19,7 +19,8 @@ import numpy as np
 
 from ..geometry.catalogue import polytope
 from ..geometry.mesh import Polytope
-from ..sources.field_checks import UnitsWarning
+from ..sources.field.checks import UnitsWarning
+from ..sources.field.inputs import _selection_from_json
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
 
@@ -54,7 +55,7 @@ OLD_MODULES = {
     "rot4d_widget.slicing": "rot4d_widget.geometry.slicing.polytope_slice",
     "rot4d_widget.offfile": "rot4d_widget.geometry.offfile",
     "rot4d_widget.source": "rot4d_widget.sources.protocol",
-    "rot4d_widget.fields": "rot4d_widget.sources.fields",
+    "rot4d_widget.fields": "rot4d_widget.sources.field.container",
     "rot4d_widget.tomography": "rot4d_widget.sources.tomography",
     "rot4d_widget.datasets": "rot4d_widget.sources.datasets",
     "rot4d_widget.export": "rot4d_widget.keep.statefile",
@@ -73,7 +74,7 @@ def module_now(module: str) -> str:
     package (or of a module under it), else ``module`` itself.
 
     >>> module_now("rot4d_widget.fields"), module_now("mylab.fields")
-    ('rot4d_widget.sources.fields', 'mylab.fields')
+    ('rot4d_widget.sources.field.container', 'mylab.fields')
     """
     for old, new in OLD_MODULES.items():
         if module == old or module.startswith(old + "."):
@@ -184,8 +185,8 @@ def _origin_path(origin, base):
 
 
 def _open_origin(origin, base):
-    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
-    from ..sources.fields import Field4D, _selection_from_json
+    # sources.field.container imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
+    from ..sources.field.container import Field4D
 
     origin = dict(origin)
     if origin.get("kind", "xarray") != "xarray":
@@ -220,8 +221,8 @@ def _open_origin(origin, base):
 
 
 def _rebuild_field(d, allow_code=False, function=None, base=None):
-    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
-    from ..sources.fields import Field4D
+    # sources.field.container imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
+    from ..sources.field.container import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
     if d.get("w_units") is not None:
@@ -297,8 +298,8 @@ def open_field(path, variable=None, *, engine=None, **kwargs):
     ``chunks=``, ``isel=``, ``sel=`` and the keywords of `Field4D.from_xarray`
     (``x=, y=, z=, w=, w_per_unit=`` ...) as in `Field4D.open`.
     """
-    # sources.fields imports numba and scikit-image (~0.5 s): only opening a field needs it
-    from ..sources.fields import Field4D
+    # sources.field.container imports numba and scikit-image (~0.5 s): only opening a field needs it
+    from ..sources.field.container import Field4D
 
     return Field4D.open(path, variable, engine=engine, **kwargs)
 

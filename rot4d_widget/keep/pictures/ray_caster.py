@@ -164,7 +164,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
                 step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True,
                 view=None) -> np.ndarray:
-    """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
+    """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field.grid.FieldGrid`) ray-cast as
     ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
     placed at ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
