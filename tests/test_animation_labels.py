@@ -78,14 +78,14 @@ def test_frames_are_cast_at_full_resolution_and_nothing_covers_the_data(renderin
     text, labels, note, ax, st, images, (xlim, ylim) = seen[-1]
     g = f.sample(st.matrix, st.c0)
     from rot4d_widget.core import look
-    from rot4d_widget.keep.pictures.ray_caster import view_rotation
+    from rot4d_widget.core.look import view_rotation
 
     want = render_grid(g, rendering, size=(300, 250), limits=(xlim, ylim), cmap="viridis",
                        scale=REFERENCE_RADIUS / f.size, pixels_per_ray=1, progress=False,
                        view=view_rotation(look.default_eye(rendering)))
     np.testing.assert_allclose(images[0], want, atol=1e-12)
     box = f.outline(st.matrix, st.c0)
-    from rot4d_widget.keep.pictures.ray_caster import view_rotation as vr
+    from rot4d_widget.core.look import view_rotation as vr
 
     pts = np.asarray(box.points)[np.unique(np.asarray(box.segments))] @ vr(look.default_eye(rendering)).T
     xy = ax.transData.transform(perspective(pts * (REFERENCE_RADIUS / f.size))[0])

@@ -17,7 +17,8 @@ from rot4d_widget.core import progress as core_progress
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures import ray_caster
 from rot4d_widget.keep.pictures.state_picture import render_state
-from rot4d_widget.keep.pictures.ray_caster import default_clim, render_grid
+from rot4d_widget.core.look import default_clim
+from rot4d_widget.keep.pictures.ray_caster import render_grid
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.sources.field.grid import sample_field
 

@@ -23,7 +23,8 @@ import numpy as np
 from PIL import Image
 from rot4d_widget import Field4D, Rot4DWidget
 from rot4d_widget.core import look
-from rot4d_widget.keep.pictures.ray_caster import render_grid, view_rotation
+from rot4d_widget.core.look import view_rotation
+from rot4d_widget.keep.pictures.ray_caster import render_grid
 
 # an off-centre blob in x, y, z, t and a second, weaker one: where the values are high and low
 x = np.linspace(-1.0, 1.0, 25)

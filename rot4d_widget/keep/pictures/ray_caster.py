@@ -52,10 +52,7 @@ from ...core.look import (
     DEFAULT_DENSITY,
     DEFAULT_SECTIONS,
     REFERENCE_RADIUS,
-    RENDERINGS,
-    check_rendering,
     default_clim,
-    view_rotation,
 )
 from ...core.progress import progress as make_progress
 from . import ray_caster_kernels
@@ -64,11 +61,10 @@ from . import ray_caster_kernels
 #: the same number: that module imports matplotlib, which the widget's import does not need)
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
-__all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
-           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids", "view_rotation"]
+__all__ = ["VOLUME_RENDERINGS", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
 
-# RENDERINGS (what `render_state` draws for a field), check_rendering and the defaults DEFAULT_DENSITY,
-# DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too), named here too.
+# RENDERINGS (what `render_state` draws for a field), check_rendering, view_rotation and the defaults
+# DEFAULT_DENSITY, DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too).
 #: The renderings ray-cast here.
 VOLUME_RENDERINGS = ("volume", "mip", "sections")
 #: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from ...core import look
-from ...core.look import REFERENCE_RADIUS
+from ...core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, check_rendering, view_rotation
 from ...core.state import RotationState
 from ...geometry.slicing.tables import Slice
 from ...sources.field_labels import box_labels
@@ -40,7 +40,7 @@ from .framing import (
     small_font,
     value_label,
 )
-from .ray_caster import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume, view_rotation
+from .ray_caster import cut_grids, draw_volume
 from .slice_drawing import (
     _REFERENCE_EDGE,
     _Z_BASE,
