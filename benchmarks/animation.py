@@ -9,7 +9,7 @@ the package at commit 7ba6e62, checked out with ``git worktree add /tmp/old-anim
 machine falls on both alike.  Prints a table of medians (seconds) and the speed-up.
 
 ``--parts`` adds, for the new code, where each render's time went (medians, seconds): slicing
-(the framing pass's ``figures._prepare``, every frame's slice), building the frame's artists
+(the framing pass's ``state_picture._prepare``, every frame's slice), building the frame's artists
 (``render_state``), Agg drawing them (``_FrameCanvas.rgba``), the encoder's work after the last
 frame (``_Encoder.finish``: x264's lookahead, the GIF's last frames) and the rest.
 
@@ -41,7 +41,7 @@ CASES = [("24-cell", ".gif"), ("24-cell", ".mp4"), ("field", ".gif"), ("field", 
 
 
 def _recording():
-    from rot4d_widget.keep.recording import Recorder
+    from rot4d_widget.keep.recorder import Recorder
     from rot4d_widget.core.state import RotationState
 
     st = RotationState()
@@ -73,12 +73,13 @@ def _timed(owner, name, part, spent, when=lambda args, kwargs: True):
 
 def _time_parts(spent: dict) -> None:
     """Time the parts of the new code's render_animation (see --parts)."""
-    from rot4d_widget.keep import figures, recording
+    from rot4d_widget.keep import animation
+    from rot4d_widget.keep.pictures import canvas, state_picture
 
-    _timed(figures, "_prepare", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
-    _timed(figures, "render_state", "building", spent)
-    _timed(figures._FrameCanvas, "rgba", "drawing", spent)
-    _timed(recording._Encoder, "finish", "encoder tail", spent)
+    _timed(state_picture, "_prepare", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
+    _timed(state_picture, "render_state", "building", spent)
+    _timed(canvas._FrameCanvas, "rgba", "drawing", spent)
+    _timed(animation._Encoder, "finish", "encoder tail", spent)
 
 
 def worker(case: str, ext: str, repeats: int, new: bool, parts: bool = False) -> list:
@@ -87,7 +88,7 @@ def worker(case: str, ext: str, repeats: int, new: bool, parts: bool = False) ->
     import inspect
 
     from rot4d_widget.sources import datasets
-    from rot4d_widget.keep.recording import render_animation
+    from rot4d_widget.keep.animation import render_animation
 
     quiet = {"progress": False} if "progress" in inspect.signature(render_animation).parameters else {}
     rec = _recording()
@@ -137,12 +138,13 @@ def flame_worker(npy: str, rendering: str, repeats: int, per_pixel: bool) -> dic
 
     import rot4d_widget
     from rot4d_widget.core.state import RotationState
-    from rot4d_widget.keep import volume
-    from rot4d_widget.keep.recording import Recorder, render_animation
-    from rot4d_widget.sources.fields import Field4D
+    from rot4d_widget.keep.pictures import ray_caster
+    from rot4d_widget.keep.recorder import Recorder
+    from rot4d_widget.keep.animation import render_animation
+    from rot4d_widget.sources.field.container import Field4D
 
     if per_pixel:
-        volume.render_grid = functools.partial(volume.render_grid, pixels_per_ray=1)
+        ray_caster.render_grid = functools.partial(ray_caster.render_grid, pixels_per_ray=1)
     ext = (0.01, 0.05)
     field = Field4D(np.load(npy), axes="wzyx", extent=(ext, ext, ext, (0.001, 0.004)), name="T", units="K",
                     space_units="m", w_units="s", w_per_unit=3e-3 / 59 / (0.04 / 79))

@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 from rot4d_widget import Field4D  # noqa: E402
-from rot4d_widget.sources import fields as F  # noqa: E402
+from rot4d_widget.sources.field import chunks, container  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
 
 
@@ -56,14 +56,14 @@ def main() -> None:
     warnings.simplefilter("ignore")
     z = zarr.open_group(store(args.size, args.chunk), mode="r")["f"]
     fetched: list = []
-    original = F._ChunkReader.read
+    original = chunks._ChunkReader.read
 
     def counting_read(self, wanted):
         with self._lock:
             fetched.extend(i for i in wanted if i not in self._cache)
         return original(self, wanted)
 
-    F._ChunkReader.read = counting_read
+    chunks._ChunkReader.read = counting_read
     print(f"store {args.size}^4 float32, {args.chunk}^4 chunks ({args.chunk ** 4 * 4 / 2**20:.0f} MiB each)")
     print(f"{'cache MiB':>9} {'seed':>4} {'distinct':>8} {'grid order':>10} {'by chunk':>8} {'time grid s':>11} {'time chunk s':>12}")
     for mb in (int(v) for v in args.cache_mb.split(",")):
@@ -71,7 +71,7 @@ def main() -> None:
         for seed in (int(v) for v in args.seeds.split(",")):
             row = {}
             for order in (False, True):
-                F._SORT_PASSES = order
+                container._SORT_PASSES = order
                 fetched.clear()
                 f = Field4D(z, axes="xyzw", extent=[(-1.0, 1.0)] * 4, levels=[0.0], chunk_cache_bytes=mb * 2**20)
                 t = time.perf_counter()
@@ -81,7 +81,7 @@ def main() -> None:
             print(f"{mb:>9} {seed:>4} {row[True][1]:>8} {row[False][0]:>10} {row[True][0]:>8} "
                   f"{row[False][2]:>11.2f} {row[True][2]:>12.2f}")
         print(f"{mb:>9} median fetches by chunk / grid order: {statistics.median(ratios):.2f}")
-    F._SORT_PASSES = True
+    container._SORT_PASSES = True
 
 
 if __name__ == "__main__":

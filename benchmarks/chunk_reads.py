@@ -27,7 +27,8 @@ import numpy as np
 import dask.array as da
 import rot4d_widget
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.fields import Field4D, sample_field, slice_field
+from rot4d_widget.sources.field.container import Field4D, slice_field
+from rot4d_widget.sources.field.grid import sample_field
 N, C = 64, 8
 
 class Counted:

@@ -37,7 +37,10 @@ import numba
 import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.sources.fields import PARALLEL_MIN_POINTS, Field4D, _get_kernels, _resample_affine, _sample, _surface
+from rot4d_widget.sources.field.kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.slicing import _sample
+from rot4d_widget.sources.field.surface import _surface
 from rot4d_widget.core.rotation import random_rotation
 
 

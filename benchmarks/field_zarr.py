@@ -204,7 +204,7 @@ def fetched_text(f, n_chunks):
 
 def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chunk_mb: float, disk: int):
     """The phases for one way of opening: (rows, notes)."""
-    from rot4d_widget.sources import fields as F
+    from rot4d_widget.sources.field import chunks
     from rot4d_widget.core.rotation import random_rotation, simple_rotation
 
     rows, notes = [], []
@@ -259,7 +259,7 @@ def measure(how: str, path: pathlib.Path, args, mem: PeakRSS, n_chunks: int, chu
     coarse = field.coarse()
     copy_bytes = coarse.values.nbytes
     acc_bytes = coarse.values.size * 8  # the float64 accumulator the copy is summed in
-    batch = max(1, min(F.CHUNK_BATCH, (64 * MB) // max(1, int(chunk_mb * MB))))
+    batch = max(1, min(chunks.CHUNK_BATCH, (64 * MB) // max(1, int(chunk_mb * MB))))
     bound = acc_bytes + copy_bytes + (batch + 4) * chunk_mb * MB
     rise = peak - start
     ok = rise <= bound

@@ -3,8 +3,8 @@
     python benchmarks/keep.py [--repeats 5]
 
 Prints a table: `export.slice_mesh` (and each mesh format's file size) for a polytope, a stack of
-parallel slices and a two-level field; `figures.render_state` at the widget's 600 x 500 for four
-sources; `recording.paper_animation` for the paper's Figs. 3 and 4 as GIF and MP4.  Medians of
+parallel slices and a two-level field; `state_picture.render_state` at the widget's 600 x 500 for four
+sources; `animation.paper_animation` for the paper's Figs. 3 and 4 as GIF and MP4.  Medians of
 ``--repeats`` runs (animations: one run each).  Files go to a temporary directory.
 """
 
@@ -20,8 +20,8 @@ import numpy as np
 
 from rot4d_widget import Field4D, RotationState
 from rot4d_widget.keep.meshes import slice_mesh
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.keep.recording import paper_animation
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.keep.animation import paper_animation
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.tomography import StackSource

@@ -1,7 +1,7 @@
 """What a compiled (numba) kernel costs a fresh process before its first answer (issue 22's question:
 would a numba star slicer keep "loads within 2x the 600-cell"?).
 
-The project's own numba kernel, `rot4d_widget.sources.field_kernels` (``cache=True``: compiled once,
+The project's own numba kernel, `rot4d_widget.sources.field.kernels` (``cache=True``: compiled once,
 loaded from numba's on-disk cache afterwards), is called on a tiny array in ``--runs`` fresh Python
 processes; each reports ``import rot4d_widget`` (which imports numba), the first call (the cached
 kernel loaded) and the second call.  The first run may compile (no cache yet): its row says so.
@@ -26,14 +26,14 @@ import numpy as np
 import rot4d_widget
 t1 = time.perf_counter()
 from rot4d_widget import Polytope, polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 p0 = polytope("600-cell")
 v, f, c = p0.vertices.copy(), [x.tolist() for x in p0.faces], [list(x) for x in p0.cells]
 t2 = time.perf_counter()
 p = Polytope(v, f, c)
 slice_polytope(p, np.eye(4), 0.1)
 t3 = time.perf_counter()
-from rot4d_widget.sources import field_kernels as fk
+from rot4d_widget.sources.field import kernels as fk
 a, idx, inside = np.zeros((3, 3, 3, 3)), np.zeros((4, 4)), np.ones(4, bool)
 t4 = time.perf_counter()
 fk._resample_points(a, idx, inside)

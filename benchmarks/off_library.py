@@ -63,7 +63,7 @@ from scipy.spatial import ConvexHull, cKDTree
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.mesh import Polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 
 #: distance (relative to the circumradius) within which a slice point and an edge crossing agree
 POINT_TOL = 1e-7

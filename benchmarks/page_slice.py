@@ -24,7 +24,7 @@ import numpy as np
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.catalogue import polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.view.buffers import group_palette, pack_rgb, slice_rows
 from rot4d_widget.view.pagegeometry import polytope_message, polytope_message_bytes

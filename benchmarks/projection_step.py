@@ -39,7 +39,7 @@ import time
 import numpy as np
 from scipy.stats import special_ortho_group
 
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.view import projection as pj
 from rot4d_widget.view.bundle import page_module
 from rot4d_widget.view.widget import Rot4DWidget

@@ -237,7 +237,7 @@ def rss_mb() -> float:
 # ============================================================================ sources
 def ball_field():
     """A small 4-D field (f = 0.64 - |q|^2 on [-1, 1]^4), two iso levels, cheap to slice."""
-    from rot4d_widget.sources.fields import Field4D
+    from rot4d_widget.sources.field.container import Field4D
 
     return Field4D.from_function(lambda x, y, z, w: 0.64 - (x * x + y * y + z * z + w * w),
                                  [(-1.0, 1.0)] * 4, levels=[0.0, 0.3], resolution=12, coarse_resolution=8)

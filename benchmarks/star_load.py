@@ -14,7 +14,7 @@ speed hits all alike):
 
 Medians over ``--repeats`` runs; the ratio is each one's over the 600-cell's of the same runs.
 
-A star polychoron's levels are cut by the general slicer (`rot4d_widget.geometry.starslice`,
+A star polychoron's levels are cut by the general slicer (`rot4d_widget.geometry.slicing.star`,
 numpy), the 600-cell's and the other convex-celled ones' by the convex-cell slicer.
 
     python benchmarks/star_load.py [--steps 20] [--repeats 5] [--names all|three]
@@ -33,7 +33,7 @@ import numpy as np
 
 from rot4d_widget import Polytope, polytope
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.geometry.star_regular import SPECS, star_arrays
 
 THREE = ["great 120-cell", "icosahedral 120-cell", "small stellated 120-cell"]

@@ -30,7 +30,7 @@ import json, sys, time
 t0 = time.perf_counter()
 import numpy as np
 from rot4d_widget.geometry import uniform
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 t1 = time.perf_counter()
 name, steps = sys.argv[1], int(sys.argv[2])
 p = uniform.build(name)

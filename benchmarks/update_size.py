@@ -26,7 +26,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from recording_comm import RecordingComm, install  # noqa: E402  (serialises like ipykernel)
 
 from rot4d_widget import SliceData  # noqa: E402
-from rot4d_widget.sources.fields import Field4D  # noqa: E402
+from rot4d_widget.sources.field.container import Field4D  # noqa: E402
 from rot4d_widget.view.buffers import MAX_UPDATE_BYTES  # noqa: E402
 from rot4d_widget.view.widget import Rot4DWidget  # noqa: E402
 

@@ -17,10 +17,11 @@ from test_labels import flame
 
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep import figures
-from rot4d_widget.keep.drawing import perspective
-from rot4d_widget.keep.recording import Recorder, render_frames
-from rot4d_widget.keep.volume import render_grid
+from rot4d_widget.keep.pictures import state_picture
+from rot4d_widget.keep.pictures.slice_drawing import perspective
+from rot4d_widget.keep.recorder import Recorder
+from rot4d_widget.keep.animation import render_frames
+from rot4d_widget.keep.pictures.ray_caster import render_grid
 
 
 def _recording():
@@ -37,7 +38,7 @@ def _frames(rendering, monkeypatch):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     seen = []
-    real = figures.render_state
+    real = state_picture.render_state
 
     def caught(state, source, *args, **kwargs):
         fig = real(state, source, *args, **kwargs)
@@ -52,7 +53,7 @@ def _frames(rendering, monkeypatch):
                      state.copy(), images, (ax.get_xlim(), ax.get_ylim())))
         return fig
 
-    monkeypatch.setattr(figures, "render_state", caught)
+    monkeypatch.setattr(state_picture, "render_state", caught)
     f = flame()
     frames = list(render_frames(_recording(), None, f, rendering=rendering, size=(300, 250), dpi=100))
     return f, frames, seen
@@ -77,14 +78,14 @@ def test_frames_are_cast_at_full_resolution_and_nothing_covers_the_data(renderin
     text, labels, note, ax, st, images, (xlim, ylim) = seen[-1]
     g = f.sample(st.matrix, st.c0)
     from rot4d_widget.core import look
-    from rot4d_widget.keep.volume import view_rotation
+    from rot4d_widget.core.look import view_rotation
 
     want = render_grid(g, rendering, size=(300, 250), limits=(xlim, ylim), cmap="viridis",
                        scale=REFERENCE_RADIUS / f.size, pixels_per_ray=1, progress=False,
                        view=view_rotation(look.default_eye(rendering)))
     np.testing.assert_allclose(images[0], want, atol=1e-12)
     box = f.outline(st.matrix, st.c0)
-    from rot4d_widget.keep.volume import view_rotation as vr
+    from rot4d_widget.core.look import view_rotation as vr
 
     pts = np.asarray(box.points)[np.unique(np.asarray(box.segments))] @ vr(look.default_eye(rendering)).T
     xy = ax.transData.transform(perspective(pts * (REFERENCE_RADIUS / f.size))[0])

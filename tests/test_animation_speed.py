@@ -12,9 +12,11 @@ from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
 from rot4d_widget.core import look
-from rot4d_widget.keep import figures
+from rot4d_widget.keep.pictures import framing, slice_drawing, state_picture
+from rot4d_widget.keep.pictures.canvas import _FrameCanvas, _glyph_caching_renderer
 from rot4d_widget.sources import datasets
-from rot4d_widget.keep.recording import Recorder, render_frames
+from rot4d_widget.keep.recorder import Recorder
+from rot4d_widget.keep.animation import render_frames
 from rot4d_widget.core.state import RotationState
 
 LINES = ["t = 0.03 s, frame 2/33", "\u03b80 = \u03c0/16, c0 = +0.1234", "w cut \u22120.5 \u2026 0.5 s",
@@ -22,7 +24,7 @@ LINES = ["t = 0.03 s, frame 2/33", "\u03b80 = \u03c0/16, c0 = +0.1234", "w cut \
 
 
 def _glyph_renderer():
-    cls = figures._glyph_caching_renderer()
+    cls = _glyph_caching_renderer()
     if not cls.glyphs_cached:
         pytest.skip("this matplotlib does not draw text glyph by glyph (3.11+)")
     return cls
@@ -96,9 +98,9 @@ def test_animation_frames_with_and_without_kept_glyphs_are_identical(monkeypatch
 
 
 def _surface_collection(state, source):
-    stack, data, _, box = figures._prepare(state, source)
-    canvas = figures._FrameCanvas()
-    figures.render_state(state, stack, frame=box, _canvas=canvas, _prepared=(stack, data, None, box))
+    stack, data, _, box = state_picture._prepare(state, source)
+    canvas = _FrameCanvas()
+    state_picture.render_state(state, stack, frame=box, _canvas=canvas, _prepared=(stack, data, None, box))
     (coll,) = [c for c in canvas.ax.collections if c.get_gid() == "surface"]
     return stack, data, coll
 
@@ -111,7 +113,7 @@ def test_surface_shading_and_order_are_the_mean_formulas_bit_for_bit(levels):
     for key in "44z1":  # turned in xw and beyond: a slanted cut, uneven triangles
         st.press(key)
     stack, data, coll = _surface_collection(st, datasets.moving_sphere(levels=levels))
-    scale = figures.REFERENCE_RADIUS / stack.size
+    scale = look.REFERENCE_RADIUS / stack.size
     pts = np.asarray(data.points, dtype=np.float64) * scale
     tri = np.asarray(data.triangles)
     groups = np.asarray(data.groups)
@@ -123,17 +125,17 @@ def test_surface_shading_and_order_are_the_mean_formulas_bit_for_bit(levels):
     light = np.array([-0.35, 0.45, 0.82])
     rgb = np.clip(rgb * (0.45 + 0.55 * np.abs(n @ (light / np.linalg.norm(light))))[:, None], 0.0, 1.0)
     order = np.argsort(pts[tri].mean(axis=1)[:, 2], kind="stable")
-    xy, _ = figures.perspective(pts)
+    xy, _ = slice_drawing.perspective(pts)
     assert len(tri) > 100
     np.testing.assert_array_equal(coll._tri_verts, xy[tri[order]])
     np.testing.assert_array_equal(coll._tri_rgba[:, :3], rgb[order])
 
 
 def test_kept_level_colours_are_look_s_and_read_only():
-    got = figures._level_colors((0.0, 0.5, 0.2), -1.0, 1.0)
+    got = framing._level_colors((0.0, 0.5, 0.2), -1.0, 1.0)
     np.testing.assert_array_equal(got, look.level_colors([0.0, 0.5, 0.2], -1.0, 1.0))
-    assert figures._level_colors([0.0, 0.5, 0.2], -1, 1) is got  # the same levels: the kept array
+    assert framing._level_colors([0.0, 0.5, 0.2], -1, 1) is got  # the same levels: the kept array
     with pytest.raises(ValueError, match="read-only"):
         got[0, 0] = 1.0
     with pytest.raises(ValueError, match="finite"):
-        figures._level_colors([float("nan")], 0.0, 1.0)
+        framing._level_colors([float("nan")], 0.0, 1.0)

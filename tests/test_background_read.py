@@ -17,7 +17,8 @@ import pytest
 
 from rot4d_widget.core import progress as core_progress
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.fields import MEMORY_BUDGET, Field4D, slice_field
+from rot4d_widget.sources.field.coarse import MEMORY_BUDGET
+from rot4d_widget.sources.field.container import Field4D, slice_field
 
 NW, NS, CW, CS = 17, 16, 4, 8  # w samples, spatial samples, chunk sizes: 5 x 2 x 2 x 2 = 40 chunks
 CHUNKS = 40
@@ -157,7 +158,7 @@ def test_the_kernel_bar_is_made_in_the_caller_s_cell_and_shown_from_the_read(mon
 
 
 def test_a_widget_shows_the_read_on_its_own_bar_while_it_runs(make, monkeypatch):
-    from rot4d_widget.sources import coarse
+    from rot4d_widget.sources.field import coarse
 
     monkeypatch.setattr(coarse, "CHUNK_BATCH", 4)  # the read counts every 4 chunks
     arr, field = _field()

@@ -7,7 +7,7 @@ import threading
 import numpy as np
 import pytest
 
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 
 NW, NS, CW, CS = 17, 16, 4, 8  # w samples, spatial samples, chunk sizes
 

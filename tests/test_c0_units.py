@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from rot4d_widget import Field4D, RotationState
-from rot4d_widget.sources.fields import slice_field
-from rot4d_widget.keep.recording import Recording, Setting, Step
+from rot4d_widget.sources.field.container import slice_field
+from rot4d_widget.keep.recorder import Recording, Setting, Step
 from rot4d_widget.sources.protocol import data_w_text, w_frame
 from rot4d_widget.sources.tomography import StackSource
 
@@ -165,7 +165,7 @@ def test_a_recording_from_before_replays_with_c0_converted(make):
 
 
 def test_a_rendered_picture_names_c0_and_the_slices_in_seconds():
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     st = RotationState(c0=26.0)
     fig = render_state(st, _field(resolution=16), annotate=True, size=(300, 250), dpi=50)

@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.fields import Field4D, sample_field, slice_field
+from rot4d_widget.sources.field.container import Field4D, slice_field
+from rot4d_widget.sources.field.grid import sample_field
 
 da = pytest.importorskip("dask.array")
 

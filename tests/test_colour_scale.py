@@ -58,7 +58,7 @@ def test_good_clim_and_stops():
 
 # -- the widget's traits --------------------------------------------------------------------------
 def _field(**kw):
-    from rot4d_widget.sources.fields import Field4D
+    from rot4d_widget.sources.field.container import Field4D
 
     x = np.linspace(-1.0, 1.0, 8)
     X, Y, Z, W = np.meshgrid(x, x, x, x, indexing="ij")

@@ -15,10 +15,12 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from rot4d_widget.core import look
 from rot4d_widget.core import progress as core_progress
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep import volume
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.keep.volume import default_clim, render_grid
-from rot4d_widget.sources.fields import Field4D, sample_field
+from rot4d_widget.keep.pictures import ray_caster
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.core.look import default_clim
+from rot4d_widget.keep.pictures.ray_caster import render_grid
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.grid import sample_field
 
 BOX = ((-1.0, 1.0),) * 4
 
@@ -148,13 +150,13 @@ def test_a_slow_render_state_shows_a_progress_bar(monkeypatch):
         bars.append(core_progress.Progress(total, description, mode="text", file=out, clock=clock))
         return bars[-1]
 
-    monkeypatch.setattr(volume, "make_progress", make)
+    monkeypatch.setattr(ray_caster, "make_progress", make)
     render_state(RotationState(), ball(), rendering="volume", size=(200, 160), dpi=50)
     text = out.getvalue()
     assert len(bars) == 1 and "rendering the cut (volume)" in text and text.endswith("\n")
     assert bars[0].count == bars[0].total
     # a quick one (the real clock) stays silent
-    monkeypatch.setattr(volume, "make_progress", core_progress.progress)
+    monkeypatch.setattr(ray_caster, "make_progress", core_progress.progress)
     quiet = io.StringIO()
     monkeypatch.setattr("sys.stderr", quiet)
     render_state(RotationState(), ball(), rendering="mip", size=(80, 60), dpi=40)

@@ -10,7 +10,7 @@ import pytest
 
 from rot4d_widget.sources import datasets
 from rot4d_widget.sources.datasets import default_cache_dir, moving_sphere, phase_separation, phase_separation_key
-from rot4d_widget.sources.fields import Field4D, slice_field
+from rot4d_widget.sources.field.container import Field4D, slice_field
 from rot4d_widget.core.rotation import simple_rotation
 
 pytest.importorskip("pde")

@@ -16,7 +16,7 @@ from rot4d_widget.core import look
 from rot4d_widget.keep.meshes import face_colors, load_mesh, slice_mesh
 from rot4d_widget.keep.rebuild import CodeNotAllowed, SourceNotRebuildable, describe_source
 from rot4d_widget.keep.statefile import load_state, save_state
-from rot4d_widget.sources.fields import slice_field  # noqa: E402
+from rot4d_widget.sources.field.container import slice_field  # noqa: E402
 from rot4d_widget.geometry.catalogue import polytope
 from rot4d_widget.geometry.regular import pentachoron  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
@@ -381,7 +381,7 @@ def test_bare_slices_from_the_slicers(field_data):
 def test_a_widget_settings_go_to_a_state_file_and_a_picture(tmp_path):
     from rot4d_widget import Rot4DWidget
     from rot4d_widget.keep.statefile import settings_of
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     w = Rot4DWidget("24-cell", slices=3, arrangement="grid", show_balls=False)
     try:

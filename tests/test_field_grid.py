@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.field_grid import FieldGrid
-from rot4d_widget.sources.fields import Field4D, sample_field
+from rot4d_widget.sources.field.grid import FieldGrid
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.grid import sample_field
 
 EXTENT = ((-1.0, 2.0), (0.0, 1.5), (-0.5, 0.5), (3.0, 5.0))
 A = np.array([0.7, -1.3, 2.1, 0.4])

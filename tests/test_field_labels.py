@@ -8,7 +8,8 @@ import pytest
 
 from rot4d_widget.core.rotation import random_rotation, simple_rotation
 from rot4d_widget.sources.field_labels import axis_names, box_labels
-from rot4d_widget.sources.fields import Field4D, sample_field
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.grid import sample_field
 
 EXTENT = ((3.0, 12.0), (-2.0, 2.0), (0.0, 6.0), (0.0, 38.0))
 

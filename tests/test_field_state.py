@@ -26,7 +26,8 @@ import pytest
 
 from rot4d_widget.keep.rebuild import SourceNotRebuildable
 from rot4d_widget.keep.statefile import load_state, save_state
-from rot4d_widget.sources.fields import COARSE_SAMPLES, Field4D
+from rot4d_widget.sources.field.coarse import COARSE_SAMPLES
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
 

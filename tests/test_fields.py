@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.sources.fields import Field4D, FieldSlice, slice_field, _box_slice, _sample
+from rot4d_widget.sources.field.container import Field4D, slice_field
+from rot4d_widget.sources.field.surface import FieldSlice
+from rot4d_widget.sources.field.slicing import _box_slice, _sample
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.sources.protocol import SliceData, as_source
 

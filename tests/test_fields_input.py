@@ -16,7 +16,8 @@ import warnings
 import numpy as np
 import pytest
 
-from rot4d_widget.sources.fields import COARSE_SAMPLES, Field4D, slice_field
+from rot4d_widget.sources.field.coarse import COARSE_SAMPLES
+from rot4d_widget.sources.field.container import Field4D, slice_field
 from rot4d_widget.core.rotation import random_rotation
 
 NT = 60
@@ -151,7 +152,7 @@ def test_an_array_without_axes_is_refused_naming_the_choices_and_repr_names_the_
 
 def test_from_xarray_names_its_dims_in_repr_and_readout():
     xr = pytest.importorskip("xarray")
-    from rot4d_widget.sources.fields import UnitsWarning
+    from rot4d_widget.sources.field.checks import UnitsWarning
 
     da = xr.DataArray(tzyx_array(), dims=("time", "z", "y", "x"), name="T")
     with warnings.catch_warnings():
@@ -190,7 +191,7 @@ def test_a_dim_with_fewer_than_two_samples_is_named(n):
 
 
 def test_infinite_samples_are_reported_once_with_count_and_place():
-    from rot4d_widget.sources.fields import NonFiniteWarning
+    from rot4d_widget.sources.field.checks import NonFiniteWarning
 
     a = tzyx_array()
     a[3, 1, 2, 4] = np.inf
@@ -214,7 +215,7 @@ def test_infinite_samples_are_reported_once_with_count_and_place():
 
 def test_infinite_samples_in_a_chunked_array_are_counted_with_the_coarse_copy():
     dsa = pytest.importorskip("dask.array")
-    from rot4d_widget.sources.fields import NonFiniteWarning
+    from rot4d_widget.sources.field.checks import NonFiniteWarning
 
     a = tzyx_array()
     a[50, 1, 2, 4] = np.inf  # beyond the coarse copy's first 48 nodes

@@ -11,18 +11,9 @@ from matplotlib.image import imread
 from matplotlib.patches import Circle
 
 from rot4d_widget import RotationState, double_rotation, pentachoron, simple_rotation, slice_polytope
-from rot4d_widget.keep import figures
-from rot4d_widget.keep.figures import (
-    CAMERA_DISTANCE,
-    FIG4_ALPHA,
-    TITLE_HEIGHT,
-    draw_slice,
-    paper_figure_3,
-    paper_figure_4,
-    perspective,
-    render_key_sequence,
-    render_slice,
-)
+from rot4d_widget.core import look
+from rot4d_widget.keep.pictures.slice_drawing import CAMERA_DISTANCE, FIG4_ALPHA, TITLE_HEIGHT, draw_slice, perspective
+from rot4d_widget.keep.pictures.panels import panel_style, paper_figure_3, paper_figure_4, render_key_sequence, render_slice
 
 A = 2.0  # the paper's pentachoron edge
 
@@ -354,25 +345,23 @@ def test_empty_slice_draws_an_empty_panel():
 
 def test_figures_import_no_pyplot_and_no_widget_library():
     code = (
-        "import sys, rot4d_widget.keep.figures\n"
+        "import sys, rot4d_widget.keep.pictures.state_picture, rot4d_widget.keep.pictures.panels\n"
         "bad = [m for m in ('matplotlib.pyplot', 'ipywidgets', 'pythreejs', 'ipyevents') if m in sys.modules]\n"
         "assert not bad, bad\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
-def test_module_exports():
-    for name in figures.__all__:
-        assert hasattr(figures, name)
+def test_render_slice_draws_balls():
     assert isinstance(render_slice(), Figure)
     assert all(isinstance(b, Circle) for b in _patches(render_slice().axes[0], "ball"))
 
 
 def test_panel_style_keeps_dense_polytopes_readable():
-    five, dense = figures.panel_style(pentachoron(A)), figures.panel_style("120-cell")
-    assert five == pytest.approx({"scale": 1.0, "radius": figures.REFERENCE_RADIUS, "ball_radius": 0.07,
+    five, dense = panel_style(pentachoron(A)), panel_style("120-cell")
+    assert five == pytest.approx({"scale": 1.0, "radius": look.REFERENCE_RADIUS, "ball_radius": 0.07,
                                   "bar_radius": 0.028})
-    assert dense["radius"] == pytest.approx(figures.REFERENCE_RADIUS)
+    assert dense["radius"] == pytest.approx(look.REFERENCE_RADIUS)
     # the live view's rule: 0.1 x the displayed edge (the 120-cell's is 2 x scale), bars 0.4 x balls
     assert dense["ball_radius"] == pytest.approx(0.1 * 2.0 * dense["scale"])
     assert dense["ball_radius"] < five["ball_radius"]
@@ -398,7 +387,7 @@ def _ndc_pixel(p3, size):
 def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path, size):
     from rot4d_widget import polytope
     from rot4d_widget.core import look
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
     from rot4d_widget.core.rotation import random_rotation
 
     st = RotationState(matrix=random_rotation(4), c0=0.1)
@@ -427,7 +416,7 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
 
 def test_render_state_display_options_and_colours(tmp_path):
     from rot4d_widget.core import look
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     st = RotationState()
     path = tmp_path / "c.png"
@@ -460,7 +449,7 @@ def test_render_state_display_options_and_colours(tmp_path):
 def test_render_state_field_levels_and_stack(tmp_path):
     from rot4d_widget import Field4D
     from rot4d_widget.core import look
-    from rot4d_widget.keep.figures import render_state, state_source
+    from rot4d_widget.keep.pictures.state_picture import render_state, state_source
     from rot4d_widget.sources.tomography import StackSource
 
     f = Field4D.from_function(lambda x, y, z, w: 1 - (x * x + y * y + z * z) - 0.3 * w,
@@ -500,7 +489,7 @@ def test_render_state_field_levels_and_stack(tmp_path):
     (dict(path="x.gif"), ValueError, "end in one of"),
 ])
 def test_render_state_bad_input(kwargs, exc, match):
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     state = kwargs.pop("state", RotationState())
     with pytest.raises(exc, match=match):

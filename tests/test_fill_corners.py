@@ -13,7 +13,7 @@ import pytest  # noqa: E402
 
 from rot4d_widget import polytope, slice_polytope  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
-from rot4d_widget.keep.drawing import _slice_collection, draw_slice  # noqa: E402
+from rot4d_widget.keep.pictures.slice_drawing import _slice_collection, draw_slice  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402
 from rot4d_widget.view.buffers import ball_count, slice_rows  # noqa: E402

@@ -19,7 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rot4d_widget import Rot4DWidget, SliceData
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.view.keyhold import steps_for
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP
 from rot4d_widget.core.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
@@ -502,7 +502,7 @@ def test_a_state_file_whose_c0_its_step_cannot_move_is_refused(make, tmp_path):
 @pytest.mark.parametrize("what", ["state", "recording"])
 def test_a_deeply_nested_json_file_is_a_value_error(tmp_path, what):
     from rot4d_widget.keep.statefile import load_state
-    from rot4d_widget.keep.recording import Recording
+    from rot4d_widget.keep.recorder import Recording
 
     path = tmp_path / "deep.json"
     path.write_text("[" * 100_000 + "]" * 100_000)  # RecursionError before

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rot4d_widget.keep.recording import Recorder, render_animation, render_frames
+from rot4d_widget.keep.recorder import Recorder
+from rot4d_widget.keep.animation import render_animation, render_frames
 from rot4d_widget.core.state import RotationState
 
 
@@ -36,7 +37,7 @@ def _filled(rgb, background=(1.0, 1.0, 1.0)):
 
 @pytest.mark.parametrize("source", ["24-cell", "5-cell"])
 def test_render_state_fills_most_of_the_picture(tmp_path, source):
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     path = tmp_path / "v.png"
     render_state(RotationState(c0=0.1), source, path, size=(600, 500), dpi=100)
@@ -56,7 +57,7 @@ def test_animation_frames_fill_the_picture_and_keep_one_frame(tmp_path):
 
 def test_annotation_is_written_when_asked(tmp_path):
     from rot4d_widget.sources import datasets
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     st = RotationState(theta0=np.pi / 16, c0=0.25)
     fig = render_state(st, "24-cell", annotate=True, size=(300, 250), dpi=50)
@@ -128,24 +129,24 @@ def test_progress_does_not_import_pythreejs():
 # -- the animation's fast path draws what render_state draws ----------------------------------------------
 
 def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
-    """`figures._slice_collection` (animations) has draw_slice's paths, colours and edges, in the
+    """`slice_drawing._slice_collection` (animations) has draw_slice's paths, colours and edges, in the
     order matplotlib would paint draw_slice's patches (by zorder, ties in the order added)."""
     from matplotlib.figure import Figure
 
     from rot4d_widget.core import look
-    from rot4d_widget.keep import figures
+    from rot4d_widget.keep.pictures import panels, slice_drawing
     from rot4d_widget.geometry.catalogue import polytope
     from rot4d_widget.core.rotation import random_rotation
-    from rot4d_widget.geometry.slicing import slice_polytope
+    from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 
     p = polytope("24-cell")
     s = slice_polytope(p, random_rotation(np.random.default_rng(3)), 0.1)
-    style = figures.panel_style(p)
+    style = panels.panel_style(p)
     ax = Figure().add_subplot()
-    d = figures.draw_slice(ax, s, **style)
+    d = slice_drawing.draw_slice(ax, s, **style)
     patches = [a for a in ax.get_children() if a in {*d.faces, *d.bars, *d.balls, *d.highlights}]
     patches.sort(key=lambda a: a.get_zorder())  # stable: matplotlib's painting order
-    coll = figures._slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
+    coll = slice_drawing._slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
                                      bar_radius=style["bar_radius"], face_alpha=look.FACE_OPACITY)
     paths = coll.get_paths()
     assert len(paths) == len(patches) == len(s.polygons) + len(s.edges) + 2 * len(s.vertices)
@@ -166,18 +167,18 @@ def test_animation_frames_are_render_states_pictures(source):
     framing and annotation (text is blended from cached pictures: equal up to rounding)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from rot4d_widget.keep import figures
+    from rot4d_widget.keep.pictures import framing, state_picture
     from rot4d_widget.sources import datasets
-    from rot4d_widget.keep.recording import animation_states
+    from rot4d_widget.keep.animation import animation_states
 
     rec = _held_4(4)
     src = datasets.moving_sphere(resolution=16) if source == "field" else source
     frames = list(render_frames(rec, None, src, size=(240, 200), dpi=40, titles=lambda k, t, s: f"frame {k}"))
-    boxes = [figures._prepare(st, s if s is not None else src)[3]
+    boxes = [state_picture._prepare(st, s if s is not None else src)[3]
              for _, st, s in animation_states(rec, None, src)]
-    box = figures.union_extent(boxes)
+    box = framing.union_extent(boxes)
     for k, (t, st, s) in enumerate(animation_states(rec, None, src)):
-        fig = figures.render_state(st, s if s is not None else src, size=(240, 200), dpi=40, frame=box,
+        fig = state_picture.render_state(st, s if s is not None else src, size=(240, 200), dpi=40, frame=box,
                                    title=f"frame {k}", annotate=f"frame {k + 1}/{len(frames)}")
         canvas = FigureCanvasAgg(fig)
         canvas.draw()
@@ -189,9 +190,9 @@ def test_animation_frames_are_render_states_pictures(source):
 def test_an_error_while_drawing_leaves_no_gif_and_no_encoder(tmp_path, monkeypatch):
     import threading
 
-    from rot4d_widget.keep import figures
+    from rot4d_widget.keep.pictures import state_picture
 
-    real, calls = figures.render_state, []
+    real, calls = state_picture.render_state, []
 
     def failing(*args, **kwargs):
         calls.append(1)
@@ -199,7 +200,7 @@ def test_an_error_while_drawing_leaves_no_gif_and_no_encoder(tmp_path, monkeypat
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(figures, "render_state", failing)
+    monkeypatch.setattr(state_picture, "render_state", failing)
     path = tmp_path / "a.gif"
     with pytest.raises(RuntimeError, match="boom"):
         render_animation(_held_4(5), None, "5-cell", path, size=(120, 100), dpi=40, progress=False)

@@ -7,7 +7,7 @@ sampling grid of the ray-cast renderings; after 90 degrees in x-w the horizontal
 says which way it runs.  The static labels' boxes, measured by matplotlib, lie outside the
 rectangle the box's cut (`Field4D.outline`, not the code under test) projects into, and cover
 no pixel of a ray-cast image.  The page's placement rule (page/labels.js) and the static one
-(`keep.framing.place_labels`) give the same places for the same labels (Node).
+(`keep.pictures.framing.place_labels`) give the same places for the same labels (Node).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ import pytest
 
 from rot4d_widget.core.look import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.drawing import perspective
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.keep.pictures.slice_drawing import perspective
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.sources.field.container import Field4D
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
@@ -128,7 +128,7 @@ console.log(JSON.stringify(out));
 def test_the_page_places_labels_by_the_static_pictures_rule():
     from page_node import run_page
 
-    from rot4d_widget.keep.framing import place_labels
+    from rot4d_widget.keep.pictures.framing import place_labels
 
     rng = np.random.default_rng(5)
     cases = []

@@ -48,9 +48,12 @@ PKG = ROOT / "rot4d_widget"
 WINGS = ("core", "geometry", "sources", "keep", "view")
 #: package modules that may be imported inside a function: what importing them pulls in
 HEAVY_MODULES = {
-    "rot4d_widget.keep.figures": "matplotlib and Pillow (~0.5 s)",
-    "rot4d_widget.keep.drawing": "matplotlib (~0.35 s; keep.volume draws with it, the widget imports keep.volume)",
-    "rot4d_widget.sources.fields": "numba and scikit-image (~0.5 s)",
+    "rot4d_widget.keep.pictures.state_picture": "matplotlib and Pillow (~0.5 s: it draws with every other picture module)",
+    "rot4d_widget.keep.pictures.canvas": "matplotlib's Figure and Text (the animation's reused figure)",
+    "rot4d_widget.keep.pictures.framing": "matplotlib, through keep.pictures.slice_drawing",
+    "rot4d_widget.keep.pictures.slice_drawing": "matplotlib (~0.35 s; keep.pictures.ray_caster draws with it, the widget imports keep.pictures.ray_caster)",
+    "rot4d_widget.sources.field.container": "numba and scikit-image (~0.5 s)",
+    "rot4d_widget.sources.field.surface": "scikit-image (marching cubes)",
     "rot4d_widget.view.scene": "pythreejs (~0.3 s)",
 }
 #: modules whose import must stay cheap (tests/test_server_extension.py): anything inside functions
@@ -228,7 +231,7 @@ def test_imports_inside_functions_say_why_and_are_not_light():
     ("    # a reason\n    from ..core.look import number_text\n", "package's rot4d_widget.core.look"),
     ("    import xarray\n", "without a comment"),
     ("    # optional\n    import xarray\n    from pde import grids\n", None),
-    ("    # numba\n    from .fields import Field4D\n", None),
+    ("    # numba\n    from .field.container import Field4D\n", None),
 ])
 def test_the_inner_import_check_sees_a_light_or_silent_import(body, problem):
     """The checker itself, on a made-up module of the sources wing."""

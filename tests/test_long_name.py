@@ -13,7 +13,7 @@ xr = pytest.importorskip("xarray")
 
 from rot4d_widget.core.state import RotationState  # noqa: E402
 from rot4d_widget.keep.statefile import load_state, save_state  # noqa: E402
-from rot4d_widget.sources.fields import Field4D  # noqa: E402
+from rot4d_widget.sources.field.container import Field4D  # noqa: E402
 
 LONG = "Sea surface temperature"
 

@@ -13,9 +13,10 @@ from matplotlib.figure import Figure
 
 from rot4d_widget import pentachoron, polytope, slice_polytope
 from rot4d_widget.core import look
-from rot4d_widget.keep import figures
+from rot4d_widget.keep.pictures import panels, slice_drawing
 from rot4d_widget.view import buffers
-from rot4d_widget.keep.figures import draw_slice, panel_style, render_slice
+from rot4d_widget.keep.pictures.slice_drawing import draw_slice
+from rot4d_widget.keep.pictures.panels import panel_style, render_slice
 
 
 def _projected_corners(slice_, k, scale):
@@ -96,7 +97,7 @@ def test_colours_are_valid_and_drawn_by_default(tmp_path):
     drawing = draw_slice(Figure().add_subplot(), s)
     assert drawing.balls[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BALL_COLOR))
     assert drawing.bars[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BAR_COLOR))
-    fig = figures.paper_figure_3(tmp_path / "f.png", dpi=20)
+    fig = panels.paper_figure_3(tmp_path / "f.png", dpi=20)
     assert fig.get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BACKGROUND))
 
 
@@ -117,7 +118,6 @@ def test_as_rgb_names_the_allowed_forms(color):
 # --------------------------------------------------------------------------- scale and radii
 def test_reference_radius_is_the_paper_pentachorons_and_figures_use_it():
     assert look.REFERENCE_RADIUS == pytest.approx(pentachoron(2.0).circumradius)
-    assert figures.REFERENCE_RADIUS == look.REFERENCE_RADIUS
     for name in ("5-cell", "8-cell", "600-cell"):
         st = panel_style(name)
         assert st["scale"] * polytope(name).circumradius == pytest.approx(look.REFERENCE_RADIUS)
@@ -175,11 +175,11 @@ def test_figure_projects_like_the_live_camera(size):
 
 
 def test_panels_of_a_grid_share_the_live_cameras_frame():
-    fig = figures.render_key_sequence("4", 2, ncols=2)
+    fig = panels.render_key_sequence("4", 2, ncols=2)
     half = look.CAMERA_POSITION[2] * math.tan(math.radians(look.CAMERA_FOV) / 2)
     for ax in fig.axes:
         assert ax.get_xlim() == pytest.approx((-half, half)) and ax.get_ylim() == pytest.approx((-half, half))
-    assert figures.CAMERA_DISTANCE == look.CAMERA_POSITION[2] and figures.CAMERA_FOV == look.CAMERA_FOV
+    assert slice_drawing.CAMERA_DISTANCE == look.CAMERA_POSITION[2] and slice_drawing.CAMERA_FOV == look.CAMERA_FOV
     assert look.CAMERA_POSITION == (0.0, 0.0, 5.0)
     assert (look.CAMERA_FOV, look.CAMERA_NEAR, look.CAMERA_FAR) == (40.0, 0.1, 100.0)
 

@@ -28,7 +28,7 @@ import numpy as np
 # a package installed read-only: its folder is no place for a cache (numba renamed the class in 0.61)
 in_tree = getattr(caching, "InTreeCacheLocator", None) or getattr(caching, "_InTreeCacheLocator")
 in_tree.from_function = classmethod(lambda cls, py_func, py_file: None)
-from rot4d_widget.sources import field_kernels as fk
+from rot4d_widget.sources.field import kernels as fk
 
 a = np.zeros((3, 3, 3, 3))
 out = {}
@@ -62,5 +62,5 @@ def test_the_kernels_are_loaded_from_the_user_cache_in_a_new_process(tmp_path):
     for name, (hits, misses, _) in second.items():
         assert hits >= 1 and misses == 0, f"{name}: {hits} cache hits, {misses} compiled in the second process"
     files = os.listdir(first["_affine_serial"][2])
-    assert any(f.startswith("field_kernels._affine_parallel") for f in files)
-    assert any(f.startswith("field_kernels._affine_serial") for f in files)
+    assert any(f.startswith("kernels._affine_parallel") for f in files)
+    assert any(f.startswith("kernels._affine_serial") for f in files)

@@ -34,7 +34,7 @@ from scipy.spatial import ConvexHull
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.mesh import Polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))

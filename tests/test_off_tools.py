@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 
 from rot4d_widget import polytope
 from rot4d_widget.geometry.mesh import MAX_TOLERANCE, MESH_TOLERANCE, Polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 
 
 def rounded_off(p, digits):

@@ -13,7 +13,7 @@ from test_companion import FakeScene, from_page
 
 from rot4d_widget import Field4D
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.field_slicing import _box_polytope
+from rot4d_widget.sources.field.slicing import _box_polytope
 from rot4d_widget.view import pagefield as pf
 from rot4d_widget.view import transfer as tr
 from rot4d_widget.view.companion import Companion

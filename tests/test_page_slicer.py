@@ -27,9 +27,10 @@ from test_slicing import check_against_halfspaces, check_closed_ccw_surface
 
 from rot4d_widget import Polytope
 from rot4d_widget.core.rotation import random_rotation, simple_rotation
-from rot4d_widget.geometry import section
+from rot4d_widget.geometry.slicing import single_level
 from rot4d_widget.geometry.catalogue import polytope
-from rot4d_widget.geometry.slicing import Slice, slice_polytope
+from rot4d_widget.geometry.slicing.tables import Slice
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 from rot4d_widget.view.buffers import ball_count, group_palette, pack_rgb, rows_needed, slice_rows
 from rot4d_widget.view.pagegeometry import polytope_message, polytope_message_bytes
@@ -85,7 +86,7 @@ class Paths:
 
     def __init__(self, monkeypatch):
         self.dims, self.exact_signs, self.faces_inside = set(), 0, 0
-        cut, faces = section._slice, section._faces_in_h
+        cut, faces = single_level._slice, single_level._faces_in_h
 
         def spy_cut(t, x, m, c0, tol):
             self.exact_signs += tol == 0.0
@@ -96,8 +97,8 @@ class Paths:
             self.faces_inside += int((~keep).sum())
             return keep, outward
 
-        monkeypatch.setattr(section, "_slice", spy_cut)
-        monkeypatch.setattr(section, "_faces_in_h", spy_faces)
+        monkeypatch.setattr(single_level, "_slice", spy_cut)
+        monkeypatch.setattr(single_level, "_faces_in_h", spy_faces)
 
 
 def compare(groups, paths=None) -> list:

@@ -2,7 +2,7 @@
 
 While it predicts such a polytope the page draws balls and bars only (its fills are the
 kernel's): ``page/slicer.js`` ``sliceStarEdges`` (``page/starslicer.js``) gives the slice's points
-and segments as `rot4d_widget.geometry.starslice.slice_star` makes them, before the fill corners
+and segments as `rot4d_widget.geometry.slicing.star.slice_star` makes them, before the fill corners
 (`Slice.n_fill`).  Compared under Node with `slice_polytope` on every polytope with ``star`` that
 the package builds or tests/data/off_library holds (the seven regular star polychora with star
 faces or cells -- the other three of the ten have convex faces and cells, and the page cuts them
@@ -28,11 +28,11 @@ from test_page_slicer import wire
 
 from rot4d_widget import Polytope
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry import starslice
+from rot4d_widget.geometry.slicing import star
 from rot4d_widget.geometry.catalogue import polytope
-from rot4d_widget.geometry.slicetables import tables
-from rot4d_widget.geometry.slicing import slice_polytope
-from rot4d_widget.geometry.starslice import star_tables
+from rot4d_widget.geometry.slicing.tables import tables
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
+from rot4d_widget.geometry.slicing.star import star_tables
 from rot4d_widget.sources.protocol import PolytopeSource, _volume_or_none
 from rot4d_widget.view.buffers import slice_rows
 from rot4d_widget.view.pagegeometry import polytope_message
@@ -153,7 +153,7 @@ def test_the_kernels_paths_are_reached(monkeypatch):
     segments are the same from either side), points at equal places along a face's line (ordered
     by how they move: numpy's lexsort).  The page's slices there are the kernel's."""
     seen = {"touching": 0, "side below": 0, "equal volumes": 0, "ties along a line": 0}
-    cut, lexsort = starslice._cut, np.lexsort
+    cut, lexsort = star._cut, np.lexsort
     calls = []
 
     def spy_cut(*args):
@@ -164,8 +164,8 @@ def test_the_kernels_paths_are_reached(monkeypatch):
         seen["ties along a line"] += 1
         return lexsort(keys)
 
-    monkeypatch.setattr(starslice, "_cut", spy_cut)
-    monkeypatch.setattr(starslice.np, "lexsort", spy_lexsort)
+    monkeypatch.setattr(star, "_cut", spy_cut)
+    monkeypatch.setattr(star.np, "lexsort", spy_lexsort)
     for kind, name in (("star", "small stellated 120-cell"), ("off", "pardesco/17-tho.off"),
                        ("off", "pardesco/60-ihi.off")):
         p = vh._polytope(kind, name)

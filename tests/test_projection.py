@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.keep.recording import ViewSetting
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.keep.recorder import ViewSetting
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.tomography import StackSource
 from rot4d_widget.view import projection as pj

@@ -111,7 +111,7 @@ def test_from_the_sections_camera_no_plane_is_edge_on():
 
 
 def test_the_static_sections_picture_is_seen_from_the_sections_camera(make, tmp_path):
-    from rot4d_widget.keep.figures import render_state
+    from rot4d_widget.keep.pictures.state_picture import render_state
 
     f = flame()
     w = make(f, rendering="sections")

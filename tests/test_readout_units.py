@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.core.look import number_text
 
 pytestmark = pytest.mark.usefixtures("recording_comms")

@@ -21,7 +21,7 @@ from nibabel.testing import data_path  # noqa: E402
 from scipy.ndimage import map_coordinates  # noqa: E402
 
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
-from rot4d_widget.sources.fields import Field4D  # noqa: E402
+from rot4d_widget.sources.field.container import Field4D  # noqa: E402
 
 try:
     import tomllib

@@ -1,4 +1,4 @@
-"""Issue 12: recorded key sequences (rot4d_widget.keep.recording): record, save, replay, animate."""
+"""Issue 12: recorded key sequences (rot4d_widget.keep.recorder, .animation): record, save, replay, animate."""
 
 import json
 
@@ -6,17 +6,8 @@ import numpy as np
 import pytest
 
 from rot4d_widget import DEFAULT_KEYMAP, RotationState
-from rot4d_widget.keep.recording import (
-    Recorder,
-    Recording,
-    Setting,
-    SourceSetting,
-    Step,
-    animation_states,
-    paper_animation,
-    paper_recording,
-    render_animation,
-)
+from rot4d_widget.keep.recorder import Recorder, Recording, Setting, SourceSetting, Step
+from rot4d_widget.keep.animation import animation_states, paper_animation, paper_recording, render_animation
 from rot4d_widget.core.rotation import random_rotation
 
 
@@ -349,20 +340,20 @@ def test_animations_follow_the_source_settings_on_their_copy():
 
 def test_render_frames_follow_the_source_settings(monkeypatch):
     """Each frame is drawn with the settings recorded up to it; the keywords given are the start."""
-    from rot4d_widget.keep import figures
-    from rot4d_widget.keep.recording import render_frames
+    from rot4d_widget.keep.pictures import state_picture
+    from rot4d_widget.keep.animation import render_frames
 
     drawn = []
 
     def fake_render_state(state, source, **kwargs):
-        stack = figures.state_source(source, **{k: kwargs.get(k) for k in
+        stack = state_picture.state_source(source, **{k: kwargs.get(k) for k in
                                                 ("levels", "slices", "spacing", "arrangement")})
         drawn.append((stack.source.levels, stack.slices, stack.spacing, stack.arrangement))
         import matplotlib.figure
 
         return matplotlib.figure.Figure(figsize=(0.2, 0.2), dpi=10)
 
-    monkeypatch.setattr(figures, "render_state", fake_render_state)
+    monkeypatch.setattr(state_picture, "render_state", fake_render_state)
     r, _ = _source_recording()
     field = _ball_field()
     frames = list(render_frames(r, None, field, levels=(1.0,), slices=None, spacing=None, arrangement="oval"))

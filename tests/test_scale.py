@@ -21,8 +21,8 @@ from scipy.spatial import ConvexHull
 from scipy.stats import special_ortho_group
 
 from rot4d_widget import Field4D, Polytope, polytope
-from rot4d_widget.sources.fields import slice_field
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.sources.field.container import slice_field
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 
 RANGE_MSG = r"1e-150 to 1e\+150"
 TINY = sys.float_info.min  # smallest normal float64

@@ -15,9 +15,11 @@ import pytest
 
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.keep.volume import RENDERINGS, VOLUME_RENDERINGS, render_grid
-from rot4d_widget.sources.fields import Field4D, sample_field
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.core.look import RENDERINGS
+from rot4d_widget.keep.pictures.ray_caster import VOLUME_RENDERINGS, render_grid
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.grid import sample_field
 
 D = 5.0
 BOX = ((-1.0, 1.0),) * 4

@@ -19,7 +19,7 @@ import pytest
 
 from rot4d_widget import polytope
 from rot4d_widget.geometry.mesh import Polytope
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource
 
 PHI = (1 + math.sqrt(5)) / 2

@@ -105,9 +105,9 @@ def test_public_names_resolve_lazily_from_their_modules():
         module = importlib.import_module(f"rot4d_widget.{rot4d_widget._LAZY[name]}")
         assert getattr(rot4d_widget, name) is getattr(module, name), name
     from rot4d_widget import Polytope, polytope
-    from rot4d_widget.geometry import slicing
+    from rot4d_widget.geometry.slicing import polytope_slice
 
-    assert isinstance(polytope("5-cell"), Polytope) and slicing.TOLERANCE > 0
+    assert isinstance(polytope("5-cell"), Polytope) and polytope_slice.TOLERANCE > 0
     with pytest.raises(AttributeError, match="no attribute 'nonesuch'"):
         rot4d_widget.nonesuch
 

@@ -19,7 +19,8 @@ import warnings
 import numpy as np
 import pytest
 
-from rot4d_widget.sources.fields import Field4D, NonFiniteWarning
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.checks import NonFiniteWarning
 
 xr = pytest.importorskip("xarray")
 pytestmark = pytest.mark.usefixtures("recording_comms")

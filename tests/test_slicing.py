@@ -13,7 +13,8 @@ from scipy.spatial import ConvexHull
 
 from reference_geometry import merged_hull_faces, random_rotation, rotation_with_w_row, slice_volume_by_halfspaces
 from rot4d_widget import polytope, slice_polytope
-from rot4d_widget.geometry.slicing import TOLERANCE, Slice
+from rot4d_widget.geometry.slicing.polytope_slice import TOLERANCE
+from rot4d_widget.geometry.slicing.tables import Slice
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 SMALL = ["5-cell", "8-cell", "16-cell", "24-cell"]

@@ -111,7 +111,7 @@ def test_a_state_file_from_before_loads_with_the_spacing_converted(make, tmp_pat
 
 
 def test_a_recording_from_before_replays_with_the_spacing_converted(make):
-    from rot4d_widget.keep.recording import Recording, SourceSetting
+    from rot4d_widget.keep.recorder import Recording, SourceSetting
 
     f = flame()
     w = make(f, slices=3)

@@ -22,7 +22,7 @@ from reference_geometry import random_rotation
 from scipy.spatial import cKDTree
 
 from rot4d_widget import polytope, slice_polytope
-from rot4d_widget.geometry.starfill import arrangement_fill
+from rot4d_widget.geometry.slicing.even_odd_fill import arrangement_fill
 
 NAMES = ["great icosahedral 120-cell", "great grand 120-cell", "great 120-cell", "small stellated 120-cell",
          "great stellated 120-cell"]

@@ -32,7 +32,7 @@ import rot4d_widget
 from rot4d_widget import polytope
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry import star_regular
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.geometry.star_regular import STAR_FAMILY, star_arrays
 
 PHI = (1 + math.sqrt(5)) / 2

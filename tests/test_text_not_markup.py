@@ -27,7 +27,7 @@ import xarray as xr
 
 from rot4d_widget import Polytope, SliceData, SourceAction, polytope
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP, Action
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from test_widget import down, up
 
 pytestmark = pytest.mark.usefixtures("recording_comms")

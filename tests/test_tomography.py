@@ -15,8 +15,8 @@ from scipy.spatial import ConvexHull
 from reference_geometry import random_rotation
 from rot4d_widget import polytope, slice_polytope
 from rot4d_widget.core import look
-from rot4d_widget.sources.fields import Field4D
-from rot4d_widget.keep.figures import render_tomography
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.keep.pictures.state_picture import render_tomography
 from rot4d_widget.core.rotation import simple_rotation
 from rot4d_widget.sources.protocol import PolytopeSource
 from rot4d_widget.sources.arrangements import ARRANGEMENTS, GAP, OVAL_PARABOLA, arrangement_layout

@@ -11,7 +11,7 @@ import pytest
 from rot4d_widget import RotationState
 from rot4d_widget.keep.statefile import load_state
 from rot4d_widget.geometry.offfile import read_off
-from rot4d_widget.keep.recording import Recording
+from rot4d_widget.keep.recorder import Recording
 from rot4d_widget.core.rotation import random_rotation
 
 from rot4d_widget.keep.rebuild import CodeNotAllowed

@@ -376,7 +376,7 @@ def test_build_gives_a_polytope(name):
 
 from reference_geometry import merged_hull_faces, random_rotation, slice_volume_by_halfspaces  # noqa: E402
 
-from rot4d_widget.geometry.slicing import slice_polytope  # noqa: E402
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope  # noqa: E402
 
 SLICE_SAMPLE = ["rectified 5-cell", "runcinated 5-cell", "truncated tesseract", "truncated 16-cell",
                 "cantellated 24-cell", "snub 24-cell", "grand antiprism", "5-7 duoprism", "3-32 duoprism",

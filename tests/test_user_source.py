@@ -24,8 +24,9 @@ from rot4d_widget import RotationState, SliceData
 from rot4d_widget.keep.meshes import slice_mesh
 from rot4d_widget.keep.rebuild import SourceNotRebuildable, describe_source
 from rot4d_widget.keep.statefile import load_state, save_state
-from rot4d_widget.keep.figures import render_state, state_source
-from rot4d_widget.keep.recording import Recorder, Recording, animation_states, render_frames
+from rot4d_widget.keep.pictures.state_picture import render_state, state_source
+from rot4d_widget.keep.recorder import Recorder, Recording
+from rot4d_widget.keep.animation import animation_states, render_frames
 from rot4d_widget.sources.protocol import as_source, inner_source, settings_of, takes_coarse
 
 

@@ -36,7 +36,7 @@ from scipy.spatial import cKDTree
 
 from rot4d_widget import polytope, polytope_names
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.geometry.slicing import slice_polytope
+from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.geometry.star_regular import STAR_FAMILY
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))

@@ -18,17 +18,10 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.statefile import SETTING_NAMES, load_state, save_state
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.keep.recording import (
-    RECORDING_VERSION,
-    VIEW_DEFAULTS,
-    Recorder,
-    Recording,
-    ViewSetting,
-    animation_states,
-    render_frames,
-)
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.keep.recorder import RECORDING_VERSION, VIEW_DEFAULTS, Recorder, Recording, ViewSetting
+from rot4d_widget.keep.animation import animation_states, render_frames
+from rot4d_widget.sources.field.container import Field4D
 
 VIEW = {"rendering": "mip", "sections": (0.2, 0.5, 0.9), "cmap": "magma", "clim": (0, 2)}
 BOX = ((-1.0, 1.0),) * 4

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core import look
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.view import volume_layer as vl
 from test_widget import down, up
 from test_widget_fields import ball_field, settle

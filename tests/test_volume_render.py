@@ -19,9 +19,11 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from rot4d_widget.core.look import CAMERA_FOV, REFERENCE_RADIUS
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
-from rot4d_widget.keep.figures import render_state
-from rot4d_widget.keep.volume import default_clim, render_grid
-from rot4d_widget.sources.fields import Field4D, sample_field
+from rot4d_widget.keep.pictures.state_picture import render_state
+from rot4d_widget.core.look import default_clim
+from rot4d_widget.keep.pictures.ray_caster import render_grid
+from rot4d_widget.sources.field.container import Field4D
+from rot4d_widget.sources.field.grid import sample_field
 
 D = 5.0  # the eye's distance
 BOX = ((-1.0, 1.0),) * 4
@@ -222,7 +224,7 @@ def test_the_compiled_caster_draws_numpys_picture(rendering, seed):
     holes of NaN: the same pixels, within the opacity at which a volume ray stops (1e-4)."""
     from matplotlib import colormaps
 
-    from rot4d_widget.keep import volume
+    from rot4d_widget.keep.pictures import ray_caster
 
     pytest.importorskip("numba")
     rng = np.random.default_rng(seed)
@@ -233,7 +235,7 @@ def test_the_compiled_caster_draws_numpys_picture(rendering, seed):
     g = sample_field(f, m, 0.1, 20)
     args = (g, rendering, colormaps["magma"], (0.2, 0.8), (90, 70), camera_limits((90, 70)), 1.3,
             np.array([0.1, -0.2, 0.3]), D, 4.0, 0.5, np.array([0.3, 0.5, 0.7]))
-    compiled = volume._cast(*args)
-    plain = volume._cast(*args, compiled=False)
+    compiled = ray_caster._cast(*args)
+    plain = ray_caster._cast(*args, compiled=False)
     assert (plain[..., 3] > 0).sum() > 500
     np.testing.assert_allclose(compiled, plain, atol=1e-4 if rendering == "volume" else 1e-12)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rot4d_widget.core import look
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 from test_widget import down, up
 from test_widget_scene import drawn, run_ticker
 from widget_time import service

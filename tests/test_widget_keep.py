@@ -1,6 +1,6 @@
 """Keeping what the widget shows (issue 12): recordings, replay, state files, meshes, pictures.
 
-The functions behind these (rot4d_widget.keep.meshes, .statefile, .recording, figures.render_state) have their
+The functions behind these (rot4d_widget.keep.meshes, .statefile, .recorder, .animation, .picture) have their
 own tests; here the widget's methods are checked against the widget itself: a replay ends
 where the live widget ended, a state file rebuilds the same view, the mesh is the slice shown.
 """
@@ -16,7 +16,7 @@ from PIL import Image
 
 from rot4d_widget import Rot4DWidget
 from rot4d_widget.keep.meshes import load_mesh
-from rot4d_widget.keep.recording import Recording
+from rot4d_widget.keep.recorder import Recording
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

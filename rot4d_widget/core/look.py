@@ -1,6 +1,6 @@
 """How things look: the one place for the palette, reference scale, camera, default radii and colours.
 
-The static figures (`rot4d_widget.keep.figures`, matplotlib) and the live view (`rot4d_widget.view.scene` and
+The static pictures (`rot4d_widget.keep`, matplotlib) and the live view (`rot4d_widget.view.scene` and
 `rot4d_widget.view.buffers`, pythreejs) both read these names, so a 4-D cell, a ball or the frame look the
 same in both.  numpy only at import: no widget library; matplotlib only inside the colour map
 functions (`level_colors`, `check_cmap`, `cmap_stops`: for its colormaps), imported when called.

@@ -6,7 +6,7 @@ Use the module as the tolerance object (like trimesh's ``constants.tol``)::
     on = np.abs(h) <= tol.ON_HYPERPLANE * radius
 
 Each constant says what it is relative to.  The older names stay where they were
-(`rot4d_widget.geometry.slicing.TOLERANCE`, `rot4d_widget.core.rotation.ORTHOGONALITY_TOLERANCE`,
+(`rot4d_widget.geometry.slicing.polytope_slice.TOLERANCE`, `rot4d_widget.core.rotation.ORTHOGONALITY_TOLERANCE`,
 `rot4d_widget.geometry.mesh.MESH_TOLERANCE`) and are these same numbers.
 
 >>> ON_HYPERPLANE, ORTHOGONALITY, MESH
@@ -21,7 +21,7 @@ __all__ = [
 ]
 
 #: A vertex is on the slicing hyperplane w = c0 when ``|w - c0| <= ON_HYPERPLANE * circumradius``:
-#: the slicer's one tolerance (``slicing.TOLERANCE``).
+#: the slicer's one tolerance (``polytope_slice.TOLERANCE``).
 ON_HYPERPLANE = 1e-9
 
 #: How far from orthogonal a user's rotation matrix may be (max ``|M M^T - I|``); within it a

@@ -11,7 +11,9 @@
 `rot4d_widget.geometry.catalogue`   `polytope(name)`: the regular six, the ten regular star
                                     ones (`rot4d_widget.geometry.star_regular`) and every
                                     uniform polychoron (`rot4d_widget.geometry.uniform`) by name
-`rot4d_widget.geometry.slicing`     `slice_polytope` and `Slice`: the w = c0 cut
+`rot4d_widget.geometry.slicing`     the w = c0 cut: `polytope_slice` (`slice_polytope`, the
+                                    entry), `single_level`, `many_levels`, `tables` (`Slice`),
+                                    `star`, `even_odd_fill`
 ==================================  ============================================================
 
 `Polytope`, `MeshError`, `pentachoron`, `polytope` and `slice_polytope` are importable from

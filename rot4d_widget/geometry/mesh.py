@@ -192,7 +192,7 @@ class Polytope:
         its outward faces), each region counted as often as the boundary winds round it
     star : None, or `rot4d_widget.geometry.meshcheck.StarData` when some face or cell is not
         convex, or the volume is not defined (its slices then come from
-        `rot4d_widget.geometry.starslice`: even-odd chords and fill, winding-weighted volume or
+        `rot4d_widget.geometry.slicing.star`: even-odd chords and fill, winding-weighted volume or
         None); such a polytope is not convex, and self-intersecting when a face is a star, a
         cell's faces wind round its centre more than once, or it has no inside
     volume_defined, why_no_volume : see the properties (False / the reason for a hemi or
@@ -421,7 +421,7 @@ class Polytope:
     def star(self):
         """`rot4d_widget.geometry.meshcheck.StarData` (read-only arrays) when some face is not a convex
         polygon or some cell not a convex polyhedron (the slicer then takes its general path:
-        `rot4d_widget.geometry.starslice`), else None."""
+        `rot4d_widget.geometry.slicing.star`), else None."""
         return self._star
 
     @property

@@ -1,10 +1,10 @@
 """Recordings drawn as animations: the frames' states, the frames, a GIF or an MP4.
 
-`render_animation` draws a recording with `rot4d_widget.keep.figures.render_state` -- one frame
+`render_animation` draws a recording with `rot4d_widget.keep.pictures.state_picture.render_state` -- one frame
 per step, or one per 1/fps seconds of the recorded time -- into an animated GIF (Pillow) or an
 MP4 (imageio with imageio-ffmpeg's ffmpeg).  `paper_animation(3)` / `paper_animation(4)` are
-the paper's Figs. 3 and 4 (the key sequences of `figures.paper_figure_3` / ``_4``) as animations.
-Part of `rot4d_widget.keep.recording`, which re-exports every public name.
+the paper's Figs. 3 and 4 (the key sequences of `panels.paper_figure_3` / ``_4``) as animations.
+The recordings themselves are `rot4d_widget.keep.recorder`'s.
 """
 
 from __future__ import annotations
@@ -141,7 +141,7 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
                   **settings) -> Iterator[np.ndarray]:
     """The frames of `render_animation`, one (H, W, 3) uint8 array at a time.
 
-    ``settings`` go to `rot4d_widget.keep.figures.render_state` (``size``, ``dpi``, ``levels``,
+    ``settings`` go to `rot4d_widget.keep.pictures.state_picture.render_state` (``size``, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...).  ``titles``: a callable ``(k, t, state) -> str`` giving each
     frame a title, or None.  More than ``max_frames`` frames raises ``ValueError`` before any is drawn.
     When the recording has source settings (``levels``, ``slices``, ``spacing``,
@@ -153,12 +153,12 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
     `render_state` takes it).
 
     ``frame="fit"`` (default): every frame is framed alike, by the union of the projected
-    bounding boxes of all frames' slices (`figures.frame_extent`), which fills 90 % of the
+    bounding boxes of all frames' slices (`framing.frame_extent`), which fills 90 % of the
     picture's width or height -- the slices are computed once for this, in a first pass, and
     kept for drawing (up to 256 MB); ``"camera"`` or a box as `render_state`.  ``annotate``
     (default True): each frame carries "frame k/n", θ0, c0 in the data's units, the turn
-    (`figures.turn_text`: how far the cut is turned from the data's own w) and what the source tells
-    of itself (`figures.annotation`), and a legend; False for a bare picture.
+    (`framing.turn_text`: how far the cut is turned from the data's own w) and what the source tells
+    of itself (`framing.annotation`), and a legend; False for a bare picture.
     """
     for f in _frames(recording, initial_state, source, per=per, fps=fps, max_frames=max_frames, titles=titles,
                      frame=frame, annotate=annotate, **settings):
@@ -168,12 +168,16 @@ def render_frames(recording: Recording, initial_state=None, source="5-cell", *, 
 def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: str = "step", fps: float = 10.0,
             max_frames: int = 3000, titles=None, frame="fit", annotate=True, **settings) -> Iterator[np.ndarray]:
     """`render_frames`' frames as they are drawn: (H, W, 4) uint8 RGBA views of one reused canvas
-    (valid until the next frame is asked for), or (H, W, 3) RGB arrays when `figures.render_state`
-    hands back a figure of its own.  Every frame is drawn into ONE figure (`figures._FrameCanvas`):
+    (valid until the next frame is asked for), or (H, W, 3) RGB arrays when `state_picture.render_state`
+    hands back a figure of its own.  Every frame is drawn into ONE figure (`canvas._FrameCanvas`):
     its artists replaced, the annotation's text and legend kept and updated."""
-    # figures imports matplotlib: imported when a frame is drawn, not with the recordings
-    from . import figures
-    from .figures import state_source
+    # the pictures import matplotlib: imported when a frame is drawn, not with the recordings.
+    # render_state and _prepare are looked up on their module at each call, so that replacing
+    # `state_picture.render_state` (a test) reaches every frame
+    from .pictures import state_picture
+    from .pictures.canvas import _FrameCanvas
+    from .pictures.framing import union_extent
+    from .pictures.state_picture import state_source
 
     fps = _positive("fps", fps)
     n = _frame_count(recording, per, fps)
@@ -186,33 +190,33 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         source = state_source(source, **start)
     # the view settings given are where the frames start; the recorded ones change them from there
     start_view = {k: settings.pop(k) for k in VIEW_SETTINGS if k in settings}
-    takes = inspect.signature(figures.render_state).parameters  # a recorded `sections` only where taken
+    takes = inspect.signature(state_picture.render_state).parameters  # a recorded `sections` only where taken
     prep = {k: settings[k] for k in _PREPARE_KEYS if k in settings}
     cache: list = []
-    canvas = figures._FrameCanvas()  # one figure for every frame
+    canvas = _FrameCanvas()  # one figure for every frame
     if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
         boxes, kept = [], 0
         for _t, state, src, view in _steps(recording, initial_state, source, per=per, fps=fps):
-            _, data, _, box = figures._prepare(state, src if src is not None else "5-cell", **prep,
+            _, data, _, box = state_picture._prepare(state, src if src is not None else "5-cell", **prep,
                                                rendering={**start_view, **view}.get("rendering", "surface"),
                                                eye=settings.get("eye"))
             boxes.append(box)
             kept += _data_bytes(data)
             cache.append(data if kept <= _SLICE_CACHE_BYTES else None)
-        box = figures.union_extent(boxes)
+        box = union_extent(boxes)
         frame = "camera" if box is None else box
     for k, (t, state, src, view) in enumerate(_steps(recording, initial_state, source, per=per, fps=fps)):
         title = titles(k, t, state) if titles is not None else None
-        note = f"frame {k + 1}/{n}" if annotate else False  # c0 and the turn follow (`figures.annotation`)
+        note = f"frame {k + 1}/{n}" if annotate else False  # c0 and the turn follow (`framing.annotation`)
         drawn = src if src is not None else "5-cell"
         extra = {}
         if k < len(cache) and cache[k] is not None:
-            extra["_prepared"] = figures._prepare(state, drawn, data=cache[k], **prep,
+            extra["_prepared"] = state_picture._prepare(state, drawn, data=cache[k], **prep,
                                                   rendering={**start_view, **view}.get("rendering", "surface"),
                                                   eye=settings.get("eye"))
             cache[k] = None  # drawn once: let it go
         look_now = {**start_view, **{n: v for n, v in view.items() if n in takes}}
-        fig = figures.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,
+        fig = state_picture.render_state(state, drawn, title=title, frame=frame, annotate=note, _canvas=canvas, **extra,
                                    **look_now, **settings)
         yield canvas.rgba() if fig is canvas.fig else _figure_rgb(fig)
 
@@ -257,7 +261,7 @@ def render_animation(recording: Recording, initial_state=None, source="5-cell", 
     octree); ``.mp4``: H.264 (imageio with imageio-ffmpeg's ffmpeg), ``fps`` frames per second,
     streamed to ffmpeg as they are drawn.  One frame per step (``per="step"``, plus the
     starting state) or per 1/``fps`` s of the recorded time (``per="time"``).  ``settings``
-    are `rot4d_widget.keep.figures.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
+    are `rot4d_widget.keep.pictures.state_picture.render_state`'s (``size=(w, h)`` pixels, ``dpi``, ``levels``,
     ``slices``, ``color_by`` ...; an MP4's size is rounded up to even numbers of pixels).
     ``frame`` and ``annotate`` as `render_frames` (default: every frame framed alike to fill
     the picture, and annotated).  ``progress``: True (default) shows a progress bar
@@ -397,10 +401,10 @@ def _write_mp4(path, fps, images) -> None:
 def paper_recording(figure: int, frames: int = 16, fps: float = 4.0) -> tuple:
     """``(recording, source)`` of the paper's Fig. 3 (key "4", R_xw, theta0 = pi/16) or Fig. 4
     (key "z", R_xz,yw, alpha = pi sqrt2 / (8 sqrt3), beta = 1 - alpha) on the a = 2 pentachoron:
-    ``frames - 1`` presses 1/fps s apart, the sequences of `figures.paper_figure_3` / ``_4``
+    ``frames - 1`` presses 1/fps s apart, the sequences of `panels.paper_figure_3` / ``_4``
     (frame k is panel k)."""
-    # figures imports matplotlib: the paper's constants come with it, only when asked for
-    from .figures import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0
+    # drawing imports matplotlib: the paper's constants come with it, only when asked for
+    from .pictures.slice_drawing import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0
 
     if figure == 3:
         state, key = RotationState(theta0=FIG3_THETA0), "4"

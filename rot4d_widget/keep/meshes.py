@@ -22,7 +22,7 @@ from typing import Mapping
 import numpy as np
 
 from ..core import look
-from ..geometry.slicing import Slice
+from ..geometry.slicing.tables import Slice
 from ..sources.protocol import SliceData
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
@@ -80,8 +80,8 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
 
 def _as_slice_data(obj):
     """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; else as is."""
-    # sources.fields imports numba and scikit-image (~0.5 s): only a bare field slice needs it
-    from ..sources.fields import FieldSlice
+    # sources.field.surface imports scikit-image: only a bare field slice needs it
+    from ..sources.field.surface import FieldSlice
 
     # The two class tests left in keep/: they name the slicers' bare results (geometry's `Slice`,
     # `slice_field`'s `FieldSlice`), not source kinds -- any source's own slice is used as it is.
@@ -210,7 +210,7 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
     frame : "data" (default) or "view"
         Where a slice that knows its data coordinates (a `Field4D`'s, a stack of them: any slice
         data whose ``extra["data_frame"]`` gives the cut's ``matrix``, offset ``d`` and the data's
-        ``centre`` and ``unit``, see `rot4d_widget.sources.fields.Field4D.slice`) puts its vertices.
+        ``centre`` and ``unit``, see `rot4d_widget.sources.field.container.Field4D.slice`) puts its vertices.
         ``"data"``: in the data's units at the data's place -- the view's 3-D picture scaled by
         the data's units of x, y, z (1 for a field) and moved by the data box's centre, so at
         rest (identity orientation) a vertex is at its data (x, y, z).  After a turn the 3

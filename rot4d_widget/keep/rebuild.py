@@ -19,7 +19,8 @@ import numpy as np
 
 from ..geometry.catalogue import polytope
 from ..geometry.mesh import Polytope
-from ..sources.field_checks import UnitsWarning
+from ..sources.field.checks import UnitsWarning
+from ..sources.field.inputs import _selection_from_json
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
 
@@ -39,6 +40,9 @@ class CodeNotAllowed(ValueError):
 #: state file names a field's function by ``"module:qualname"``; one written before the wings can
 #: name package code by an old path, which the package no longer imports (issue 38: no import
 #: hook before 1.0), so the loader translates it with this table -- data, nothing imported.
+#: A file can name only a module that defined a field's function (its ``__module__``), so modules
+#: that defined none have no entry: ``rot4d_widget.recording`` and ``rot4d_widget.figures`` (the
+#: recordings and the static pictures, split since over several modules of keep).
 OLD_MODULES = {
     "rot4d_widget.rotation": "rot4d_widget.core.rotation",
     "rot4d_widget.keymap": "rot4d_widget.core.keymap",
@@ -48,15 +52,13 @@ OLD_MODULES = {
     "rot4d_widget.progress": "rot4d_widget.core.progress",
     "rot4d_widget.polytopes": "rot4d_widget.geometry.catalogue",
     "rot4d_widget.uniform": "rot4d_widget.geometry.uniform",
-    "rot4d_widget.slicing": "rot4d_widget.geometry.slicing",
+    "rot4d_widget.slicing": "rot4d_widget.geometry.slicing.polytope_slice",
     "rot4d_widget.offfile": "rot4d_widget.geometry.offfile",
     "rot4d_widget.source": "rot4d_widget.sources.protocol",
-    "rot4d_widget.fields": "rot4d_widget.sources.fields",
+    "rot4d_widget.fields": "rot4d_widget.sources.field.container",
     "rot4d_widget.tomography": "rot4d_widget.sources.tomography",
     "rot4d_widget.datasets": "rot4d_widget.sources.datasets",
     "rot4d_widget.export": "rot4d_widget.keep.statefile",
-    "rot4d_widget.recording": "rot4d_widget.keep.recording",
-    "rot4d_widget.figures": "rot4d_widget.keep.figures",
     "rot4d_widget.widget": "rot4d_widget.view.widget",
     "rot4d_widget.scene": "rot4d_widget.view.scene",
     "rot4d_widget.buffers": "rot4d_widget.view.buffers",
@@ -72,7 +74,7 @@ def module_now(module: str) -> str:
     package (or of a module under it), else ``module`` itself.
 
     >>> module_now("rot4d_widget.fields"), module_now("mylab.fields")
-    ('rot4d_widget.sources.fields', 'mylab.fields')
+    ('rot4d_widget.sources.field.container', 'mylab.fields')
     """
     for old, new in OLD_MODULES.items():
         if module == old or module.startswith(old + "."):
@@ -183,8 +185,8 @@ def _origin_path(origin, base):
 
 
 def _open_origin(origin, base):
-    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
-    from ..sources.fields import Field4D, _selection_from_json
+    # sources.field.container imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
+    from ..sources.field.container import Field4D
 
     origin = dict(origin)
     if origin.get("kind", "xarray") != "xarray":
@@ -219,8 +221,8 @@ def _open_origin(origin, base):
 
 
 def _rebuild_field(d, allow_code=False, function=None, base=None):
-    # sources.fields imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
-    from ..sources.fields import Field4D
+    # sources.field.container imports numba and scikit-image (~0.5 s): only a field's rebuild needs it
+    from ..sources.field.container import Field4D
 
     common = dict(name=d.get("name"), units=d.get("units"), w_per_unit=d.get("w_per_unit"))
     if d.get("w_units") is not None:
@@ -296,8 +298,8 @@ def open_field(path, variable=None, *, engine=None, **kwargs):
     ``chunks=``, ``isel=``, ``sel=`` and the keywords of `Field4D.from_xarray`
     (``x=, y=, z=, w=, w_per_unit=`` ...) as in `Field4D.open`.
     """
-    # sources.fields imports numba and scikit-image (~0.5 s): only opening a field needs it
-    from ..sources.fields import Field4D
+    # sources.field.container imports numba and scikit-image (~0.5 s): only opening a field needs it
+    from ..sources.field.container import Field4D
 
     return Field4D.open(path, variable, engine=engine, **kwargs)
 

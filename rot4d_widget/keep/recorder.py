@@ -30,8 +30,7 @@ slice keys) and the source's settings are replayed on a source when one is given
 (`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
 view into a stack replaces its source), else skipped; view settings change neither state nor
 source: they go to ``set_view=`` (the widget sets its traits), else are skipped.
-Part of `rot4d_widget.keep.recording`, which re-exports every public name; the animations are
-`rot4d_widget.keep.animation`'s.
+The animations are `rot4d_widget.keep.animation`'s.
 """
 
 from __future__ import annotations
@@ -75,7 +74,7 @@ SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement
 #: The view settings `Recorder.record_view` takes (the widget's traits): how a field's cut is drawn,
 #: its colour scale and where its sections lie -- they change the picture, not the state or source.
 VIEW_SETTINGS = ("rendering", "cmap", "clim", "sections", "projection")
-#: Each view setting's default (the widget's and `rot4d_widget.keep.figures.render_state`'s), as JSON.
+#: Each view setting's default (the widget's and `rot4d_widget.keep.pictures.state_picture.render_state`'s), as JSON.
 VIEW_DEFAULTS = {"rendering": look.RENDERINGS[0], "cmap": look.LEVEL_COLORMAP, "clim": None,
                  "sections": list(look.DEFAULT_SECTIONS)}
 #: The settings of a field (a stack's inner source).

@@ -54,7 +54,7 @@ from .rebuild import (
 from .recorder import VIEW_SETTINGS, check_view_setting
 
 #: The widget's settings a state file keeps, by their trait names (`settings_of` reads them;
-#: `rot4d_widget.keep.figures.render_state` takes them as keywords).
+#: `rot4d_widget.keep.pictures.state_picture.render_state` takes them as keywords).
 SETTING_NAMES = ("levels", "inside", "caps", "slices", "spacing", "arrangement", "color_by", "face_opacity",
                  "ball_radius", "bar_radius", "background", "show_balls", "show_bars", "show_faces", "cmap", "clim",
                  "rendering", "sections", "projection")
@@ -66,7 +66,7 @@ STATE_FILE_VERSION = 2
 
 def settings_of(widget) -> dict:
     """The `SETTING_NAMES` a widget (or any object) has, as JSON-able values: what `save_state`
-    stores and `rot4d_widget.keep.figures.render_state` takes (``render_state(w.state, w.source,
+    stores and `rot4d_widget.keep.pictures.state_picture.render_state` takes (``render_state(w.state, w.source,
     **settings_of(w))``).  A stack's ``spacing`` is None while it follows its default."""
     out = {}
     for name in SETTING_NAMES:
@@ -93,7 +93,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
     the widget: its traits (``levels``, ``slices``, ``spacing``, ``arrangement``,
     ``face_opacity``, ``ball_radius``, ``bar_radius``, ``background``, ``show_balls``,
     ``show_bars``, ``show_faces``, ``color_by``, ``cmap``, ``clim``, ``rendering``, ``sections``)
-    -- `rot4d_widget.keep.figures.render_state` takes the same names; the view settings are
+    -- `rot4d_widget.keep.pictures.state_picture.render_state` takes the same names; the view settings are
     checked (as `load_state` will), so no file is written that cannot be loaded.  A source that
     cannot be rebuilt (an in-memory array, a lambda) is described anyway, with a
     `SourceNotRebuildable` warning saying so.  Returns the dict written.

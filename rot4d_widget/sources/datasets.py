@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 from scipy.ndimage import gaussian_filter
 
-from .field_checks import _real
-from .fields import Field4D
+from .field.checks import _real
+from .field.container import Field4D
 
 __all__ = ["phase_separation", "moving_sphere", "default_cache_dir", "phase_separation_key", "INSTALL_HINT"]
 
@@ -256,7 +256,7 @@ def moving_sphere(v: float = 0.75, radius: float = 0.5, *, t_max: float = 1.0, m
     The box: w in [-t_max, t_max], x in +-(|v| t_max + radius + margin), y and z in
     +-(radius + margin).  Further keyword arguments go to `Field4D.from_function`
     (``resolution``, ``levels`` ...); ``levels`` defaults to ``[0.0]``.
-    Returns a `rot4d_widget.sources.fields.Field4D`.
+    Returns a `rot4d_widget.sources.field.container.Field4D`.
     """
     v = _float(v, "v")
     r = _float(radius, "radius")

@@ -4,7 +4,7 @@ After a turn, x of the picture may be time in the data.  `box_labels` names, at 
 corner, the data coordinates there, and at the far end of each of the three grid edges leaving it,
 the data coordinates that change along that edge ("time 0 → 38 s, x 3 → 12 mm"), so a picture says
 which way each data axis runs.  Pure numpy, no drawing: the static renders
-(`rot4d_widget.keep.picture`) and the page place the same texts at the same points.
+(`rot4d_widget.keep.pictures.state_picture`) and the page place the same texts at the same points.
 """
 
 from __future__ import annotations

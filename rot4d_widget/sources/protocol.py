@@ -66,7 +66,7 @@ that comes from these optional members, never from its class (`inner_source`,
 ``sample(matrix, c0, resolution=None, *, coarse=False)`` (optional)
     The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
     spacing, units, data range): what the volume and maximum-intensity renderings
-    draw (`rot4d_widget.keep.volume`); a source without it has only surfaces.
+    draw (`rot4d_widget.keep.pictures.ray_caster`); a source without it has only surfaces.
 ``describe()`` returns everything a state file needs to rebuild the source: its
 ``"kind"`` and, when it cannot be rebuilt from the description, ``"rebuild"``:
 the reason (a string; True or absent when it can).  A copy of a source
@@ -93,7 +93,7 @@ from ..core.look import number_text
 from ..geometry.catalogue import polytope as get_polytope
 from ..geometry.mesh import Polytope
 from ..geometry.regular import POLYTOPE_NAMES
-from ..geometry.slicing import slice_polytope
+from ..geometry.slicing.polytope_slice import slice_polytope
 from .field_labels import axis_names, coordinate_text
 
 __all__ = [

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..core import look
 from ..core.rotation import as_rotation_matrix
-from ..geometry.slicing import slice_polytope
+from ..geometry.slicing.polytope_slice import slice_polytope
 from .arrangements import arrangement_layout, check_arrangement
 from .protocol import (
     PolytopeSource,

@@ -2,7 +2,7 @@
 around them, read through the source protocol (``sample``, a stack's ``cuts``), never a class.
 
 `grid_cut` is the volume renderings' ``source.slice``: where a surface rendering asks the source
-for its isosurfaces, these ask for the values on a grid (`rot4d_widget.sources.field_grid`) --
+for its isosurfaces, these ask for the values on a grid (`rot4d_widget.sources.field.grid`) --
 no isosurface is computed for a single field, so a held key costs a coarse sampling only.
 """
 

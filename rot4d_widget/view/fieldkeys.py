@@ -11,7 +11,7 @@ replay are what they were.
 
 The page applies the same rules (``page/state.js``): the rendering cycle of `look.RENDERINGS`, the
 section step (`SECTION_STEP`, rounded to 1/1024, refused at 0 and 1) and the level step
-(`rot4d_widget.sources.field_levels.FieldLevels.step_levels`: every level by ``level_step``,
+(`rot4d_widget.sources.field.levels.FieldLevels.step_levels`: every level by ``level_step``,
 refused beyond the data range widened by one step) with the numbers `view_rules` gives.  The levels
 are predicted only while the field's range is known without reading it (in memory, or its coarse
 copy made): before that, o / i are the kernel's keys alone.
@@ -20,7 +20,7 @@ copy made): before that, o / i are the kernel's keys alone.
 from __future__ import annotations
 
 from ..core import look
-from ..sources.field_levels import FieldLevels
+from ..sources.field.levels import FieldLevels
 from ..sources.protocol import inner_source
 from .cuts import can_sample
 

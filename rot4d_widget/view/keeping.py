@@ -13,8 +13,9 @@ import inspect
 import os
 
 from ..core.state import without_source_keys
+from ..keep.animation import render_animation
 from ..keep.meshes import slice_mesh
-from ..keep.recording import VIEW_DEFAULTS, VIEW_SETTINGS, Recorder, Recording, check_view_setting, render_animation
+from ..keep.recorder import VIEW_DEFAULTS, VIEW_SETTINGS, Recorder, Recording, check_view_setting
 from ..keep.statefile import SETTING_NAMES, load_state, save_state
 from ..keep.statefile import settings_of as widget_settings
 from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of
@@ -42,7 +43,7 @@ def _view_now(widget) -> dict:
 
 def _taken_by_render_state(settings: dict) -> dict:
     """``settings`` less the names `render_state` does not take (a trait newer than it)."""
-    from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
+    from ..keep.pictures.state_picture import render_state  # matplotlib: imported when a figure is drawn
 
     takes = inspect.signature(render_state).parameters
     return {k: v for k, v in settings.items() if k in takes}
@@ -159,7 +160,7 @@ class Keeper:
             if kwargs.get("slices") is not None and "spacing" not in options:
                 kwargs["spacing"] = w.spacing  # the slices the view shows, its default spread where it was
         size = (w.scene.width, w.scene.height) if size is None else size
-        from ..keep.figures import render_state  # matplotlib: imported when a figure is drawn
+        from ..keep.pictures.state_picture import render_state  # matplotlib: imported when a figure is drawn
 
         return render_state(state, inner_source(w.source), path, size=size, dpi=dpi, **kwargs)
 

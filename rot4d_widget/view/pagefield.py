@@ -1,6 +1,6 @@
 """Whether the page holds a field's 4-D data itself (issue 36), and the copy it is sent.
 
-A field (`rot4d_widget.sources.fields.Field4D`, alone or inside a stack of parallel slices) whose
+A field (`rot4d_widget.sources.field.container.Field4D`, alone or inside a stack of parallel slices) whose
 values are an array on evenly spaced nodes is cut in the page while the page is ahead of the
 kernel: the page's fragment shader turns each sample point of the slice into a 4-D point through
 its predicted rotation and c0 and reads the value there (``page/field.js``, ``glsl/field.frag``).
@@ -45,8 +45,8 @@ import uuid
 
 import numpy as np
 
-from ..sources.field_slicing import _box_polytope
-from ..sources.fields import Field4D
+from ..sources.field.container import Field4D
+from ..sources.field.slicing import _box_polytope
 from ..sources.protocol import inner_source
 from .fieldview import copy_clim
 from .pagecut import polytope_transfer

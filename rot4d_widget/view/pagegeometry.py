@@ -1,8 +1,8 @@
 """What the page needs to cut a polytope itself: the slicer's own tables, as one flat message.
 
 The page (``page/slicer.js``) slices the polytope of its latest state without waiting for the
-kernel, and must get what `rot4d_widget.geometry.slicing.slice_polytope` gets, array for array.
-So the message is built from the slicer's own tables (`rot4d_widget.geometry.slicetables.tables`),
+kernel, and must get what `rot4d_widget.geometry.slicing.polytope_slice.slice_polytope` gets, array for array.
+So the message is built from the slicer's own tables (`rot4d_widget.geometry.slicing.tables.tables`),
 in their scale: the *unit* vertices (the polytope's divided by the power of two ``unit``), the
 tolerance and circumradius in that scale, the cells' outward normals and vertex means as the
 slicer computed them (the page never recomputes a float the kernel has), and the ragged incidence
@@ -27,7 +27,7 @@ cell_centres              f64 4C   each cell's vertex mean, in the unit scale
 ========================  =======  ===========================================================
 
 A polytope with star faces or non-convex cells (``star``) adds what the star slicer's points
-and segments need (`rot4d_widget.geometry.starslice.star_tables`; ``page/starslicer.js``):
+and segments need (`rot4d_widget.geometry.slicing.star.star_tables`; ``page/starslicer.js``):
 
 ========================  =======  ===========================================================
 face_basis                f64 8F   each face's two orthonormal in-plane axes (4 numbers each)
@@ -53,8 +53,8 @@ import numpy as np
 
 from ..core import tolerances as tol_
 from ..geometry.mesh import Polytope
-from ..geometry.slicetables import tables
-from ..geometry.starslice import star_tables
+from ..geometry.slicing.star import star_tables
+from ..geometry.slicing.tables import tables
 
 __all__ = ["polytope_message", "polytope_message_bytes"]
 

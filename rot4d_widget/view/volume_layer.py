@@ -6,7 +6,7 @@ The kernel's picture of a cut: its grid travels as a 2-D texture whose tiles are
 node is finite, 0 where it is not); the shader interpolates within a tile bilinearly (the
 texture's filter) and between two tiles linearly: trilinear.  A sample counts only where both
 layers' alpha is 1, i.e. where its cell's nodes are finite: the static renders' rule
-(`rot4d_widget.keep.volume`), whose camera, step, colour table and optical depth the shader
+(`rot4d_widget.keep.pictures.ray_caster`), whose camera, step, colour table and optical depth the shader
 repeats, so the page and ``w.render`` agree.  The context is WebGL2 wherever the browser has it
 (pythreejs's `Renderer` asks for it; measured in Chromium on SwiftShader:
 ``tests/browser/test_webgl_probe_browser.py``, docs/fields.md "The page's WebGL"), and the atlas

@@ -362,7 +362,7 @@ class Rot4DWidget(widgets.HBox):
     @property
     def recording(self):
         """What was applied since the widget was made (or `start_recording`): a
-        `rot4d_widget.keep.recording.Recording` of every step (keys, key pad, `press`, repeats) and
+        `rot4d_widget.keep.recorder.Recording` of every step (keys, key pad, `press`, repeats) and
         every parameter set (sliders, traits, `refresh`), time-stamped.  Save it
         (``.save(path)``), replay it (`replay`) or render it (`render_animation`)."""
         return self._recorder.recording()
@@ -383,7 +383,7 @@ class Rot4DWidget(widgets.HBox):
         (Pillow) or MP4 (imageio-ffmpeg), by ``path``'s extension; one frame per step
         (``per="step"``) or per 1/fps s of recorded time (``per="time"``); the widget's look
         (`render` settings).  Returns the number of frames.  See
-        `rot4d_widget.keep.recording.render_animation` for ``options`` (size, dpi, max_frames ...)."""
+        `rot4d_widget.keep.animation.render_animation` for ``options`` (size, dpi, max_frames ...)."""
         return self._keeper.render_animation(path, recording=recording, fps=fps, per=per, **options)
 
     def render(self, path=None, *, size=None, dpi: float = 100, **options):

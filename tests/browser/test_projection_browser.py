@@ -89,7 +89,7 @@ def _check_page_projection(jp):
 FIELD_CELL = """\
 import numpy as np
 from rot4d_widget import Rot4DWidget
-from rot4d_widget.sources.fields import Field4D
+from rot4d_widget.sources.field.container import Field4D
 x = np.linspace(-1, 1, 17)
 q = np.stack(np.meshgrid(x, x, x, x, indexing="ij"), -1)
 f = Field4D((0.6 - (q ** 2).sum(-1)).astype(np.float32), axes="xyzw", extent=((-1, 1),) * 4, name="ball")

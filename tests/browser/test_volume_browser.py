@@ -2,7 +2,7 @@
 companion's shader from the grid the kernel sends, in JupyterLab and Notebook 7.
 
 The page's picture (the canvas as a PNG, `w.screenshot`) is compared with the static render of
-the same cut through the same camera (`rot4d_widget.keep.volume.render_grid`, numpy ray casting,
+the same cut through the same camera (`rot4d_widget.keep.pictures.ray_caster.render_grid`, numpy ray casting,
 the live view's frustum): the coloured region overlaps (IoU), its colour-weighted centre is in the
 same place within a few pixels, and the colours agree.  The key v cycles the renderings in the
 page, Shift+v backwards.  Screenshots kept in test-artifacts/volume-<rendering>-<front end>.png.
@@ -23,7 +23,8 @@ import numpy as np
 from PIL import Image
 from rot4d_widget import Field4D, Rot4DWidget
 from rot4d_widget.core import look
-from rot4d_widget.keep.volume import render_grid, view_rotation
+from rot4d_widget.core.look import view_rotation
+from rot4d_widget.keep.pictures.ray_caster import render_grid
 
 # an off-centre blob in x, y, z, t and a second, weaker one: where the values are high and low
 x = np.linspace(-1.0, 1.0, 25)

@@ -19,9 +19,9 @@ import warnings
 
 import numpy as np
 
-from ..core._arrays import sealed as _sealed
+from ...core._arrays import sealed as _sealed
+from .checks import _AXES, UnitsWarning
 from .chunks import _array_kind
-from .field_checks import _AXES, UnitsWarning
 
 
 def _dataset_error(ds) -> TypeError:

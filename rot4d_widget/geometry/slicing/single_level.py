@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import tolerances as tol_
-from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from ...core import tolerances as tol_
+from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
 
 __all__: list = []
 

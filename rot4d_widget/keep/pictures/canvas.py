@@ -1,7 +1,7 @@
 """The figures pictures are drawn in: text as written, and the animation frame canvas (one reused
 figure, text drawn from kept glyph bitmaps).
 
-Part of `rot4d_widget.keep.figures` (`_FrameCanvas`, `render_state(..., _canvas=)`).
+`_FrameCanvas` is what `render_state(..., _canvas=)` draws an animation's frames into.
 """
 
 from __future__ import annotations

@@ -2,7 +2,6 @@
 
 ``render_key_sequence(key, n_panels)`` shows what holding a key does: panel k is drawn after k
 presses; :func:`paper_figure_3` and :func:`paper_figure_4` reproduce the paper's figures.
-Part of `rot4d_widget.keep.figures`, which re-exports every public name.
 """
 
 from __future__ import annotations
@@ -13,14 +12,24 @@ import string
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..core import look
-from ..core.look import REFERENCE_RADIUS
-from ..core.state import RotationState
-from ..geometry.mesh import Polytope
-from ..geometry.regular import pentachoron
-from ..geometry.slicing import slice_polytope
+from ...core import look
+from ...core.look import REFERENCE_RADIUS
+from ...core.state import RotationState
+from ...geometry.mesh import Polytope
+from ...geometry.regular import pentachoron
+from ...geometry.slicing.polytope_slice import slice_polytope
 from .canvas import LiteralTextFigure
-from .drawing import FIG3_THETA0, FIG4_ALPHA, FIG4_THETA0, TITLE_HEIGHT, _as_polytope, _count, _real, _save, draw_slice
+from .slice_drawing import (
+    FIG3_THETA0,
+    FIG4_ALPHA,
+    FIG4_THETA0,
+    TITLE_HEIGHT,
+    _as_polytope,
+    _count,
+    _real,
+    _save,
+    draw_slice,
+)
 
 
 # --------------------------------------------------------------------------- grids of panels

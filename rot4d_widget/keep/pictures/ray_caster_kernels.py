@@ -1,7 +1,7 @@
-"""The ray caster of `rot4d_widget.keep.volume` compiled by numba: one loop per ray instead of numpy
+"""The ray caster of `rot4d_widget.keep.pictures.ray_caster` compiled by numba: one loop per ray instead of numpy
 passes over every ray at once (issue 37: an animation's ray-cast frames, one ray per pixel).
 
-`cast` computes what `volume._cast` computes -- the same rays through the same pixel centres, the
+`cast` computes what `ray_caster._cast` computes -- the same rays through the same pixel centres, the
 same box entry, the same samples at the middle of each piece of a ray, the same trilinear values and
 cell rule, the same colour lookup (matplotlib's: entry ``int(x N)``, the top end in the last entry) --
 ray by ray: a volume ray stops compositing as soon as its transparency is at most ``opaque`` (numpy's
@@ -52,7 +52,7 @@ def _get_kernel():
 
 
 def _trilinear(vals, nx, ny, nz, x, y, z):  # pragma: no cover - compiled by numba
-    """(value, cell) as `volume._trilinear`: the trilinear interpolant of the flat C-ordered ``vals``
+    """(value, cell) as `ray_caster._trilinear`: the trilinear interpolant of the flat C-ordered ``vals``
     at index (x, y, z), each within [0, n - 1], and the flat index of its cell's lowest corner."""
     ix = min(int(x), nx - 2)
     iy = min(int(y), ny - 2)
@@ -192,7 +192,7 @@ _BAND = 64
 
 def cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density, step, fractions,
          tick=lambda f: None, view=None, *, cells, opaque):
-    """`volume._cast`'s picture (H, W, 4) straight RGBA float64 from the compiled kernel, or None
+    """`ray_caster._cast`'s picture (H, W, 4) straight RGBA float64 from the compiled kernel, or None
     without numba (the caller casts in numpy); ``view`` the camera's rotation (None: identity);
     ``cells`` (nx, ny, nz) bool the cells of eight finite nodes and ``opaque`` the transparency at
     which a volume ray stops -- `volume`'s rule, handed in."""

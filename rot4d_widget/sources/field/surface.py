@@ -16,8 +16,8 @@ import numpy as np
 from scipy.ndimage import binary_dilation, distance_transform_edt, map_coordinates
 from skimage.measure import marching_cubes
 
-from ..core._arrays import sealed as _sealed
-from .protocol import SliceData
+from ...core._arrays import sealed as _sealed
+from ..protocol import SliceData
 
 __all__ = ["FieldSlice", "FieldSliceData"]
 

@@ -8,14 +8,14 @@ import math
 
 import numpy as np
 
-from .field_checks import _as_levels, _check_resolution
-from .protocol import SourceAction
+from ..protocol import SourceAction
+from .checks import _as_levels, _check_resolution
 
 
 class FieldLevels:
     """What `Field4D` takes from here: ``levels``, ``inside``, ``caps``, the level keys, the
     settings and the resolutions of its steps.  The field provides ``_levels`` (None until first
-    asked), ``data_range`` and ``_stat`` (`rot4d_widget.sources.field_stats.FieldStatistics`)."""
+    asked), ``data_range`` and ``_stat`` (`rot4d_widget.sources.field.stats.FieldStatistics`)."""
 
     @property
     def inside(self) -> str:

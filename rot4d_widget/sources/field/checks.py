@@ -8,7 +8,7 @@ import numbers
 
 import numpy as np
 
-from ..geometry.mesh import COORDINATE_RANGE, check_scale
+from ...geometry.mesh import COORDINATE_RANGE, check_scale
 
 __all__ = ["AxesWarning", "NonFiniteWarning", "MAX_SAMPLE_BYTES", "BYTES_PER_SAMPLE"]
 
@@ -71,7 +71,7 @@ def _check_resolution(resolution, name: str = "resolution") -> int:
         raise ValueError(
             f"`{name}`={r} would need up to {_bytes_text(need)} of samples ({r}^3 points x "
             f"{BYTES_PER_SAMPLE} bytes); the limit is {_bytes_text(MAX_SAMPLE_BYTES)} "
-            f"(rot4d_widget.sources.fields.MAX_SAMPLE_BYTES), i.e. resolution <= {r_max}"
+            f"(rot4d_widget.sources.field.checks.MAX_SAMPLE_BYTES), i.e. resolution <= {r_max}"
         )
     return r
 

@@ -17,7 +17,7 @@ polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the s
 * **triangles**: a convex cell's one cycle is fanned as before; a non-convex cell's section whose
   cycles are each star-shaped round their corners' centroid (and apart) is fanned from those
   centroids; a section of cycles that cross is filled even-odd from its segments' arrangement
-  (`rot4d_widget.geometry.starfill`: its odd faces, convex, fanned; the crossings are the new
+  (`rot4d_widget.geometry.slicing.even_odd_fill`: its odd faces, convex, fanned; the crossings are the new
   corners); any other section (nested cycles, a polygon star-shaped round no such point, an odd
   face that is not convex) by the even-odd rule with a slab decomposition (the plane cut into
   slabs at the corners' and crossings' heights, the segments crossing each slab paired left to
@@ -52,17 +52,17 @@ import weakref
 
 import numpy as np
 
-from ..core import tolerances as tol_
-from ._ragged import _ptr
-from .section import _touching
-from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
-from .starfill import _upper, arrangement_fill
+from ...core import tolerances as tol_
+from .._ragged import _ptr
+from .even_odd_fill import _upper, arrangement_fill
+from .single_level import _touching
+from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
 
 __all__: list = []
 
 
 class _StarTables:
-    """What the general slicer adds to `slicetables._Tables`, once per polytope."""
+    """What the general slicer adds to `tables._Tables`, once per polytope."""
 
     def __init__(self, p, t: _Tables):
         st = p.star
@@ -432,7 +432,7 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
 def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices, crossings=None):
     """Even-odd fill of each cell's section from its segments: ((k, 3) triangles, (k,) cells,
     (n, 3) extra vertices numbered from ``n_vertices``).  ``crossings``: ((k,) cells, (k,) heights
-    v) where the cells' segments cross, if known (`starfill.arrangement_fill` gives them).
+    v) where the cells' segments cross, if known (`even_odd_fill.arrangement_fill` gives them).
 
     In each cell's plane (axes u, v of `_inplane_axes`, right-handed about the outward normal),
     the segments are cut at every corner's height v; within each slab the segments crossing it,

@@ -47,7 +47,7 @@ replaced it:
   does, else 0 (a convex polytope touches in one face, edge or vertex).
 
 A polytope with no inside (`Polytope.volume_defined` False: a hemi or non-orientable
-polychoron) is cut like a star one (`rot4d_widget.geometry.starslice`: the edges' crossings, even-odd
+polychoron) is cut like a star one (`rot4d_widget.geometry.slicing.star`: the edges' crossings, even-odd
 segments, each cell's section filled even-odd), and every slice's ``volume`` is None.
 
 The volume (divergence theorem over the outward triangles, about any point)
@@ -97,17 +97,16 @@ import dataclasses
 
 import numpy as np
 
-from ..core import tolerances as tol_
-from ..core.rotation import as_rotation_matrix
-from ..core.validate import is_real
-from .catalogue import polytope as _get_polytope
-from .multislice import _slice_many
-from .section import slice_level as _slice_level
-from .slicetables import Slice
-from .slicetables import tables as _tables
-from .starslice import slice_star
+from ...core import tolerances as tol_
+from ...core.rotation import as_rotation_matrix
+from ...core.validate import is_real
+from ..catalogue import polytope as _get_polytope
+from .many_levels import _slice_many
+from .single_level import slice_level as _slice_level
+from .star import slice_star
+from .tables import tables as _tables
 
-__all__ = ["Slice", "slice_polytope", "TOLERANCE"]
+__all__ = ["slice_polytope", "TOLERANCE"]
 
 #: The one tolerance for "on H", relative to the polytope's circumradius
 #: (`rot4d_widget.core.tolerances.ON_HYPERPLANE`).

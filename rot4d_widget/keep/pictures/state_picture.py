@@ -2,8 +2,7 @@
 
 :func:`render_state` draws a `RotationState` and any source (polytope, field, stack, a user's
 own) with the widget's display settings at a chosen size in pixels; :func:`render_tomography`
-draws N parallel slices as the live view lays them out.  Part of `rot4d_widget.keep.figures`,
-which re-exports every public name.
+draws N parallel slices as the live view lays them out.
 """
 
 from __future__ import annotations
@@ -16,26 +15,14 @@ from matplotlib.colors import ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from ..core import look
-from ..core.look import REFERENCE_RADIUS
-from ..core.state import RotationState
-from ..geometry.slicing import Slice
-from ..sources.field_labels import box_labels
-from ..sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
-from ..sources.tomography import StackSource
+from ...core import look
+from ...core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, check_rendering, view_rotation
+from ...core.state import RotationState
+from ...geometry.slicing.tables import Slice
+from ...sources.field_labels import box_labels
+from ...sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
+from ...sources.tomography import StackSource
 from .canvas import LiteralTextFigure
-from .drawing import (
-    _REFERENCE_EDGE,
-    _Z_BASE,
-    CAMERA_FOV,
-    TITLE_HEIGHT,
-    _add_patch,
-    _real,
-    _save,
-    _slice_collection,
-    draw_slice,
-    perspective,
-)
 from .framing import (
     _as_box,
     _draw_annotation,
@@ -53,7 +40,19 @@ from .framing import (
     small_font,
     value_label,
 )
-from .volume import DEFAULT_SECTIONS, check_rendering, cut_grids, draw_volume, view_rotation
+from .ray_caster import cut_grids, draw_volume
+from .slice_drawing import (
+    _REFERENCE_EDGE,
+    _Z_BASE,
+    CAMERA_FOV,
+    TITLE_HEIGHT,
+    _add_patch,
+    _real,
+    _save,
+    _slice_collection,
+    draw_slice,
+    perspective,
+)
 
 
 def render_tomography(
@@ -126,7 +125,7 @@ def render_tomography(
     A field (a source with a ``data_range``) is drawn as ``rendering``: ``"surface"`` its
     isosurfaces, coloured along ``cmap`` (by rank while ``clim`` is None, else by value over
     ``clim``, as the live view colours them); ``"volume"``, ``"mip"`` or ``"sections"`` its cut
-    sampled on a grid and ray-cast (`rot4d_widget.keep.volume.render_grid`; ``clim`` None: the
+    sampled on a grid and ray-cast (`rot4d_widget.keep.pictures.ray_caster.render_grid`; ``clim`` None: the
     1st-99th percentile of the cuts' values; ``sections`` the planes' places; ``progress``: a bar
     when the casting takes more than a second, see `render_grid`), the box's edges drawn over it.
     ``colorbar``: a colour bar in a strip right of the picture (`colorbar_width` inches: the
@@ -586,7 +585,7 @@ def render_state(
     (emission-absorption with a transfer function: colour ``cmap``, opacity rising linearly over
     ``clim``) or ``"sections"`` (three orthogonal colour-mapped planes at ``sections`` = (fx, fy,
     fz), fractions of the cut's extent), ray-cast in numpy through the cut sampled on a grid
-    (`rot4d_widget.keep.volume`; the box's edges drawn over it; ``progress``: a bar when that
+    (`rot4d_widget.keep.pictures.ray_caster`; the box's edges drawn over it; ``progress``: a bar when that
     takes more than a second).  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
     default the 1st-99th percentile of the finite values of the cut (of all the cuts of a stack):
     robust to a few outliers.  ``colorbar``: a field's colour bar right of the picture (the

@@ -20,8 +20,7 @@ face's centroid), so nearer things cover farther ones.
 * translucent faces (slice polygons), coloured by the 4-D cell they are cut from
   (``look.group_palette``, the live view's palette).
 
-Also the validators and the saving helper the other figure modules share.  Part of
-`rot4d_widget.keep.figures`, which re-exports every public name.
+Also the validators and the saving helper the other picture modules share.
 """
 
 from __future__ import annotations
@@ -37,12 +36,12 @@ from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from ..core import look
-from ..core.look import REFERENCE_RADIUS
-from ..core.state import PAPER_ALPHA_RATIO
-from ..geometry.catalogue import polytope as _named_polytope
-from ..geometry.mesh import Polytope
-from ..geometry.slicing import Slice
+from ...core import look
+from ...core.look import REFERENCE_RADIUS
+from ...core.state import PAPER_ALPHA_RATIO
+from ...geometry.catalogue import polytope as _named_polytope
+from ...geometry.mesh import Polytope
+from ...geometry.slicing.tables import Slice
 
 #: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])

@@ -4,7 +4,7 @@ A chunked or lazy array is read chunk by chunk, once: into the coarse copy (`Fie
 for held keys and the data range) and, when it fits the field's `memory_budget`, whole
 (`FieldMemory.resident`: steps then run on it as on data given in memory).  `FieldMemory.prepare`
 does it on a daemon thread, counted by a `rot4d_widget.core.progress.Progress`; the work itself
-is `rot4d_widget.sources.coarse.CoarseCopy`'s.
+is `rot4d_widget.sources.field.coarse.CoarseCopy`'s.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..core.validate import int_in_range
+from ...core.validate import int_in_range
 
 __all__ = ["FieldMemory"]
 
@@ -21,8 +21,8 @@ __all__ = ["FieldMemory"]
 class FieldMemory:
     """What `Field4D` takes from here: the coarse copy, the array read whole, the memory budget, the
     background read and what it found missing (`missing`).  The field provides ``_values``,
-    ``_kind``, ``_coarse_copy`` (its `rot4d_widget.sources.coarse.CoarseCopy`), ``_stat`` (its
-    `rot4d_widget.sources.field_stats.FieldStatistics`) and ``_reader`` (its chunk reader, or None)."""
+    ``_kind``, ``_coarse_copy`` (its `rot4d_widget.sources.field.coarse.CoarseCopy`), ``_stat`` (its
+    `rot4d_widget.sources.field.stats.FieldStatistics`) and ``_reader`` (its chunk reader, or None)."""
 
     @property
     def memory_budget(self) -> int:

@@ -8,9 +8,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .field_checks import _axes_text
-from .field_input import _LazyXarray
-from .protocol import w_span_text
+from ..protocol import w_span_text
+from .checks import _axes_text
+from .inputs import _LazyXarray
 
 
 def _readout(field, m, c0, slices, box, coarse) -> tuple:

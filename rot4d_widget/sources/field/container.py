@@ -60,49 +60,30 @@ import numbers
 
 import numpy as np
 
-from ..core._arrays import sealed as _sealed
-from ..core.rotation import as_rotation_matrix
-from ..geometry.mesh import check_scale
-from .chunks import CHUNK_BATCH, CHUNKED_POINTS, _chunked_values, _ChunkReader
-from .coarse import COARSE_SAMPLES, MEMORY_BUDGET, CoarseCopy
-from .field_checks import (
+from ...core._arrays import sealed as _sealed
+from ...core.rotation import as_rotation_matrix
+from ...geometry.mesh import check_scale
+from .checks import (
     _AXES,
-    BYTES_PER_SAMPLE,
-    MAX_SAMPLE_BYTES,
-    AxesWarning,
-    NonFiniteWarning,
-    UnitsWarning,
     _as_levels,
     _check_extent,
     _check_positive,
     _check_resolution,
     _real,
 )
-from .field_grid import FieldGrid, field_sample, sample_field
+from .chunks import _chunked_values, _ChunkReader
+from .coarse import MEMORY_BUDGET, CoarseCopy
+from .grid import field_sample
+from .inputs import _as_array, _metadata_range, _open_dataarray, _xarray_arguments, _zarr_attrs
+from .kernels import _resample_points
+from .levels import FieldLevels
+from .memory import FieldMemory
+from .readout import _describe, _order_text, _outline_readout, _readout
+from .slicing import LastCut, _box_slice, _sample, _slice_offset
+from .stats import FieldStatistics
+from .surface import FieldSliceData, _empty_slice, _surface
 
-# Names kept reachable here (tests, benchmarks and older code import them from this module).
-from .field_input import (  # noqa: F401,E402  (export reads them)
-    _as_array,
-    _metadata_range,
-    _open_dataarray,
-    _selection_from_json,
-    _selection_json,
-    _xarray_arguments,
-    _zarr_attrs,
-)
-from .field_kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine, _resample_points
-from .field_levels import FieldLevels
-from .field_memory import FieldMemory
-from .field_readout import _describe, _order_text, _outline_readout, _readout
-from .field_slicing import LastCut, _box_slice, _sample, _sample_raw, _slice_offset
-from .field_stats import FieldStatistics
-from .field_surface import FieldSlice, FieldSliceData, _empty_slice, _surface
-
-__all__ = ["Field4D", "FieldSlice", "FieldSliceData", "FieldGrid", "slice_field", "sample_field", "AxesWarning",
-           "NonFiniteWarning", "UnitsWarning", "COARSE_SAMPLES", "MAX_SAMPLE_BYTES", "MEMORY_BUDGET"]
-
-_REEXPORTED = (BYTES_PER_SAMPLE, CHUNK_BATCH, CHUNKED_POINTS, PARALLEL_MIN_POINTS, _ChunkReader, _get_kernels,
-               _resample_affine, _sample_raw, _surface)
+__all__ = ["Field4D", "slice_field"]
 
 #: Order a step's points by the chunk their cell starts in before cutting them into passes
 #: (benchmarks/chunk_fetches.py flips it to compare both orders: fewer chunk fetches when the cache is small)
@@ -222,7 +203,7 @@ class Field4D(FieldLevels, FieldMemory):
         self.chunk_cache_bytes = int(chunk_cache_bytes)
         self.memory_budget = memory_budget
         self._reader = None
-        #: the last cut sampled from chunked data (`rot4d_widget.sources.field_slicing.LastCut`)
+        #: the last cut sampled from chunked data (`rot4d_widget.sources.field.slicing.LastCut`)
         self.last_cut = LastCut()
         self._levels = None if levels is None else _as_levels(levels)
         self.inside = inside
@@ -368,7 +349,7 @@ class Field4D(FieldLevels, FieldMemory):
 
     def cap_scale(self, samples=None, first_cut: bool = False) -> float:
         """K, a typical |grad f| (level units per slice unit): how steeply the caps on the box's faces
-        rise, for one step's ``samples`` (`rot4d_widget.sources.field_stats.FieldStatistics.cap_scale`)."""
+        rise, for one step's ``samples`` (`rot4d_widget.sources.field.stats.FieldStatistics.cap_scale`)."""
         return self._stat.cap_scale(samples, first_cut)
 
     @property
@@ -439,8 +420,8 @@ class Field4D(FieldLevels, FieldMemory):
         return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box := _box_slice(self, m, d),
                                        _outline_readout(self, m, d, box), frame)
 
-    sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in field_grid: class size)
-    long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; field_input._long_name)
+    sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in grid)
+    long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; inputs._long_name)
 
     def describe(self) -> dict:
         """A JSON-able description (the source protocol's ``describe()``): the frame, levels, surface

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import tolerances as tol_
-from ..core._arrays import sealed as _sealed
-from ._ragged import _owner
-from .mesh import Polytope
+from ...core import tolerances as tol_
+from ...core._arrays import sealed as _sealed
+from .._ragged import _owner
+from ..mesh import Polytope
 
 __all__ = ["Slice"]
 
@@ -113,7 +113,7 @@ class Slice:
     dim : int -- 3 solid, 2/1/0 when H only touches a face/edge/vertex, -1 empty
     n_fill : int -- the last ``n_fill`` vertices are not points of the slice but extra corners of
         the triangles that fill a non-convex or self-intersecting section even-odd (0 unless
-        the polytope has star faces or non-convex cells: `rot4d_widget.geometry.starslice`)
+        the polytope has star faces or non-convex cells: `rot4d_widget.geometry.slicing.star`)
 
     Every array is read-only (a missed slice shares its empty arrays with
     every other missed slice of the polytope); copy one to edit it.

@@ -1,6 +1,6 @@
 """Volume renderings of a field's cut without a browser: numpy ray casting through a `FieldGrid`.
 
-The camera is the static renders' and the live view's (`rot4d_widget.keep.drawing`): the eye at
+The camera is the static renders' and the live view's (`rot4d_widget.keep.pictures.slice_drawing`): the eye at
 (0, 0, ``distance``) looking down -z, the picture plane z = 0 with its limits ``(x0, x1)``,
 ``(y0, y1)`` (what `render_state` sets on its axes).  Pixel (row r, column c) of an H x W picture
 looks along the ray from the eye through its centre,
@@ -47,28 +47,24 @@ import math
 import numpy as np
 from scipy.ndimage import map_coordinates
 
-from ..core import look
-from ..core.look import (
+from ...core import look
+from ...core.look import (
     DEFAULT_DENSITY,
     DEFAULT_SECTIONS,
     REFERENCE_RADIUS,
-    RENDERINGS,
-    check_rendering,
     default_clim,
-    view_rotation,
 )
-from ..core.progress import progress as make_progress
-from . import volume_kernels
+from ...core.progress import progress as make_progress
+from . import ray_caster_kernels
 
-#: How far the live view's camera is from the centre (`rot4d_widget.keep.drawing.CAMERA_DISTANCE`,
+#: How far the live view's camera is from the centre (`rot4d_widget.keep.pictures.slice_drawing.CAMERA_DISTANCE`,
 #: the same number: that module imports matplotlib, which the widget's import does not need)
 CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
 
-__all__ = ["RENDERINGS", "VOLUME_RENDERINGS", "DEFAULT_DENSITY", "DEFAULT_SECTIONS", "default_clim",
-           "check_rendering", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids", "view_rotation"]
+__all__ = ["VOLUME_RENDERINGS", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
 
-# RENDERINGS (what `render_state` draws for a field), check_rendering and the defaults DEFAULT_DENSITY,
-# DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too), named here too.
+# RENDERINGS (what `render_state` draws for a field), check_rendering, view_rotation and the defaults
+# DEFAULT_DENSITY, DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too).
 #: The renderings ray-cast here.
 VOLUME_RENDERINGS = ("volume", "mip", "sections")
 #: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).
@@ -164,7 +160,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
                 shift=(0.0, 0.0, 0.0), distance: float = CAMERA_DISTANCE, density: float = DEFAULT_DENSITY,
                 step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True,
                 view=None) -> np.ndarray:
-    """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field_grid.FieldGrid`) ray-cast as
+    """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field.grid.FieldGrid`) ray-cast as
     ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
     placed at ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
@@ -175,7 +171,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     the rays' pixels bilinear in premultiplied colour (1, the default: a ray through every pixel's
     centre, the full resolution); "auto": two rays per grid spacing where the grid is nearest, at
     most one per pixel (sections: always one per pixel).  The rays are cast by a compiled kernel
-    (`rot4d_widget.keep.volume_kernels`) when numba is installed, else in numpy: the same picture.
+    (`rot4d_widget.keep.pictures.ray_caster_kernels`) when numba is installed, else in numpy: the same picture.
     ``progress``: True a progress bar once the casting took a second
     (`rot4d_widget.core.progress`), False none, or a callable given the fraction done (0 to 1).
     ``view``: (3, 3) the camera's rotation (`view_rotation` of its position; None: the identity,
@@ -245,11 +241,11 @@ def _cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance,
           tick=lambda f: None, view=None, *, compiled: bool = True):
     """`render_grid` with a ray through every pixel's centre; ``tick(fraction)`` as it goes; ``view``
     the camera's rotation (None: the identity).  The compiled kernel's picture
-    (`rot4d_widget.keep.volume_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
+    (`rot4d_widget.keep.pictures.ray_caster_kernels.cast`, ray by ray) when numba is there and ``compiled``, else
     numpy's (every ray at once, a step at a time)."""
     view = np.eye(3) if view is None else np.asarray(view, dtype=np.float64).reshape(3, 3)
     if compiled:
-        out = volume_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
+        out = ray_caster_kernels.cast(grid, rendering, colormap, clim, size, limits, scale, shift, distance, density,
                                   step, fractions, tick, view, cells=_cell_flags(np.asarray(grid.values)),
                                   opaque=_OPAQUE)
         if out is not None:
@@ -426,7 +422,7 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         close()
     if not images:
         return None
-    from .drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
+    from .slice_drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
 
     (x0, x1), (y0, y1) = limits
     image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",

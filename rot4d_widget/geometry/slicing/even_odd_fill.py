@@ -1,7 +1,7 @@
 """The even-odd fill of a cell's section by its segments' arrangement: the general slicer's fill
 for sections whose cycles cross.
 
-`rot4d_widget.geometry.starslice` cuts a non-convex cell into segments (one per stretch of a face's
+`rot4d_widget.geometry.slicing.star` cuts a non-convex cell into segments (one per stretch of a face's
 line inside the face) that chain into cycles; where the cycles cross, the section is their
 **even-odd** region.  That region's boundary is every segment, split where segments cross: the
 segments' *arrangement*.  Its faces (the pieces of the plane the split segments bound) are
@@ -27,7 +27,7 @@ every cell at once (no Python loop over geometry):
 
 A cell whose segments do not cross (its cycles apart or nested: a hole is no convex face), where
 a crossing falls within `_EPS` of a segment's end, or where any check fails or any odd face is
-not convex, is left whole to the slab fill (`starslice._slabs`), with the crossings found here.
+not convex, is left whole to the slab fill (`star._slabs`), with the crossings found here.
 The fill's corners are the section's points and the crossings: none where a slab line would cut
 a segment, and about (segments + crossings) triangles a cell, against slabs x segments for the
 slab fill.
@@ -39,8 +39,8 @@ import functools
 
 import numpy as np
 
-from ._ragged import _ptr
-from .slicetables import _inplane_axes
+from .._ragged import _ptr
+from .tables import _inplane_axes
 
 __all__: list = []
 
@@ -81,7 +81,7 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
 
     Returns ((k, 3) triangles, (k,) their cells, (x, 3) new corners numbered from ``n_vertices``,
     (r,) bool: the records whose cell was not filled here, ((m,) cells, (m,) heights v): where
-    those cells' segments cross, in `starslice._slabs`' frame (`_inplane_axes` about ``anchor``)).
+    those cells' segments cross, in `star._slabs`' frame (`_inplane_axes` about ``anchor``)).
     """
     nr = len(rec)
     C = len(normals)

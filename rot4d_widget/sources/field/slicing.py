@@ -17,11 +17,11 @@ import itertools
 
 import numpy as np
 
-from ..geometry.mesh import Polytope
-from ..geometry.slicing import slice_polytope
-from .field_checks import _AXES, _call
-from .field_kernels import _resample_affine
-from .field_surface import _empty_slice, _surface
+from ...geometry.mesh import Polytope
+from ...geometry.slicing.polytope_slice import slice_polytope
+from .checks import _AXES, _call
+from .kernels import _resample_affine
+from .surface import _empty_slice, _surface
 
 _BOX_CACHE: dict = {}
 

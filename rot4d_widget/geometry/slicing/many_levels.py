@@ -5,16 +5,16 @@ comparison, the crossing faces and cells of all levels come from their w-ranges,
 slicer's steps run on arrays that carry a level index; each level's `Slice` is a read-only view of
 the shared arrays, equal to the single slice at that level.  Levels within the tolerance of a
 vertex height (the on-H cases), and levels with vertices on both sides but no crossing edge (a
-polytope in pieces), take the single slicer (`rot4d_widget.geometry.section`).
+polytope in pieces), take the single slicer (`rot4d_widget.geometry.slicing.single_level`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..core._arrays import sealed as _sealed
-from .section import slice_level
-from .slicetables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from ...core._arrays import sealed as _sealed
+from .single_level import slice_level
+from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
 
 __all__: list = []
 

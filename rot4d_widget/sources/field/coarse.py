@@ -18,10 +18,10 @@ import threading
 
 import numpy as np
 
-from ..core._arrays import sealed as _sealed
-from ..core.progress import progress
+from ...core._arrays import sealed as _sealed
+from ...core.progress import progress
+from .checks import _AXES
 from .chunks import CHUNK_BATCH, _ChunkReader
-from .field_checks import _AXES
 
 __all__ = ["COARSE_SAMPLES", "MEMORY_BUDGET", "CoarseCopy"]
 

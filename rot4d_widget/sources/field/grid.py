@@ -2,7 +2,7 @@
 
 Volume rendering, maximum intensity projections and colour-mapped sections need the values of
 the cut itself, not a surface through it.  `sample_field` reuses one step's resampling
-(`rot4d_widget.sources.field_slicing._sample_raw`: the same grid, the same kernels, the same
+(`rot4d_widget.sources.field.slicing._sample_raw`: the same grid, the same kernels, the same
 numbers as the isosurfaces) and hands back a frozen `FieldGrid`: float32 values, read-only, NaN
 outside the data's box, with the grid's origin, spacing and extent in slice coordinates.
 """
@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import tolerances as tol
-from ..core._arrays import sealed
-from ..core.rotation import as_rotation_matrix
-from .field_checks import _check_resolution
-from .field_slicing import _box_slice, _sample_raw
+from ...core import tolerances as tol
+from ...core._arrays import sealed
+from ...core.rotation import as_rotation_matrix
+from .checks import _check_resolution
+from .slicing import _box_slice, _sample_raw
 
 __all__ = ["FieldGrid", "sample_field", "field_sample"]
 

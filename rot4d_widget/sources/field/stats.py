@@ -13,10 +13,10 @@ import warnings
 
 import numpy as np
 
-from ..geometry.mesh import _power_of_two_unit
-from .field_checks import NonFiniteWarning, _axes_text, _call
-from .field_slicing import _sample_raw
-from .protocol import w_span_text, w_value_text
+from ...geometry.mesh import _power_of_two_unit
+from ..protocol import w_span_text, w_value_text
+from .checks import NonFiniteWarning, _axes_text, _call
+from .slicing import _sample_raw
 
 #: Nodes per axis of the grid a function field is sampled on for its range.
 _FUNCTION_PROBE = 21

@@ -2,7 +2,7 @@
 
 `frame_extent` / `union_extent`: the projected bounding box of a slice (or of an animation's
 frames) that ``frame="fit"`` fills `FIT_FILL` of the picture with; `annotation`: the corner text
-and legend of a picture.  Part of `rot4d_widget.keep.figures`, which re-exports every public name.
+and legend of a picture.
 """
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ import math
 
 import numpy as np
 
-from ..core import look
-from ..core.look import REFERENCE_RADIUS
-from ..sources.field_labels import axis_names
-from ..sources.protocol import c0_text
-from .drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
+from ...core import look
+from ...core.look import REFERENCE_RADIUS
+from ...sources.field_labels import axis_names
+from ...sources.protocol import c0_text
+from .slice_drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
 #: With ``frame="fit"`` the bounding box of what is drawn spans this fraction of the picture's
