@@ -56,7 +56,7 @@ import numpy as np
 
 from rot4d_widget import Field4D
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.core.look import default_clim
+from rot4d_widget.core.colours import default_clim
 from rot4d_widget.view.cuts import grid_cut
 from rot4d_widget.view.painter import checked_slice
 from rot4d_widget.view.volume_layer import volume_message

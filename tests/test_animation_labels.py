@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from test_labels import flame
 
-from rot4d_widget.core.look import REFERENCE_RADIUS
+from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures import state_picture
 from rot4d_widget.keep.pictures.slice_drawing import perspective
@@ -77,17 +77,17 @@ def test_frames_are_cast_at_full_resolution_and_nothing_covers_the_data(renderin
     f, frames, seen = _frames(rendering, monkeypatch)
     text, labels, note, ax, st, images, (xlim, ylim) = seen[-1]
     g = f.sample(st.matrix, st.c0)
-    from rot4d_widget.core import look
-    from rot4d_widget.core.look import view_rotation
+    from rot4d_widget.core import camera
+    from rot4d_widget.core.camera import view_rotation
 
     want = render_grid(g, rendering, size=(300, 250), limits=(xlim, ylim), cmap="viridis",
                        scale=REFERENCE_RADIUS / f.size, pixels_per_ray=1, progress=False,
-                       view=view_rotation(look.default_eye(rendering)))
+                       view=view_rotation(camera.default_eye(rendering)))
     np.testing.assert_allclose(images[0], want, atol=1e-12)
     box = f.outline(st.matrix, st.c0)
-    from rot4d_widget.core.look import view_rotation as vr
+    from rot4d_widget.core.camera import view_rotation as vr
 
-    pts = np.asarray(box.points)[np.unique(np.asarray(box.segments))] @ vr(look.default_eye(rendering)).T
+    pts = np.asarray(box.points)[np.unique(np.asarray(box.segments))] @ vr(camera.default_eye(rendering)).T
     xy = ax.transData.transform(perspective(pts * (REFERENCE_RADIUS / f.size))[0])
     x0, y0 = xy.min(axis=0)
     x1, y1 = xy.max(axis=0)

@@ -11,7 +11,7 @@ import pytest
 from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
-from rot4d_widget.core import look
+from rot4d_widget.core import colours, sizes
 from rot4d_widget.keep.pictures import framing, slice_drawing, state_picture
 from rot4d_widget.keep.pictures.canvas import _FrameCanvas, _glyph_caching_renderer
 from rot4d_widget.sources import datasets
@@ -113,13 +113,13 @@ def test_surface_shading_and_order_are_the_mean_formulas_bit_for_bit(levels):
     for key in "44z1":  # turned in xw and beyond: a slanted cut, uneven triangles
         st.press(key)
     stack, data, coll = _surface_collection(st, datasets.moving_sphere(levels=levels))
-    scale = look.REFERENCE_RADIUS / stack.size
+    scale = sizes.REFERENCE_RADIUS / stack.size
     pts = np.asarray(data.points, dtype=np.float64) * scale
     tri = np.asarray(data.triangles)
     groups = np.asarray(data.groups)
     inner = stack.source
     lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
-    rgb = look.level_colors(inner.levels, lo, hi)[groups]
+    rgb = colours.level_colors(inner.levels, lo, hi)[groups]
     n = np.asarray(data.normals)[tri].mean(axis=1)
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
     light = np.array([-0.35, 0.45, 0.82])
@@ -133,7 +133,7 @@ def test_surface_shading_and_order_are_the_mean_formulas_bit_for_bit(levels):
 
 def test_kept_level_colours_are_look_s_and_read_only():
     got = framing._level_colors((0.0, 0.5, 0.2), -1.0, 1.0)
-    np.testing.assert_array_equal(got, look.level_colors([0.0, 0.5, 0.2], -1.0, 1.0))
+    np.testing.assert_array_equal(got, colours.level_colors([0.0, 0.5, 0.2], -1.0, 1.0))
     assert framing._level_colors([0.0, 0.5, 0.2], -1, 1) is got  # the same levels: the kept array
     with pytest.raises(ValueError, match="read-only"):
         got[0, 0] = 1.0

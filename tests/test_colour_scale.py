@@ -1,4 +1,4 @@
-"""The colour scale: `cmap` / `clim` checks and colours (core.look), the widget's traits, and the
+"""The colour scale: `cmap` / `clim` checks and colours (core.colours), the widget's traits, and the
 colour bar in the readout."""
 
 from __future__ import annotations
@@ -6,25 +6,25 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rot4d_widget.core import look
+from rot4d_widget.core import colours, text
 
 
-# -- core.look ------------------------------------------------------------------------------------
+# -- core.colours ---------------------------------------------------------------------------------
 def test_default_level_colours_are_todays_viridis_by_rank():
     from matplotlib import colormaps
 
     levels = [0.3, -0.2, 0.9]
     want = np.asarray(colormaps["viridis"]([0.52, 0.12, 0.92]))[:, :3]
-    np.testing.assert_allclose(look.level_colors(levels, -1.0, 1.0), want)
-    np.testing.assert_allclose(look.level_colors([0.1], -1.0, 1.0), np.asarray(colormaps["viridis"]([0.75]))[:, :3])
+    np.testing.assert_allclose(colours.level_colors(levels, -1.0, 1.0), want)
+    np.testing.assert_allclose(colours.level_colors([0.1], -1.0, 1.0), np.asarray(colormaps["viridis"]([0.75]))[:, :3])
 
 
 def test_level_colours_take_the_cmap_and_by_value_the_limits():
     from matplotlib import colormaps
 
-    got = look.level_colors([0.0, 5.0, 20.0], 0.0, 10.0, "magma", by_value=True)
+    got = colours.level_colors([0.0, 5.0, 20.0], 0.0, 10.0, "magma", by_value=True)
     np.testing.assert_allclose(got, np.asarray(colormaps["magma"]([0.0, 0.5, 1.0]))[:, :3])  # clamped above
-    assert not np.allclose(look.level_colors([0.0, 1.0], 0, 1, "magma"), look.level_colors([0.0, 1.0], 0, 1))
+    assert not np.allclose(colours.level_colors([0.0, 1.0], 0, 1, "magma"), colours.level_colors([0.0, 1.0], 0, 1))
 
 
 @pytest.mark.parametrize("bad, exc, match", [
@@ -35,7 +35,7 @@ def test_level_colours_take_the_cmap_and_by_value_the_limits():
 ])
 def test_bad_cmap_names_how_to_list_them(bad, exc, match):
     with pytest.raises(exc, match=match):
-        look.check_cmap(bad)
+        colours.check_cmap(bad)
 
 
 @pytest.mark.parametrize("bad, exc", [
@@ -46,14 +46,14 @@ def test_bad_cmap_names_how_to_list_them(bad, exc, match):
 def test_bad_clim_names_what_is_allowed(bad, exc):
     with pytest.raises(exc, match=r"`clim` to be None \(the data's range\) or \(lo, hi\), two finite numbers "
                                   r"with lo < hi"):
-        look.check_clim(bad)
+        colours.check_clim(bad)
 
 
 def test_good_clim_and_stops():
-    assert look.check_clim(np.array([1, 2])) == (1.0, 2.0)
-    assert look.check_clim(None) is None
-    assert look.cmap_stops("viridis", 2) == ("#440154", "#fde725")
-    assert look.cmap_stops("viridis") != look.cmap_stops("magma")
+    assert colours.check_clim(np.array([1, 2])) == (1.0, 2.0)
+    assert colours.check_clim(None) is None
+    assert colours.cmap_stops("viridis", 2) == ("#440154", "#fde725")
+    assert colours.cmap_stops("viridis") != colours.cmap_stops("magma")
 
 
 # -- the widget's traits --------------------------------------------------------------------------
@@ -84,7 +84,7 @@ def widget():
 def test_traits_default_to_todays_colours(widget):
     w = widget(levels=[0.5, 1.0, 2.0])
     assert (w.cmap, w.clim) == ("viridis", None)
-    np.testing.assert_allclose(w._painter.colours()[0], look.level_colors([0.5, 1.0, 2.0], *w.source.data_range))
+    np.testing.assert_allclose(w._painter.colours()[0], colours.level_colors([0.5, 1.0, 2.0], *w.source.data_range))
 
 
 def test_cmap_and_clim_recolour_the_surfaces(widget):
@@ -92,11 +92,11 @@ def test_cmap_and_clim_recolour_the_surfaces(widget):
     sent = w.scene.update_id
     w.cmap = "magma"
     assert w.scene.update_id > sent  # a new picture
-    np.testing.assert_allclose(w._painter.colours()[0], look.level_colors([0.5, 1.0], 0, 1, "magma"))
+    np.testing.assert_allclose(w._painter.colours()[0], colours.level_colors([0.5, 1.0], 0, 1, "magma"))
     w.clim = [0.0, 2.0]
     assert w.clim == (0.0, 2.0)
     np.testing.assert_allclose(w._painter.colours()[0],
-                               look.level_colors([0.5, 1.0], 0.0, 2.0, "magma", by_value=True))
+                               colours.level_colors([0.5, 1.0], 0.0, 2.0, "magma", by_value=True))
 
 
 @pytest.mark.parametrize("name, bad, exc, match", [
@@ -166,7 +166,7 @@ def test_the_bar_names_the_variable_its_units_the_limits_and_marks_each_level(wi
     assert "<span>0</span><span>4 m²</span>" in bar  # ticks at lo and hi, in the data's units
     marks = _marks(bar)
     assert [m[0] for m in marks] == [25.0, 50.0, 75.0]  # (level - lo) / (hi - lo)
-    assert [m[1] for m in marks] == [look.hex_color(c) for c in w._painter.colours()[0]]  # the surfaces' colours
+    assert [m[1] for m in marks] == [colours.hex_color(c) for c in w._painter.colours()[0]]  # the surfaces' colours
     assert "title='level 2 m²'" in bar
 
 
@@ -174,7 +174,7 @@ def test_the_bar_spans_the_data_range_when_clim_is_none(widget):
     w = widget(levels=[1.0])
     lo, hi = w.source.data_range
     bar = _bar(w)
-    assert f"<span>{look.number_text(lo, hi)}</span><span>{look.number_text(hi, hi)} m²</span>" in bar
+    assert f"<span>{text.number_text(lo, hi)}</span><span>{text.number_text(hi, hi)} m²</span>" in bar
     assert _marks(bar)[0][0] == pytest.approx(100 * (1.0 - lo) / (hi - lo), abs=0.01)
 
 

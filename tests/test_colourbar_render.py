@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from rot4d_widget.core import look
+from rot4d_widget.core import colours
 from rot4d_widget.core import progress as core_progress
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures import ray_caster
 from rot4d_widget.keep.pictures.state_picture import render_state
-from rot4d_widget.core.look import default_clim
+from rot4d_widget.core.colours import default_clim
 from rot4d_widget.keep.pictures.ray_caster import render_grid
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.sources.field.grid import sample_field
@@ -86,14 +86,14 @@ def test_levels_are_marked_in_their_surfaces_colours_and_surfaces_follow_the_map
         marks = [ln for ln in cax.lines if ln.get_gid() == "level-mark" and ln.get_marker() == ">"]
         assert [m.get_ydata()[0] for m in marks] == [0.3, 0.6]
         lo, hi = f.data_range
-        want = (look.level_colors([0.3, 0.6], lo, hi, "magma") if clim is None
-                else look.level_colors([0.3, 0.6], 0.0, 1.0, "magma", by_value=True))
+        want = (colours.level_colors([0.3, 0.6], lo, hi, "magma") if clim is None
+                else colours.level_colors([0.3, 0.6], 0.0, 1.0, "magma", by_value=True))
         np.testing.assert_allclose([matplotlib.colors.to_rgb(m.get_color()) for m in marks], want, atol=1e-9)
         # one level alone is opaque: the surface at the picture's centre has its colour, shaded
         one = render_state(state, f, levels=(0.3,), cmap="magma", clim=clim, size=(240, 200), dpi=50,
                            show_bars=False, axis_labels=False)
-        want = (look.level_colors([0.3], lo, hi, "magma") if clim is None
-                else look.level_colors([0.3], 0.0, 1.0, "magma", by_value=True))[0]
+        want = (colours.level_colors([0.3], lo, hi, "magma") if clim is None
+                else colours.level_colors([0.3], 0.0, 1.0, "magma", by_value=True))[0]
         pixel = pixels(one)[0][100, 120]
         cos = pixel @ want / np.linalg.norm(pixel) / np.linalg.norm(want)
         assert cos > 0.995, (clim, pixel, want)

@@ -24,7 +24,7 @@ MUST_HAVE = {
     "rot4d_widget.core.rotation": ["simple_rotation", "double_rotation", "as_rotation_matrix"],
     "rot4d_widget.core.keymap": ["Action.parse", "Keymap"],
     "rot4d_widget.core.state": ["RotationState.press", "RotationState.to_dict"],
-    "rot4d_widget.core.look": ["number_text"],
+    "rot4d_widget.core.text": ["number_text"],
 }
 
 

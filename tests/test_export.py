@@ -12,7 +12,7 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 
 from rot4d_widget import Field4D, RotationState  # noqa: E402
-from rot4d_widget.core import look
+from rot4d_widget.core import colours
 from rot4d_widget.keep.meshes import face_colors, load_mesh, slice_mesh
 from rot4d_widget.keep.rebuild import CodeNotAllowed, SourceNotRebuildable, describe_source
 from rot4d_widget.keep.statefile import load_state, save_state
@@ -91,7 +91,7 @@ def test_polytope_mesh_is_the_slice(polytope_data):
     assert mesh.volume == pytest.approx(s.volume, rel=1e-12)
     assert mesh.metadata["rot4d_widget"] == {"kind": "polytope", "volume": s.volume}
     # the live view's colours: the cell palette, rounded to 8 bits
-    want = np.rint(look.group_palette(int(s.triangle_cells.max()) + 1)[s.triangle_cells] * 255)
+    want = np.rint(colours.group_palette(int(s.triangle_cells.max()) + 1)[s.triangle_cells] * 255)
     np.testing.assert_array_equal(mesh.visual.face_colors[:, :3], want)
     assert (mesh.visual.face_colors[:, 3] == 255).all()
 
@@ -130,8 +130,8 @@ def test_separate_groups_keeps_face_colours_in_vertex_colour_formats(polytope_da
 
 
 def test_single_colour_and_opacity(polytope_data):
-    mesh = slice_mesh(polytope_data, color_by="#9fb6cd", opacity=look.FACE_OPACITY)
-    assert (mesh.visual.face_colors == [0x9f, 0xb6, 0xcd, round(255 * look.FACE_OPACITY)]).all()
+    mesh = slice_mesh(polytope_data, color_by="#9fb6cd", opacity=colours.FACE_OPACITY)
+    assert (mesh.visual.face_colors == [0x9f, 0xb6, 0xcd, round(255 * colours.FACE_OPACITY)]).all()
     with pytest.raises(ValueError, match="color_by"):
         slice_mesh(polytope_data, color_by="blue-ish")
     with pytest.raises(ValueError, match="opacity"):
@@ -166,7 +166,7 @@ def test_field_mesh_groups_by_level_and_volume_is_the_field_slices(field_data, t
     again = slice_field(field, M, 0.2, list(field.levels), field.resolution)
     assert mesh.volume == pytest.approx(sum(s.volume for s in again), rel=1e-9)
     # the colours of the live view's levels (colormap over the field's data range)
-    want = np.rint(look.level_colors(field.levels, *field.data_range) * 255)
+    want = np.rint(colours.level_colors(field.levels, *field.data_range) * 255)
     np.testing.assert_array_equal(mesh.visual.face_colors[:, :3], want[mesh.face_attributes["group"]])
     for ext in FORMATS:
         back = _assert_round_trip(mesh, tmp_path / f"f.{ext}", ext)

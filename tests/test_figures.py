@@ -11,7 +11,7 @@ from matplotlib.image import imread
 from matplotlib.patches import Circle
 
 from rot4d_widget import RotationState, double_rotation, pentachoron, simple_rotation, slice_polytope
-from rot4d_widget.core import look
+from rot4d_widget.core import camera, colours, sizes
 from rot4d_widget.keep.pictures.slice_drawing import CAMERA_DISTANCE, FIG4_ALPHA, TITLE_HEIGHT, draw_slice, perspective
 from rot4d_widget.keep.pictures.panels import panel_style, paper_figure_3, paper_figure_4, render_key_sequence, render_slice
 
@@ -359,9 +359,9 @@ def test_render_slice_draws_balls():
 
 def test_panel_style_keeps_dense_polytopes_readable():
     five, dense = panel_style(pentachoron(A)), panel_style("120-cell")
-    assert five == pytest.approx({"scale": 1.0, "radius": look.REFERENCE_RADIUS, "ball_radius": 0.07,
+    assert five == pytest.approx({"scale": 1.0, "radius": sizes.REFERENCE_RADIUS, "ball_radius": 0.07,
                                   "bar_radius": 0.028})
-    assert dense["radius"] == pytest.approx(look.REFERENCE_RADIUS)
+    assert dense["radius"] == pytest.approx(sizes.REFERENCE_RADIUS)
     # the live view's rule: 0.1 x the displayed edge (the 120-cell's is 2 x scale), bars 0.4 x balls
     assert dense["ball_radius"] == pytest.approx(0.1 * 2.0 * dense["scale"])
     assert dense["ball_radius"] < five["ball_radius"]
@@ -370,13 +370,12 @@ def test_panel_style_keeps_dense_polytopes_readable():
 
 # --------------------------------------------------------------------------- render_state (issue 12)
 def _ndc_pixel(p3, size):
-    """Where the live view's three.js camera (look: eye (0, 0, 5), vertical fov 40 deg, aspect
+    """Where the live view's three.js camera (core.camera: eye (0, 0, 5), vertical fov 40 deg, aspect
     w / h) puts the displayed point p3: pixel (column, row) of a w x h image, written out here."""
-    from rot4d_widget.core import look
 
     w, h = size
-    d = look.CAMERA_POSITION[2]
-    t = math.tan(math.radians(look.CAMERA_FOV) / 2)
+    d = camera.CAMERA_POSITION[2]
+    t = math.tan(math.radians(camera.CAMERA_FOV) / 2)
     x, y, z = p3
     ndc_x = x / ((d - z) * t * (w / h))
     ndc_y = y / ((d - z) * t)
@@ -386,7 +385,6 @@ def _ndc_pixel(p3, size):
 @pytest.mark.parametrize("size", [(600, 500), (320, 400)])
 def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path, size):
     from rot4d_widget import polytope
-    from rot4d_widget.core import look
     from rot4d_widget.keep.pictures.state_picture import render_state
     from rot4d_widget.core.rotation import random_rotation
 
@@ -396,11 +394,11 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
     img = imread(path)
     assert img.shape[:2] == (size[1], size[0])  # the size asked for, in pixels
     s = slice_polytope(polytope("24-cell"), st.matrix, st.c0)
-    v = np.asarray(s.vertices) * look.REFERENCE_RADIUS / 2.0  # displayed units (24-cell: circumradius 2)
+    v = np.asarray(s.vertices) * sizes.REFERENCE_RADIUS / 2.0  # displayed units (24-cell: circumradius 2)
     near = v[np.argmax(v[:, 2])]
     col, row = _ndc_pixel(near, size)
     pixel = img[int(row), int(col), :3]
-    np.testing.assert_allclose(pixel, look.as_rgb(look.BALL_COLOR), atol=0.03)
+    np.testing.assert_allclose(pixel, colours.as_rgb(colours.BALL_COLOR), atol=0.03)
     # a corner is background
     np.testing.assert_allclose(img[2, 2, :3], [1, 1, 1], atol=1e-6)
     # balls only: every vertex, the widest ones too, is drawn where the camera puts it
@@ -415,7 +413,6 @@ def test_render_state_puts_the_nearest_ball_where_the_live_camera_does(tmp_path,
 
 
 def test_render_state_display_options_and_colours(tmp_path):
-    from rot4d_widget.core import look
     from rot4d_widget.keep.pictures.state_picture import render_state
 
     st = RotationState()
@@ -432,7 +429,7 @@ def test_render_state_display_options_and_colours(tmp_path):
     # by group (the default): the cells' palette colours over white, no pure red
     render_state(st, "5-cell", path, face_opacity=1.0, show_balls=False, show_bars=False, size=(200, 200), dpi=50)
     img = imread(path)[..., :3].reshape(-1, 3)
-    pal = look.group_palette(5)
+    pal = colours.group_palette(5)
     drawn = img[np.abs(img - 1).max(axis=1) > 0.02]  # not background
     near = np.abs(drawn[:, None, :] - pal[None]).max(axis=2).min(axis=1) < 0.02
     assert len(drawn) > 0.05 * len(img) and near.mean() > 0.75  # (edges antialiased) opaque faces in the cells' colours
@@ -448,7 +445,6 @@ def test_render_state_display_options_and_colours(tmp_path):
 
 def test_render_state_field_levels_and_stack(tmp_path):
     from rot4d_widget import Field4D
-    from rot4d_widget.core import look
     from rot4d_widget.keep.pictures.state_picture import render_state, state_source
     from rot4d_widget.sources.tomography import StackSource
 
@@ -460,7 +456,7 @@ def test_render_state_field_levels_and_stack(tmp_path):
     img = imread(path)[..., :3]
     col, row = _ndc_pixel((0.0, 0.0, 0.0), (240, 200))
     pixel = img[int(row), int(col)]
-    want = look.level_colors([0.4], *f.data_range)[0]
+    want = colours.level_colors([0.4], *f.data_range)[0]
     cos = pixel @ want / np.linalg.norm(pixel) / np.linalg.norm(want)
     assert cos > 0.995  # the level's colour, shaded
     # levels given: the field itself is left alone

@@ -133,7 +133,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     order matplotlib would paint draw_slice's patches (by zorder, ties in the order added)."""
     from matplotlib.figure import Figure
 
-    from rot4d_widget.core import look
+    from rot4d_widget.core import colours
     from rot4d_widget.keep.pictures import panels, slice_drawing
     from rot4d_widget.geometry.catalogue import polytope
     from rot4d_widget.core.rotation import random_rotation
@@ -147,7 +147,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     patches = [a for a in ax.get_children() if a in {*d.faces, *d.bars, *d.balls, *d.highlights}]
     patches.sort(key=lambda a: a.get_zorder())  # stable: matplotlib's painting order
     coll = slice_drawing._slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
-                                     bar_radius=style["bar_radius"], face_alpha=look.FACE_OPACITY)
+                                     bar_radius=style["bar_radius"], face_alpha=colours.FACE_OPACITY)
     paths = coll.get_paths()
     assert len(paths) == len(patches) == len(s.polygons) + len(s.edges) + 2 * len(s.vertices)
     for k, (patch, path) in enumerate(zip(patches, paths)):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rot4d_widget.core.look import REFERENCE_RADIUS
+from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures.slice_drawing import perspective
 from rot4d_widget.keep.pictures.state_picture import render_state

@@ -228,7 +228,7 @@ def test_imports_inside_functions_say_why_and_are_not_light():
 @pytest.mark.parametrize("body, problem", [
     ("    import os\n", "without a comment"),
     ("    import os  # why not\n", "standard library's os"),
-    ("    # a reason\n    from ..core.look import number_text\n", "package's rot4d_widget.core.look"),
+    ("    # a reason\n    from ..core.text import number_text\n", "package's rot4d_widget.core.text"),
     ("    import xarray\n", "without a comment"),
     ("    # optional\n    import xarray\n    from pde import grids\n", None),
     ("    # numba\n    from .field.container import Field4D\n", None),

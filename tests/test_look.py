@@ -1,4 +1,5 @@
-"""rot4d_widget.core.look: one palette, scale, camera and default radii for the figures and the live view."""
+"""rot4d_widget.core.colours, .sizes and .camera: one palette, scale, camera and default radii for the figures and
+the live view."""
 
 import math
 import subprocess
@@ -12,7 +13,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from rot4d_widget import pentachoron, polytope, slice_polytope
-from rot4d_widget.core import look
+from rot4d_widget.core import camera, colours, sizes
 from rot4d_widget.keep.pictures import panels, slice_drawing
 from rot4d_widget.view import buffers
 from rot4d_widget.keep.pictures.slice_drawing import draw_slice
@@ -22,7 +23,7 @@ from rot4d_widget.keep.pictures.panels import panel_style, render_slice
 def _projected_corners(slice_, k, scale):
     """Corners of slice polygon k as figures place them: x d / (d - z), y d / (d - z)."""
     p = np.asarray(slice_.vertices)[slice_.polygons[k]] * scale
-    d = look.CAMERA_POSITION[2]
+    d = camera.CAMERA_POSITION[2]
     return p[:, :2] * (d / (d - p[:, 2]))[:, None]
 
 
@@ -48,57 +49,57 @@ def test_a_cell_has_the_live_views_colour_in_a_figure(name, seed):
     style = panel_style(p)
     ax = Figure().add_subplot()
     drawing = draw_slice(ax, s, **style)
-    palette = look.group_palette(len(p.cells))  # what the live view is given for this polytope
+    palette = colours.group_palette(len(p.cells))  # what the live view is given for this polytope
     assert len(drawing.faces) == len(s.cell_ids)
     for k, cell in enumerate(s.cell_ids):
         face = _face_of_polygon(drawing.faces, _projected_corners(s, k, style["scale"]))
         rgba = face.get_facecolor()
         np.testing.assert_array_equal(np.float32(rgba[:3]), palette[cell])  # the RGB, before blending
-        assert rgba[3] == pytest.approx(look.FACE_OPACITY)
+        assert rgba[3] == pytest.approx(colours.FACE_OPACITY)
 
 
 def test_a_rendered_panel_uses_the_palette_too():
     fig = render_slice("24-cell", random_rotation(np.random.default_rng(7)))
     s = slice_polytope(polytope("24-cell"), random_rotation(np.random.default_rng(7)), 0.0)
     faces = [f for f in fig.axes[0].patches if f.get_gid() == "face"]
-    colours = {tuple(np.float32(f.get_facecolor()[:3])) for f in faces}
-    palette = look.group_palette(24)
-    assert colours == {tuple(palette[c]) for c in s.cell_ids}
+    seen = {tuple(np.float32(f.get_facecolor()[:3])) for f in faces}
+    palette = colours.group_palette(24)
+    assert seen == {tuple(palette[c]) for c in s.cell_ids}
 
 
 def test_buffers_palette_is_looks():
     for n in (0, 1, 5, 24, 120, 600):
-        np.testing.assert_array_equal(buffers.cell_palette(n), look.group_palette(n))
-    assert look.cell_palette is look.group_palette
-    assert buffers.as_rgb("#c8102e", "ball_color") == look.as_rgb("#c8102e", "ball_color")
+        np.testing.assert_array_equal(buffers.cell_palette(n), colours.group_palette(n))
+    assert colours.cell_palette is colours.group_palette
+    assert buffers.as_rgb("#c8102e", "ball_color") == colours.as_rgb("#c8102e", "ball_color")
 
 
 def test_group_palette_is_distinct_prefix_stable_and_in_range():
-    a = look.group_palette(600)
+    a = colours.group_palette(600)
     assert a.shape == (600, 3) and a.dtype == np.float32
     assert 0.0 <= a.min() and a.max() <= 1.0
     assert len({tuple(c) for c in np.rint(a * 255).astype(int)}) == 600  # distinct 8-bit colours
-    np.testing.assert_array_equal(a[:24], look.group_palette(24))
-    assert look.group_palette(0).shape == (0, 3)
+    np.testing.assert_array_equal(a[:24], colours.group_palette(24))
+    assert colours.group_palette(0).shape == (0, 3)
     with pytest.raises(ValueError, match="n_cells"):
-        look.group_palette(-1)
+        colours.group_palette(-1)
 
 
 # --------------------------------------------------------------------------- colours
 def test_colours_are_valid_and_drawn_by_default(tmp_path):
     for name in ("BACKGROUND", "BALL_COLOR", "BAR_COLOR", "SINGLE_FACE_COLOR"):
-        rgb = look.as_rgb(getattr(look, name), name)
+        rgb = colours.as_rgb(getattr(colours, name), name)
         assert len(rgb) == 3
     # the single face colour is a light, low-saturation blue: blue the largest, all of it light
-    r, g, b = look.as_rgb(look.SINGLE_FACE_COLOR)
+    r, g, b = colours.as_rgb(colours.SINGLE_FACE_COLOR)
     assert b > g > r > 0.5
-    assert 0.0 < look.FACE_OPACITY < 1.0
+    assert 0.0 < colours.FACE_OPACITY < 1.0
     s = slice_polytope(pentachoron(2.0), np.eye(4), 0.0)
     drawing = draw_slice(Figure().add_subplot(), s)
-    assert drawing.balls[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BALL_COLOR))
-    assert drawing.bars[0].get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BAR_COLOR))
+    assert drawing.balls[0].get_facecolor()[:3] == pytest.approx(colours.as_rgb(colours.BALL_COLOR))
+    assert drawing.bars[0].get_facecolor()[:3] == pytest.approx(colours.as_rgb(colours.BAR_COLOR))
     fig = panels.paper_figure_3(tmp_path / "f.png", dpi=20)
-    assert fig.get_facecolor()[:3] == pytest.approx(look.as_rgb(look.BACKGROUND))
+    assert fig.get_facecolor()[:3] == pytest.approx(colours.as_rgb(colours.BACKGROUND))
 
 
 @pytest.mark.parametrize(
@@ -106,46 +107,46 @@ def test_colours_are_valid_and_drawn_by_default(tmp_path):
     [("#fff", (1.0, 1.0, 1.0)), (" #C8102E ", (200 / 255, 16 / 255, 46 / 255)), ((0, 0.5, 1), (0.0, 0.5, 1.0))],
 )
 def test_as_rgb_reads_hex_and_triples(color, rgb):
-    assert look.as_rgb(color) == pytest.approx(rgb)
+    assert colours.as_rgb(color) == pytest.approx(rgb)
 
 
 @pytest.mark.parametrize("color", ["red", "#12345", (0, 0, 2), (0, 0), None])
 def test_as_rgb_names_the_allowed_forms(color):
     with pytest.raises(ValueError, match=r"Expected `face` to be '#rgb', '#rrggbb' or three floats in \[0, 1\]"):
-        look.as_rgb(color, "face")
+        colours.as_rgb(color, "face")
 
 
 # --------------------------------------------------------------------------- scale and radii
 def test_reference_radius_is_the_paper_pentachorons_and_figures_use_it():
-    assert look.REFERENCE_RADIUS == pytest.approx(pentachoron(2.0).circumradius)
+    assert sizes.REFERENCE_RADIUS == pytest.approx(pentachoron(2.0).circumradius)
     for name in ("5-cell", "8-cell", "600-cell"):
         st = panel_style(name)
-        assert st["scale"] * polytope(name).circumradius == pytest.approx(look.REFERENCE_RADIUS)
+        assert st["scale"] * polytope(name).circumradius == pytest.approx(sizes.REFERENCE_RADIUS)
 
 
 def test_default_radii_follow_the_displayed_edge():
-    assert look.default_ball_radius(2.0) == pytest.approx(0.07)  # capped
-    assert look.default_ball_radius(0.3) == pytest.approx(0.03)
-    assert look.default_bar_radius(0.05) == pytest.approx(0.02)
+    assert sizes.default_ball_radius(2.0) == pytest.approx(0.07)  # capped
+    assert sizes.default_ball_radius(0.3) == pytest.approx(0.03)
+    assert sizes.default_bar_radius(0.05) == pytest.approx(0.02)
     for name in ("5-cell", "24-cell", "120-cell"):
         p = polytope(name)
         st = panel_style(p)
         e = p.edges[0]
         edge = float(np.linalg.norm(p.vertices[e[0]] - p.vertices[e[1]])) * st["scale"]
-        assert st["ball_radius"] == pytest.approx(look.default_ball_radius(edge))
-        assert st["bar_radius"] == pytest.approx(look.default_bar_radius(st["ball_radius"]))
+        assert st["ball_radius"] == pytest.approx(sizes.default_ball_radius(edge))
+        assert st["bar_radius"] == pytest.approx(sizes.default_bar_radius(st["ball_radius"]))
     # draw_slice without sizes: the reference pentachoron's
     s = slice_polytope(pentachoron(2.0), np.eye(4), 0.0)
     d = draw_slice(Figure().add_subplot(), s)
     radii = np.array([b.radius for b in d.balls]) / d.factors
-    np.testing.assert_allclose(radii, look.default_ball_radius(2.0))
+    np.testing.assert_allclose(radii, sizes.default_ball_radius(2.0))
 
 
 # --------------------------------------------------------------------------- camera
 def _three_ndc(points, aspect):
     """NDC of a three.js PerspectiveCamera at CAMERA_POSITION looking down -z (makePerspective)."""
-    near, far = look.CAMERA_NEAR, look.CAMERA_FAR
-    top = near * math.tan(math.radians(look.CAMERA_FOV) / 2)
+    near, far = camera.CAMERA_NEAR, camera.CAMERA_FAR
+    top = near * math.tan(math.radians(camera.CAMERA_FOV) / 2)
     right = top * aspect
     proj = np.array([
         [near / right, 0, 0, 0],
@@ -154,7 +155,7 @@ def _three_ndc(points, aspect):
         [0, 0, -1, 0],
     ])
     view = np.eye(4)
-    view[:3, 3] = -np.asarray(look.CAMERA_POSITION)  # the inverse of the camera's translation
+    view[:3, 3] = -np.asarray(camera.CAMERA_POSITION)  # the inverse of the camera's translation
     h = np.c_[points, np.ones(len(points))] @ (proj @ view).T
     return h[:, :2] / h[:, 3:]
 
@@ -176,17 +177,18 @@ def test_figure_projects_like_the_live_camera(size):
 
 def test_panels_of_a_grid_share_the_live_cameras_frame():
     fig = panels.render_key_sequence("4", 2, ncols=2)
-    half = look.CAMERA_POSITION[2] * math.tan(math.radians(look.CAMERA_FOV) / 2)
+    half = camera.CAMERA_POSITION[2] * math.tan(math.radians(camera.CAMERA_FOV) / 2)
     for ax in fig.axes:
         assert ax.get_xlim() == pytest.approx((-half, half)) and ax.get_ylim() == pytest.approx((-half, half))
-    assert slice_drawing.CAMERA_DISTANCE == look.CAMERA_POSITION[2] and slice_drawing.CAMERA_FOV == look.CAMERA_FOV
-    assert look.CAMERA_POSITION == (0.0, 0.0, 5.0)
-    assert (look.CAMERA_FOV, look.CAMERA_NEAR, look.CAMERA_FAR) == (40.0, 0.1, 100.0)
+    assert slice_drawing.CAMERA_DISTANCE == camera.CAMERA_POSITION[2] and slice_drawing.CAMERA_FOV == camera.CAMERA_FOV
+    assert camera.CAMERA_POSITION == (0.0, 0.0, 5.0)
+    assert (camera.CAMERA_FOV, camera.CAMERA_NEAR, camera.CAMERA_FAR) == (40.0, 0.1, 100.0)
 
 
-def test_look_imports_numpy_only():
+def test_the_look_modules_import_numpy_only():
     code = (
-        "import sys, rot4d_widget.core.look\n"
+        "import sys, rot4d_widget.core.camera, rot4d_widget.core.colours, rot4d_widget.core.renderings\n"
+        "import rot4d_widget.core.sizes, rot4d_widget.core.text\n"
         "bad = [m for m in ('matplotlib', 'ipywidgets', 'pythreejs', 'ipyevents', 'traitlets') if m in sys.modules]\n"
         "assert not bad, bad\n"
     )

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from test_labels import flame, turned
 
-from rot4d_widget.core import look
+from rot4d_widget.core import camera
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
@@ -65,17 +65,17 @@ def test_sections_name_their_planes_in_the_data_s_coordinates(make):
 
 def test_the_camera_shows_all_three_planes_unless_the_user_moved_it(make):
     w = make(flame())
-    assert w.scene.eye == look.CAMERA_POSITION
+    assert w.scene.eye == camera.CAMERA_POSITION
     w.rendering = "sections"
-    np.testing.assert_allclose(w.scene.eye, look.SECTIONS_CAMERA_POSITION)
+    np.testing.assert_allclose(w.scene.eye, camera.SECTIONS_CAMERA_POSITION)
     w.rendering = "mip"
-    np.testing.assert_allclose(w.scene.eye, look.CAMERA_POSITION)
+    np.testing.assert_allclose(w.scene.eye, camera.CAMERA_POSITION)
     w.rendering = "sections"
     w.scene.canvas.camera.position = (0.0, 3.0, 4.0)  # the user orbits: the camera stays where it is put
     w.rendering = "surface"
     np.testing.assert_allclose(w.scene.eye, (0.0, 3.0, 4.0))
     v = make(flame(), rendering="sections")  # made to show sections
-    np.testing.assert_allclose(v.scene.eye, look.SECTIONS_CAMERA_POSITION)
+    np.testing.assert_allclose(v.scene.eye, camera.SECTIONS_CAMERA_POSITION)
 
 
 def _look_at(eye):
@@ -93,7 +93,7 @@ def _area(poly):
 
 
 def test_from_the_sections_camera_no_plane_is_edge_on():
-    view, dist = _look_at(look.default_eye("sections"))
+    view, dist = _look_at(camera.default_eye("sections"))
     cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
 
     def project(p):
@@ -106,7 +106,7 @@ def test_from_the_sections_camera_no_plane_is_edge_on():
         quad[:, b] = [-1, 1, 1, -1]
         quad[:, c] = [-1, -1, 1, 1]
         assert _area(project(quad)) > 0.25 * _area(project(cube[[0, 1, 3, 2]])), a
-    view0, _ = _look_at(look.default_eye("mip"))
+    view0, _ = _look_at(camera.default_eye("mip"))
     np.testing.assert_allclose(view0, np.eye(3))
 
 
@@ -117,13 +117,13 @@ def test_the_static_sections_picture_is_seen_from_the_sections_camera(make, tmp_
     w = make(f, rendering="sections")
     fig = w.render(progress=False)
     st = w.state.copy()
-    same = render_state(st, f, rendering="sections", eye=look.SECTIONS_CAMERA_POSITION, size=(600, 500),
+    same = render_state(st, f, rendering="sections", eye=camera.SECTIONS_CAMERA_POSITION, size=(600, 500),
                         progress=False)
-    front = render_state(st, f, rendering="sections", eye=look.CAMERA_POSITION, size=(600, 500), progress=False)
+    front = render_state(st, f, rendering="sections", eye=camera.CAMERA_POSITION, size=(600, 500), progress=False)
 
     def image(fig):
         (im,) = [a for a in fig.axes[0].images if a.get_gid() == "sections"]
         return np.asarray(im.get_array())
 
     assert np.array_equal(image(fig), image(same)) and not np.array_equal(image(fig), image(front))
-    assert math.isclose(np.linalg.norm(look.SECTIONS_CAMERA_POSITION), 5.0)
+    assert math.isclose(np.linalg.norm(camera.SECTIONS_CAMERA_POSITION), 5.0)

@@ -10,7 +10,7 @@ import re
 import pytest
 
 from rot4d_widget.sources.field.container import Field4D
-from rot4d_widget.core.look import number_text
+from rot4d_widget.core.text import number_text
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 

@@ -24,7 +24,7 @@ from ipywidgets.widgets import widget as ipywidget_module
 import rot4d_widget
 from rot4d_widget.view import buffers as bf
 from rot4d_widget import polytope
-from rot4d_widget.core import look
+from rot4d_widget.core import camera, colours, sizes
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.sources.protocol import PolytopeSource
@@ -56,7 +56,7 @@ def log(recording_comms):
 
 def scene_options(src, **kw):
     """What Rot4DWidget gives the Scene for a source: its scale, groups and estimated capacity."""
-    kw.setdefault("scale", look.REFERENCE_RADIUS / src.size)
+    kw.setdefault("scale", sizes.REFERENCE_RADIUS / src.size)
     kw.setdefault("n_groups", src.n_groups)
     kw.setdefault("capacity", bf.estimate_capacity(src))
     return kw
@@ -116,7 +116,7 @@ def test_camera_controls_renderer_as_the_paper_and_the_issue_ask(scenes):
     assert isinstance(canvas, p3.Renderer)
     cam = canvas.camera
     assert isinstance(cam, p3.PerspectiveCamera)
-    assert tuple(cam.position) == look.CAMERA_POSITION == (0.0, 0.0, 5.0)
+    assert tuple(cam.position) == camera.CAMERA_POSITION == (0.0, 0.0, 5.0)
     assert sc.eye == (0.0, 0.0, 5.0)
     assert tuple(cam.quaternion) == (0.0, 0.0, 0.0, 1.0)  # looking down -z
     assert cam.aspect == pytest.approx(420 / 300)
@@ -149,7 +149,7 @@ def test_no_directional_light_and_shaders_do_the_lighting(scenes):
         assert {"u_ambient", "u_sky", "u_ground", "u_light_position"} <= set(m.material.uniforms)
     faces = parts[2].material
     assert faces.transparent and faces.depthWrite is False and faces.side == "DoubleSide"
-    assert faces.uniforms["u_opacity"]["value"] == pytest.approx(look.FACE_OPACITY) == pytest.approx(0.35)
+    assert faces.uniforms["u_opacity"]["value"] == pytest.approx(colours.FACE_OPACITY) == pytest.approx(0.35)
 
 
 def _facing(rows, eye):
@@ -249,12 +249,12 @@ def test_every_polytope_appears_the_size_of_the_pentachoron(scenes, name):
     """At the scale the widget gives (REFERENCE_RADIUS / size) the rows hold the points scaled."""
     p = polytope(name)
     sc, src = scenes(p, capacity=16)
-    assert look.REFERENCE_RADIUS == pytest.approx(polytope("5-cell").circumradius)
+    assert sizes.REFERENCE_RADIUS == pytest.approx(polytope("5-cell").circumradius)
     s = src.slice(np.eye(4), 0.0)
     sc.show(s)
-    scale = look.REFERENCE_RADIUS / p.circumradius
+    scale = sizes.REFERENCE_RADIUS / p.circumradius
     np.testing.assert_allclose(sc.rows[: len(s.points), :3], s.points * scale, rtol=1e-6, atol=1e-7)
-    assert np.linalg.norm(sc.rows[:, :3], axis=1).max() <= look.REFERENCE_RADIUS * (1 + 1e-6)
+    assert np.linalg.norm(sc.rows[:, :3], axis=1).max() <= sizes.REFERENCE_RADIUS * (1 + 1e-6)
     if name == "120-cell":
         assert p.circumradius == pytest.approx(7.4, abs=0.01)
 
@@ -280,7 +280,7 @@ def test_one_show_is_one_message_to_the_buffer(scenes, log):
         assert len(bufs) == 1 and bufs[0].nbytes == sc.capacity * bf.ROW_BYTES
         rows = bufs[0].view(np.float32).reshape(sc.capacity, 20)
         want = bf.slice_rows(
-            s, scale=look.REFERENCE_RADIUS / src.size, group_rgb=look.group_palette(src.n_groups),
+            s, scale=sizes.REFERENCE_RADIUS / src.size, group_rgb=colours.group_palette(src.n_groups),
             capacity=sc.capacity, eye=sc.eye,
         )
         np.testing.assert_array_equal(rows, want)
@@ -547,7 +547,7 @@ def test_group_colors_are_used(scenes):
     nt = len(s.triangles)
     rgb = [[int(c[i : i + 2], 16) for i in (1, 3, 5)] for c in colors]
     # rows are in the order for the eye: match each to its triangle by its corners
-    scale = look.REFERENCE_RADIUS / src.size
+    scale = sizes.REFERENCE_RADIUS / src.size
     want = {tuple(np.round((s.points[t] * scale).astype(np.float32), 4).ravel()): rgb[g]
             for t, g in zip(s.triangles, s.groups)}
     corners = sc.rows[:nt, 10:19]
@@ -560,7 +560,7 @@ def test_single_rgb_paints_every_face_and_is_an_update(scenes, log):
     s = src.slice(random_rotation(np.random.default_rng(2)), 0.0)
     assert sc.show(s)
     log.clear()
-    assert sc.show(s, single_rgb=look.as_rgb(look.SINGLE_FACE_COLOR)) is True  # same slice, new colours
+    assert sc.show(s, single_rgb=colours.as_rgb(colours.SINGLE_FACE_COLOR)) is True  # same slice, new colours
     nt = len(s.triangles)
     assert np.all(bf.unpack_rgb(sc.rows[:nt, 19]) == [0x9F, 0xB6, 0xCD])
     assert len(buffer_messages(sc, log)) == 1

@@ -16,7 +16,7 @@ import pytest
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures.state_picture import render_state
-from rot4d_widget.core.look import RENDERINGS
+from rot4d_widget.core.renderings import RENDERINGS
 from rot4d_widget.keep.pictures.ray_caster import VOLUME_RENDERINGS, render_grid
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.sources.field.grid import sample_field

@@ -17,7 +17,7 @@ from rot4d_widget.core.rotation import random_rotation
 import pytest
 
 from rot4d_widget import SliceData, polytope, simple_rotation, slice_polytope
-from rot4d_widget.core.look import REFERENCE_RADIUS
+from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget import PolytopeSource, SourceAction
 from rot4d_widget.sources.protocol import as_source, census_text
 from rot4d_widget.view.widget import Rot4DWidget

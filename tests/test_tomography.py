@@ -14,7 +14,7 @@ from scipy.spatial import ConvexHull
 
 from reference_geometry import random_rotation
 from rot4d_widget import polytope, slice_polytope
-from rot4d_widget.core import look
+from rot4d_widget.core import camera, sizes
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.keep.pictures.state_picture import render_tomography
 from rot4d_widget.core.rotation import simple_rotation
@@ -29,9 +29,9 @@ from rot4d_widget.sources.tomography import (
 
 NAMES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell"]
 SLICE_ARRAYS = ("vertices", "edges", "polygon_indices", "polygon_offsets", "cell_ids", "triangles", "triangle_cells")
-R_D = look.REFERENCE_RADIUS
-D = look.CAMERA_POSITION[2]
-HALF_H = D * math.tan(math.radians(look.CAMERA_FOV) / 2)
+R_D = sizes.REFERENCE_RADIUS
+D = camera.CAMERA_POSITION[2]
+HALF_H = D * math.tan(math.radians(camera.CAMERA_FOV) / 2)
 
 
 def assert_same_slice(a, b, where=""):
@@ -353,7 +353,7 @@ def test_oval_centres_on_the_documented_parabola(n):
     y0 = centres[:, 1] - C * u * u  # one Y0 for every slice: they lie on one parabola
     np.testing.assert_allclose(y0, y0[0], atol=1e-12)
     # centred: the spheres' images reach as far above the frame's middle as below it
-    f = look.CAMERA_POSITION[2] / (look.CAMERA_POSITION[2] - centres[:, 2])
+    f = camera.CAMERA_POSITION[2] / (camera.CAMERA_POSITION[2] - centres[:, 2])
     r = R_D * scales
     assert ((centres[:, 1] + r) * f).max() == pytest.approx(-((centres[:, 1] - r) * f).min(), abs=1e-9)
     np.testing.assert_allclose(centres[:, 2], -B * u * u, atol=1e-12)

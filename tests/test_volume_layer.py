@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rot4d_widget.core import look
+from rot4d_widget.core import renderings
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.view import volume_layer as vl
 from test_widget import down, up
@@ -110,7 +110,7 @@ def test_back_to_surface_hides_the_volume_in_the_same_message(make):
 
 
 def test_default_clim_is_the_cuts_1st_to_99th_percentile(make):
-    from rot4d_widget.core.look import default_clim
+    from rot4d_widget.core.colours import default_clim
 
     f = blob()
     w = make(f, rendering="mip")
@@ -201,7 +201,7 @@ def test_bad_values_are_refused_and_the_trait_kept(make, name, bad, exc, match):
 
 
 def test_the_default_sections_are_the_middle():
-    assert look.DEFAULT_SECTIONS == (0.5, 0.5, 0.5)
+    assert renderings.DEFAULT_SECTIONS == (0.5, 0.5, 0.5)
     assert ball_field().n_groups >= 1
 
 

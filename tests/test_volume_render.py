@@ -16,11 +16,12 @@ import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from rot4d_widget.core.look import CAMERA_FOV, REFERENCE_RADIUS
+from rot4d_widget.core.camera import CAMERA_FOV
+from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.core.state import RotationState
 from rot4d_widget.keep.pictures.state_picture import render_state
-from rot4d_widget.core.look import default_clim
+from rot4d_widget.core.colours import default_clim
 from rot4d_widget.keep.pictures.ray_caster import render_grid
 from rot4d_widget.sources.field.container import Field4D
 from rot4d_widget.sources.field.grid import sample_field

@@ -24,7 +24,7 @@ from widget_time import service
 from rot4d_widget import polytope, simple_rotation, slice_polytope
 from rot4d_widget.view import widget as wmod
 from rot4d_widget.core.keymap import RESERVED_KINDS
-from rot4d_widget.core.look import REFERENCE_RADIUS
+from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget.core.state import DEFAULT_THETA0
 from rot4d_widget.view.pagecut import PageCut
 from rot4d_widget.view.pagefield import PageField
@@ -104,9 +104,9 @@ class FakeScene:
 
     @staticmethod
     def palette(n_groups):
-        from rot4d_widget.core import look
+        from rot4d_widget.core import colours
 
-        return look.group_palette(max(int(n_groups), 1))
+        return colours.group_palette(max(int(n_groups), 1))
 
     def show(self, s, single_rgb=None, group_rgb=None, volume=None, labels=()):
         """Like Scene.show: True if sent, False (and no new update_id) if the picture is unchanged."""

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from rot4d_widget.core import look
+from rot4d_widget.core import colours
 from rot4d_widget.sources.field.container import Field4D
 from test_widget import down, up
 from test_widget_scene import drawn, run_ticker
@@ -131,7 +131,7 @@ def test_levels_trait_and_level_keys_follow_each_other(make, clock):
     drawn(w)
     service(w, clock.t)
     s = w.scene.surface
-    assert s["opacity"] == pytest.approx(look.SURFACE_OPACITY)  # nested: translucent
+    assert s["opacity"] == pytest.approx(colours.SURFACE_OPACITY)  # nested: translucent
     rgb = np.frombuffer(s["rgb"], dtype=np.uint8).reshape(-1, 3)
     assert len(np.unique(rgb, axis=0)) == 2  # one colour per level
     before = w.levels
@@ -235,7 +235,7 @@ def test_the_readout_has_a_colour_legend_of_the_levels(make, clock):
     f = ball_field()
     w = make(f, levels=[-0.2, 0.1])
     html = w.readout.value
-    colors = look.level_colors(f.levels, *f.data_range)
+    colors = colours.level_colors(f.levels, *f.data_range)
     for lv, rgb in zip(f.levels, colors):
         hexed = "#" + "".join(f"{round(255 * c):02x}" for c in rgb)
         assert hexed in html and f"{lv:.4g}" in html

@@ -24,7 +24,7 @@ from ipywidgets.widgets import widget as ipywidget_module
 
 from rot4d_widget.view import buffers as bf
 from rot4d_widget import polytope
-from rot4d_widget.core import look
+from rot4d_widget.core import sizes
 from rot4d_widget.geometry.regular import POLYTOPE_NAMES
 from rot4d_widget.view.widget import Rot4DWidget
 from test_widget import down, up, xw_steps
@@ -71,7 +71,7 @@ def run_ticker(w, clock, until):
 def scaled_points(w, data=None):
     """The points of a slice as the view shows them: every source the pentachoron's size."""
     data = w.slice if data is None else data
-    return np.asarray(data.points) * (look.REFERENCE_RADIUS / w.source.size)
+    return np.asarray(data.points) * (sizes.REFERENCE_RADIUS / w.source.size)
 
 
 # --------------------------------------------------------------------- tests
@@ -320,7 +320,7 @@ def test_bad_scene_options_raise_and_leave_nothing_open(kwargs, exc, match):
 def test_default_radii_follow_the_displayed_edge(make):
     assert make("5-cell").scene.display["ball_radius"] == pytest.approx(0.07)
     w = make("120-cell")
-    edge = 2.0 * look.REFERENCE_RADIUS / polytope("120-cell").circumradius  # edge 2, shown scaled
+    edge = 2.0 * sizes.REFERENCE_RADIUS / polytope("120-cell").circumradius  # edge 2, shown scaled
     d = w.scene.display
     assert d["ball_radius"] == pytest.approx(0.1 * edge) == pytest.approx(w.ball_radius)
     assert d["bar_radius"] == pytest.approx(0.4 * d["ball_radius"]) == pytest.approx(w.bar_radius)

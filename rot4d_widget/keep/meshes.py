@@ -8,7 +8,7 @@ data's place, each vertex's 4-D data coordinates in ``mesh.vertex_attributes["da
 each face keeping its colour group
 (``mesh.face_attributes["group"]``: a polytope's 4-D cell, a field's level index, a stack's
 slice index when coloured by w) and its colour (``mesh.visual.face_colors``, the live view's
-palette from `rot4d_widget.core.look`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
+palette from `rot4d_widget.core.colours`).  ``mesh.export(path)`` writes OBJ, PLY, STL or GLB by the
 extension (trimesh's own writers); what each keeps is listed in `MESH_FORMATS`.
 `load_mesh(path)` reads one back with the groups a PLY file carries.
 """
@@ -21,7 +21,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..core import look
+from ..core import colours
 from ..geometry.slicing.tables import Slice
 from ..sources.protocol import SliceData
 
@@ -56,23 +56,23 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
     ``color_by`` is the widget's: ``"group"`` or one colour for every face (``"#9fb6cd"``).
     Groups are coloured by ``group_colors`` (one colour per group) if given, else as the widget
     chooses: a stack coloured by w by its levels' colormap, a field by its levels' colormap
-    (`look.level_colors`), anything else by `look.group_palette` (a polytope's cells).
+    (`colours.level_colors`), anything else by `colours.group_palette` (a polytope's cells).
     """
     data = _as_slice_data(data)
     groups = np.asarray(data.groups, dtype=np.intp)
     if color_by != "group":
-        return np.tile(np.asarray(look.as_rgb(color_by, "color_by"), dtype=np.float64), (len(groups), 1))
+        return np.tile(np.asarray(colours.as_rgb(color_by, "color_by"), dtype=np.float64), (len(groups), 1))
     n = int(groups.max()) + 1 if len(groups) else 0
     if group_colors is not None:
-        palette = np.array([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
+        palette = np.array([colours.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
                            dtype=np.float64).reshape(-1, 3)
     elif _is_stack_data(data) and data.extra.get("group_rgb") is not None:
         palette = np.asarray(data.extra["group_rgb"], dtype=np.float64)
     elif _is_field_data(data) and len(data.extra["levels"]):
         levels = [s.level for s in data.extra["levels"]]
-        palette = look.level_colors(levels, min(levels), max(levels))
+        palette = colours.level_colors(levels, min(levels), max(levels))
     else:
-        palette = look.group_palette(n).astype(np.float64)
+        palette = colours.group_palette(n).astype(np.float64)
     if n > len(palette):
         raise ValueError(f"Expected a colour for every group (0 ... {n - 1}), got {len(palette)} colours")
     return palette[groups].reshape(-1, 3)
@@ -206,7 +206,7 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
         formats that keep only vertex colours (OBJ, GLB) show every face in its own colour.
     opacity : float in [0, 1]
         The colours' alpha (default opaque; the live view draws polytope faces at
-        `look.FACE_OPACITY`).
+        `colours.FACE_OPACITY`).
     frame : "data" (default) or "view"
         Where a slice that knows its data coordinates (a `Field4D`'s, a stack of them: any slice
         data whose ``extra["data_frame"]`` gives the cut's ``matrix``, offset ``d`` and the data's

@@ -47,7 +47,6 @@ OLD_MODULES = {
     "rot4d_widget.rotation": "rot4d_widget.core.rotation",
     "rot4d_widget.keymap": "rot4d_widget.core.keymap",
     "rot4d_widget.state": "rot4d_widget.core.state",
-    "rot4d_widget.look": "rot4d_widget.core.look",
     "rot4d_widget._arrays": "rot4d_widget.core._arrays",
     "rot4d_widget.progress": "rot4d_widget.core.progress",
     "rot4d_widget.polytopes": "rot4d_widget.geometry.catalogue",

@@ -48,7 +48,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..core import look
+from ..core import colours, renderings
 from ..core.keymap import Action
 from ..core.rotation import as_rotation_matrix
 from ..core.state import STATE_FORMAT, RotationState, action_from_data, action_to_data, spacing_factor
@@ -75,8 +75,8 @@ SOURCE_SETTINGS = ("levels", "inside", "caps", "slices", "spacing", "arrangement
 #: its colour scale and where its sections lie -- they change the picture, not the state or source.
 VIEW_SETTINGS = ("rendering", "cmap", "clim", "sections", "projection")
 #: Each view setting's default (the widget's and `rot4d_widget.keep.pictures.state_picture.render_state`'s), as JSON.
-VIEW_DEFAULTS = {"rendering": look.RENDERINGS[0], "cmap": look.LEVEL_COLORMAP, "clim": None,
-                 "sections": list(look.DEFAULT_SECTIONS)}
+VIEW_DEFAULTS = {"rendering": renderings.RENDERINGS[0], "cmap": colours.LEVEL_COLORMAP, "clim": None,
+                 "sections": list(renderings.DEFAULT_SECTIONS)}
 #: The settings of a field (a stack's inner source).
 _FIELD_SETTINGS = ("levels", "inside", "caps")
 #: The settings that need parallel slices (a `StackSource`).
@@ -144,7 +144,7 @@ class SourceSetting(_NamedValue):
 @dataclass(frozen=True)
 class ViewSetting(_NamedValue):
     """A view setting (the widget's traits): ``name`` in `VIEW_SETTINGS` and its ``value`` as JSON
-    -- ``rendering`` one of `look.RENDERINGS`, ``cmap`` a matplotlib colour map name, ``clim``
+    -- ``rendering`` one of `renderings.RENDERINGS`, ``cmap`` a matplotlib colour map name, ``clim``
     [lo, hi] or None (the data's range), ``sections`` [fx, fy, fz] in [0, 1].  It changes how
     the cut is drawn, not the state or the source."""
 
@@ -152,12 +152,13 @@ class ViewSetting(_NamedValue):
 
 
 def check_view_setting(name, value):
-    """``value`` as a `ViewSetting` holds it (JSON: a tuple as a list), checked by `look`'s checks:
+    """``value`` as a `ViewSetting` holds it (JSON: a tuple as a list), checked by the core's checks
+    (`rot4d_widget.core.renderings`, `rot4d_widget.core.colours`):
     a ValueError (or a TypeError for a value of the wrong type) naming what is allowed."""
     if name not in VIEW_SETTINGS:
         raise ValueError(f"Expected a view setting among {', '.join(map(repr, VIEW_SETTINGS))}, got {name!r}")
-    check = {"rendering": look.check_rendering, "cmap": look.check_cmap, "clim": look.check_clim,
-             "sections": look.check_sections, "projection": look.check_projection}[name]
+    check = {"rendering": renderings.check_rendering, "cmap": colours.check_cmap, "clim": colours.check_clim,
+             "sections": renderings.check_sections, "projection": renderings.check_projection}[name]
     value = check(value, name)
     return list(value) if isinstance(value, tuple) else value
 

@@ -1,7 +1,7 @@
 """Where a stack's N parallel slices sit in the view: the oval, the grid and the row.
 
 `arrangement_layout` is designed in displayed units -- the object's circumradius
-`look.REFERENCE_RADIUS`, the eye at (0, 0, 5) looking down -z, vertical fov 40 degrees, the
+`sizes.REFERENCE_RADIUS`, the eye at (0, 0, 5) looking down -z, vertical fov 40 degrees, the
 default canvas aspect 600 / 500 -- and scaled to the source's units.  A point p of slice k is
 drawn at ``centre_k + scale_k * p`` (`rot4d_widget.sources.tomography.StackSource`).
 
@@ -46,7 +46,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
-from ..core import look
+from ..core import camera, sizes
 
 __all__ = ["ARRANGEMENTS", "OVAL_PARABOLA", "arrangement_layout", "check_arrangement"]
 
@@ -65,8 +65,8 @@ FRAME_MARGIN = 0.97
 #: The widget's default canvas, width / height (600 x 500).
 VIEW_ASPECT = 600.0 / 500.0
 
-_D = float(look.CAMERA_POSITION[2])
-_HALF_H = _D * math.tan(math.radians(look.CAMERA_FOV) / 2.0)  # frame half-height at z = 0
+_D = float(camera.CAMERA_POSITION[2])
+_HALF_H = _D * math.tan(math.radians(camera.CAMERA_FOV) / 2.0)  # frame half-height at z = 0
 
 
 def check_arrangement(a) -> str:
@@ -85,7 +85,7 @@ def _frame_fit(cx, cy, cz, r):
 
 
 def _oval(n: int):
-    R = look.REFERENCE_RADIUS
+    R = sizes.REFERENCE_RADIUS
     A, B, C, Y0, UM = (OVAL_PARABOLA[k] for k in ("A", "B", "C", "Y0", "U_MAX"))
     tau = (np.arange(n) - (n - 1) / 2.0) / ((n - 1) / 2.0)
     g = 1.0 - OVAL_SHRINK * tau * tau
@@ -128,7 +128,7 @@ def _vertical_centring(centres, radii) -> float:
 
 
 def _rows(n: int, cols: int):
-    R = look.REFERENCE_RADIUS
+    R = sizes.REFERENCE_RADIUS
     rows = -(-n // cols)
     lim_y = FRAME_MARGIN * _HALF_H
     lim_x = VIEW_ASPECT * lim_y
@@ -140,12 +140,12 @@ def _rows(n: int, cols: int):
     return centres, np.full(n, s)
 
 
-def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS):
+def arrangement_layout(name: str, n: int, radius: float = sizes.REFERENCE_RADIUS):
     """Where each of ``n`` slices goes: ``(centres (n, 3) float64, scales (n,) float64)``.
 
     Slice k of an object of circumradius ``radius`` is drawn at ``centres[k] + scales[k] * p``.
-    Designed for ``radius = look.REFERENCE_RADIUS`` (what the widget shows) and the camera of
-    `rot4d_widget.core.look`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
+    Designed for ``radius = sizes.REFERENCE_RADIUS`` (what the widget shows) and the camera of
+    `rot4d_widget.core.camera`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
     picture is the same once the widget scales the source to its displayed size.  See the
     module docstring for each arrangement's constants.  ``n = 1``: centre 0, scale 1.
     """
@@ -164,4 +164,4 @@ def arrangement_layout(name: str, n: int, radius: float = look.REFERENCE_RADIUS)
         centres, scales = _rows(n, math.ceil(math.sqrt(n)))
     else:
         centres, scales = _rows(n, n)
-    return centres * (float(radius) / look.REFERENCE_RADIUS), scales
+    return centres * (float(radius) / sizes.REFERENCE_RADIUS), scales

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.look import number_text
+from ..core.text import number_text
 
 __all__ = ["box_labels", "axis_names", "axis_units", "coordinate_text", "date_time_text"]
 

@@ -89,7 +89,7 @@ from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..core.look import number_text
+from ..core.text import number_text
 from ..geometry.catalogue import polytope as get_polytope
 from ..geometry.mesh import Polytope
 from ..geometry.regular import POLYTOPE_NAMES

@@ -18,7 +18,7 @@ the one at w = c0 (k = (N - 1) / 2 for odd N; for even N no slice is at c0 and k
 the first above it, is highlighted).
 
 Colour: ``color_by="w"`` gives triangles group k (slice k) and `StackSource.group_colors`
-spreads ``look.LEVEL_COLORMAP`` over the N levels (lowest w darkest); ``color_by="cell"``
+spreads ``colours.LEVEL_COLORMAP`` over the N levels (lowest w darkest); ``color_by="cell"``
 keeps the inner source's groups, so a 4-D cell has one colour in every slice (today's
 colours).  With one slice, colour by w keeps the inner groups too (today's view).
 
@@ -36,7 +36,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
-from ..core import look
+from ..core import colours, text
 from ..core.rotation import as_rotation_matrix
 from ..geometry.slicing.polytope_slice import slice_polytope
 from .arrangements import arrangement_layout, check_arrangement
@@ -392,7 +392,7 @@ class StackSource:
         """(n_groups, 3) float64 colours when coloured by w (a colormap over the levels), else None."""
         if not self.groups_by_w:
             return None
-        return look.level_colors(np.arange(self._slices, dtype=float), 0.0, self._slices - 1.0)
+        return colours.level_colors(np.arange(self._slices, dtype=float), 0.0, self._slices - 1.0)
 
     def describe(self) -> dict:
         return {"kind": "stack", "source": self.source.describe(), "slices": self._slices,
@@ -505,7 +505,7 @@ class StackSource:
         n = len(cuts)
         how = "colour by w (viridis, low w dark)" if self._color_by == "w" else "colour by cell"
         unit = _w_units(self.source)
-        delta = look.number_text(self.spacing) + (f" {unit}" if unit else "")
+        delta = text.number_text(self.spacing) + (f" {unit}" if unit else "")
         delta += "" if self._spacing is not None else " (spread over the record)"
         rows = [("stack", f"{n} slices, \u0394 = {delta}, {self._arrangement}, {how}")]
         polytope = self._polytope is not None
@@ -517,7 +517,7 @@ class StackSource:
                     parts.append(_short_census(piece.slice))
                 if v is not None and not label.endswith("(outside the data)"):
                     space = getattr(self.source, "space_units", None)
-                    parts.append(f"vol {look.number_text(v)}" + (f" {space}\u00b3" if space else ""))
+                    parts.append(f"vol {text.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
             if getattr(self.source, "extent", None) is None:  # a polytope's own w

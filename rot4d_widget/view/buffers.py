@@ -29,7 +29,7 @@ nothing: a ball with flag 0 is moved outside the clip volume, a bar of length
 row is a hidden row, and hidden rows cost bytes but never pixels.
 
 Positions are multiplied by the scene's ``scale`` here (the 3-D view shows
-every source the size of the pentachoron, `rot4d_widget.core.look.REFERENCE_RADIUS`).  A 24-bit colour packed into a
+every source the size of the pentachoron, `rot4d_widget.core.sizes.REFERENCE_RADIUS`).  A 24-bit colour packed into a
 float32 is exact (float32 holds every integer below 2**24); the face shader
 unpacks it with ``floor``.
 
@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ..core.look import as_rgb, cell_palette, group_palette
+from ..core.colours import as_rgb, cell_palette, group_palette
 from ..core.rotation import random_rotation
 from ..sources.protocol import BadSlice, outline_of
 
@@ -364,7 +364,7 @@ def surface_message(arrays: dict, opacity) -> dict:
     }
 
 
-# -- colours (the palette itself lives in rot4d_widget.core.look) --------------------
+# -- colours (the palette itself lives in rot4d_widget.core.colours) -----------------
 
 
 def pack_rgb(rgb) -> np.ndarray:

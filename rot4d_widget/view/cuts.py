@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.look import RENDERING_TEXT, number_text
+from ..core.renderings import RENDERING_TEXT
+from ..core.text import number_text
 from ..sources.field_labels import axis_names, axis_units, box_labels
 from ..sources.protocol import SliceData, data_w_text, inner_source, outline_of, settings_of
 

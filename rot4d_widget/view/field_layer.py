@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pythreejs as p3
 
-from ..core import look
+from ..core import renderings
 
 __all__ = ["FieldLayer", "ATTRIBUTES"]
 
@@ -42,8 +42,9 @@ class FieldLayer:
         # the textures, arrays and matrices are set by the page (placeholders name them here)
         return dict(
             light,
-            u_mode={"value": 0.0}, u_clim={"value": [0.0, 1.0]}, u_sections={"value": list(look.DEFAULT_SECTIONS)},
-            u_density={"value": look.DEFAULT_DENSITY}, u_step={"value": 0.5}, u_march={"value": 0.01},
+            u_mode={"value": 0.0}, u_clim={"value": [0.0, 1.0]},
+            u_sections={"value": list(renderings.DEFAULT_SECTIONS)},
+            u_density={"value": renderings.DEFAULT_DENSITY}, u_step={"value": 0.5}, u_march={"value": 0.01},
             u_sign={"value": 1.0}, u_caps={"value": 1.0}, u_opacity={"value": 1.0}, u_nlevels={"value": 0.0},
             u_box_colours={"value": 0.0}, u_output={"value": 0.0}, u_depth_scale={"value": 100.0},
             u_shape={"value": [1.0, 1.0, 1.0, 1.0]}, u_tiles={"value": [1.0, 1.0, 1.0]},

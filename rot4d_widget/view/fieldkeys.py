@@ -9,7 +9,7 @@ rendering and sections through `rot4d_widget.view.renderings.Renderings`, record
 they set; the levels through the field's own action, recorded as a step), so a recording and a
 replay are what they were.
 
-The page applies the same rules (``page/state.js``): the rendering cycle of `look.RENDERINGS`, the
+The page applies the same rules (``page/state.js``): the rendering cycle of `renderings.RENDERINGS`, the
 section step (`SECTION_STEP`, rounded to 1/1024, refused at 0 and 1) and the level step
 (`rot4d_widget.sources.field.levels.FieldLevels.step_levels`: every level by ``level_step``,
 refused beyond the data range widened by one step) with the numbers `view_rules` gives.  The levels
@@ -19,7 +19,7 @@ copy made): before that, o / i are the kernel's keys alone.
 
 from __future__ import annotations
 
-from ..core import look
+from ..core import renderings
 from ..sources.field.levels import FieldLevels
 from ..sources.protocol import inner_source
 from .cuts import can_sample
@@ -50,7 +50,7 @@ def level_actions(source) -> dict:
 def view_rules(source) -> dict:
     """The numbers the page steps a field's view by: the renderings in key order, the section step
     and, while the levels are predicted, ``level_step`` and ``level_range`` (`FieldLevels`)."""
-    out = {"renderings": list(look.RENDERINGS), "section_step": SECTION_STEP}
+    out = {"renderings": list(renderings.RENDERINGS), "section_step": SECTION_STEP}
     inner = inner_source(source)
     if level_actions(source):
         lo, hi = inner.data_range

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import look
+from ..core import colours, renderings
 from ..sources.protocol import inner_source, w_frame
 from ..sources.tomography import StackSource
 from .cuts import STACK_NODES, can_sample
@@ -54,13 +54,13 @@ def copy_clim(values) -> list:
     """The 1st and 99th percentiles of a copy's values (every 7th: the same to a few codes, quickly):
     the page's colour limits when neither ``clim`` nor a ray-cast picture of the kernel's gives any."""
     v = np.asarray(values).reshape(-1)[::7]
-    return [float(x) for x in look.default_clim(v)]
+    return [float(x) for x in colours.default_clim(v)]
 
 
-def field_config(widget, field, default_clim_: list, texture_side: int, colours) -> dict:
+def field_config(widget, field, default_clim_: list, texture_side: int, painted) -> dict:
     """The page's ``field_config`` for ``field`` (the `Field4D` the page holds) shown by ``widget``;
     ``default_clim_`` the copy's `copy_clim`, ``texture_side`` the copy's longest texture side,
-    ``colours`` the painter's ``(rgb, labels)`` (`Painter.colours`)."""
+    ``painted`` the painter's ``(rgb, labels)`` (`Painter.colours`)."""
     w = widget
     src = w.source
     origin, per = w_frame(src)
@@ -75,8 +75,8 @@ def field_config(widget, field, default_clim_: list, texture_side: int, colours)
     clim = w.clim if w.clim is not None else painter.cast_clim
     if clim is None:
         clim = default_clim_
-    rgb, labels = colours
-    single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+    rgb, labels = painted
+    single = None if w.color_by == "group" else colours.as_rgb(w.color_by, "color_by")
     by_slice = labels is not None and inner_source(src) is not src  # a stack coloured by w
     return {
         "hw": [float(h) for h in field.half_widths],
@@ -88,12 +88,12 @@ def field_config(widget, field, default_clim_: list, texture_side: int, colours)
         "march": float(MARCH), "held_march": float(HELD_MARCH),
         "lut": [int(b) for b in colour_table(w.cmap).reshape(-1)],
         "clim": [float(clim[0]), float(clim[1])],
-        "density": float(look.DEFAULT_DENSITY),
+        "density": float(renderings.DEFAULT_DENSITY),
         "inside": field.inside, "caps": bool(field.caps),
         "level_rgb": _rgb(rgb) if not by_slice else [],
         "level_by_value": w.clim is not None and single is None and not by_slice,
         "box_rgb": _rgb(rgb) if by_slice and single is None else None,
         "single_rgb": None if single is None else _rgb([single])[0],
-        "surface_opacity": float(look.SURFACE_OPACITY),
+        "surface_opacity": float(colours.SURFACE_OPACITY),
         "texture_side": int(texture_side),
     }

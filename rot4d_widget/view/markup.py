@@ -26,7 +26,7 @@ import ipywidgets as widgets
 import numpy as np
 from markupsafe import Markup
 
-from ..core.look import number_text
+from ..core.text import number_text
 
 __all__ = ["Markup", "html_widget", "show", "readout_html", "help_html", "gizmo_svg", "gauge_html",
            "colourbar_html", "legend_html", "projection_caption_html", "views_html", "keypad_label_html",

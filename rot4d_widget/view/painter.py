@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import look
+from ..core import colours
 from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, known_range, outline_of
 from . import markup as ro
 from .buffers import check_update_size
@@ -148,7 +148,7 @@ class Painter:
         w = self.w
         st, scene = w.state, w.scene
         held = bool(w._keys.held)
-        single = None if w.color_by == "group" else look.as_rgb(w.color_by, "color_by")
+        single = None if w.color_by == "group" else colours.as_rgb(w.color_by, "color_by")
         cut = w.companion.page_cut
         cut.sync(w.source, self.group_colors(), w._scale, single)
         self.sync_field()
@@ -185,7 +185,7 @@ class Painter:
                     w._pump.mark_dirty()
                     return None
                 self.grid_cache = (m, c0, version, coarse_, cut)
-            clim = w.clim if w.clim is not None else look.default_clim(cut.finite_values)
+            clim = w.clim if w.clim is not None else colours.default_clim(cut.finite_values)
             volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
             labels = cut_labels(w.source, m, c0, cut.data)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
@@ -419,8 +419,8 @@ class Painter:
         if level_rgb is None or w.color_by != "group":
             level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
         label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
-        marks = [] if cast else [(float(v), look.hex_color(c)) for v, c in zip(levels, level_rgb)]
-        return ro.colourbar_html(look.cmap_stops(w.cmap), lo, hi, str(label), getattr(inner, "units", None),
+        marks = [] if cast else [(float(v), colours.hex_color(c)) for v, c in zip(levels, level_rgb)]
+        return ro.colourbar_html(colours.cmap_stops(w.cmap), lo, hi, str(label), getattr(inner, "units", None),
                                  marks, cmap=w.cmap)
 
     def group_colors(self):
@@ -444,7 +444,7 @@ class Painter:
         return w.scene.palette(int(src.n_groups)), None
 
 
-def level_colors(source, cmap: str = look.LEVEL_COLORMAP, clim=None):
+def level_colors(source, cmap: str = colours.LEVEL_COLORMAP, clim=None):
     """Colours of a source's iso levels along the colour map ``cmap``, or None: spread over it by
     rank (``clim`` None: the data's range as known without a full read -- a chunked store's first
     cut until its background read is done -- today's look), else each at its value in ``clim``."""
@@ -452,9 +452,9 @@ def level_colors(source, cmap: str = look.LEVEL_COLORMAP, clim=None):
     if not levels:
         return None
     if clim is not None:
-        return look.level_colors(levels, clim[0], clim[1], cmap, by_value=True)
+        return colours.level_colors(levels, clim[0], clim[1], cmap, by_value=True)
     lo, hi = known_range(source, (min(levels), max(levels)))
-    return look.level_colors(levels, lo, hi, cmap)
+    return colours.level_colors(levels, lo, hi, cmap)
 
 
 def volume_text(source, volume: float, matrix) -> str:

@@ -49,7 +49,7 @@ import uuid
 
 import numpy as np
 
-from ..core import look
+from ..core import camera, colours, renderings
 from ..sources.protocol import inner_source, w_frame
 from . import markup
 from .keypad import close_quietly
@@ -75,12 +75,12 @@ CROSSING_RGB = "#e07b00"
 
 
 class ProjectionFlag(Checked):
-    """The ``projection`` trait: True or False (`rot4d_widget.core.look.check_projection`)."""
+    """The ``projection`` trait: True or False (`rot4d_widget.core.renderings.check_projection`)."""
 
     info_text = "True or False"
 
     def check(self, name, value):
-        return look.check_projection(value)
+        return renderings.check_projection(value)
 
 
 def tesseract(half_widths) -> tuple:
@@ -279,12 +279,12 @@ class ProjectionView:
         self._points = p3.Points(geometry=self._point_geometry, material=self._point_material,
                                  frustumCulled=False, name="projection crossings", visible=False)
         self._camera = p3.PerspectiveCamera(
-            position=[c * CAMERA_FARTHER for c in look.CAMERA_POSITION], fov=look.CAMERA_FOV, aspect=width / height,
-            near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
+            position=[c * CAMERA_FARTHER for c in camera.CAMERA_POSITION], fov=camera.CAMERA_FOV, aspect=width / height,
+            near=camera.CAMERA_NEAR, far=camera.CAMERA_FAR,
         )
         self._scene = p3.Scene(children=[self._lines, self._points, self._camera], background=None)
         self._controls = p3.OrbitControls(controlling=self._camera, enableKeys=False)
-        background = look.hex_color(look.as_rgb(w.background, "background"))
+        background = colours.hex_color(colours.as_rgb(w.background, "background"))
         self.renderer = p3.Renderer(camera=self._camera, scene=self._scene, controls=[self._controls],
                                     width=width, height=height, background=background, background_opacity=1.0,
                                     clearColor=background)

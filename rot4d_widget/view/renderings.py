@@ -3,7 +3,7 @@ keys that change them (v cycles the rendering, Shift+v backwards; a, s, d move t
 section plane, Shift back).
 
 Both are view settings: they change what the scene shows of the same cut, not the state or the
-source.  The "sections" rendering is seen from `look.SECTIONS_CAMERA_POSITION` (no plane
+source.  The "sections" rendering is seen from `camera.SECTIONS_CAMERA_POSITION` (no plane
 edge-on) while the camera is where the rendering before left it by default; a camera the user
 moved stays.  Every change, by trait or key, redraws; the keeper records it (it watches the traits:
 `rot4d_widget.view.keeping.Keeper`), so a replay and an animation draw the same.  A source that
@@ -13,7 +13,7 @@ surface rendering: setting another is a ValueError that says so, and the keys do
 
 from __future__ import annotations
 
-from ..core import look
+from ..core import camera, renderings
 from ..core.rotation import quaternion_xyzw
 from .cuts import can_sample
 from .fieldkeys import SECTION_STEP
@@ -33,18 +33,18 @@ class Renderings:
         self.follow_camera("surface", self.w.rendering)  # made to show sections: seen at a slant
 
     def follow_camera(self, old: str, new: str) -> None:
-        """The camera to ``new``'s default (`look.default_eye`: sections at a slant, so that all three
+        """The camera to ``new``'s default (`camera.default_eye`: sections at a slant, so that all three
         planes show) when it is at ``old``'s, i.e. the user has not moved it; else left alone.  The
         camera (the canvas's) gets its position and its turn in one message -- three.js turns no
-        camera that moves -- looking at the origin, +y up (`look.view_rotation`, the static
+        camera that moves -- looking at the origin, +y up (`camera.view_rotation`, the static
         pictures' look-at); the scene's eye callbacks follow (the faces re-sent in their order)."""
         scene = self.w.scene
-        before, after = look.default_eye(old), look.default_eye(new)
+        before, after = camera.default_eye(old), camera.default_eye(new)
         if before != after and all(abs(a - b) < 1e-9 for a, b in zip(scene.eye, before)):
-            camera = scene.canvas.camera
-            with camera.hold_sync():
-                camera.quaternion = quaternion_xyzw(look.view_rotation(after).T)
-                camera.position = [float(v) for v in after]
+            cam = scene.canvas.camera
+            with cam.hold_sync():
+                cam.quaternion = quaternion_xyzw(camera.view_rotation(after).T)
+                cam.position = [float(v) for v in after]
 
     # -- traits -----------------------------------------------------------------------------
     def on_trait(self, change) -> None:
@@ -72,7 +72,7 @@ class Renderings:
             return False
         direction = -1 if inverted else 1
         if action.kind == "rendering":
-            order = look.RENDERINGS
+            order = renderings.RENDERINGS
             old = w.rendering
             new = order[(order.index(old) + direction * action.sign) % len(order)]
             self._set("rendering", new)

@@ -10,7 +10,7 @@ Layers
 ------
 Balls at a slice's points, bars along its segments and translucent faces
 coloured by group, seen by a perspective camera at (0, 0, 5) looking down -z
-(the paper's view; `rot4d_widget.core.look`), turned with the mouse by
+(the paper's view; `rot4d_widget.core.camera`), turned with the mouse by
 OrbitControls (keys disabled).  Every source is scaled by
 ``REFERENCE_RADIUS / source.size`` so it appears the size of the pentachoron.
 Each layer is one instanced mesh with its own `ShaderMaterial` (GLSL in
@@ -68,7 +68,7 @@ import uuid
 import numpy as np
 import pythreejs as p3
 
-from ..core import look
+from ..core import camera, colours
 from . import buffers as bf
 from .cuts import NO_LABELS, CutLabels
 from .field_layer import FieldLayer
@@ -105,7 +105,7 @@ def _pixels(name, value):
 
 def _group_colors(value, n_groups):
     if value is None:
-        return look.group_palette(max(n_groups, 1))
+        return colours.group_palette(max(n_groups, 1))
     if isinstance(value, str):
         raise ValueError("Expected `group_colors` to be a sequence of colours, one per group, got a string")
     try:
@@ -115,7 +115,7 @@ def _group_colors(value, n_groups):
     if len(items) < n_groups:
         raise ValueError(f"Expected `group_colors` to have at least {n_groups} colours (one per group), "
                          f"got {len(items)}")
-    rgb = [look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(items)]
+    rgb = [colours.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(items)]
     return np.asarray(rgb, dtype=np.float32)
 
 
@@ -144,7 +144,7 @@ class Scene:
     face_opacity : float in [0, 1]
     background, ball_color, bar_color : '#rgb', '#rrggbb' or (r, g, b) in [0, 1]
     group_colors : sequence of such colours, at least one per group, optional
-        Default `rot4d_widget.core.look.group_palette`.
+        Default `rot4d_widget.core.colours.group_palette`.
     show_balls, show_bars, show_faces : bool
     antialias : bool
         WebGL multisampling (default False).
@@ -168,10 +168,10 @@ class Scene:
         height=500,
         ball_radius=0.07,
         bar_radius=0.028,
-        face_opacity=look.FACE_OPACITY,
-        background=look.BACKGROUND,
-        ball_color=look.BALL_COLOR,
-        bar_color=look.BAR_COLOR,
+        face_opacity=colours.FACE_OPACITY,
+        background=colours.BACKGROUND,
+        ball_color=colours.BALL_COLOR,
+        bar_color=colours.BAR_COLOR,
         group_colors=None,
         show_balls=True,
         show_bars=True,
@@ -183,8 +183,8 @@ class Scene:
             raise ValueError(f"Expected `n_groups` to be an int >= 1, got {n_groups!r}")
         self.width = _pixels("width", width)
         self.height = _pixels("height", height)
-        self.ball_color = look.as_rgb(ball_color, "ball_color")
-        self.bar_color = look.as_rgb(bar_color, "bar_color")
+        self.ball_color = colours.as_rgb(ball_color, "ball_color")
+        self.bar_color = colours.as_rgb(bar_color, "bar_color")
         if not isinstance(antialias, bool):
             raise TypeError(f"Expected `antialias` to be True or False, got {antialias!r}")
         self.group_rgb = _group_colors(group_colors, int(n_groups))
@@ -306,7 +306,7 @@ class Scene:
             elif name == "face_opacity":
                 out[name] = _unit(name, value)
             elif name == "background":
-                look.as_rgb(value, "background")
+                colours.as_rgb(value, "background")
                 out[name] = value
             elif name in ("show_balls", "show_bars", "show_faces"):
                 out[name] = _flag(name, value)
@@ -325,7 +325,7 @@ class Scene:
             elif name == "face_opacity":
                 self._materials["face"].uniforms = self._face_uniforms(value)
             elif name == "background":
-                h = look.hex_color(look.as_rgb(value, "background"))
+                h = colours.hex_color(colours.as_rgb(value, "background"))
                 with self._renderer.hold_sync():
                     self._renderer.background = h
                     self._renderer.clearColor = h
@@ -337,14 +337,14 @@ class Scene:
 
     def palette(self, n_groups: int) -> np.ndarray:
         """(n, 3) colours for ``n_groups`` groups: the ``group_colors`` given, followed where they
-        run out by `rot4d_widget.core.look.group_palette` (a source's group count may change at run
+        run out by `rot4d_widget.core.colours.group_palette` (a source's group count may change at run
         time: a stack taken down to one slice shows its inner source's cells)."""
         n = max(int(n_groups), 1)
         if self._user_rgb is None:
-            return look.group_palette(n) if n != len(self.group_rgb) else self.group_rgb
+            return colours.group_palette(n) if n != len(self.group_rgb) else self.group_rgb
         if len(self._user_rgb) >= n:
             return self._user_rgb
-        more = np.asarray(look.group_palette(n), dtype=np.float32)[len(self._user_rgb):]
+        more = np.asarray(colours.group_palette(n), dtype=np.float32)[len(self._user_rgb):]
         return np.concatenate([self._user_rgb, more])
 
     # -- the update --------------------------------------------------------
@@ -374,7 +374,7 @@ class Scene:
             arrays = bf.surface_arrays(data, scale=self.scale, eye=self.eye, single_rgb=single_rgb,
                                        group_rgb=self.group_rgb if group_rgb is None else group_rgb)
             n_levels = len(np.unique(np.asarray(data.groups))) if len(data.groups) else 0
-            surface = bf.surface_message(arrays, 1.0 if n_levels <= 1 else look.SURFACE_OPACITY)
+            surface = bf.surface_message(arrays, 1.0 if n_levels <= 1 else colours.SURFACE_OPACITY)
             data = bf.without_triangles(data)
         elif self._surface_shown or volume is not None:
             surface = {}
@@ -611,12 +611,12 @@ def _build_three(scene, antialias, display):
     scene._field = FieldLayer(scene._light)  # the page's own picture of a field (issue 36): hidden
     scene._meshes["field"] = scene._field.build(shader_source)
     scene._camera = p3.PerspectiveCamera(
-        position=list(look.CAMERA_POSITION), fov=look.CAMERA_FOV, aspect=scene.width / scene.height,
-        near=look.CAMERA_NEAR, far=look.CAMERA_FAR,
+        position=list(camera.CAMERA_POSITION), fov=camera.CAMERA_FOV, aspect=scene.width / scene.height,
+        near=camera.CAMERA_NEAR, far=camera.CAMERA_FAR,
     )
     scene._three_scene = p3.Scene(children=[*scene._meshes.values(), scene._camera], background=None)
     scene._controls = p3.OrbitControls(controlling=scene._camera, enableKeys=False)
-    background = look.hex_color(look.as_rgb(display["background"], "background"))
+    background = colours.hex_color(colours.as_rgb(display["background"], "background"))
     scene._renderer = p3.Renderer(
         camera=scene._camera,
         scene=scene._three_scene,

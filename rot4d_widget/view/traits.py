@@ -24,7 +24,7 @@ from numbers import Integral, Real
 import numpy as np
 import traitlets
 
-from ..core import look
+from ..core import colours, renderings
 from ..core.state import check_theta0
 from ..core.validate import real
 
@@ -69,7 +69,7 @@ def check_color_by(value):
     if value == "group":
         return value
     try:
-        look.as_rgb(value, "color_by")
+        colours.as_rgb(value, "color_by")
     except ValueError:
         raise ValueError(
             "Expected `color_by` to be 'group' or one colour ('#rrggbb', '#rgb', three floats in [0, 1]), "
@@ -138,7 +138,7 @@ class Colour(Checked):
     info_text = "a colour ('#rrggbb', '#rgb' or three floats in [0, 1])"
 
     def check(self, name, value):
-        look.as_rgb(value, name)
+        colours.as_rgb(value, name)
         return value
 
 
@@ -225,41 +225,41 @@ class Levels(Checked):
 
 
 class Cmap(Checked):
-    """A matplotlib colour map name (`rot4d_widget.core.look.check_cmap`: the message says how to
+    """A matplotlib colour map name (`rot4d_widget.core.colours.check_cmap`: the message says how to
     list them)."""
 
     info_text = "a matplotlib colour map name"
 
     def check(self, name, value):
-        return look.check_cmap(value, name)
+        return colours.check_cmap(value, name)
 
 
 class Clim(Checked):
     """Colour limits (lo, hi): two finite numbers, lo < hi, kept as a tuple of floats; None (when
-    ``allow_none``) for the data's range (`rot4d_widget.core.look.check_clim`)."""
+    ``allow_none``) for the data's range (`rot4d_widget.core.colours.check_clim`)."""
 
     info_text = "(lo, hi), two finite numbers with lo < hi"
 
     def check(self, name, value):
         if value is None:  # None is refused here only when the trait does not allow it
             raise TypeError(f"Expected `{name}` to be {self.info_text}, got None")
-        return look.check_clim(value, name)
+        return colours.check_clim(value, name)
 
 
 class Rendering(Checked):
-    """How a field's cut is drawn: one of `rot4d_widget.core.look.RENDERINGS`."""
+    """How a field's cut is drawn: one of `rot4d_widget.core.renderings.RENDERINGS`."""
 
-    info_text = " or ".join(map(repr, look.RENDERINGS))
+    info_text = " or ".join(map(repr, renderings.RENDERINGS))
 
     def check(self, name, value):
-        return look.check_rendering(value, name)
+        return renderings.check_rendering(value, name)
 
 
 class Sections(Checked):
     """The section planes' positions (fx, fy, fz), each in [0, 1] of the cut's extent, as a tuple of
-    floats (`rot4d_widget.core.look.check_sections`)."""
+    floats (`rot4d_widget.core.renderings.check_sections`)."""
 
     info_text = "(fx, fy, fz), three numbers in [0, 1]"
 
     def check(self, name, value):
-        return look.check_sections(value, name)
+        return renderings.check_sections(value, name)

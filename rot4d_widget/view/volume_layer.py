@@ -36,7 +36,7 @@ import math
 import numpy as np
 import pythreejs as p3
 
-from ..core import look
+from ..core import colours, renderings
 
 __all__ = ["VolumeLayer", "volume_message", "pack_atlas", "colour_table", "MODES", "ATLAS_MAX"]
 
@@ -60,10 +60,10 @@ def _table_bytes(cmap: str) -> bytes:
 
 def colour_table(cmap: str) -> np.ndarray:
     """(256, 4) uint8: matplotlib's table of ``cmap`` (entry i = ``cmap(i / 255)``), alpha 255."""
-    # matplotlib's colour map registry, looked up by name (core.look names the maps)
+    # matplotlib's colour map registry, looked up by name (core.colours names the maps)
     from matplotlib import colormaps
 
-    rgba = np.asarray(colormaps[look.check_cmap(cmap)](np.arange(256) / 255.0))
+    rgba = np.asarray(colormaps[colours.check_cmap(cmap)](np.arange(256) / 255.0))
     return np.round(np.clip(rgba, 0.0, 1.0) * 255.0).astype(np.uint8)
 
 
@@ -116,7 +116,7 @@ def pack_atlas(grids, clim):
     return atlas, places
 
 
-def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = look.DEFAULT_DENSITY, *,
+def volume_message(parts, rendering: str, cmap: str, clim, sections, density: float = renderings.DEFAULT_DENSITY, *,
                    held: bool = False) -> dict:
     """The synced dict of one volume update.
 
@@ -146,9 +146,9 @@ def volume_message(parts, rendering: str, cmap: str, clim, sections, density: fl
         "boxes": memoryview(boxes.astype("<f4").tobytes()),
         "atlas": memoryview(np.ascontiguousarray(atlas).tobytes()),
         "atlas_size": [int(w), int(h)],
-        "lut": memoryview(_table_bytes(look.check_cmap(cmap))),
+        "lut": memoryview(_table_bytes(colours.check_cmap(cmap))),
         "mode": MODES[rendering],
-        "sections": [float(s) for s in look.check_sections(sections)],
+        "sections": [float(s) for s in renderings.check_sections(sections)],
         "density": float(density),
         "step": float(step),
         "held": bool(held),
@@ -182,7 +182,8 @@ class VolumeLayer:
                 # ShaderMaterial): placeholders, so that the names are in the material's uniforms
                 "u_atlas": {"value": None}, "u_lut": {"value": None},
                 "u_atlas_size": {"value": [1.0, 1.0]}, "u_mode": {"value": 0.0},
-                "u_sections": {"value": list(look.DEFAULT_SECTIONS)}, "u_density": {"value": look.DEFAULT_DENSITY},
+                "u_sections": {"value": list(renderings.DEFAULT_SECTIONS)},
+                "u_density": {"value": renderings.DEFAULT_DENSITY},
                 "u_step": {"value": STEP},
             },
             side="BackSide", transparent=True, depthWrite=False,

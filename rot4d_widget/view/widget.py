@@ -49,7 +49,7 @@ import numpy as np
 import traitlets
 from ipyevents import Event
 
-from ..core import look
+from ..core import colours, renderings, sizes
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
 from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
 from ..sources.arrangements import ARRANGEMENTS
@@ -123,7 +123,7 @@ class Rot4DWidget(widgets.HBox):
         Canvas size in pixels (default 600 x 500).
     ball_radius, bar_radius : float, optional
         In displayed units (every source is drawn with circumradius
-        `rot4d_widget.core.look.REFERENCE_RADIUS`).  Default from the source's edge
+        `rot4d_widget.core.sizes.REFERENCE_RADIUS`).  Default from the source's edge
         length (polytopes) or its first slice.
     face_opacity : float in [0, 1]
     background : colour ('#rrggbb', '#rgb' or three floats in [0, 1])
@@ -171,8 +171,8 @@ class Rot4DWidget(widgets.HBox):
     orientation = traitlets.Any(read_only=True, help="(4, 4) rotation matrix, read-only")
     ball_radius = t.Positive(0.07, upper=10.0, help="ball radius, displayed units")
     bar_radius = t.Positive(0.028, upper=10.0, help="bar radius, displayed units")
-    face_opacity = t.Fraction(look.FACE_OPACITY, help="opacity of the faces, in [0, 1]")
-    background = t.Colour(look.BACKGROUND, help="background colour")
+    face_opacity = t.Fraction(colours.FACE_OPACITY, help="opacity of the faces, in [0, 1]")
+    background = t.Colour(colours.BACKGROUND, help="background colour")
     show_balls = t.Flag(True)
     show_bars = t.Flag(True)
     show_faces = t.Flag(True)
@@ -188,19 +188,19 @@ class Rot4DWidget(widgets.HBox):
                      help="parallel slices shown; None for a single view until set (or n pressed)")
     spacing = t.Spacing(None, allow_none=True, help="distance between parallel slices, in the source's w units")
     arrangement = t.Choice(None, ARRANGEMENTS, allow_none=True, help="where the parallel slices are placed")
-    cmap = t.Cmap(look.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
+    cmap = t.Cmap(colours.LEVEL_COLORMAP, help="a field's colour map (a matplotlib colour map name)")
     clim = t.Clim(None, allow_none=True, help="a field's colour limits (lo, hi); None: the data's range")
     rendering = t.Rendering("surface", help="how a field's cut is drawn: surface, volume, mip or sections")
-    sections = t.Sections(look.DEFAULT_SECTIONS, help="the section planes, fractions (fx, fy, fz) of the cut")
+    sections = t.Sections(renderings.DEFAULT_SECTIONS, help="the section planes, fractions (fx, fy, fz) of the cut")
     projection = ProjectionFlag(False, help="the whole object projected, beside the slice (`view.projection`)")
 
     def __init__(
         self, source="5-cell", theta0: float = DEFAULT_THETA0, alpha: float | None = None, c0: float | None = None,
         *, keymap: Keymap = DEFAULT_KEYMAP, c0_step: float | None = None, width: int = 600, height: int = 500,
-        ball_radius: float | None = None, bar_radius: float | None = None, face_opacity: float = look.FACE_OPACITY,
-        background=look.BACKGROUND, show_balls: bool = True, show_bars: bool = True, show_faces: bool = True,
+        ball_radius: float | None = None, bar_radius: float | None = None, face_opacity: float = colours.FACE_OPACITY,
+        background=colours.BACKGROUND, show_balls: bool = True, show_bars: bool = True, show_faces: bool = True,
         color_by="group", group_colors=None, levels=None, slices=None, spacing=None, arrangement="oval",
-        cmap: str = look.LEVEL_COLORMAP, clim=None, rendering: str = "surface", sections=look.DEFAULT_SECTIONS,
+        cmap: str = colours.LEVEL_COLORMAP, clim=None, rendering: str = "surface", sections=renderings.DEFAULT_SECTIONS,
         antialias: bool = False, keypad: bool = False, projection: bool = False, hold_delay: float = HOLD_DELAY,
         tick_rate: float = TICK_RATE, ack_timeout: float = ACK_TIMEOUT, _clock=None, _autotick: bool = True,
     ):
@@ -213,16 +213,16 @@ class Rot4DWidget(widgets.HBox):
         ack_timeout = positive_seconds("ack_timeout", ack_timeout)
         if _clock is not None and not callable(_clock):
             raise TypeError(f"Expected `_clock` to be a callable returning seconds, got {type(_clock).__name__}")
-        color_by, cmap, clim = t.check_color_by(color_by), look.check_cmap(cmap), look.check_clim(clim)
-        rendering, sections, projection = (_check_rendering(src, rendering), look.check_sections(sections),
-                                           look.check_projection(projection))
-        scale = look.REFERENCE_RADIUS / float(src.size)
+        color_by, cmap, clim = t.check_color_by(color_by), colours.check_cmap(cmap), colours.check_clim(clim)
+        rendering, sections, projection = (_check_rendering(src, rendering), renderings.check_sections(sections),
+                                           renderings.check_projection(projection))
+        scale = sizes.REFERENCE_RADIUS / float(src.size)
         coarse_ok = takes_coarse(src)
         if ball_radius is None:
             ball_radius = _default_ball_radius(src, scale, state)
         if bar_radius is None:
             # a field's bars only outline its data's box: thin
-            bar_radius = look.default_bar_radius(ball_radius) * (0.35 if coarse_ok else 1.0)
+            bar_radius = sizes.default_bar_radius(ball_radius) * (0.35 if coarse_ok else 1.0)
 
         self.source = src
         self.state = state
@@ -604,9 +604,9 @@ def _build_children(w, options) -> None:
 
 
 def _check_rendering(source, rendering) -> str:
-    """``rendering`` checked (`look.check_rendering`) and possible for ``source``: only a source that
+    """``rendering`` checked (`renderings.check_rendering`) and possible for ``source``: only a source that
     gives its cut on a grid (``sample``) has more than the surface."""
-    rendering = look.check_rendering(rendering)
+    rendering = renderings.check_rendering(rendering)
     if rendering != "surface" and not can_sample(source):
         raise ValueError(f"rendering={rendering!r} needs a field (a source with `sample`, the cut on a grid); "
                          f"{title(source)} has only rendering='surface'")
@@ -656,5 +656,5 @@ def _default_ball_radius(source, scale, state) -> float:
             p = np.asarray(data.points, dtype=np.float64)
             edge = float(np.median(np.linalg.norm(p[seg[:, 0]] - p[seg[:, 1]], axis=1)))
         if not edge:
-            return look.default_ball_radius(0.3)
-    return look.default_ball_radius(float(edge) * scale)
+            return sizes.default_ball_radius(0.3)
+    return sizes.default_ball_radius(float(edge) * scale)

@@ -18,7 +18,7 @@ import pytest
 
 from jupyter_page import JupyterPage
 from rot4d_widget import simple_rotation
-from rot4d_widget.core import look
+from rot4d_widget.core import colours
 from test_widget_browser import TAP_KEYS, _bad_console, _canvas, _hover, _state, _timing_bound
 
 #: Screenshots to look at (not test artifacts: the issue asks for them here).
@@ -65,7 +65,7 @@ def _surface_pixels(jp, sel):
 
 def test_the_level_colour_is_green():
     """What _SURFACE_PIXELS looks for: the colour of a single level."""
-    r, g, b = look.level_colors([0.0], -1.0, 1.0)[0]
+    r, g, b = colours.level_colors([0.0], -1.0, 1.0)[0]
     assert g > r + 0.3 and g > b + 0.3, (r, g, b)
 
 

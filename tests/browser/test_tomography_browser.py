@@ -21,7 +21,7 @@ CELL = """\
 import itertools
 import numpy as np
 from rot4d_widget import Rot4DWidget
-from rot4d_widget.core import look
+from rot4d_widget.core import camera
 w = Rot4DWidget('24-cell', slices=5, spacing=0.3, arrangement='oval')
 
 def slice_boxes():
@@ -29,7 +29,7 @@ def slice_boxes():
     centres, scales = w.source.layout()
     k, r = w.scene.scale, w.source.size
     eye = np.array(w.scene.eye)
-    f = 1.0 / np.tan(np.radians(look.CAMERA_FOV) / 2)
+    f = 1.0 / np.tan(np.radians(camera.CAMERA_FOV) / 2)
     W, H = w.scene.width, w.scene.height
     out = []
     for c, s in zip(np.asarray(centres), np.asarray(scales)):

@@ -22,8 +22,8 @@ import io, math
 import numpy as np
 from PIL import Image
 from rot4d_widget import Field4D, Rot4DWidget
-from rot4d_widget.core import look
-from rot4d_widget.core.look import view_rotation
+from rot4d_widget.core import camera
+from rot4d_widget.core.camera import view_rotation
 from rot4d_widget.keep.pictures.ray_caster import render_grid
 
 # an off-centre blob in x, y, z, t and a second, weaker one: where the values are high and low
@@ -41,7 +41,7 @@ def compare(png, rendering):
     '''The page's PNG against render_grid of the widget's cut through the live camera.'''
     page = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(float) / 255.0
     g = field.sample(w.state.matrix, w.c0)
-    half_h = look.CAMERA_POSITION[2] * math.tan(math.radians(look.CAMERA_FOV / 2))
+    half_h = camera.CAMERA_POSITION[2] * math.tan(math.radians(camera.CAMERA_FOV / 2))
     half_w = half_h * W / H
     opts = dict(sections=tuple(w.sections)) if rendering == "sections" else {}
     rgba = render_grid(g, rendering, size=(W, H), limits=((-half_w, half_w), (-half_h, half_h)), cmap=w.cmap,

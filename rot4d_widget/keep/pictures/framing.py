@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from ...core import look
-from ...core.look import REFERENCE_RADIUS
+from ...core import colours
+from ...core.sizes import REFERENCE_RADIUS
 from ...sources.field_labels import axis_names
 from ...sources.protocol import c0_text
 from .slice_drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
@@ -78,25 +78,25 @@ def _fmt_angle(theta: float) -> str:
     return f"{theta:.4g} rad ({math.degrees(theta):.4g}\u00b0)"
 
 
-def _level_colors(levels, lo, hi, cmap: str = look.LEVEL_COLORMAP, by_value: bool = False) -> np.ndarray:
-    """`look.level_colors` (read-only), kept for the levels, range, map and rule it was asked for:
+def _level_colors(levels, lo, hi, cmap: str = colours.LEVEL_COLORMAP, by_value: bool = False) -> np.ndarray:
+    """`colours.level_colors` (read-only), kept for the levels, range, map and rule it was asked for:
     it copies the colormap and builds its table on every call, twice an animation's frame."""
     try:
         key = (tuple(float(v) for v in levels), lo, hi, cmap, bool(by_value))
         hash(key)
-    except TypeError:  # nothing to key it by: as look computes it
-        return look.level_colors(levels, lo, hi, cmap, by_value=by_value)
+    except TypeError:  # nothing to key it by: as colours computes it
+        return colours.level_colors(levels, lo, hi, cmap, by_value=by_value)
     return _level_colors_kept(*key)
 
 
 @functools.lru_cache(maxsize=64)
 def _level_colors_kept(levels: tuple, lo: float, hi: float, cmap: str, by_value: bool) -> np.ndarray:
-    rgb = look.level_colors(levels, lo, hi, cmap, by_value=by_value)
+    rgb = colours.level_colors(levels, lo, hi, cmap, by_value=by_value)
     rgb.flags.writeable = False
     return rgb
 
 
-def level_rgb(inner, cmap: str = look.LEVEL_COLORMAP, clim=None):
+def level_rgb(inner, cmap: str = colours.LEVEL_COLORMAP, clim=None):
     """(n, 3) colours of ``inner``'s iso ``levels`` along ``cmap`` (None without levels): the live
     view's rule (`rot4d_widget.view.painter.level_colors`) -- ``clim`` None: spread by rank over the
     map (the data's range orders them), else each at its value over ``clim``."""
@@ -109,7 +109,7 @@ def level_rgb(inner, cmap: str = look.LEVEL_COLORMAP, clim=None):
     return _level_colors(levels, lo, hi, cmap)
 
 
-def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: str = look.LEVEL_COLORMAP,
+def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: str = colours.LEVEL_COLORMAP,
                clim=None, matrix=None):
     """``(lines, legend)`` describing slice ``data`` of ``source`` (a `StackSource`) at ``c0``:
     ``lines`` of text (θ0 when given and c0; the inner source's ``name`` and ``units``; its

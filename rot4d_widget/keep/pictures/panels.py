@@ -12,8 +12,8 @@ import string
 import numpy as np
 from matplotlib.figure import Figure
 
-from ...core import look
-from ...core.look import REFERENCE_RADIUS
+from ...core import colours, sizes
+from ...core.sizes import REFERENCE_RADIUS
 from ...core.state import RotationState
 from ...geometry.mesh import Polytope
 from ...geometry.regular import pentachoron
@@ -42,7 +42,7 @@ def _grid_figure(n_panels: int, ncols: int, panel_size: float, dpi: float, title
     nrows = -(-n_panels // ncols)
     top = TITLE_HEIGHT if title else 0.0
     width, height = ncols * panel_size, nrows * panel_size + top
-    fig = LiteralTextFigure(figsize=(width, height), dpi=dpi, facecolor=look.BACKGROUND)
+    fig = LiteralTextFigure(figsize=(width, height), dpi=dpi, facecolor=colours.BACKGROUND)
     axes = []
     for k in range(nrows * ncols):
         r, c = divmod(k, ncols)
@@ -77,7 +77,7 @@ def panel_style(polytope, scale: float | None = None) -> dict:
 
     ``scale`` defaults to ``REFERENCE_RADIUS / circumradius`` (every polytope the size of the paper's
     pentachoron); the ``radius`` is the scaled circumradius; balls and bars follow the scaled
-    edge length as in the live view (``look.default_ball_radius`` and ``look.default_bar_radius``:
+    edge length as in the live view (``sizes.default_ball_radius`` and ``sizes.default_bar_radius``:
     the pentachoron's 0.07 and 0.028 at most, so that the 600 vertices of the 120-cell do not
     merge).  Use as ``draw_slice(ax, s, **panel_style(p))``.
     """
@@ -85,9 +85,9 @@ def panel_style(polytope, scale: float | None = None) -> dict:
     s = _default_scale(poly, scale)
     e = np.asarray(poly.edges, dtype=np.int64).reshape(-1, 2)
     edge = float(np.linalg.norm(poly.vertices[e[:, 0]] - poly.vertices[e[:, 1]], axis=1).mean()) if len(e) else 1.0
-    ball = look.default_ball_radius(edge * s)
+    ball = sizes.default_ball_radius(edge * s)
     return {"scale": s, "radius": s * float(poly.circumradius), "ball_radius": ball,
-            "bar_radius": look.default_bar_radius(ball)}
+            "bar_radius": sizes.default_bar_radius(ball)}
 
 
 def render_slice(

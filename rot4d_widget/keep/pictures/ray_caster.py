@@ -47,24 +47,22 @@ import math
 import numpy as np
 from scipy.ndimage import map_coordinates
 
-from ...core import look
-from ...core.look import (
-    DEFAULT_DENSITY,
-    DEFAULT_SECTIONS,
-    REFERENCE_RADIUS,
-    default_clim,
-)
+from ...core import camera, colours, renderings
+from ...core.colours import default_clim
 from ...core.progress import progress as make_progress
+from ...core.renderings import DEFAULT_DENSITY, DEFAULT_SECTIONS
+from ...core.sizes import REFERENCE_RADIUS
 from . import ray_caster_kernels
 
 #: How far the live view's camera is from the centre (`rot4d_widget.keep.pictures.slice_drawing.CAMERA_DISTANCE`,
 #: the same number: that module imports matplotlib, which the widget's import does not need)
-CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
+CAMERA_DISTANCE = float(camera.CAMERA_POSITION[2])
 
 __all__ = ["VOLUME_RENDERINGS", "pixel_rays", "render_grid", "composite", "draw_volume", "cut_grids"]
 
-# RENDERINGS (what `render_state` draws for a field), check_rendering, view_rotation and the defaults
-# DEFAULT_DENSITY, DEFAULT_SECTIONS and default_clim are core.look's (the live view uses them too).
+# RENDERINGS (what `render_state` draws for a field), check_rendering and the defaults DEFAULT_DENSITY
+# and DEFAULT_SECTIONS are core.renderings', view_rotation core.camera's and default_clim core.colours'
+# (the live view uses them too).
 #: The renderings ray-cast here.
 VOLUME_RENDERINGS = ("volume", "mip", "sections")
 #: Samples handed to one interpolation call (memory: about 200 bytes each while they are worked on).
@@ -182,10 +180,10 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
     if rendering not in VOLUME_RENDERINGS:
         raise ValueError(f"Expected `rendering` to be one of {', '.join(map(repr, VOLUME_RENDERINGS))}, "
                          f"got {rendering!r}")
-    colormap = colormaps[look.check_cmap(cmap)]
-    fractions = np.asarray(look.check_sections(sections), dtype=np.float64)
+    colormap = colormaps[colours.check_cmap(cmap)]
+    fractions = np.asarray(renderings.check_sections(sections), dtype=np.float64)
     vals = np.asarray(grid.values)
-    clim = default_clim(vals) if clim is None else look.check_clim(clim)
+    clim = default_clim(vals) if clim is None else colours.check_clim(clim)
     w_px, h_px = (int(v) for v in size)
     if grid.empty or min(vals.shape) < 2:
         return np.zeros((h_px, w_px, 4))

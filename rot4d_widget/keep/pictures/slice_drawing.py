@@ -7,10 +7,11 @@ paper).  A 3-D point is projected by hand,
     x' = x d / (d - z),    y' = y d / (d - z),
 
 and every radius at that point is multiplied by the same factor ``d / (d - z)``.  The frame is the
-live view's camera (:mod:`rot4d_widget.core.look`): a vertical field of view of ``fov`` = 40 degrees, so
+live view's camera (:mod:`rot4d_widget.core.camera`): a vertical field of view of ``fov`` = 40 degrees, so
 the axes span ``|y'| <= d tan(fov / 2)`` and ``|x'| <=`` that times the panel's aspect, and a point
 sits in the panel where a three.js ``PerspectiveCamera`` at (0, 0, 5) with that fov and aspect puts
-it.  Palette, scale, default radii and colours come from :mod:`rot4d_widget.core.look` too, so a 4-D
+it.  Palette and colours come from :mod:`rot4d_widget.core.colours`, scale and default radii from
+:mod:`rot4d_widget.core.sizes`, so a 4-D
 cell has the same colour here and in the widget.  Artists are
 painted back to front (painter's algorithm, by the depth of a ball's centre, a bar's midpoint, a
 face's centroid), so nearer things cover farther ones.
@@ -18,7 +19,7 @@ face's centroid), so nearer things cover farther ones.
 * balls at slice vertices (circles, with a small highlight),
 * bars along slice edges (trapezoids whose width follows the perspective of each end),
 * translucent faces (slice polygons), coloured by the 4-D cell they are cut from
-  (``look.group_palette``, the live view's palette).
+  (``colours.group_palette``, the live view's palette).
 
 Also the validators and the saving helper the other picture modules share.
 """
@@ -36,21 +37,21 @@ from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from ...core import look
-from ...core.look import REFERENCE_RADIUS
+from ...core import camera, colours, sizes
+from ...core.sizes import REFERENCE_RADIUS
 from ...core.state import PAPER_ALPHA_RATIO
 from ...geometry.catalogue import polytope as _named_polytope
 from ...geometry.mesh import Polytope
 from ...geometry.slicing.tables import Slice
 
-#: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``look.CAMERA_POSITION``).
-CAMERA_DISTANCE = float(look.CAMERA_POSITION[2])
-#: Vertical field of view of the frame, degrees (``look.CAMERA_FOV``, the live camera's).
-CAMERA_FOV = float(look.CAMERA_FOV)
-# REFERENCE_RADIUS (from look): the paper's pentachoron's circumradius (edge a = 2), sqrt(2/5) * a.
+#: The paper's viewpoint: the eye at (0, 0, 5) looking down -z (``camera.CAMERA_POSITION``).
+CAMERA_DISTANCE = float(camera.CAMERA_POSITION[2])
+#: Vertical field of view of the frame, degrees (``camera.CAMERA_FOV``, the live camera's).
+CAMERA_FOV = float(camera.CAMERA_FOV)
+# REFERENCE_RADIUS (from core.sizes): the paper's pentachoron's circumradius (edge a = 2), sqrt(2/5) * a.
 # Other polytopes are scaled to it by default so that they appear the same size.
 #: Edge of the pentachoron of circumradius REFERENCE_RADIUS: the default ball and bar radii of
-#: :func:`draw_slice` are this edge's (``look.default_ball_radius(2.0)`` = 0.07).
+#: :func:`draw_slice` are this edge's (``sizes.default_ball_radius(2.0)`` = 0.07).
 _REFERENCE_EDGE = REFERENCE_RADIUS / math.sqrt(2.0 / 5.0)
 #: Fig. 3: key "4" (R_xw) with theta0 = pi/16.
 FIG3_THETA0 = math.pi / 16
@@ -123,11 +124,11 @@ def _as_colormap(cmap) -> Colormap:
 def _cell_colors(cell_ids: np.ndarray, cmap: Colormap | None) -> np.ndarray:
     """(P, 4) RGBA per polygon: the same 4-D cell always gets the same colour.
 
-    ``cmap`` None: ``look.group_palette`` (the live view's colour of each cell, unrounded).
+    ``cmap`` None: ``colours.group_palette`` (the live view's colour of each cell, unrounded).
     """
     ids = np.asarray(cell_ids, dtype=np.int64)
     if cmap is None:
-        rgb = look.group_palette(int(ids.max()) + 1 if len(ids) else 0)[ids].astype(np.float64)
+        rgb = colours.group_palette(int(ids.max()) + 1 if len(ids) else 0)[ids].astype(np.float64)
         return np.concatenate([rgb, np.ones((len(ids), 1))], axis=1)
     if isinstance(cmap, ListedColormap):  # qualitative maps: cycle through the list
         return np.asarray(cmap(ids % cmap.N))
@@ -216,9 +217,9 @@ def draw_slice(
     radius: float | None = None,
     ball_radius: float | None = None,
     bar_radius: float | None = None,
-    face_alpha: float = look.FACE_OPACITY,
-    ball_color=look.BALL_COLOR,
-    bar_color=look.BAR_COLOR,
+    face_alpha: float = colours.FACE_OPACITY,
+    ball_color=colours.BALL_COLOR,
+    bar_color=colours.BAR_COLOR,
     cmap=None,
     label: str | None = None,
 ) -> SliceDrawing:
@@ -226,13 +227,13 @@ def draw_slice(
 
     ``slice`` is a :class:`rot4d_widget.Slice`; its vertices are multiplied by ``scale`` first.
     ``ball_radius`` and ``bar_radius`` are 3-D sizes (after scaling), shrunk with distance like
-    everything else; by default ``look.default_ball_radius`` of the reference pentachoron's edge
-    (0.07) and ``look.default_bar_radius(ball_radius)``, as in the live view.
+    everything else; by default ``sizes.default_ball_radius`` of the reference pentachoron's edge
+    (0.07) and ``sizes.default_bar_radius(ball_radius)``, as in the live view.
     The frame is the camera's: vertical field of view ``fov`` degrees and the aspect of ``ax``,
     so every panel of a sequence shares it and a point sits where the live view puts it.  With
     ``fov=None`` the frame fits a sphere of ``radius`` (after scaling) if given, else this slice;
     with a camera, ``radius`` only checks that the eye is outside that sphere.
-    Faces are coloured by ``slice.cell_ids`` with ``look.group_palette`` (the live view's colours),
+    Faces are coloured by ``slice.cell_ids`` with ``colours.group_palette`` (the live view's colours),
     or through ``cmap`` (a matplotlib colormap name or Colormap) if given.
 
     Returns a :class:`SliceDrawing` listing the artists; they also carry the gids "ball", "bar",
@@ -249,10 +250,10 @@ def draw_slice(
         if fov >= 180.0:
             raise ValueError(f"Expected `fov` < 180 degrees, got {fov:g}")
     if ball_radius is None:
-        ball_radius = look.default_ball_radius(_REFERENCE_EDGE)
+        ball_radius = sizes.default_ball_radius(_REFERENCE_EDGE)
     ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
     if bar_radius is None:
-        bar_radius = look.default_bar_radius(ball_radius)
+        bar_radius = sizes.default_bar_radius(ball_radius)
     bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
     face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
     if radius is not None:
@@ -391,7 +392,7 @@ def _closed_codes(n: int) -> np.ndarray:
 
 
 def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radius: float, face_alpha: float,
-                      cmap=None, ball_color=look.BALL_COLOR, bar_color=look.BAR_COLOR, z_shift: float = 0.0,
+                      cmap=None, ball_color=colours.BALL_COLOR, bar_color=colours.BAR_COLOR, z_shift: float = 0.0,
                       distance: float = CAMERA_DISTANCE):
     """What `draw_slice` draws -- the same faces, bars, balls and highlights, with the same paths,
     colours, edges and painter's order (zorders plus ``z_shift``, ties in draw_slice's order) --

@@ -15,8 +15,10 @@ from matplotlib.colors import ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from ...core import look
-from ...core.look import DEFAULT_SECTIONS, REFERENCE_RADIUS, check_rendering, view_rotation
+from ...core import camera, colours, renderings, sizes
+from ...core.camera import view_rotation
+from ...core.renderings import DEFAULT_SECTIONS, check_rendering
+from ...core.sizes import REFERENCE_RADIUS
 from ...core.state import RotationState
 from ...geometry.slicing.tables import Slice
 from ...sources.field_labels import box_labels
@@ -70,7 +72,7 @@ def render_tomography(
     dpi: float = 100,
     title: str | bool | None = True,
     labels: bool = True,
-    face_alpha: float = look.FACE_OPACITY,
+    face_alpha: float = colours.FACE_OPACITY,
     ball_radius: float | None = None,
     bar_radius: float | None = None,
     show_balls: bool = True,
@@ -78,11 +80,11 @@ def render_tomography(
     show_faces: bool = True,
     face_color=None,
     group_colors=None,
-    background=look.BACKGROUND,
+    background=colours.BACKGROUND,
     frame="camera",
     annotate=False,
     rendering: str = "surface",
-    cmap: str = look.LEVEL_COLORMAP,
+    cmap: str = colours.LEVEL_COLORMAP,
     clim=None,
     sections=DEFAULT_SECTIONS,
     colorbar: bool = True,
@@ -137,7 +139,7 @@ def render_tomography(
     what changes along each edge leaving it), so the picture says which way time runs.
     ``eye``: where the camera is (displayed units; it looks at the origin, +y up, as the live view's
     OrbitControls do; only its direction counts, the distance is the live view's 5); None: the
-    live view's default for ``rendering`` (`look.default_eye`: for "sections" above, right of and in
+    live view's default for ``rendering`` (`camera.default_eye`: for "sections" above, right of and in
     front of the cut, so that no plane is edge-on).
     """
     # a source that wraps another is parallel slices already (the protocol's ``wraps``)
@@ -157,20 +159,20 @@ def render_tomography(
         bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
     palette = None  # an override of the group colours: one colour, or the caller's
     if face_color is not None:
-        palette = np.asarray([look.as_rgb(face_color, "face_color")], dtype=np.float64)
+        palette = np.asarray([colours.as_rgb(face_color, "face_color")], dtype=np.float64)
     elif group_colors is not None:
-        palette = np.asarray([look.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
+        palette = np.asarray([colours.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
                              dtype=np.float64).reshape(-1, 3)
     background = to_rgba(background)
     rendering = check_rendering(rendering)
-    cmap, clim = look.check_cmap(cmap), look.check_clim(clim)
+    cmap, clim = colours.check_cmap(cmap), colours.check_clim(clim)
     inner = inner_source(src)
     field = getattr(inner, "data_range", None) is not None  # a field: values to colour
     volume = rendering != "surface"
     data = src.slice(matrix, c0) if _data is None else _data
     # a volume rendering's cuts, sampled once (drawn, and the box labelled); no `sample`: a TypeError here
     grids = cut_grids(src, data, matrix) if volume else None
-    view = view_rotation(look.default_eye(rendering) if eye is None else eye)
+    view = view_rotation(camera.default_eye(rendering) if eye is None else eye)
     cut = data  # the slice in the scene's coordinates (labels, grids); `data` as the camera sees it
     data = seen_from(data, view)
     ex = data.extra
@@ -194,7 +196,7 @@ def render_tomography(
         fig, ax = _canvas.begin(width, height, top, dpi, background, right)
     aspect = width / height
     edge = getattr(src.source, "edge_length", None)
-    base_ball = look.default_ball_radius(edge * scale) if edge else look.default_ball_radius(_REFERENCE_EDGE)
+    base_ball = sizes.default_ball_radius(edge * scale) if edge else sizes.default_ball_radius(_REFERENCE_EDGE)
     if isinstance(frame, str) and frame == "fit":
         box = frame_extent(data, src, ball_radius=(ball_radius if ball_radius is not None else base_ball)
                            if show_balls else 0.0)
@@ -209,8 +211,8 @@ def render_tomography(
         if volume:
             legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
             name = getattr(inner, "name", None) or "the value"  # no level drawn: say what is
-            lines = [look.RENDERING_TEXT[rendering].format(name=name) if ln.startswith(("level ", "levels ")) else ln
-                     for ln in lines]
+            cast_text = renderings.RENDERING_TEXT[rendering].format(name=name)
+            lines = [cast_text if ln.startswith(("level ", "levels ")) else ln for ln in lines]
         if isinstance(annotate, str):
             lines = [annotate, *lines]
         notes = (lines, legend, annotation_boxes(lines, legend, height, dpi, (width * dpi, height * dpi)))
@@ -239,7 +241,7 @@ def render_tomography(
     for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
         z_shift = 1e3 * rank
         ball = base_ball * scales[k] if ball_radius is None else ball_radius
-        bar = look.default_bar_radius(ball) if bar_radius is None else bar_radius
+        bar = sizes.default_bar_radius(ball) if bar_radius is None else bar_radius
         if poly is not None:
             s = ex["slices"][k]
             vertices = np.asarray(s.vertices) * scales[k] + np.asarray(cut.extra["centres"][k]) if n > 1 else s.vertices
@@ -431,7 +433,7 @@ _TRIANGLES = None
 
 
 def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_alpha, z_shift, bar_width,
-                  show_faces=True, cmap=look.LEVEL_COLORMAP, clim=None):
+                  show_faces=True, cmap=colours.LEVEL_COLORMAP, clim=None):
     """Slice k of a stack of smooth surfaces: shaded triangles back to front, its bars as lines; a
     field's levels coloured along ``cmap`` (by value over ``clim`` when given: `level_rgb`)."""
     # matplotlib collections: imported when a surface is drawn
@@ -455,7 +457,7 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
             if level_colours is not None:
                 rgb = level_colours[groups]
             else:
-                rgb = look.group_palette(int(groups.max()) + 1)[groups].astype(np.float64)
+                rgb = colours.group_palette(int(groups.max()) + 1)[groups].astype(np.float64)
         # a triangle's mean normal and depth as (c0 + c1 + c2) / 3: the sums and the division of
         # ``[tri].mean(axis=1)``, bit for bit, from three gathers instead of one (T, 3, 3) reduction
         t0, t1, t2 = tri[:, 0], tri[:, 1], tri[:, 2]
@@ -470,12 +472,12 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
         z = pts[:, 2]
         depth = (z[t0] + z[t1] + z[t2]) / 3.0
         order = np.argsort(depth, kind="stable")
-        alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, look.SURFACE_OPACITY)
+        alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, colours.SURFACE_OPACITY)
         coll = _Triangles(xy[tri[order]], np.column_stack([rgb[order], np.full(len(order), alpha)]),
                           zorder=z_base, gid="surface")
         ax.add_collection(coll, autolim=False)
     if len(seg) and bar_width > 0:
-        lines = LineCollection(xy[seg], colors=look.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
+        lines = LineCollection(xy[seg], colors=colours.BAR_COLOR, linewidths=max(0.3, 72 * bar_width),
                                zorder=z_base + 1e-3, gid="bar")
         ax.add_collection(lines, autolim=False)
 
@@ -527,10 +529,10 @@ def render_state(
     caps: bool | None = None,
     color_by="group",
     group_colors=None,
-    face_opacity: float = look.FACE_OPACITY,
+    face_opacity: float = colours.FACE_OPACITY,
     ball_radius: float | None = None,
     bar_radius: float | None = None,
-    background=look.BACKGROUND,
+    background=colours.BACKGROUND,
     show_balls: bool = True,
     show_bars: bool = True,
     show_faces: bool = True,
@@ -564,12 +566,12 @@ def render_state(
     ``show_balls`` / ``show_bars`` / ``show_faces``.
 
     The scene is the live view's: every source scaled to the displayed circumradius
-    `look.REFERENCE_RADIUS`, the eye at `look.CAMERA_POSITION` looking down -z (``eye``: elsewhere,
-    looking at the origin; None: `look.default_eye` of ``rendering``, the live view's default camera
+    `sizes.REFERENCE_RADIUS`, the eye at `camera.CAMERA_POSITION` looking down -z (``eye``: elsewhere,
+    looking at the origin; None: `camera.default_eye` of ``rendering``, the live view's default camera
     -- for "sections" an oblique one) with the vertical
-    field of view `look.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
-    widget's canvas is 600 x 500), the cell palette `look.group_palette` (a field's levels:
-    `look.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
+    field of view `camera.CAMERA_FOV` and the aspect of ``size`` (pixels, width x height; the
+    widget's canvas is 600 x 500), the cell palette `colours.group_palette` (a field's levels:
+    `colours.level_colors`; a stack coloured by w: a colormap over its cuts).  It does not follow a
     camera the user dragged.  ``labels`` writes each parallel slice's w in the data's units (None, the
     default: when there are several, so every slice of the view carries its time); ``title`` goes above.
 
@@ -598,7 +600,7 @@ def render_state(
     Returns the Figure.
     """
     rendering = check_rendering(rendering)
-    cmap, clim, sections = look.check_cmap(cmap), look.check_clim(clim), look.check_sections(sections)
+    cmap, clim, sections = colours.check_cmap(cmap), colours.check_clim(clim), renderings.check_sections(sections)
     if not isinstance(state, RotationState):
         raise TypeError(f"Expected `state` to be a rot4d_widget.RotationState, got {type(state).__name__}")
     try:
@@ -612,7 +614,7 @@ def render_state(
         raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
     face_color = None
     if color_by != "group":
-        face_color = look.as_rgb(color_by, "color_by")
+        face_color = colours.as_rgb(color_by, "color_by")
     if _prepared is None:
         _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
                              ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps,
@@ -646,12 +648,12 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
     if ball_radius is None:
         edge = getattr(stack, "edge_length", None)
         if edge:
-            ball_radius = look.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
+            ball_radius = sizes.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
     if data is None:
         data = stack.slice(state.matrix, state.c0)
     if show_balls:
-        ball = ball_radius if ball_radius is not None else look.default_ball_radius(_REFERENCE_EDGE)
+        ball = ball_radius if ball_radius is not None else sizes.default_ball_radius(_REFERENCE_EDGE)
     else:
         ball = 0.0
-    seen = seen_from(data, view_rotation(look.default_eye(rendering) if eye is None else eye))
+    seen = seen_from(data, view_rotation(camera.default_eye(rendering) if eye is None else eye))
     return stack, data, ball_radius, frame_extent(seen, stack, ball_radius=ball)
