@@ -103,25 +103,6 @@ def _resolve(module: str, is_package: bool, node: ast.ImportFrom | ast.Import, k
     return out
 
 
-def _resolve(module: str, is_package: bool, node: ast.ImportFrom | ast.Import, known) -> list:
-    """The rot4d_widget modules an import statement of ``module`` names."""
-    if isinstance(node, ast.Import):
-        return [a.name for a in node.names if a.name.split(".")[0] == "rot4d_widget"]
-    base = module.split(".") if is_package else module.split(".")[:-1]
-    if node.level:
-        base = base[: len(base) - (node.level - 1)]
-        target = ".".join(base + ([node.module] if node.module else []))
-    else:
-        target = node.module or ""
-    if target.split(".")[0] != "rot4d_widget":
-        return []
-    out = []
-    for alias in node.names:  # `from .pkg import module` names a module
-        sub = f"{target}.{alias.name}"
-        out.append(sub if sub in known else target)
-    return out
-
-
 def _lint_imports(root: pathlib.Path, config: pathlib.Path) -> subprocess.CompletedProcess:
     """``lint-imports`` on the package under ``root`` (first on its path), with the contracts of ``config``."""
     code = ("import importlib.util, pathlib, sys; "
