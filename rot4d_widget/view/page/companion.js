@@ -418,7 +418,7 @@ async function render({ model, el }) {
         set("u_density", Number(v.density) || 0);
         set("u_step", Number(v.step) || 0.5);
         obj.material.uniformsNeedUpdate = true;
-        obj.visible = !fieldOwn;  // while the page draws its own field picture the kernel's stays hidden
+        obj.visible = true;  // hidden again before each frame while the page draws its own (beforeRender)
         volumeApplied = { geometry: g, position: arrays.position, atlas, image: atlas.image };
       };
       // 6. rows drawn without instancing: geometries[i] is meshes[i]'s (balls, bars, faces)
