@@ -15,27 +15,15 @@ first changed, and how many pixels differ from the background (a blank canvas is
 from __future__ import annotations
 
 import argparse
-import os
 import pathlib
-import shutil
 import sys
-import tempfile
 import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from browser_latency import (  # noqa: E402  (the latency benchmark's browser set-up)
-    CHROMIUM_FLAGS,
-    FIELD_CASES,
-    QUIET_DEBUG,
-    VIEWPORT,
-    JupyterPage,
-    JupyterServer,
-    export_revision,
-    find_chromium,
-    write_notebook,
-)
+from browser_latency import FIELD_CASES  # noqa: E402  (the latency benchmark's field cases)
+from store_timeline import JupyterPage, lab_browser, write_notebook  # noqa: E402  (the same browser set-up)
 
 DATASETS = {
     "allen-cahn": FIELD_CASES["allen-cahn"],
@@ -57,64 +45,46 @@ def main(argv=None) -> int:
     ap.add_argument("--rev", default=None, help="draw a clean `git archive` of this revision")
     ap.add_argument("--datasets", default=",".join(DATASETS))
     args = ap.parse_args(argv)
-    from playwright.sync_api import sync_playwright
-
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    tmp = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-screens-"))
-    server = JupyterServer("lab", tmp / "server")
-    if args.rev:
-        export_revision(args.rev, tmp / "src")
-        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp / "src"), server.env.get("PYTHONPATH")]))
     failures = []
-    try:
-        server.start()
-        with sync_playwright() as p:
-            context = p.chromium.launch_persistent_context(str(tmp / "profile"), executable_path=find_chromium(),
-                                                           headless=True, args=CHROMIUM_FLAGS, viewport=VIEWPORT)
-            context.add_init_script(QUIET_DEBUG)
-            try:
-                for name in args.datasets.split(","):
-                    nb = f"{name}.ipynb"
-                    write_notebook(server.root / nb, [f"{DATASETS[name]}\nfrom rot4d_widget import Rot4DWidget\n"
-                                                      "w = Rot4DWidget(field)\nw"])
-                    page = context.new_page()
-                    jp = JupyterPage(page, server, nb).open(timeout=180)
-                    jp.run_all(timeout=600)
-                    page.wait_for_selector(SEL, timeout=120_000)
-                    holds = jp.wait_for(lambda jp=jp: "page draws" in jp.kernel("print(w.readout.value)"), timeout=180)
-                    print(f"{name}: the page holds its copy: {bool(holds)}", flush=True)
-                    box = page.locator(SEL).bounding_box()
-                    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2, steps=2)
-                    jp.watch_pixels(SEL)
-                    for r in RENDERINGS:
-                        jp.kernel(f"w.rendering = {r!r}")
-                        jp.wait_quiet(1.0, timeout=60)
-                        rest = out / f"{name}-{r}-rest.png"
-                        page.locator(SEL).screenshot(path=str(rest))
-                        t0 = jp.page_now()
-                        page.keyboard.down("4")
-                        time.sleep(1.0)
-                        held = out / f"{name}-{r}-held.png"
-                        page.locator(SEL).screenshot(path=str(held))
-                        page.keyboard.up("4")
-                        changes = jp.pixel_changes(after_ms=t0)
-                        first = f"{changes[0] - t0:.0f} ms" if changes else "never"
-                        jp.wait_quiet(1.0, timeout=60)
-                        stats = jp.canvas_stats(SEL)
-                        drawn = stats and stats.get("count", 0) > 50
-                        count = stats.get("count") if stats else 0
-                        print(f"  {r}: first change after the key {first}; at rest {count} pixels not background; "
-                              f"{held.name}, {rest.name}", flush=True)
-                        if not drawn or not changes:
-                            failures.append(f"{name} {r}")
-                    jp.shutdown_kernel()
-                    page.close()
-            finally:
-                context.close()
-    finally:
-        server.stop()
-        shutil.rmtree(tmp, ignore_errors=True)
+    with lab_browser("rot4d-screens-", args.rev) as (server, context, _code):
+        for name in args.datasets.split(","):
+            nb = f"{name}.ipynb"
+            write_notebook(server.root / nb, [f"{DATASETS[name]}\nfrom rot4d_widget import Rot4DWidget\n"
+                                              "w = Rot4DWidget(field)\nw"])
+            page = context.new_page()
+            jp = JupyterPage(page, server, nb).open(timeout=180)
+            jp.run_all(timeout=600)
+            page.wait_for_selector(SEL, timeout=120_000)
+            holds = jp.wait_for(lambda jp=jp: "page draws" in jp.kernel("print(w.readout.value)"), timeout=180)
+            print(f"{name}: the page holds its copy: {bool(holds)}", flush=True)
+            box = page.locator(SEL).bounding_box()
+            page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2, steps=2)
+            jp.watch_pixels(SEL)
+            for r in RENDERINGS:
+                jp.kernel(f"w.rendering = {r!r}")
+                jp.wait_quiet(1.0, timeout=60)
+                rest = out / f"{name}-{r}-rest.png"
+                page.locator(SEL).screenshot(path=str(rest))
+                t0 = jp.page_now()
+                page.keyboard.down("4")
+                time.sleep(1.0)
+                held = out / f"{name}-{r}-held.png"
+                page.locator(SEL).screenshot(path=str(held))
+                page.keyboard.up("4")
+                changes = jp.pixel_changes(after_ms=t0)
+                first = f"{changes[0] - t0:.0f} ms" if changes else "never"
+                jp.wait_quiet(1.0, timeout=60)
+                stats = jp.canvas_stats(SEL)
+                drawn = stats and stats.get("count", 0) > 50
+                count = stats.get("count") if stats else 0
+                print(f"  {r}: first change after the key {first}; at rest {count} pixels not background; "
+                      f"{held.name}, {rest.name}", flush=True)
+                if not drawn or not changes:
+                    failures.append(f"{name} {r}")
+            jp.shutdown_kernel()
+            page.close()
     if failures:
         print(f"blank or unturned: {', '.join(failures)}", file=sys.stderr)
     return 1 if failures else 0

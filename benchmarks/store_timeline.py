@@ -23,6 +23,7 @@ Prints one row a second and a summary.  ``--rev`` measures a clean ``git archive
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -60,6 +61,34 @@ DOM_READ = r"""
   return {turning, progress: shown, now: performance.now()};
 }
 """
+
+
+@contextlib.contextmanager
+def lab_browser(prefix: str, rev: str | None = None):
+    """A JupyterLab 4 server and a headless Chromium on it, both gone afterwards: yields
+    ``(server, browser context, the code measured)`` -- with ``rev``, a clean `git archive` of that
+    revision first on the kernels' path, else the working tree."""
+    from playwright.sync_api import sync_playwright
+
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix=prefix))
+    server = JupyterServer("lab", tmp / "server")
+    code = "working tree"
+    if rev:
+        code = export_revision(rev, tmp / "src")
+        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp / "src"), server.env.get("PYTHONPATH")]))
+    try:
+        server.start()
+        with sync_playwright() as p:
+            context = p.chromium.launch_persistent_context(str(tmp / "profile"), executable_path=find_chromium(),
+                                                           headless=True, args=CHROMIUM_FLAGS, viewport=VIEWPORT)
+            context.add_init_script(QUIET_DEBUG)
+            try:
+                yield server, context, code
+            finally:
+                context.close()
+    finally:
+        server.stop()
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def store_path(gb: float, chunk: int) -> pathlib.Path:
@@ -132,15 +161,7 @@ def main(argv=None) -> int:
     ap.add_argument("--nodes", type=int, default=64,
                     help="nodes a side of the in-memory comparison (default 64: the 64^4 figures)")
     args = ap.parse_args(argv)
-    from playwright.sync_api import sync_playwright
-
     store = store_path(args.gb, args.chunk)
-    tmp = pathlib.Path(tempfile.mkdtemp(prefix="rot4d-timeline-"))
-    server = JupyterServer("lab", tmp / "server")
-    code = "working tree"
-    if args.rev:
-        code = export_revision(args.rev, tmp / "src")
-        server.env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(tmp / "src"), server.env.get("PYTHONPATH")]))
     opening = (f"import os, xarray\nfrom rot4d_widget import Field4D, Rot4DWidget\n"
                f"open('kernel.pid', 'w').write(str(os.getpid()))\n"
                f"field = Field4D.from_xarray(xarray.open_zarr({str(store)!r})['f'])\n"
@@ -149,40 +170,29 @@ def main(argv=None) -> int:
             f"from rot4d_widget import Field4D, Rot4DWidget\n"
             f"field = Field4D(values(np.arange({args.nodes}), {args.nodes}), axes='xyzw', extent=[(-1.0, 1.0)] * 4)\n"
             f"b = Rot4DWidget(field, rendering={args.rendering!r})\nb")
-    write_notebook(server.root / "store.ipynb", [opening])
-    write_notebook(server.root / "blob.ipynb", [blob])
     load_before = os.getloadavg()
-    try:
-        server.start()
-        with sync_playwright() as p:
-            context = p.chromium.launch_persistent_context(str(tmp / "profile"), executable_path=find_chromium(),
-                                                           headless=True, args=CHROMIUM_FLAGS, viewport=VIEWPORT)
-            context.add_init_script(QUIET_DEBUG)
-            try:
-                page = context.new_page()
-                jp = JupyterPage(page, server, "store.ipynb").open(timeout=180)
-                t_run = time.monotonic()
-                page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
-                sel = ".rot4d-canvas canvas"
-                page.wait_for_selector(sel, timeout=300_000)
-                shown = time.monotonic() - t_run
-                t_down, reads, t, h = hold(page, sel, args.seconds, pid=int((server.root / "kernel.pid").read_text()),
-                                           repress=args.repress)
-                jp.wait_idle(timeout=300)
-                jp.shutdown_kernel()
-                page.close()
-                page = context.new_page()
-                jb = JupyterPage(page, server, "blob.ipynb").open(timeout=180)
-                jb.run_all(timeout=300)
-                readout = lambda: jb.kernel("print(b.readout.value)")  # noqa: E731
-                jb.wait_for(lambda: "page draws" in readout(), timeout=120)
-                b_down, _, bt, bh = hold(page, sel, 4.5)
-                jb.shutdown_kernel()
-            finally:
-                context.close()
-    finally:
-        server.stop()
-        shutil.rmtree(tmp, ignore_errors=True)
+    with lab_browser("rot4d-timeline-", args.rev) as (server, context, code):
+        write_notebook(server.root / "store.ipynb", [opening])
+        write_notebook(server.root / "blob.ipynb", [blob])
+        page = context.new_page()
+        jp = JupyterPage(page, server, "store.ipynb").open(timeout=180)
+        t_run = time.monotonic()
+        page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
+        sel = ".rot4d-canvas canvas"
+        page.wait_for_selector(sel, timeout=300_000)
+        shown = time.monotonic() - t_run
+        t_down, reads, t, h = hold(page, sel, args.seconds, pid=int((server.root / "kernel.pid").read_text()),
+                                   repress=args.repress)
+        jp.wait_idle(timeout=300)
+        jp.shutdown_kernel()
+        page.close()
+        page = context.new_page()
+        jb = JupyterPage(page, server, "blob.ipynb").open(timeout=180)
+        jb.run_all(timeout=300)
+        readout = lambda: jb.kernel("print(b.readout.value)")  # noqa: E731
+        jb.wait_for(lambda: "page draws" in readout(), timeout=120)
+        b_down, _, bt, bh = hold(page, sel, 4.5)
+        jb.shutdown_kernel()
 
     per_second = frames_per_second(t, h, t_down, args.seconds)
     blob_fps = statistics.median(frames_per_second(bt, bh, b_down + 500, 4))
