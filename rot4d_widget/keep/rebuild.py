@@ -40,9 +40,8 @@ class CodeNotAllowed(ValueError):
 #: state file names a field's function by ``"module:qualname"``; one written before the wings can
 #: name package code by an old path, which the package no longer imports (issue 38: no import
 #: hook before 1.0), so the loader translates it with this table -- data, nothing imported.
-#: A file can name only a module that defined a field's function (its ``__module__``), so modules
-#: that defined none have no entry: ``rot4d_widget.recording`` and ``rot4d_widget.figures`` (the
-#: recordings and the static pictures, split since over several modules of keep).
+#: Every flat module path is here except ``rot4d_widget.recording`` and ``rot4d_widget.figures``,
+#: whose code is now spread over several modules of keep (no one place to send them).
 OLD_MODULES = {
     "rot4d_widget.rotation": "rot4d_widget.core.rotation",
     "rot4d_widget.keymap": "rot4d_widget.core.keymap",
