@@ -54,7 +54,7 @@ DIR`` keeps each code's pictures in a subfolder and compares them with the first
 Variants: ``default`` (the widget as shipped: no multisampling), ``msaa``
 (``antialias=True``: WebGL's 4x multisampling).  Prints a table of medians
 (ms) per pass, their sum, and the median frame.  The figures this benchmark
-produced, and the commands, are in docs/design.md and docs/performance.md.
+produced, and the commands, are in docs/performance.md.
 """
 
 from __future__ import annotations

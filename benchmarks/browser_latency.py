@@ -19,7 +19,7 @@ every rendering): a 64^4 field (a Gaussian
 blob travelling along x as w grows, the array of benchmarks/volume_step.py) in each rendering,
 with a table of held fps, its ratio to the same run's baseline (target >= 0.6x for volume and
 mip) and bytes per update; ``--volume-step S`` sets the ray's sample spacing (a diagnosis).
-Figures and commands: docs/volume-speed.md.  Since issue 36 the page draws a field's held pictures
+Figures and commands: docs/performance.md.  Since issue 36 the page draws a field's held pictures
 from its own copy of the data: a field's case waits (up to 2 min) for the readout to say so and
 reports how long that took ("page's copy after"); a revision without it (``--rev``) is measured as
 it was.

@@ -22,7 +22,7 @@ by path):
     circumradius``) is an edge of the slice between those ends' points;
   - every slice point is finite (it lies in the hyperplane by construction: it is given in the
     hyperplane's own 3-D coordinates); the volume is finite (a negative one is counted, not a
-    failure: the volume is weighted by the winding number, docs/meshes.md, and a self-intersecting
+    failure: the volume is weighted by the winding number, docs/design.md, and a self-intersecting
     polytope with reflex ridges, not detected as self-intersecting, can wind round negatively), or,
     for a polytope with no inside (``Polytope.volume_defined`` False: hemi cells or a boundary that
     is not orientable), None and nothing else (the table's ``novol`` column says why);
@@ -39,7 +39,7 @@ by path):
         [--max-bytes N] [--timeout S] [--json out.json] [--quiet]
 
 ``--numbers A-B`` takes only files whose name starts with a number in A..B (the Bowers numbers of
-Pardesco/4d-polytope-viewer's ``public/data/polytopes``; docs/off-library.md).  Prints one row
+Pardesco/4d-polytope-viewer's ``public/data/polytopes``; docs/performance.md).  Prints one row
 per file (file, V, E, F, C, convex, self-intersecting, tolerance, load ms, slice ms, result) and a
 summary: how many loaded (with the default or a looser tolerance), sliced and checked, and the
 refusals grouped by kind of error.

@@ -25,7 +25,7 @@ Each pass is timed between 1-pixel reads; the table gives medians over ``--round
 * ``opaque faces``: the faces drawn without blending -- what blending costs.
 
 ``--screenshots DIR`` saves each code's picture and compares it with the first code's.  The
-figures this benchmark produced, and the commands, are in docs/design.md.
+figures this benchmark produced, and the commands, are in docs/performance.md.
 """
 
 from __future__ import annotations

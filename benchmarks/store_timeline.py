@@ -15,7 +15,7 @@ readout's row saying who draws while keys are held ("turning"), the progress bar
 number of distinct pictures drawn in that second (every frame's pixels hashed after drawing, as
 `browser_latency.py` does).  Then the same function sampled on 64^4 nodes, an array in memory
 (``field_zarr.values``), in the same rendering, is held for 4 s in the same page: the frame rate a
-store should reach once the page holds its copy (the 64^4 figures of docs/fields.md).
+store should reach once the page holds its copy (the 64^4 figures of docs/performance.md).
 
 Prints one row a second and a summary.  ``--rev`` measures a clean ``git archive`` of a revision.
 """

@@ -5,7 +5,8 @@ algorithm then holds every frame of a burst after the first (the kernel's
 "busy" status, then the widget's update) until the browser's delayed ACK, up
 to 40 ms.  With at most three updates in flight by design (``MAX_IN_FLIGHT``
 in rot4d_widget/view/pump.py), a held key's updates keep meeting that stall.
-``benchmarks/browser_latency.py --nagle`` switches this extension off to measure it; the figures are in docs/design.md.
+``benchmarks/browser_latency.py --nagle`` switches this extension off to measure it; the figures
+are in docs/performance.md.
 
 This module and the package's ``__init__`` import nothing heavy (no numpy,
 scipy or widget library): every Jupyter server in the environment loads it at

@@ -59,7 +59,7 @@ def test_the_rows_show_balls_only_at_the_edges_crossings(cut):
 def test_the_scene_draws_as_many_balls_as_crossings(cut):
     """What the page's ball layer draws (`Scene.counts`, sent with the rows) is the crossings, not
     the points with the fill corners: the great icosahedral 120-cell's 10,000 fill corners were
-    drawn as hidden balls (22 ms of a frame on software WebGL, docs/meshes.md)."""
+    drawn as hidden balls (22 ms of a frame on software WebGL, docs/performance.md)."""
     p, m, data = cut
     scene = Scene(scale=1.0, n_groups=int(np.max(data.groups)) + 1)
     try:

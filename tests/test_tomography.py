@@ -3,7 +3,7 @@ render_tomography.
 
 Every slice of a stack must equal the single slice at its level; Cavalieri's principle over a
 stack must converge like the midpoint rule (|error| <= C Δ^2, one C per object); the layouts
-must put each slice where docs/tomography.md says, without overlaps.
+must put each slice where docs/design.md ("Parallel slices") says, without overlaps.
 """
 
 import math

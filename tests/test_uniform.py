@@ -3,7 +3,7 @@
 Published (V, E, F, C) are from the English Wikipedia articles on the uniform 4-polytopes (the
 "Uniform 4-polytope" list and the per-family articles, e.g. "Runcinated 120-cells", "Truncated
 120-cells") and R. Klitzing's incidence matrices (bendwavy.org/klitzing, "Convex uniform
-polychora"); see docs/uniform.md.
+polychora"); see docs/user-guide.md, "Polytopes by name".
 """
 
 import itertools

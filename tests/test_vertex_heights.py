@@ -21,7 +21,7 @@ every edge whose ends lie strictly on both sides of H, and every vertex on H (``
 (either way, within 1e-7 x the circumradius, as benchmarks/off_library.py does): several edges
 may cross H at one point.  And every edge of P lying in H (both ends on H) is an edge of the
 slice, between those two points.  The whole public libraries are checked the same way by
-``python benchmarks/off_library.py DIR --vertex-heights`` (docs/off-library.md).
+``python benchmarks/off_library.py DIR --vertex-heights`` (docs/performance.md).
 """
 
 from __future__ import annotations

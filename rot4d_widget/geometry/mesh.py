@@ -166,7 +166,7 @@ class Polytope:
     gives their slices as two polygons.  Not checked: that the boundary does not
     intersect itself, or is a manifold at its vertices and edges (two pieces may touch
     there).  Everything is vectorised, no loop over pairs (build times of the biggest,
-    the omnitruncated 120-cell: docs/uniform.md).  ``validate=False`` skips the per-cell
+    the omnitruncated 120-cell: docs/performance.md).  ``validate=False`` skips the per-cell
     closedness and convexity checks (for combinatorics known to be right, e.g. from a
     Wythoff construction); the faces' geometry and the orientation are still derived
     and checked, and a non-convex cell with convex faces then gives wrong normals, or the

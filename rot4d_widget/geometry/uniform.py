@@ -278,7 +278,7 @@ def _as_polytope(comb: Combinatorics, name: str):
 
     Validated even though the construction is exact: the constructor's checks (planar convex
     faces, closed convex cells, orientable boundary) are part of the build times in
-    docs/uniform.md (`benchmarks/uniform_build.py`).
+    docs/performance.md (`benchmarks/uniform_build.py`).
     """
     return Polytope(comb.vertices, comb.faces, comb.cells, name=name)
 

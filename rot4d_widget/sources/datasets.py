@@ -76,7 +76,7 @@ def _params(n, steps, t_end, interface, bias, seed) -> dict:
         raise ValueError(f"Expected `t_end` > 0 (time of the last stored frame), got {t_end}")
     xi = _float(interface, "interface")
     # tanh(x / (sqrt(2) xi)) goes from -0.8 to 0.8 over 3.1 xi: below 0.65 that is < 2 grid
-    # spacings, and rotated slices of such a field converge slowly (docs/fields.md)
+    # spacings, and rotated slices of such a field converge slowly (docs/performance.md, "Accuracy")
     if not 0.65 <= xi <= n / 8:
         raise ValueError(
             f"Expected `interface` (the interface length xi, in grid spacings) in [0.65, n/8 = {n / 8:g}], got {xi}: "

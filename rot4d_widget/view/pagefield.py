@@ -19,7 +19,7 @@ one-time transfer ``"field"``, in chunks the page acknowledges, counted on the w
 * **laid out as one 3-D texture**: time (w) tiled -- tile k holds the x, y, z nodes of time k, the
   tiles placed ``tiles = (tx, ty, tz)`` a side, k = (kz ty + ky) tx + kx -- each texel two bytes
   (luminance: the code's high byte, alpha: its low byte; linear filtering of both, recombined, is
-  linear filtering of the code: docs/fields.md "The page's WebGL").  The shader clamps sample
+  linear filtering of the code: docs/design.md "The field on the GPU").  The shader clamps sample
   points half a texel inside each tile, so filtering never reads a neighbouring tile.
 
 With the data goes their **block ranges**: the least and greatest code over each block of `BLOCK`

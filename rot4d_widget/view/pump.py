@@ -8,7 +8,7 @@ the round trip to the kernel is no longer in series with the page's frames;
 the page always draws the newest picture it holds.  Three, not two: the
 page's acknowledgement comes one frame after the draw (so it follows what
 the renderer really finished), and with two the held key waited on it; the
-measurements behind the bound are in docs/design.md.  Nothing queues beyond that
+measurements behind the bound are in docs/performance.md.  Nothing queues beyond that
 bound, so the view never falls behind and settles as soon as the state stops
 changing.  An acknowledgement names an update and retires it and every older
 one (the page acknowledges only the newest of several arriving before a frame).
@@ -26,7 +26,7 @@ update travels): the page says with each acknowledgement how long it took from t
 arrival to the acknowledgement (``draw_time``), and while the recent median of that times
 ``max_in_flight`` exceeds `PAGE_BUDGET` the bound in force (`limit`) is what fits in it.  What
 is in flight when a key is released is drawn after the release, so this bounds how long the
-picture goes on moving then (measurements: docs/design.md, "Fewer in flight for a slow page").
+picture goes on moving then (measurements: docs/performance.md, "Updates in flight").
 
 Without an answer (no view: scripting, nbval; a hidden tab) the latest state
 is sent anyway once the oldest update in flight is ``timeout`` old, where

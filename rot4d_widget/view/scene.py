@@ -3,8 +3,9 @@
 The only module that imports pythreejs.  The widget talks to it through a
 small interface: `Scene.canvas` (the element ipyevents watches), `view_count`
 and `on_view_count`, `eye` and `on_eye_moved`, `show` (returns whether it
-sent an update) and `set_display`.  Measured figures behind the choices below
-are in docs/design.md with the commands that make them.
+sent an update) and `set_display`.  The reasons for the choices below are in
+docs/design.md ("Drawing on software WebGL"), the figures and their commands in
+docs/performance.md.
 
 Layers
 ------

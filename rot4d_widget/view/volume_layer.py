@@ -9,7 +9,7 @@ layers' alpha is 1, i.e. where its cell's nodes are finite: the static renders' 
 (`rot4d_widget.keep.pictures.ray_caster`), whose camera, step, colour table and optical depth the shader
 repeats, so the page and ``w.render`` agree.  The context is WebGL2 wherever the browser has it
 (pythreejs's `Renderer` asks for it; measured in Chromium on SwiftShader:
-``tests/browser/test_webgl_probe_browser.py``, docs/fields.md "The page's WebGL"), and the atlas
+``tests/browser/test_webgl_probe_browser.py``, docs/design.md "The field on the GPU"), and the atlas
 needs nothing of WebGL2: the kernel's pictures draw on a WebGL1 context too.  The page's own copy
 of the 4-D field (a 3-D texture, `rot4d_widget.view.pagefield`) needs WebGL2; without it the page
 never asks for the copy and every picture is the kernel's.

@@ -9,7 +9,7 @@ and whether a ``THREE.DataTexture3D`` in unsized luminance, luminance-alpha, RGB
 formats uploads, filters linearly and samples through a ``sampler3D`` uniform: the value read
 back, recombined from two byte channels into a 16-bit code, against exact trilinear
 interpolation.  The figures are written to test-artifacts/webgl-probe-<front end>.json (quoted in
-docs/fields.md).
+docs/design.md).
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ def test_webgl_probe(jupyter_server, page, artifacts):
     out = json.loads(got)
     (artifacts / f"webgl-probe-{jupyter_server.kind}.json").write_text(json.dumps(out, indent=1))
     print(json.dumps(out, indent=1))
-    # what the page's field needs (docs/fields.md, "The page's WebGL")
+    # what the page's field needs (docs/design.md, "The field on the GPU")
     assert out["context"] == "webgl2" and out["isWebGL2"], out
     assert out["max_3d_texture_size"] >= 256 and out["max_texture_size"] >= 4096, out
     for kind in ("luminanceAlpha", "luminance"):

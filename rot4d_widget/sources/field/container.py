@@ -144,7 +144,7 @@ class Field4D(FieldLevels, FieldMemory):
         periodic ones, whose caps would hide the inside; ``volume`` is then NaN (not closed).
     chunk_cache_bytes : int
         Recently read chunks of a chunked array kept in memory (default 128 MiB: with the
-        rest of a full step, a 4 GB store stays under 1 GB resident; docs/fields.md).
+        rest of a full step, a 4 GB store stays under 1 GB resident; docs/performance.md).
     memory_budget : int
         Bytes a chunked or lazy array may take in memory (float32 kept, other types as
         float64) to be read whole when the coarse copy is made (`prepare`, `coarse`); default

@@ -7,7 +7,7 @@ uniform float u_specular;
 // Ambient + a hemisphere fixed in the world (sky above the world's +y) + a point light riding
 // with the camera, and a Blinn-Phong highlight of exponent 40.  Software WebGL runs it for every
 // pixel an impostor covers, hidden or not, so it costs no more operations than it must
-// (docs/design.md, "Where a frame of the great icosahedral 120-cell goes").
+// (docs/design.md, "Drawing on software WebGL"; figures in docs/performance.md, "The draw").
 
 // x^40 by six products (pow is exp2(40 log2 x): two polynomial approximations in software WebGL)
 float highlight(float x) {

@@ -39,7 +39,7 @@
 //     (a row becomes its template's 6 or 3 vertices, each carrying the row's columns) and
 //     draws that instead of the instanced geometry.  Software WebGL (SwiftShader, what a
 //     machine without a GPU runs) pays a fixed cost for every instance of an instanced draw
-//     call; figures and command in docs/design.md.  The shaders are unchanged: an attribute
+//     call; figures and command in docs/performance.md.  The shaders are unchanged: an attribute
 //     reads the same columns, per vertex instead of per instance.  Filled in the scene's
 //     `beforeRender` from the array three.js holds at that moment, so a frame draws one
 //     whole update, and the drawn acknowledgement (job 1) stays exact.
