@@ -104,7 +104,7 @@ def page_times(w, states):
     node = shutil.which("node") or shutil.which("nodejs")
     if node is None:
         return None
-    sk = pj.skeleton_message(w.source, w._scale)
+    sk = pj.skeleton_message(w.source, w._showing.scale)
     sk.update({k: base64.b64encode(bytes(sk[k])).decode() for k in ("vertices", "edges")})
     with tempfile.TemporaryDirectory() as tmp:
         js = pathlib.Path(tmp) / "page.mjs"

@@ -266,7 +266,8 @@ def test_a_stack_coloured_by_w_gives_every_level_a_colour(make):
 
     field = Field4D(_blob(), axes="xyzw", extent=[(-1, 1)] * 4, levels=[0.2, 0.5])
     w = make(field, slices=3)
-    cfg = field_config(w, field, [0.0, 1.0], 64, w._painter.colours())
+    cfg = field_config(w.source, w._showing.scale, field, cmap=w.cmap, clim=w.clim, color_by=w.color_by,
+                       cast_clim=None, default_clim_=[0.0, 1.0], texture_side=64, painted=w._painter.colours())
     assert cfg["level_rgb"] == [] and cfg["box_rgb"]
     got = run_page(LEVEL_COLOURS, {"cfg": cfg, "levels": [0.2, 0.5]})
     assert len(got) == 2 and all(len(c) == 3 and all(isinstance(x, (int, float)) for x in c) for c in got)

@@ -140,7 +140,7 @@ def test_stack_marks_every_slice(widgets):
     for o in out["offsets"]:
         c = pj.crossings(r, src.polytope.edges, [o])
         assert len(c), "every slice has crossings"
-        wanted.append(pj.perspective(c, d) * w._scale)
+        wanted.append(pj.perspective(c, d) * w._showing.scale)
     assert _match(out["points"], np.concatenate(wanted), atol=1e-5)
 
 
@@ -156,7 +156,7 @@ def test_both_views_update_from_one_message(widgets, recording_comms):
     vertices, edges = pj.skeleton(w.source)
     np.testing.assert_array_equal(np.frombuffer(sk["vertices"], "<f8").reshape(-1, 4), vertices)
     np.testing.assert_array_equal(np.frombuffer(sk["edges"], "<u4").reshape(-1, 2), edges)
-    assert sk["distance"] == pytest.approx(3.0 * w.source.size) and sk["scale"] == w._scale
+    assert sk["distance"] == pytest.approx(3.0 * w.source.size) and sk["scale"] == w._showing.scale
     own = {x.model_id for x in w._projection._widgets}
     for key in ("4", "l", "c"):  # a rotation in w, c0 up, a rotation in xy
         log.clear()
@@ -169,7 +169,7 @@ def test_both_views_update_from_one_message(widgets, recording_comms):
         assert data["state"]["_rot4d_project"] == pj.state_message(w.source, w.state.matrix, w.state.c0)
         assert "_rot4d_skeleton" not in data["state"]
         assert w._projection.shown_key[0] is w.state.matrix and w._projection.shown_key[1] == w.state.c0
-    now = pj.projection_arrays(w.source, w.state.matrix, w.state.c0, w._scale)
+    now = pj.projection_arrays(w.source, w.state.matrix, w.state.c0, w._showing.scale)
     np.testing.assert_array_equal(w._projection.arrays["positions"], now["positions"])
 
 

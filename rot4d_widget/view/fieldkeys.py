@@ -62,40 +62,39 @@ def view_rules(source) -> dict:
 class FieldKeys:
     """One widget's field view as `PageSteps` steps it (the pump's lock held by every caller)."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, traits, showing, renderings, keeper, sync, apply_step):
+        self.traits = traits  # the widget's traits: ``rendering``, ``sections``
+        self.showing, self.renderings, self.keeper, self.sync = showing, renderings, keeper, sync
+        self.apply_step = apply_step  # the kernel's own step of a key (`KeyPath.apply_step`)
 
     def kinds(self) -> frozenset:
         """The view's kinds the page steps for the source shown (none for a source without renderings)."""
-        return VIEW_KINDS if can_sample(self.w.source) else frozenset()
+        return VIEW_KINDS if can_sample(self.showing.source) else frozenset()
 
     def steps(self, action) -> bool:
         """True for an action the page steps here: a view kind of a field, a level key of one."""
-        w = self.w
         if action.kind in VIEW_KINDS:
-            return can_sample(w.source)
-        return action.kind == "custom" and action.name in level_actions(w.source)
+            return can_sample(self.showing.source)
+        return action.kind == "custom" and action.name in level_actions(self.showing.source)
 
     def snapshot(self) -> tuple:
         """``(rendering, sections, levels)`` now (levels None for a source without them)."""
-        w = self.w
-        inner = inner_source(w.source)
+        inner = inner_source(self.showing.source)
         levels = tuple(inner.levels) if isinstance(inner, FieldLevels) else None
-        return (w.rendering, tuple(w.sections), levels)
+        return (self.traits.rendering, tuple(self.traits.sections), levels)
 
     def restore(self, snap: tuple) -> None:
         """Set a `snapshot` back exactly (a rebuild): the traits recorded as they are set."""
-        w = self.w
         rendering, sections, levels = snap
-        w._renderings.set_quietly("rendering", rendering)
-        w._renderings.set_quietly("sections", sections)
-        inner = inner_source(w.source)
+        self.renderings.set_quietly("rendering", rendering)
+        self.renderings.set_quietly("sections", sections)
+        inner = inner_source(self.showing.source)
         if levels is not None and isinstance(inner, FieldLevels) and tuple(inner.levels) != levels:
             inner.levels = levels
-            w._source_version += 1
-            w._keeper.record_changed_settings()
-            w._sync.source_traits()
+            self.showing.changed()
+            self.keeper.record_changed_settings()
+            self.sync.source_traits()
 
     def apply(self, action, inverted: bool) -> bool:
         """One step of a field key, as the kernel's own path makes it (recorded there)."""
-        return self.w._keys.apply_step(action, inverted)
+        return self.apply_step(action, inverted)

@@ -34,14 +34,13 @@ MARCH = 0.5
 HELD_MARCH = 1.0
 
 
-def view_message(widget):
+def view_message(source, rendering: str, sections) -> dict | None:
     """``{"rendering", "sections", "levels"}`` of a field's view (None for a source without renderings)."""
-    w = widget
-    if not can_sample(w.source):
+    if not can_sample(source):
         return None
-    inner = inner_source(w.source)
-    return {"rendering": w.rendering, "sections": [float(s) for s in w.sections],
-            "levels": [float(v) for v in inner.levels], **view_rules(w.source)}
+    inner = inner_source(source)
+    return {"rendering": rendering, "sections": [float(s) for s in sections],
+            "levels": [float(v) for v in inner.levels], **view_rules(source)}
 
 
 def _rgb(colours) -> list:
@@ -57,12 +56,13 @@ def copy_clim(values) -> list:
     return [float(x) for x in colours.default_clim(v)]
 
 
-def field_config(widget, field, default_clim_: list, texture_side: int, painted) -> dict:
-    """The page's ``field_config`` for ``field`` (the `Field4D` the page holds) shown by ``widget``;
-    ``default_clim_`` the copy's `copy_clim`, ``texture_side`` the copy's longest texture side,
-    ``painted`` the painter's ``(rgb, labels)`` (`Painter.colours`)."""
-    w = widget
-    src = w.source
+def field_config(src, scale: float, field, *, cmap: str, clim, color_by, cast_clim, default_clim_: list,
+                 texture_side: int, painted) -> dict:
+    """The page's ``field_config`` for ``field`` (the `Field4D` the page holds) inside the shown source
+    ``src``, drawn at ``scale``; ``cmap``, ``clim``, ``color_by`` the view's, ``cast_clim`` the
+    limits of the kernel's last ray-cast picture (`Painter.cast_clim`); ``default_clim_`` the copy's
+    `copy_clim`, ``texture_side`` the copy's longest texture side, ``painted`` the painter's
+    ``(rgb, labels)`` (`Painter.colours`)."""
     origin, per = w_frame(src)
     if isinstance(src, StackSource) and src.slices > 1:
         dc = np.asarray(src.cuts_at(0.0), dtype=np.float64)
@@ -71,27 +71,27 @@ def field_config(widget, field, default_clim_: list, texture_side: int, painted)
                   for k in range(len(dc))]
     else:
         slices = [{"dc": 0.0, "centre": [0.0, 0.0, 0.0], "scale": 1.0}]
-    painter = w._painter
-    clim = w.clim if w.clim is not None else painter.cast_clim
+    level_by_value = clim is not None
+    clim = clim if clim is not None else cast_clim
     if clim is None:
         clim = default_clim_
     rgb, labels = painted
-    single = None if w.color_by == "group" else colours.as_rgb(w.color_by, "color_by")
+    single = None if color_by == "group" else colours.as_rgb(color_by, "color_by")
     by_slice = labels is not None and inner_source(src) is not src  # a stack coloured by w
     return {
         "hw": [float(h) for h in field.half_widths],
-        "origin": float(origin), "per_unit": float(per), "scale": float(w._scale),
+        "origin": float(origin), "per_unit": float(per), "scale": float(scale),
         "slices": slices,
         "resolution": int(field.resolution), "coarse_resolution": int(field.coarse_resolution),
         "stack_nodes": int(STACK_NODES),
         "step": float(STEP), "held_step": float(HELD_STEP), "max_steps": int(MAX_STEPS),
         "march": float(MARCH), "held_march": float(HELD_MARCH),
-        "lut": [int(b) for b in colour_table(w.cmap).reshape(-1)],
+        "lut": [int(b) for b in colour_table(cmap).reshape(-1)],
         "clim": [float(clim[0]), float(clim[1])],
         "density": float(renderings.DEFAULT_DENSITY),
         "inside": field.inside, "caps": bool(field.caps),
         "level_rgb": _rgb(rgb) if not by_slice else [],
-        "level_by_value": w.clim is not None and single is None and not by_slice,
+        "level_by_value": level_by_value and single is None and not by_slice,
         "box_rgb": _rgb(rgb) if by_slice and single is None else None,
         "single_rgb": None if single is None else _rgb([single])[0],
         "surface_opacity": float(colours.SURFACE_OPACITY),

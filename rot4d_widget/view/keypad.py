@@ -35,20 +35,20 @@ PAD_EVENTS = ("mousedown", "mouseup", "mouseleave", "touchstart", "touchend", "t
 class KeyPad:
     """One widget's key pad: ``box`` (None until first shown) and its buttons' ``events``."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, canvas_box, state, scene, pump, keys, errors):
+        self.canvas_box = canvas_box  # the pad goes under the canvas, in this box
+        self.state, self.scene, self.pump, self.keys, self.errors = state, scene, pump, keys, errors
         self.box = None
         self.events = []
 
     def show(self, visible: bool) -> None:
         """Show (building it the first time) or hide the pad; hiding releases held keys."""
-        w = self.w
         if visible and self.box is None:
             self.box = self.build()
-            w._canvas_box.children = (*w._canvas_box.children, self.box)
+            self.canvas_box.children = (*self.canvas_box.children, self.box)
         if self.box is not None:
             if not visible:  # first: hiding must release them even if the layout's send fails
-                w.release_keys()
+                self.keys.release_all()
             self.box.layout.display = None if visible else "none"
 
     def build(self):
@@ -66,7 +66,7 @@ class KeyPad:
             raise
 
     def _make(self):
-        keymap = self.w.state.keymap
+        keymap = self.state.keymap
         rows = []
         for title, row in PAD_ROWS:
             buttons = []
@@ -82,7 +82,7 @@ class KeyPad:
                 )
                 b.add_class("rot4d-pad-button")
                 # for the page, which steps the pad's keys itself (page/turning.js): whose, which key
-                b.add_class(f"{self.w.scene.canvas_class}-pad")
+                b.add_class(f"{self.scene.canvas_class}-pad")
                 b.add_class(f"rot4d-pad-key-{ord(key):x}" + ("-shift" if shift else ""))
                 ev = Event(source=b, watched_events=list(PAD_EVENTS), prevent_default_action=True)
                 ev.on_dom_event(lambda event, key=key, shift=shift: self.handle(key, shift, event))
@@ -97,25 +97,24 @@ class KeyPad:
 
     def handle(self, key, shift, event) -> None:
         """A key pad button: mousedown / touchstart press its key, the rest release it. Never raises."""
-        w = self.w
         try:
             etype = event.get("type") if isinstance(event, Mapping) else None
             key_id = f"pad:{key}{'+shift' if shift else ''}"
             if etype in ("mousedown", "touchstart"):
                 if etype == "mousedown" and event.get("button", 0) != 0:
                     return  # the main button only (a right click opens no repeat)
-                found = w.state.keymap.resolve(key, shift)
-                if found is None or w._keys.no_view():
+                found = self.state.keymap.resolve(key, shift)
+                if found is None or self.keys.no_view():
                     return
                 action, inverted = found
-                with w._pump.lock:
-                    if w._closed or key_id in w._keys.held:
+                with self.pump.lock:
+                    if self.pump.closed or key_id in self.keys.held:
                         return  # a touch's emulated mousedown: one press only
-                    w._keys.press(key_id, action, inverted, page_time(event))
+                    self.keys.press(key_id, action, inverted, page_time(event))
             elif etype in ("mouseup", "mouseleave", "touchend", "touchcancel"):
-                w._keys.release(key_id, page_time(event))
+                self.keys.release(key_id, page_time(event))
         except Exception as exc:  # shown, never lost, never raised into the kernel
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def close(self) -> None:
         """Close the buttons' Events first (their document listeners go before the buttons), then

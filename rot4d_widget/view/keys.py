@@ -30,27 +30,44 @@ class KeyPath:
     """Keys and key pad buttons of one widget, from the event to the pump (the pump's lock held
     where it says so)."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, traits, showing, state, repeater, custom, pump, scene, companion, help_panel, errors):
+        self.showing, self.state, self.repeater, self.pump, self.errors = showing, state, repeater, pump, errors
+        self.scene, self.companion, self.help_panel = scene, companion, help_panel
+        #: a source's own keys: ``{action name: (run, repeats)}`` (`source_actions`)
+        self.custom = custom
         self.was_displayed = False  # a view of the canvas was counted once
         self.last = LastStep()  # the readout's "last" row
-        self.page = None  # the page's keys (`PageSteps`), once the recorder and clock exist
+        self.traits = traits  # the widget's traits (the field view's keys step ``rendering``, ``sections``)
+        self.painter = self.sync = self.keeper = self.shots = self.renderings = self.stacking = None
+        self.page = None  # the page's keys (`PageSteps`), once `connect`ed
 
-    def use_page_steps(self, recorder, clock) -> None:
-        """Take the page's keys by their timestamps from now on (`PageSteps`)."""
-        rep = self.w._repeater
-        self.page = PageSteps(self.w.state, recorder, self.last, hold_delay=rep.hold_delay,
-                              tick_rate=rep.tick_rate, clock=clock, view=FieldKeys(self.w))
+    def connect(self, painter, sync, keeper, shots, renderings, stacking) -> None:
+        """The units a key's step reaches (each action kind its own), and from now on the page's keys
+        by their timestamps (`PageSteps`, recorded by the keeper's recorder)."""
+        self.painter, self.sync, self.keeper, self.shots = painter, sync, keeper, shots
+        self.renderings, self.stacking = renderings, stacking
+        rep = self.repeater
+        view = FieldKeys(self.traits, self.showing, renderings, keeper, sync, self.apply_step)
+        self.page = PageSteps(self.state, keeper.recorder, self.last, hold_delay=rep.hold_delay,
+                              tick_rate=rep.tick_rate, clock=self.pump.clock, view=view)
+
+    @property
+    def help_visible(self) -> bool:
+        """The key table (key ?) is shown."""
+        return self.help_panel.layout.display != "none"
+
+    @help_visible.setter
+    def help_visible(self, value: bool) -> None:
+        self.help_panel.layout.display = None if value else "none"
 
     @property
     def held(self) -> tuple:
         """Every key held now: the page's (`PageSteps`) and the kernel's (the repeater)."""
-        return self.page.held + self.w._repeater.held_keys
+        return self.page.held + self.repeater.held_keys
 
     # -- events ----------------------------------------------------------------------------
     def handle_event(self, event) -> None:
         """ipyevents callback: never raises."""
-        w = self.w
         try:
             if not isinstance(event, Mapping):
                 return
@@ -62,23 +79,22 @@ class KeyPath:
                 if kid is not None:
                     self.release(kid, page_time(event))
             elif etype == "mouseleave":
-                w.release_keys(page_time(event))
+                self.release_all(page_time(event))
         except Exception as exc:  # shown, never lost, never raised into the kernel
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def key_down(self, event: Mapping) -> None:
-        w = self.w
         if event.get("repeat") is True:
             return  # browser auto-repeat: the ticker repeats, not the browser
         if self.no_view():
             return  # a listener leaked by a destroyed view (ipyevents): act on nothing
-        found = w.state.keymap.lookup(event)
+        found = self.state.keymap.lookup(event)
         kid = key_id(event)
         if found is None or kid is None:
             return
         action, inverted = found
-        with w._pump.lock:
-            if w._closed or w._repeater.held(kid) is not None or self.page.held_key(kid) is not None:
+        with self.pump.lock:
+            if self.pump.closed or self.repeater.held(kid) is not None or self.page.held_key(kid) is not None:
                 # a keydown of a key held (no keyup between: a browser or an OS that repeats
                 # without the repeat flag) is a repeat, not a new press
                 return
@@ -89,43 +105,40 @@ class KeyPath:
 
         ``when``: the page's time of the keydown (s), against which the keyup's corrects the
         number of steps (`rot4d_widget.view.keyhold`)."""
-        w = self.w
         if action.kind == "help":
-            w.help_visible = not w.help_visible
+            self.help_visible = not self.help_visible
             return
         if (action.kind in PREDICTED_KINDS or self.page.view.steps(action)) and when is not None:  # the page's
-            repeats = action.kind in REPEATING_KINDS or (action.kind == "custom" and w._custom[action.name][1])
+            repeats = action.kind in REPEATING_KINDS or (action.kind == "custom" and self.custom[action.name][1])
             self.page.press(kid, action, inverted, 1000.0 * when, repeats)
             self.advance()
-            w._pump.flush()
+            self.pump.flush()
             return
         self.advance()  # the page's steps so far come before this one
-        now = w._pump.clock()
+        now = self.pump.clock()
         changed = self.step(action, inverted)
-        if action.kind in REPEATING_KINDS or (action.kind == "custom" and w._custom[action.name][1]):
-            w._repeater.press(kid, action, inverted, now, page_time=when, applied=changed)
-        w._pump.flush(now)
+        if action.kind in REPEATING_KINDS or (action.kind == "custom" and self.custom[action.name][1]):
+            self.repeater.press(kid, action, inverted, now, page_time=when, applied=changed)
+        self.pump.flush(now)
 
     def release(self, kid, when=None) -> None:
         """Key (or key pad button) ``kid`` went up at the page's ``when`` (s): no more repeats,
         its steps corrected to what the page says the hold was; at rest, settle."""
-        w = self.w
-        with w._pump.lock:
+        with self.pump.lock:
             if self.page.release(kid, None if when is None else 1000.0 * when):
                 self.advance()
-            held = w._repeater.held(kid)
-            correction = w._repeater.release(kid, when)
+            held = self.repeater.held(kid)
+            correction = self.repeater.release(kid, when)
             if held is not None:
                 self.correct(*held, correction)
             self.settle()
 
     def release_all(self, when=None) -> None:
         """Every held key up (mouseleave, focus lost, no view left)."""
-        w = self.w
-        with w._pump.lock:
+        with self.pump.lock:
             if self.page.release_all(None if when is None else 1000.0 * when):
                 self.advance()
-            for action, inverted, correction in w._repeater.release_all(when):
+            for action, inverted, correction in self.repeater.release_all(when):
                 self.correct(action, inverted, correction)
             self.settle()
 
@@ -135,52 +148,49 @@ class KeyPath:
         `page_edge`): applied first, each once whichever way it came (`StepLog`), so the time heard
         never passes an event the kernel has not had -- ipyevents' way can be held up by a busy
         kernel while this one is not.  Never raises."""
-        w = self.w
         try:
             if isinstance(t_ms, bool) or not isinstance(t_ms, (int, float)) or not math.isfinite(t_ms):
                 return
-            with w._pump.lock:
-                if w._closed:
+            with self.pump.lock:
+                if self.pump.closed:
                     return
                 released = False
-                heard = (page_edge(e, w.state.keymap) for e in (edges if isinstance(edges, (list, tuple)) else ()))
+                heard = (page_edge(e, self.state.keymap) for e in (edges if isinstance(edges, (list, tuple)) else ()))
                 for edge in sorted(filter(None, heard), key=lambda e: e[2]):
                     kid, down, t, found = edge
                     if not down:
                         released = self.page.release(kid, t) or released
                     elif found is not None and found[0].kind in PREDICTED_KINDS and not self.no_view() \
-                            and w._repeater.held(kid) is None:
+                            and self.repeater.held(kid) is None:
                         self.page.press(kid, found[0], found[1], t, found[0].kind in REPEATING_KINDS)
                 self.page.heartbeat(float(t_ms))
                 self.advance()
                 if released:
                     self.settle()
-                w._pump.flush()
+                self.pump.flush()
         except Exception as exc:
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def advance(self) -> None:
         """The page's steps heard of and not applied yet (lock held): applied, recorded, the picture
         dirty and the traits synced once."""
-        w = self.w
         applied = self.page.advance()
         if applied.changed:
-            w._pump.mark_dirty()
+            self.pump.mark_dirty()
             if any(a.kind == "custom" for a in applied.actions):  # a field's levels (the source changed)
-                w._sync.source_traits()
-            w._sync.state_traits()
+                self.sync.source_traits()
+            self.sync.state_traits()
             # the page learns the kernel answers; the picture of this state is owed (the pump sends it)
-            w._painter.send_state("pending", throttle=bool(self.page.held))
+            self.painter.send_state("pending", throttle=bool(self.page.held))
 
     def settle(self) -> None:
         """At rest (no key held): bring the readout up to date and the rows into the turned frame,
         and send a picture still owed (one whose send failed)."""
-        w = self.w
-        if w._closed or self.held:
+        if self.pump.closed or self.held:
             return
-        if w._painter.readout_stale or not w._painter.settled:
-            w._pump.mark_dirty()
-        w._pump.flush()
+        if self.painter.readout_stale or not self.painter.settled:
+            self.pump.mark_dirty()
+        self.pump.flush()
 
     def correct(self, action: Action, inverted: bool, correction: int) -> None:
         """Take back (``correction`` < 0) or add (> 0) steps of a released key (lock held).
@@ -188,7 +198,6 @@ class KeyPath:
         A late keyup lets the ticker repeat a key the user had already released; the page's
         timestamps say how many steps the hold made, and this makes the state agree.  Each
         step taken back is the opposite step, recorded like any other."""
-        w = self.w
         if correction < 0:  # however many (a keyup 80 s late): the traits are synced once
             opposite = _opposite(action, inverted)
             undone = sum(self.apply_step(*opposite) for _ in range(-correction))
@@ -197,10 +206,10 @@ class KeyPath:
                 if last.label == action.label(inverted):
                     last.count = max(last.count - undone, 1)
                 self.after_steps(action)
-        clock = w._pump.clock
+        clock = self.pump.clock
         start = clock()
         for _ in range(max(correction, 0)):  # missing steps: within one tick's time, like a tick
-            if clock() - start > w._repeater.period:
+            if clock() - start > self.repeater.period:
                 break
             self.step(action, inverted)
 
@@ -209,9 +218,9 @@ class KeyPath:
         will come: every key up then."""
         try:
             ok = isinstance(t_ms, (int, float)) and not isinstance(t_ms, bool) and math.isfinite(t_ms)
-            self.w.release_keys(t_ms / 1000.0 if ok else None)
+            self.release_all(t_ms / 1000.0 if ok else None)
         except Exception as exc:
-            self.w._report_error(exc)
+            self.errors.report(exc)
 
     def view_count(self, n) -> None:
         """Scene: the canvas has ``n`` views; none left: every key up (no keyup will come)."""
@@ -219,9 +228,9 @@ class KeyPath:
             if n > 0:
                 self.was_displayed = True
             else:
-                self.w.release_keys()
+                self.release_all()
         except Exception as exc:
-            self.w._report_error(exc)
+            self.errors.report(exc)
 
     def no_view(self) -> bool:
         """True when the canvas was displayed and every view of it is gone.
@@ -229,40 +238,37 @@ class KeyPath:
         Front ends that do not count views leave the count at 0 and never set
         ``was_displayed``: their keys are always accepted.
         """
-        return self.was_displayed and self.w.scene.view_count == 0
+        return self.was_displayed and self.scene.view_count == 0
 
     def use_keymap(self, keymap, source) -> None:
         """Bind ``keymap`` plus ``source``'s own keys (its actions runnable), and show them in the help."""
-        w = self.w
         actions = source_actions(source)
         if actions:
             keymap = keymap.extended({k: a for k, (a, _, _) in actions.items()})
-        w._custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
-        w.state.keymap = keymap
-        markup.show(w.help_panel, markup.help_html(help_groups(keymap), w._repeater.hold_delay,
-                                                   w._repeater.tick_rate))
+        self.custom.update({a.name: (run, repeat) for a, run, repeat in actions.values()})
+        self.state.keymap = keymap
+        markup.show(self.help_panel, markup.help_html(help_groups(keymap), self.repeater.hold_delay,
+                                                   self.repeater.tick_rate))
         self.send_config()
 
     def send_config(self) -> None:
         """The key table and rules the page steps its copy of the state by (`pagestate.page_config`)."""
-        w = self.w
-        rep = w._repeater
+        rep = self.repeater
         predicted = PREDICTED_KINDS | self.page.view.kinds()
-        levels = level_actions(w.source)
-        actions = {name: {"rule": "levels", "sign": sign, "repeat": bool(w._custom[name][1])}
-                   for name, sign in levels.items() if name in w._custom}
-        config = page_config(w.state.keymap, hold_delay=rep.hold_delay, tick_rate=rep.tick_rate,
+        levels = level_actions(self.showing.source)
+        actions = {name: {"rule": "levels", "sign": sign, "repeat": bool(self.custom[name][1])}
+                   for name, sign in levels.items() if name in self.custom}
+        config = page_config(self.state.keymap, hold_delay=rep.hold_delay, tick_rate=rep.tick_rate,
                              max_lag=rep.max_steps * rep.period, predicted=predicted, predicted_actions=actions)
-        if config != w.companion.config:
-            w.companion.config = config
+        if config != self.companion.config:
+            self.companion.config = config
 
     # -- steps -----------------------------------------------------------------------------
     def tick(self, now: float) -> None:
         """Pump callback: the held keys' steps due by ``now``; a tick that overran (slow
         observers, a loaded machine) drops the ticks it missed instead of bursting."""
-        w = self.w
-        rep = w._repeater
-        clock = w._pump.clock
+        rep = self.repeater
+        clock = self.pump.clock
         if self.page.held:  # the page silent for a while: its steps by the kernel's estimate
             self.page.tick()
             self.advance()
@@ -278,10 +284,9 @@ class KeyPath:
     def deadline(self):
         """When `tick` next wants to run: the repeater's next tick, or with a key of the page held,
         when the page will have been silent too long (`HEARTBEAT_STALE`)."""
-        w = self.w
-        d = w._repeater.next_deadline()
+        d = self.repeater.next_deadline()
         if self.page.held:
-            soon = w._pump.clock() + HEARTBEAT_STALE
+            soon = self.pump.clock() + HEARTBEAT_STALE
             d = soon if d is None else min(d, soon)
         return d
 
@@ -295,45 +300,43 @@ class KeyPath:
 
     def apply_step(self, action: Action, inverted: bool) -> bool:
         """Apply and record one step (no trait sync: `after_steps` does it once); True if it changed."""
-        w = self.w
         if action.kind == "custom":
-            run = w._custom.get(action.name)
+            run = self.custom.get(action.name)
             if run is None:
                 return False
-            with w._source_lock:
-                note_matrix(w.source, w.state.matrix)  # n: a default spacing spread along today's w
+            with self.showing.lock:
+                note_matrix(self.showing.source, self.state.matrix)  # n: a default spacing spread along today's w
                 result = run[0](-1 if inverted else 1)
             if result is False:  # refused (at a bound): nothing changed, nothing recorded
                 return False
-            w._source_version += 1
-            w._recorder.record(None, False, action, inverted)
-            w._keeper.note_settings()
+            self.showing.changed()
+            self.keeper.recorder.record(None, False, action, inverted)
+            self.keeper.note_settings()
             return True
         if action.kind == "screenshot":
-            w._shots.key_p()
+            self.shots.key_p()
             return False
         if action.kind in ("rendering", "section"):  # the view's field keys (`renderings`)
-            return w._renderings.step(action, inverted)
-        if action.kind == "slices" and not w._stacking.is_stack:
+            return self.renderings.step(action, inverted)
+        if action.kind == "slices" and not self.stacking.is_stack:
             # n on a single slice: the first added slice makes the view a stack of two (recorded
             # as the source setting it is; the stack's own keys are steps from here on)
             if (-1 if inverted else 1) * action.sign <= 0:
                 return False
-            w._stacking.wrap(2)
-            w._recorder.record_source("slices", 2)
+            self.stacking.wrap(2)
+            self.keeper.recorder.record_source("slices", 2)
             return True
-        changed = w.state.apply(action, inverted)
+        changed = self.state.apply(action, inverted)
         if changed:
-            w._recorder.record(None, False, action, inverted)
+            self.keeper.recorder.record(None, False, action, inverted)
         return changed
 
     def after_steps(self, action: Action) -> None:
         """After steps of ``action`` changed something: redraw, and the traits say what it is."""
-        w = self.w
-        w._pump.mark_dirty()
+        self.pump.mark_dirty()
         if action.kind in ("custom", "slices"):
-            w._sync.source_traits()
-        w._sync.state_traits()
+            self.sync.source_traits()
+        self.sync.state_traits()
 
 
 def _opposite(action: Action, inverted: bool):

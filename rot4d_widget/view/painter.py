@@ -94,8 +94,11 @@ class Painter:
     (the view may be turned from it); ``rows_data`` the slice those rows show.
     """
 
-    def __init__(self, widget, coarse_ok: bool):
-        self.w = widget
+    def __init__(self, traits, showing, state, pump, scene, companion, readout, errors, coarse_ok: bool):
+        self.traits = traits  # the widget's traits: how a field is coloured and drawn
+        self.showing, self.state, self.pump, self.errors = showing, state, pump, errors
+        self.scene, self.companion, self.readout = scene, companion, readout
+        self.keys = self.shots = self.projection_view = None  # `connect`
         #: sources whose slice(matrix, c0, coarse=...) has a cheaper coarse version (fields):
         #: coarse while keys repeat, full at rest; their rows are turned, not re-sliced, at rest
         self.coarse_ok = coarse_ok
@@ -113,16 +116,20 @@ class Painter:
         self.readout_stale = False  # the readout lags the state (keys were repeating)
         self.state_at = -math.inf  # when the kernel's state was last sent to the page
 
+    def connect(self, keys, shots, projection_view) -> None:
+        """The units a picture tells: the keys (held, the page's steps, the key table), the
+        screenshots owed, the projection's part of each update."""
+        self.keys, self.shots, self.projection_view = keys, shots, projection_view
+
     # -- slices -----------------------------------------------------------------------------
     def current_slice(self, coarse: bool = False):
-        w = self.w
-        st = w.state
-        m, c0, version = st.matrix, st.c0, w._source_version
+        st = self.state
+        m, c0, version = st.matrix, st.c0, self.showing.version
         coarse = bool(coarse and self.coarse_ok)
         cached = self.cached_slice(m, c0, version, coarse)
         if cached is not None:
             return cached
-        data = checked_slice(w.source, m, c0, coarse, w._source_lock)
+        data = checked_slice(self.showing.source, m, c0, coarse, self.showing.lock)
         self.cache = (m, c0, version, coarse, data)
         return data
 
@@ -145,26 +152,26 @@ class Painter:
         sent as a turn, a few bytes, without slicing; at rest the rows are
         re-sent in the new frame (the faces' order is exact again).
         """
-        w = self.w
-        st, scene = w.state, w.scene
-        held = bool(w._keys.held)
-        single = None if w.color_by == "group" else colours.as_rgb(w.color_by, "color_by")
-        cut = w.companion.page_cut
-        cut.sync(w.source, self.group_colors(), w._scale, single)
+        st, scene = self.state, self.scene
+        held = bool(self.keys.held)
+        single = None if self.traits.color_by == "group" else colours.as_rgb(self.traits.color_by, "color_by")
+        cut = self.companion.page_cut
+        cut.sync(self.showing.source, self.group_colors(), self.showing.scale, single)
         self.sync_field()
-        if held and (cut.page_draws or w.companion.page_field.page_draws):  # the page draws them: no work here
+        if held and (cut.page_draws or self.companion.page_field.page_draws):  # the page draws them: no work here
             self.send_state("pending")
             self.readout_stale = True  # at rest the picture and the readout follow (`KeyPath.settle`)
             return None
         coarse = held and self.coarse_ok
         shown, rows = self.shown, self.rows_key
-        cast = w.rendering != "surface" and can_sample(w.source)  # ray-cast from the cut on grids
-        key = ViewKey(st.matrix, st.c0, scene.eye, w._source_version, w.color_by, coarse,
-                      (w.cmap, w.clim, w.rendering if cast else "surface", w.sections if cast else None))
+        cast = self.traits.rendering != "surface" and can_sample(self.showing.source)  # ray-cast from the cut on grids
+        t = self.traits
+        key = ViewKey(st.matrix, st.c0, scene.eye, self.showing.version, t.color_by, coarse,
+                      (t.cmap, t.clim, t.rendering if cast else "surface", t.sections if cast else None))
         sent = None
         same_cut = rows is not None and key.same_cut(rows)
         # a stack turns each slice about its own centre: never turned as a whole
-        turn = key.turn_from(rows) if same_cut and inner_source(w.source) is w.source else None
+        turn = key.turn_from(rows) if same_cut and inner_source(self.showing.source) is self.showing.source else None
         if shown is not None and key.same(shown) and (shown is rows or held) and not scene.unsent:
             pass  # the page shows this state (turned rows only while keys are held)
         elif held and turn is not None and (key.coarse or not rows.coarse):
@@ -177,17 +184,17 @@ class Painter:
             if cached is not None and cached[0] is m and cached[1:4] == (c0, version, coarse_):
                 cut = cached[4]
             else:
-                source, lock, scale = w.source, w._source_lock, w._scale
+                source, lock, scale = self.showing.source, self.showing.lock, self.showing.scale
                 cut = yield (lambda: grid_cut(source, m, c0, coarse_, lock, scale))  # the slow part, unlocked
-                if w._closed:
+                if self.pump.closed:
                     return None
-                if w._source_version != version or w.source is not source:
-                    w._pump.mark_dirty()
+                if self.showing.version != version or self.showing.source is not source:
+                    self.pump.mark_dirty()
                     return None
                 self.grid_cache = (m, c0, version, coarse_, cut)
-            clim = w.clim if w.clim is not None else colours.default_clim(cut.finite_values)
-            volume = volume_message(cut.parts, w.rendering, w.cmap, clim, w.sections, held=coarse_)
-            labels = cut_labels(w.source, m, c0, cut.data)
+            clim = self.traits.clim if self.traits.clim is not None else colours.default_clim(cut.finite_values)
+            volume = volume_message(cut.parts, t.rendering, t.cmap, clim, t.sections, held=coarse_)
+            labels = cut_labels(self.showing.source, m, c0, cut.data)
             if scene.show(cut.data, single_rgb=single, volume=volume, labels=labels, **self.projection(key)):
                 self.labelled = bool(labels)
                 sent = scene.update_id
@@ -204,19 +211,19 @@ class Painter:
                 m, c0, version, coarse_ = key.matrix, key.c0, key.version, bool(coarse and self.coarse_ok)
                 data = self.cached_slice(m, c0, version, coarse_)
                 if data is None:
-                    source, lock = w.source, w._source_lock
+                    source, lock = self.showing.source, self.showing.lock
                     # the slow part: on the ticker thread it runs with the pump's lock free, so
                     # keys go on changing the state meanwhile (the next picture takes the latest)
                     data = yield (lambda: checked_slice(source, m, c0, coarse_, lock))
-                    if w._closed:
+                    if self.pump.closed:
                         return None
-                    if w._source_version != version or w.source is not source:
-                        w._pump.mark_dirty()  # the source changed meanwhile: never show the old one
+                    if self.showing.version != version or self.showing.source is not source:
+                        self.pump.mark_dirty()  # the source changed meanwhile: never show the old one
                         return None
                     self.cache = (m, c0, version, coarse_, data)
             colors = self.group_colors()
             extra = {} if colors is None else {"group_rgb": colors}
-            labels = cut_labels(w.source, key.matrix, key.c0, data)
+            labels = cut_labels(self.showing.source, key.matrix, key.c0, data)
             if labels or self.labelled:  # a source with labels (a field), or to take them away
                 extra["labels"] = labels
             if scene.show(data, single_rgb=single, **extra, **self.projection(key)):
@@ -226,15 +233,15 @@ class Painter:
             self.shown = self.rows_key = key
         # the state and its id, and which picture shows it: this one, if it is of the state now (keys
         # may have changed it while the picture was made), else one is owed
-        now_shown = key.matrix is w.state.matrix and key.c0 == w.state.c0
+        now_shown = key.matrix is self.state.matrix and key.c0 == self.state.c0
         self.sync_field()  # the colour limits this picture used (the page's while it draws)
         self.send_state(picture=(sent if now_shown else "pending") if sent is not None else
                         (None if now_shown else "pending"))
-        w._shots.send_owed()  # screenshots asked meanwhile: of this picture
-        now = w._pump.clock()
-        w._error_area.clear_update_errors()  # a good picture: the widget has recovered
-        if not w._keys.held or now - self.readout_at >= READOUT_PERIOD:
-            ro.show(w.readout, self.readout_html())
+        self.shots.send_owed()  # screenshots asked meanwhile: of this picture
+        now = self.pump.clock()
+        self.errors.clear_update_errors()  # a good picture: the widget has recovered
+        if not self.keys.held or now - self.readout_at >= READOUT_PERIOD:
+            ro.show(self.readout, self.readout_html())
             self.readout_at, self.readout_stale = now, False
         else:
             self.readout_stale = True
@@ -245,91 +252,90 @@ class Painter:
         ``picture``: the update id of the scene's picture that shows it, None when the picture shown
         does, or "pending" when one is owed (the pump sends it).  ``throttle`` (a step of the
         page's keys, many a second): not sooner than `STATE_PERIOD` after the last (the next goes)."""
-        w = self.w
-        now = w._pump.clock()
+        now = self.pump.clock()
         if throttle and now - self.state_at < STATE_PERIOD:
             return
-        w._keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
-        epoch, upto = w._keys.page.state_id
+        self.keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
+        epoch, upto = self.keys.page.state_id
         msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None,
-               "state": state_message(w.state, view_message(w)), "keys": w._keys.page.held_since(),
+               "state": state_message(self.state, view_message(self.showing.source, self.traits.rendering,
+                                                                self.traits.sections)),
+               "keys": self.keys.page.held_since(),
                "picture": picture}
-        old = w.companion.kernel_state
+        old = self.companion.kernel_state
         if picture is None and old.get("picture") != "pending" and old.get("state") == msg["state"] \
                 and old.get("epoch") == epoch and old.get("upto") == msg["upto"] and old.get("keys") == msg["keys"]:
             return  # unchanged: nothing to send (the picture named before still shows it)
-        w.companion.kernel_state = msg
+        self.companion.kernel_state = msg
         self.state_at = now
 
     def sync_field(self) -> None:
         """Offer the page the field's copy once it is in memory (`pagefield.PageField`) and say how
         it draws it (`fieldview.field_config`, sent when it changed)."""
-        w = self.w
-        pf = w.companion.page_field
-        pf.sync(w.source)
-        w._keys.send_config()  # a field's levels are predicted once its range is known without a read
-        field = page_field(w.source)
+        pf = self.companion.page_field
+        pf.sync(self.showing.source)
+        self.keys.send_config()  # a field's levels are predicted once its range is known without a read
+        field = page_field(self.showing.source)
         if field is None or not pf.offered:
             return
-        cfg = field_config(w, field, pf.clim, pf.texture_side, self.colours())
-        if cfg != w.companion.field_config:
-            w.companion.field_config = cfg
+        t = self.traits
+        cfg = field_config(self.showing.source, self.showing.scale, field, cmap=t.cmap, clim=t.clim,
+                           color_by=t.color_by, cast_clim=self.cast_clim, default_clim_=pf.clim,
+                           texture_side=pf.texture_side, painted=self.colours())
+        if cfg != self.companion.field_config:
+            self.companion.field_config = cfg
 
     def projection(self, key: ViewKey) -> dict:
         """The projection view's part of the update showing ``key`` (`ProjectionView.message`), as the
         scene's ``projection`` keyword ({} while the projection is off): both views from one message."""
-        message = self.w._projection.message(key.matrix, key.c0, key.version)
+        message = self.projection_view.message(key.matrix, key.c0, key.version)
         return {} if message is None else {"projection": message}
 
     def data_read(self) -> None:
         """The source's background read is over (`ViewBar.follow`): draw again from the data now in
         memory, the readout with what the read found (a field's blocks of NaN: its "missing" row)."""
-        w = self.w
         try:
-            with w._pump.lock:
-                if w._closed:
+            with self.pump.lock:
+                if self.pump.closed:
                     return
-                w._source_version += 1  # the same source, read: slice it again
-                w._pump.mark_dirty()
-                w._pump.flush()
+                self.showing.changed()  # the same source, read: slice it again
+                self.pump.mark_dirty()
+                self.pump.flush()
         except Exception as exc:
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def eye_moved(self, eye) -> None:
         """Scene: the camera moved (a mouse orbit ended): send the faces in the order for the new eye."""
-        w = self.w
         try:
-            with w._pump.lock:
-                if not w._closed:
-                    w._pump.mark_dirty()
-                    w._pump.flush()
+            with self.pump.lock:
+                if not self.pump.closed:
+                    self.pump.mark_dirty()
+                    self.pump.flush()
         except Exception as exc:
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def page_holds(self, name) -> None:
         """Companion: the page holds a one-time transfer: the readout says who draws while turning."""
-        w = self.w
         try:
-            with w._pump.lock:
-                if not w._closed and name in ("field", "field_box"):
-                    ro.show(w.readout, self.readout_html())
+            with self.pump.lock:
+                if not self.pump.closed and name in ("field", "field_box"):
+                    ro.show(self.readout, self.readout_html())
         except Exception as exc:
-            w._report_error(exc)
+            self.errors.report(exc)
 
     def turning_text(self):
         """Who draws a field's pictures while keys are held (the readout's "turning" row), or None
         for a source that is not a field."""
-        w = self.w
-        if not can_sample(w.source):
+        if not can_sample(self.showing.source):
             return None
-        pf = w.companion.page_field
-        if page_field(w.source) is None:
+        pf = self.companion.page_field
+        if page_field(self.showing.source) is None:
             return "the kernel draws every picture (the page holds no copy of a function or of unevenly spaced data)"
         if pf.page_draws:
             shape = " \u00d7 ".join(str(n) for n in pf.shape)
             what = "the data" if pf.which == "data" else "the coarse copy"
             return f"the page draws while keys are held, from its copy of {what} ({shape}); the kernel at rest"
-        sending = w.companion.transfers.sending("field")
+        sending = self.companion.transfers.sending("field")
         if sending is not None:
             return (f"the kernel draws while keys are held: the page's copy is on its way "
                     f"({sending[0]}/{sending[1]} parts)")
@@ -341,14 +347,13 @@ class Painter:
     # -- the readout ------------------------------------------------------------------------
     def set_note(self, text: str) -> None:
         self.note = text
-        ro.show(self.w.readout, self.readout_html())
+        ro.show(self.readout, self.readout_html())
 
     def readout_html(self) -> ro.Markup:
-        w = self.w
-        st, source = w.state, w.source
+        st, source = self.state, self.showing.source
         # a turned view shows the rows' slice turned in 3-D: same census and volume, no new slice
         data = self.rows_data if self.rows_data is not None else self.current_slice()
-        label, count = w._keys.last.label, w._keys.last.count
+        label, count = self.keys.last.label, self.keys.last.count
         if label is None:
             last = "\u2014"
         else:
@@ -369,10 +374,10 @@ class Painter:
         if cast and single and self.labelled:  # what the ray-cast picture shows, and where its planes are
             cut = self.grid_cache[4] if self.grid_cache is not None else None
             if cut is not None and len(cut.grids) == 1:
-                rows += rendering_rows(source, self.shown.matrix, self.shown.c0, w.rendering, w.sections,
-                                       cut.grids[0])
+                rows += rendering_rows(source, self.shown.matrix, self.shown.c0, self.traits.rendering,
+                                       self.traits.sections, cut.grids[0])
         colors, labels = self.colours()
-        if labels is not None and w.color_by == "group" and not cast:  # the legend: what each colour is
+        if labels is not None and self.traits.color_by == "group" and not cast:  # the legend: what each colour is
             rows.append(("colours", ro.legend_html(labels, colors)))  # (a ray-cast picture: the bar says)
         bar = self.colourbar(colors if labels is not None and single else None)
         if bar:
@@ -387,7 +392,7 @@ class Painter:
             rows.append(("turning", turning))
         if self.note:
             rows.append(("picture", self.note))
-        views = w._projection.readout_row()  # which view is which, with the projection shown
+        views = self.projection_view.readout_row()  # which view is which, with the projection shown
         if views is not None:
             rows.insert(0, views)
         return ro.readout_html(title(source), rows, gizmo=ro.gizmo_svg(st.matrix))
@@ -404,8 +409,7 @@ class Painter:
         coloured otherwise: a stack by w, one colour).  A ray-cast picture's bar spans the limits
         its colours used (``clim``, or the cut's 1st-99th percentile) and marks no level.  "" for
         a source without levels."""
-        w = self.w
-        inner = inner_source(w.source)
+        inner = inner_source(self.showing.source)
         levels = getattr(inner, "levels", None)
         if not levels:
             return ""
@@ -413,15 +417,17 @@ class Painter:
         if cast and self.cast_clim is not None:  # a ray-cast picture: the limits its colours used
             lo, hi = self.cast_clim
         else:
-            lo, hi = w.clim if w.clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
+            clim = self.traits.clim
+            lo, hi = clim if clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
             return f"no colour scale (the data's range is {lo:.4g} \u2026 {hi:.4g})"
-        if level_rgb is None or w.color_by != "group":
+        if level_rgb is None or self.traits.color_by != "group":
             level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
         label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
         marks = [] if cast else [(float(v), colours.hex_color(c)) for v, c in zip(levels, level_rgb)]
-        return ro.colourbar_html(colours.cmap_stops(w.cmap), lo, hi, str(label), getattr(inner, "units", None),
-                                 marks, cmap=w.cmap)
+        cmap = self.traits.cmap
+        return ro.colourbar_html(colours.cmap_stops(cmap), lo, hi, str(label), getattr(inner, "units", None),
+                                 marks, cmap=cmap)
 
     def group_colors(self):
         """The colour of every group of the source as it is now (`colours`)."""
@@ -431,17 +437,16 @@ class Painter:
         """``(rgb (G, 3), labels or None)``: a stack's colours by w, else a field's by level (also
         inside a stack of one slice), else the scene's palette sized to the source's groups
         now (labels None: cells need no legend).  Follows the source when it changes."""
-        w = self.w
-        src = w.source
+        src = self.showing.source
         inner = inner_source(src)
         if inner is not src:  # parallel slices: coloured by their w (`group_colors`, `cuts_at`)
             rgb = src.group_colors()
             if rgb is not None:
-                return rgb, [data_w_text(inner, cut) for cut in src.cuts_at(w.state.c0)]
-        rgb = level_colors(inner, w.cmap, w.clim)
+                return rgb, [data_w_text(inner, cut) for cut in src.cuts_at(self.state.c0)]
+        rgb = level_colors(inner, self.traits.cmap, self.traits.clim)
         if rgb is not None:
             return rgb, [f"{lv:.4g}" for lv in inner.levels]
-        return w.scene.palette(int(src.n_groups)), None
+        return self.scene.palette(int(src.n_groups)), None
 
 
 def level_colors(source, cmap: str = colours.LEVEL_COLORMAP, clim=None):

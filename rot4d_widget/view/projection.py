@@ -241,8 +241,12 @@ class ProjectionView:
     geometries of its own, filled in the page from the skeleton and the state (the kernel never
     sends an array to them)."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, traits, place, showing, state, scene, companion, pump, on_event):
+        self.traits = traits  # the widget's traits: ``projection``, ``background``, ``ball_radius``
+        self.place = place  # place(box, on): the widget puts the projection's box beside the slice view, or not
+        self.showing, self.state, self.scene, self.companion, self.pump = showing, state, scene, companion, pump
+        self.on_event = on_event  # keys over the projection's canvas go where the slice view's go
+        self.painter = None  # `connect`
         self.box = None  # the ipywidgets VBox (caption + canvas), once built
         self.shown_key = None  # (matrix, c0, version) of the state last handed to the scene
         self._skeleton_key = None  # (source, version, scale) whose skeleton the page was sent
@@ -251,17 +255,19 @@ class ProjectionView:
         self.events = None  # the ipyevents listener on the projection's canvas, once built
         self.canvas_class = f"rot4d-projection-{uuid.uuid4().hex[:12]}"
 
+    def connect(self, painter) -> None:
+        """The painter, whose picture a projection turned on first shows."""
+        self.painter = painter
+
     @property
     def on(self) -> bool:
-        return bool(getattr(self.w, "projection", False))
+        return bool(self.traits.projection)
 
     # -- building ----------------------------------------------------------------------------
     def _build(self) -> None:
         import ipywidgets as widgets  # with pythreejs: only when the projection is first shown
         import pythreejs as p3  # heavy (~0.3 s): imported when the projection is first shown
-
-        w = self.w
-        scene = w.scene
+        scene = self.scene
         width, height = int(scene.width), int(scene.height)
 
         def placeholder(rows):  # plain attributes: the companion makes its geometries of their classes
@@ -274,7 +280,7 @@ class ProjectionView:
         self._lines = p3.LineSegments(geometry=self._edge_geometry, material=self._edge_material,
                                       frustumCulled=False, name="projection edges")
         self._point_geometry = p3.BufferGeometry(attributes={"position": placeholder(1)})
-        ball = 4.0 * float(getattr(w, "ball_radius", 0.07))
+        ball = 4.0 * float(self.traits.ball_radius)
         self._point_material = p3.PointsMaterial(color=CROSSING_RGB, size=ball, sizeAttenuation=True)
         self._points = p3.Points(geometry=self._point_geometry, material=self._point_material,
                                  frustumCulled=False, name="projection crossings", visible=False)
@@ -284,7 +290,7 @@ class ProjectionView:
         )
         self._scene = p3.Scene(children=[self._lines, self._points, self._camera], background=None)
         self._controls = p3.OrbitControls(controlling=self._camera, enableKeys=False)
-        background = colours.hex_color(colours.as_rgb(w.background, "background"))
+        background = colours.hex_color(colours.as_rgb(self.traits.background, "background"))
         self.renderer = p3.Renderer(camera=self._camera, scene=self._scene, controls=[self._controls],
                                     width=width, height=height, background=background, background_opacity=1.0,
                                     clearColor=background)
@@ -294,7 +300,7 @@ class ProjectionView:
 
         self.events = Event(source=self.renderer, watched_events=list(KEY_EVENTS), prevent_default_action=True,
                             ignore_modifier_key_events=True)
-        self.events.on_dom_event(w._handle_event)
+        self.events.on_dom_event(self.on_event)
         self.caption = markup.html_widget(self._caption_html())
         self.box = widgets.VBox([self.caption, self.renderer], layout=widgets.Layout(flex="0 0 auto"))
         self._widgets = [self.events, self.box, self.caption, self.renderer, self._controls, self._scene, self._camera,
@@ -302,12 +308,12 @@ class ProjectionView:
                          self._point_geometry, self._point_material]
         self._widgets += [a for g in (self._edge_geometry, self._point_geometry) for a in g.attributes.values()]
         # the companion finds the meshes and the scene it draws into, and the canvas (key guards)
-        with w.companion.hold_sync():
-            w.companion.projection_model_ids = [self._lines.model_id, self._points.model_id, self._scene.model_id]
-            w.companion.projection_class = self.canvas_class
+        with self.companion.hold_sync():
+            self.companion.projection_model_ids = [self._lines.model_id, self._points.model_id, self._scene.model_id]
+            self.companion.projection_class = self.canvas_class
 
     def _caption_html(self) -> markup.Markup:
-        note = "this source has no edges or box to project" if skeleton(self.w.source) is None else None
+        note = "this source has no edges or box to project" if skeleton(self.showing.source) is None else None
         return markup.projection_caption_html(EYE_DISTANCE, note)
 
     # -- showing --------------------------------------------------------------------------
@@ -315,21 +321,16 @@ class ProjectionView:
         """The ``projection`` trait changed (or the widget was just wired): show or hide the canvas
         beside the slice view; when it is turned on, send the state the slice view shows (one
         message with the skeleton); later updates carry it with the slice (`message`)."""
-        w = self.w
         if self.on and self.box is None:
             self._build()
         if self.box is not None:
-            kids = [c for c in w.children if c is not self.box]
-            if self.on:
-                kids.insert(1, self.box)
-            if tuple(kids) != tuple(w.children):
-                w.children = tuple(kids)
+            self.place(self.box, self.on)
         self._skeleton_key = None  # the next message carries the skeleton again
         if change is not None and self.on:
-            with w._pump.lock:
-                shown = w._painter.shown
-                if not w._closed and shown is not None:
-                    w.scene.project(self.message(shown.matrix, shown.c0, shown.version))
+            with self.pump.lock:
+                shown = self.painter.shown
+                if not self.pump.closed and shown is not None:
+                    self.scene.project(self.message(shown.matrix, shown.c0, shown.version))
 
     def message(self, matrix, c0, version) -> dict | None:
         """What the slice view's update carries for the projection (`rot4d_widget.view.scene.Scene.show`'s
@@ -338,11 +339,10 @@ class ProjectionView:
         the scale changed.  Called just before the scene sends the update."""
         if not self.on or self.box is None:
             return None
-        w = self.w
-        out = {"state": state_message(w.source, matrix, c0)}
-        key = (w.source, version, w._scale)
+        out = {"state": state_message(self.showing.source, matrix, c0)}
+        key = (self.showing.source, version, self.showing.scale)
         if self._skeleton_key is None or any(a is not b and a != b for a, b in zip(key, self._skeleton_key)):
-            out["skeleton"] = skeleton_message(w.source, w._scale)
+            out["skeleton"] = skeleton_message(self.showing.source, self.showing.scale)
             self._skeleton_key = key
             markup.show(self.caption, self._caption_html())
         self.shown_key = (matrix, c0, version)
@@ -356,7 +356,7 @@ class ProjectionView:
         if key is None:
             return None
         if self._arrays[0] is not key:
-            self._arrays = (key, projection_arrays(self.w.source, key[0], key[1], self.w._scale))
+            self._arrays = (key, projection_arrays(self.showing.source, key[0], key[1], self.showing.scale))
         return self._arrays[1]
 
     def readout_row(self):
@@ -367,7 +367,7 @@ class ProjectionView:
 
     def close(self) -> None:
         if self.events is not None:
-            self.events.on_dom_event(self.w._handle_event, remove=True)
+            self.events.on_dom_event(self.on_event, remove=True)
             self.events = None
         for x in self._widgets:
             close_quietly(x)

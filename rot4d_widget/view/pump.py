@@ -182,7 +182,22 @@ class UpdatePump:
         self._sending = False  # a send is being computed outside the lock (ticker thread)
         self._failed = False  # the last send raised: retried on the next ack, key or flush, not at once
 
+    def connect(self, send, *, tick=None, deadline=None) -> None:
+        """The callbacks, for an owner whose units are made after the pump (they take its lock):
+        ``send``, and optionally ``tick`` and ``deadline``, as the constructor's."""
+        self._send, self._tick, self._deadline = send, tick, deadline
+
     # -- state ----------------------------------------------------------------
+    @property
+    def closed(self) -> bool:
+        """True once `shut` (or `close`): nothing is sent, acknowledged or ticked any more."""
+        return self._closed
+
+    def check_open(self) -> None:
+        """Raise RuntimeError when `closed` (the widget's API refuses to act then)."""
+        if self._closed:
+            raise RuntimeError("This Rot4DWidget is closed")
+
     @property
     def in_flight(self):
         """Id of the newest update awaiting its acknowledgement, or None."""
@@ -429,13 +444,16 @@ class UpdatePump:
         t = self._thread
         return t is not None and t.is_alive()
 
-    def close(self) -> None:
-        """Stop the thread (joined unless called from it); idempotent."""
+    def shut(self) -> None:
+        """From now on `closed`: nothing more is sent; the thread ends (`close` joins it)."""
         with self.lock:
-            if self._closed:
-                return
             self._closed = True
             self._wakeup.notify_all()
+
+    def close(self) -> None:
+        """`shut`, and join the thread (unless called from it); idempotent."""
+        with self.lock:
+            self.shut()
             thread, self._thread = self._thread, None
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout=2.0)

@@ -25,12 +25,13 @@ __all__ = ["Renderings", "SECTION_STEP"]
 class Renderings:
     """One widget's rendering and sections: trait observers and key steps."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, traits, showing, scene, pump):
+        self.traits = traits  # the widget's traits: ``rendering``, ``sections``
+        self.showing, self.scene, self.pump = showing, scene, pump
 
     def observe(self) -> None:
-        self.w.observe(self.on_trait, names=["rendering", "sections"])
-        self.follow_camera("surface", self.w.rendering)  # made to show sections: seen at a slant
+        self.traits.observe(self.on_trait, names=["rendering", "sections"])
+        self.follow_camera("surface", self.traits.rendering)  # made to show sections: seen at a slant
 
     def follow_camera(self, old: str, new: str) -> None:
         """The camera to ``new``'s default (`camera.default_eye`: sections at a slant, so that all three
@@ -38,7 +39,7 @@ class Renderings:
         camera (the canvas's) gets its position and its turn in one message -- three.js turns no
         camera that moves -- looking at the origin, +y up (`camera.view_rotation`, the static
         pictures' look-at); the scene's eye callbacks follow (the faces re-sent in their order)."""
-        scene = self.w.scene
+        scene = self.scene
         before, after = camera.default_eye(old), camera.default_eye(new)
         if before != after and all(abs(a - b) < 1e-9 for a, b in zip(scene.eye, before)):
             cam = scene.canvas.camera
@@ -49,37 +50,35 @@ class Renderings:
     # -- traits -----------------------------------------------------------------------------
     def on_trait(self, change) -> None:
         """A user set ``rendering`` or ``sections``: checked against the source, drawn, recorded."""
-        w = self.w
         name, new = change["name"], change["new"]
-        if name == "rendering" and new != "surface" and not can_sample(w.source):
-            w.set_trait("rendering", change["old"])
+        if name == "rendering" and new != "surface" and not can_sample(self.showing.source):
+            self.traits.set_trait("rendering", change["old"])
             raise ValueError(f"rendering={new!r} needs a field (a source with `sample`, the cut on a grid); "
-                             f"{title(w.source)} has only rendering='surface'")
-        with w._pump.lock:
-            if w._closed:
+                             f"{title(self.showing.source)} has only rendering='surface'")
+        with self.pump.lock:
+            if self.pump.closed:
                 return
             if name == "rendering":
                 self.follow_camera(change["old"], new)
-            w._pump.mark_dirty()
-            w._pump.flush()
+            self.pump.mark_dirty()
+            self.pump.flush()
 
     # -- keys -------------------------------------------------------------------------------
     def step(self, action, inverted: bool) -> bool:
         """One step of a "rendering" or "section" key; True if it changed the view (the caller,
         holding the pump's lock, redraws)."""
-        w = self.w
-        if not can_sample(w.source):
+        if not can_sample(self.showing.source):
             return False
         direction = -1 if inverted else 1
         if action.kind == "rendering":
             order = renderings.RENDERINGS
-            old = w.rendering
+            old = self.traits.rendering
             new = order[(order.index(old) + direction * action.sign) % len(order)]
             self._set("rendering", new)
             self.follow_camera(old, new)
             return True
         axis = "xyz".index(action.name)
-        pos = list(w.sections)
+        pos = list(self.traits.sections)
         moved = min(1.0, max(0.0, round((pos[axis] + direction * action.sign * SECTION_STEP) * 1024) / 1024))
         if moved == pos[axis]:
             return False  # at the edge: refused, not clamped, so the opposite key undoes every step
@@ -90,14 +89,13 @@ class Renderings:
     def set_quietly(self, name, value) -> None:
         """Set ``rendering`` or ``sections`` without the observer's redraw (the caller marks the picture
         dirty; the keeper records the trait); nothing when it holds that value."""
-        if getattr(self.w, name) != value:
+        if getattr(self.traits, name) != value:
             self._set(name, value)
 
     def _set(self, name, value) -> None:
         """Set the trait from a key (the pump's lock is held: the observer's redraw waits for it)."""
-        w = self.w
-        w.unobserve(self.on_trait, names=[name])
+        self.traits.unobserve(self.on_trait, names=[name])
         try:
-            setattr(w, name, value)
+            setattr(self.traits, name, value)
         finally:
-            w.observe(self.on_trait, names=[name])
+            self.traits.observe(self.on_trait, names=[name])

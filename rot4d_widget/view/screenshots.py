@@ -27,20 +27,27 @@ KEY_P = object()
 class Screenshots:
     """One widget's screenshot requests (the pump's lock held by the callers that say so)."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, pump, scene, companion, errors):
+        self.pump, self.scene, self.companion, self.errors = pump, scene, companion, errors
+        self.painter = self.keys = None  # `connect`
+        #: The PNG of the view the page sent last (`Rot4DWidget.screenshot`, key p), or None.
+        self.last = None
         self.pending = {}  # request id -> (path, callback, time asked): asked, not answered yet
         self.seq = 0
         self.shot_number = 1  # key p's next file number (rot4d-001.png ...)
         self.owed = []  # requests to send once the picture of the latest state has left
+
+    def connect(self, painter, keys) -> None:
+        """The painter (whose readout says what became of a request) and the keys (none held: a
+        request goes to the page at once)."""
+        self.painter, self.keys = painter, keys
 
     def ask(self, path, callback, warn=False):
         """Ask every view for a PNG (lock held); the request id, or None when no view is shown."""
         # asked in any case: a front end that does not count views (count 0) may still answer;
         # unanswered requests are dropped after SCREENSHOT_TIMEOUT and beyond
         # MAX_PENDING_SCREENSHOTS, so none piles up whatever is pressed
-        w = self.w
-        now = w._pump.clock()
+        now = self.pump.clock()
         for old in [k for k, v in self.pending.items() if now - v[2] > SCREENSHOT_TIMEOUT]:
             del self.pending[old]  # nobody answered: dropped
         while len(self.pending) >= MAX_PENDING_SCREENSHOTS:
@@ -48,30 +55,29 @@ class Screenshots:
         self.seq += 1
         rid = self.seq
         self.pending[rid] = (path, callback, now)
-        if w._pump.dirty or w._keys.held:
+        if self.pump.dirty or self.keys.held:
             self.owed.append(rid)  # asked of the page after the picture of the latest state (`send_owed`)
         else:
-            w.companion.request_screenshot(rid)
-        if w.scene.view_count == 0:  # kept, bounded by the timeout and the cap above
+            self.companion.request_screenshot(rid)
+        if self.scene.view_count == 0:  # kept, bounded by the timeout and the cap above
             text = "no view is displayed to answer: no screenshot (display the widget first)"
-            w._painter.set_note(text)
+            self.painter.set_note(text)
             if warn:  # from code: say it where the code runs (key p: the readout says it)
                 warnings.warn(f"Rot4DWidget.screenshot: {text}", stacklevel=3)
             return None
         shown = "rot4d-NNN.png" if path is KEY_P else path
-        w._painter.set_note(f"screenshot asked{' for ' + str(shown) if shown is not None else ''}\u2026")
+        self.painter.set_note(f"screenshot asked{' for ' + str(shown) if shown is not None else ''}\u2026")
         return rid
 
     def send_owed(self) -> None:
         """After the picture of the latest state left (the pump's send, no key held): the requests
         asked meanwhile go to the page now, after that picture, so it shows the state they asked
         of (the page also waits until its own steps and the kernel's state agree)."""
-        w = self.w
-        if self.owed and not w._pump.dirty and not w._keys.held:
+        if self.owed and not self.pump.dirty and not self.keys.held:
             owed, self.owed = self.owed, []
             for rid in owed:
                 if rid in self.pending:
-                    w.companion.request_screenshot(rid)
+                    self.companion.request_screenshot(rid)
 
     def key_p(self) -> None:
         """Key p: a numbered PNG in the current directory (rot4d-001.png, ...), never overwriting
@@ -83,27 +89,26 @@ class Screenshots:
         Never raises (it runs in the companion's message handler): a note that cannot be shown
         (its send failed) or a callback's error goes to the widget's errors area.  The file is
         written with the pump's lock free (a slow disk never holds up keys)."""
-        w = self.w
         try:
-            with w._pump.lock:
+            with self.pump.lock:
                 asked = self.pending.pop(rid, None)
-                if asked is None or w._closed:
+                if asked is None or self.pump.closed:
                     return
                 if png is not None:
-                    w.last_screenshot = png
+                    self.last = png
             path, callback, _ = asked
             note = self._saved(path, png, error)
-            with w._pump.lock:
-                if not w._closed:
-                    w._painter.set_note(note)
+            with self.pump.lock:
+                if not self.pump.closed:
+                    self.painter.set_note(note)
         except Exception as exc:
-            w._report_error(exc)
+            self.errors.report(exc)
             return
         if callback is not None and png is not None:
             try:
                 callback(png)
             except Exception as exc:  # shown like any callback error, never lost
-                w._report_error(exc)
+                self.errors.report(exc)
 
     def _saved(self, path, png, error) -> str:
         """Write the answer where it was asked to go; the readout's note on what became of it."""

@@ -28,12 +28,17 @@ def make_stack(source, slices, spacing=None, arrangement="oval", matrix=None):
 class Stacking:
     """One widget's single view <-> stack: wraps the source when asked, applies the stack's traits."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, showing, state, pump, sync, keeper):
+        self.showing, self.state, self.pump, self.sync, self.keeper = showing, state, pump, sync, keeper
+        self.keys = None  # `connect`
+
+    def connect(self, keys) -> None:
+        """The key path, which binds a stack's keys when a view becomes one."""
+        self.keys = keys
 
     @property
     def is_stack(self) -> bool:
-        return is_stack(self.w.source)
+        return is_stack(self.showing.source)
 
     def wrap(self, slices) -> None:
         """Show ``slices`` parallel slices of the current source from now on (the lock is held).
@@ -41,31 +46,26 @@ class Stacking:
         The source is wrapped in a stack (oval, default spacing), its keys n / b / g / f join the
         keymap and the help.  Raises before any change if ``slices`` is not allowed.
         """
-        w = self.w
-        stack = make_stack(w.source, slices, matrix=w.state.matrix)
+        stack = make_stack(self.showing.source, slices, matrix=self.state.matrix)
         # the stack brings the inner source's keys too: rebind them from the reserved ones
-        w._keys.use_keymap(without_source_keys(w.state.keymap), stack)
-        with w._source_lock:
-            w.source = stack
-        w._source_version += 1
-        w._painter.cache = None
-        w._sync.source_traits()
+        self.keys.use_keymap(without_source_keys(self.state.keymap), stack)
+        self.showing.replace(stack)  # a new version: nothing sliced from the single view is shown again
+        self.sync.source_traits()
 
     def on_stack_trait(self, change) -> None:
         """``slices``, ``spacing``, ``arrangement``: a stack's settings; ``slices`` on a single
         view wraps it first."""
-        w = self.w
-        sync = w._sync
+        sync = self.sync
         if change["name"] == "slices" and not sync.syncing and not self.is_stack and change["new"] is not None:
-            with w._pump.lock:  # parallel slices asked for at run time: wrap the source now
+            with self.pump.lock:  # parallel slices asked for at run time: wrap the source now
                 try:
                     self.wrap(change["new"])
                 except Exception:
                     sync.set_quietly("slices", change["old"])
                     raise
-                w._keeper.record_source("slices", change["new"])
-                w._pump.mark_dirty()
-                w._pump.flush()
+                self.keeper.record_source("slices", change["new"])
+                self.pump.mark_dirty()
+                self.pump.flush()
             return
-        sync.source_setting(change, w.source if self.is_stack else None,
+        sync.source_setting(change, self.showing.source if self.is_stack else None,
                             f"`{change['name']}` applies to parallel slices: set `slices` (or press n) first")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from ..sources.protocol import inner_source, note_matrix
 from .painter import title
+from .stacking import is_stack
 
 __all__ = ["TraitSync", "STATE_TRAITS", "DISPLAY_TRAITS", "FIELD_TRAITS", "STACK_TRAITS", "COLOUR_TRAITS"]
 
@@ -27,47 +28,44 @@ COLOUR_TRAITS = ("cmap", "clim")
 class TraitSync:
     """Keeps one widget's traits in step with its state and source."""
 
-    def __init__(self, widget):
-        self.w = widget
+    def __init__(self, traits, showing, state, pump, scene, keeper):
+        self.traits = traits  # the widget's traits, kept in step
+        self.showing, self.state, self.pump, self.scene, self.keeper = showing, state, pump, scene, keeper
         self.syncing = False  # the widget is copying its own state into the traits
 
     def observe(self) -> None:
         """Attach the observers (each with ``names=``)."""
-        w = self.w
-        w.observe(self.on_state_trait, names=list(STATE_TRAITS))
-        w.observe(self.on_display_trait, names=list(DISPLAY_TRAITS))
-        w.observe(self.on_color_by, names=["color_by", *COLOUR_TRAITS])
-        w.observe(self.on_field_trait, names=list(FIELD_TRAITS))
-        w.observe(w._stacking.on_stack_trait, names=list(STACK_TRAITS))
+        self.traits.observe(self.on_state_trait, names=list(STATE_TRAITS))
+        self.traits.observe(self.on_display_trait, names=list(DISPLAY_TRAITS))
+        self.traits.observe(self.on_color_by, names=["color_by", *COLOUR_TRAITS])
+        self.traits.observe(self.on_field_trait, names=list(FIELD_TRAITS))
 
     # -- the widget's state into the traits -----------------------------------------------
     def state_traits(self) -> None:
         """Copy the state's parameters into the traits (observers fire for what changed)."""
-        w = self.w
-        st = w.state
+        st = self.state
         self.syncing = True
         try:
-            w.set_trait("orientation", st.matrix)
+            self.traits.set_trait("orientation", st.matrix)
             for name in STATE_TRAITS:
                 value = getattr(st, name)
-                if getattr(w, name) != value:
-                    setattr(w, name, value)
+                if getattr(self.traits, name) != value:
+                    setattr(self.traits, name, value)
         finally:
             self.syncing = False
 
     def source_traits(self) -> None:
         """Copy the source's settings (a field's levels, inside, caps; a stack's N, spacing and
         arrangement) into the traits of the same names."""
-        w = self.w
-        inner = inner_source(w.source)
+        inner = inner_source(self.showing.source)
         levels = getattr(inner, "levels", None)
         if levels is not None:
             self.set_quietly("levels", tuple(float(v) for v in levels))
         for name in ("inside", "caps"):
             if hasattr(inner, name):
                 self.set_quietly(name, getattr(inner, name))
-        if w._stacking.is_stack:
-            src = w.source
+        if is_stack(self.showing.source):
+            src = self.showing.source
             self.set_quietly("slices", src.slices)
             self.set_quietly("spacing", float(src.spacing))
             self.set_quietly("arrangement", src.arrangement)
@@ -76,7 +74,7 @@ class TraitSync:
         """Set a trait without acting on it (the widget copying its own state)."""
         self.syncing = True
         try:
-            setattr(self.w, name, value)
+            setattr(self.traits, name, value)
         finally:
             self.syncing = False
 
@@ -86,57 +84,52 @@ class TraitSync:
         or, if ``target`` is None or refuses the value, put the trait back and raise."""
         if self.syncing:
             return
-        w = self.w
-        with w._pump.lock:
+        with self.pump.lock:
             try:
                 if target is None:
                     raise TypeError(why_not)
-                with w._source_lock:
-                    note_matrix(w.source, w.state.matrix)  # `slices`: a default spacing spread along today's w
+                with self.showing.lock:
+                    note_matrix(self.showing.source, self.state.matrix)  # `slices`: a default spacing along today's w
                     setattr(target, change["name"], change["new"])
             except Exception:
                 self.set_quietly(change["name"], change["old"])
                 raise
-            w._source_version += 1
-            w._keeper.record_source(change["name"], change["new"])
+            self.showing.changed()
+            self.keeper.record_source(change["name"], change["new"])
             self.source_traits()
-            w._pump.mark_dirty()
-            w._pump.flush()
+            self.pump.mark_dirty()
+            self.pump.flush()
 
     def on_field_trait(self, change) -> None:
         """``levels``, ``inside``, ``caps``: settings of the (inner) source, where it has them."""
-        w = self.w
         name = change["name"]
-        inner = inner_source(w.source)
+        inner = inner_source(self.showing.source)
         has = hasattr(inner, name)
         if name == "levels":
-            why = f"{title(w.source)} has no iso levels: `levels` applies to field sources"
+            why = f"{title(self.showing.source)} has no iso levels: `levels` applies to field sources"
         else:
-            why = f"{title(w.source)} has no `{name}`: it applies to field sources"
+            why = f"{title(self.showing.source)} has no `{name}`: it applies to field sources"
         self.source_setting(change, inner if has else None, why)
 
     def on_state_trait(self, change) -> None:
         if self.syncing:
             return
-        w = self.w
-        with w._pump.lock:
-            setattr(w.state, change["name"], change["new"])
-            w._recorder.record_set(change["name"], change["new"])
+        with self.pump.lock:
+            setattr(self.state, change["name"], change["new"])
+            self.keeper.recorder.record_set(change["name"], change["new"])
             if change["name"] == "theta0":  # alpha keeps its ratio to theta0
                 self.state_traits()
-            w._pump.mark_dirty()
-            w._pump.flush()
+            self.pump.mark_dirty()
+            self.pump.flush()
 
     def on_display_trait(self, change) -> None:
-        w = self.w
-        with w._pump.lock:
-            if not w._closed:
-                w.scene.set_display(**{change["name"]: change["new"]})
+        with self.pump.lock:
+            if not self.pump.closed:
+                self.scene.set_display(**{change["name"]: change["new"]})
 
     def on_color_by(self, change) -> None:
         """``color_by``, ``cmap``, ``clim``: the same slice in other colours (and the colour bar)."""
-        w = self.w
-        with w._pump.lock:
-            if not w._closed:
-                w._pump.mark_dirty()
-                w._pump.flush()
+        with self.pump.lock:
+            if not self.pump.closed:
+                self.pump.mark_dirty()
+                self.pump.flush()

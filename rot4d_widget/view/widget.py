@@ -5,14 +5,19 @@ The only module that makes the widget's ipyevents `Event`.  A key travels one wa
     ipyevents dict -> keys.KeyPath -> keymap.lookup -> state.apply -> (pump: flow control)
     -> painter.Painter.send -> source.slice -> buffers -> scene.show (one new float32 array) + readout
 
-The widget holds the traits and the public API and wires small units together:
+The widget holds the traits and the public API and wires small units together, handing each
+the collaborators it uses by name (its constructor, and ``connect`` where two units call each
+other); none is handed the widget, except as its ``traits`` (the settings it reads and observes,
+nothing else: `tests/test_rules.py`).  What they share:
 
+* `rot4d_widget.view.showing.Showing` -- the source shown, its scale, its lock and version;
+* `rot4d_widget.view.errors.ErrorArea` -- where an exception of a callback is shown;
 * `rot4d_widget.view.keys.KeyPath` -- key and key pad events to steps: press, release,
   the steps a held key makes, their recording;
 * `rot4d_widget.view.keyhold.KeyRepeater` -- which steps held keys make when
   (hold delay, tick rate, no burst after a stall);
 * `rot4d_widget.view.pump.UpdatePump` -- at most `MAX_IN_FLIGHT` updates in flight, the
-  "drawn" acknowledgements, the timeout, the ticker thread, the lock;
+  "drawn" acknowledgements, the timeout, the ticker thread, the lock, open or closed;
 * `rot4d_widget.view.painter.Painter` -- what is shown: slice, turn or nothing, the slice
   cache, the readout;
 * `rot4d_widget.view.sync.TraitSync` -- traits <-> state and source settings;
@@ -70,8 +75,9 @@ from .projection import ProjectionFlag, ProjectionView
 from .pump import ACK_TIMEOUT, MAX_IN_FLIGHT, UpdatePump
 from .renderings import Renderings
 from .screenshots import Screenshots
+from .showing import C0_LIMIT_SIZES, Showing
 from .stacking import Stacking, make_stack
-from .sync import DISPLAY_TRAITS, TraitSync
+from .sync import DISPLAY_TRAITS, STACK_TRAITS, TraitSync
 
 __all__ = ["Rot4DWidget", "HOLD_DELAY", "TICK_RATE", "ACK_TIMEOUT", "MAX_IN_FLIGHT", "C0_STEP_FRACTION",
            "READOUT_PERIOD"]
@@ -80,8 +86,6 @@ log = logging.getLogger(__name__)
 
 #: The l/h step as a fraction of the source's size (circumradius).
 C0_STEP_FRACTION = 1.0 / 64.0
-#: The l / h keys keep |c0| within this many times the source's size (`RotationState.c0_limit`).
-C0_LIMIT_SIZES = 2.0
 
 _WATCHED_EVENTS = ["keydown", "keyup", "mouseleave"]
 
@@ -224,41 +228,45 @@ class Rot4DWidget(widgets.HBox):
             # a field's bars only outline its data's box: thin
             bar_radius = sizes.default_bar_radius(ball_radius) * (0.35 if coarse_ok else 1.0)
 
-        self.source = src
         self.state = state
         self._repeater = repeater
-        self._custom = {a.name: (run, repeat) for a, run, repeat in actions.values()}
-        self._scale = scale
-        self._source_version = 0
-        self._closed = False
-        self._source_lock = threading.RLock()  # source.slice and source changes (never the pump lock inside)
-        self._error_area = ErrorArea(repeater)
-        #: The PNG of the view the page sent last (`screenshot`, key p), or None.
-        self.last_screenshot = None
-        # the units, each with this widget as its context
-        self._painter = Painter(self, coarse_ok)
-        self._keys = KeyPath(self)
-        self._sync = TraitSync(self)
-        self._stacking = Stacking(self)
-        self._shots = Screenshots(self)
-        self._keypad = KeyPad(self)
-        self._renderings, self._projection = Renderings(self), ProjectionView(self)
-        self._pump = UpdatePump(
-            self._painter.send, tick=self._keys.tick, deadline=self._keys.deadline, clock=_clock,
-            ack_timeout=ack_timeout, autotick=_autotick, on_error=self._report_error,
+        self._showing = showing = Showing(src, scale)
+        self._error_area = errors = ErrorArea(repeater)
+        pump = self._pump = UpdatePump(
+            None, clock=_clock, ack_timeout=ack_timeout, autotick=_autotick, on_error=errors.report,
             name=f"rot4d-ticker-{id(self):x}", tick_rate=repeater.tick_rate,
-        )
+        )  # its callbacks are the painter's and the keys', `connect`ed below
         # every applied action and parameter set, time-stamped (bounded; see `recording`)
-        self._keeper = Keeper(self, state, self._pump.clock)
-        self._recorder = self._keeper.recorder
-        self._keys.use_page_steps(self._recorder, self._pump.clock)  # the page's keys (`pagesteps`)
+        self._keeper = keeper = Keeper(self, showing, state, pump)
+        self._recorder = keeper.recorder
 
         # -- widgets ------------------------------------------------------------
-        _build_children(self, dict(
+        self._build_children(dict(
             scale=scale, n_groups=int(src.n_groups), width=width, height=height, ball_radius=ball_radius,
             bar_radius=bar_radius, face_opacity=face_opacity, background=background, show_balls=show_balls,
             show_bars=show_bars, show_faces=show_faces, group_colors=group_colors, antialias=antialias,
         ))
+        # -- the units, each handed what it uses; `connect` closes the loops between them ----------
+        scene, companion = self.scene, self.companion
+        custom = {a.name: (run, repeat) for a, run, repeat in actions.values()}
+        self._painter = painter = Painter(self, showing, state, pump, scene, companion, self.readout, errors,
+                                          coarse_ok)
+        self._sync = sync = TraitSync(self, showing, state, pump, scene, keeper)
+        self._stacking = stacking = Stacking(showing, state, pump, sync, keeper)
+        self._shots = shots = Screenshots(pump, scene, companion, errors)
+        self._renderings = field_view = Renderings(self, showing, scene, pump)
+        self._keys = keys = KeyPath(self, showing, state, repeater, custom, pump, scene, companion, self.help_panel,
+                                    errors)
+        self._projection = projection_view = ProjectionView(self, self._place_projection, showing, state, scene,
+                                                            companion, pump, keys.handle_event)
+        self._keypad = KeyPad(self._canvas_box, state, scene, pump, keys, errors)
+        keeper.connect(painter, keys, sync, scene)
+        painter.connect(keys, shots, projection_view)
+        stacking.connect(keys)
+        shots.connect(painter, keys)
+        projection_view.connect(painter)
+        keys.connect(painter, sync, keeper, shots, field_view, stacking)  # the page's keys from here on
+        pump.connect(painter.send, tick=keys.tick, deadline=keys.deadline)
         super().__init__(
             [self._canvas_box, self._side_box],
             layout=widgets.Layout(flex_flow="row wrap", align_items="flex-start"),
@@ -266,12 +274,26 @@ class Rot4DWidget(widgets.HBox):
             color_by=color_by, cmap=cmap, clim=clim, rendering=rendering, sections=sections, projection=projection,
         )
         try:
-            _wire(self, keypad)
+            self._wire(keypad)
         except BaseException:
             self.close()  # a source failing here must not leave the widget models behind
             raise
 
     # ------------------------------------------------------------------ API
+    @property
+    def source(self):
+        """The source shown (a stack around the one given once parallel slices are asked for)."""
+        return self._showing.source
+
+    @property
+    def last_screenshot(self):
+        """The PNG of the view the page sent last (`screenshot`, key p), or None."""
+        return self._shots.last
+
+    @last_screenshot.setter
+    def last_screenshot(self, png) -> None:
+        self._shots.last = png
+
     @property
     def polytope(self):
         """The `Polytope` shown, or None when the source is not a polytope."""
@@ -301,11 +323,11 @@ class Rot4DWidget(widgets.HBox):
 
     @property
     def help_visible(self) -> bool:
-        return self.help_panel.layout.display != "none"
+        return self._keys.help_visible
 
     @help_visible.setter
     def help_visible(self, value: bool) -> None:
-        self.help_panel.layout.display = None if value else "none"
+        self._keys.help_visible = value
 
     def press(self, key: str, shift: bool = False) -> bool:
         """Press ``key`` once from code (one step; no hold); False if unbound or no change.  Returns once
@@ -346,17 +368,7 @@ class Rot4DWidget(widgets.HBox):
         """Redraw after changing `state` or the source directly; obeys the flow control.  The
         source's own settings (the source protocol's ``settings``) that changed since they were
         last recorded are recorded."""
-        with self._pump.lock:
-            self._check_open()
-            self._source_version += 1
-            st = self.state
-            _fit_c0_range(st, self.source)  # a field's w_per_unit may have changed
-            for name in ("c0_step", "theta0", "alpha", "c0", "matrix"):  # `state` may have been set directly
-                self._recorder.record_set(name, getattr(st, name))
-            self._keeper.record_changed_settings()
-            self._sync.state_traits()
-            self._pump.mark_dirty()
-            self._pump.flush()
+        self._keeper.refresh()
 
     # ------------------------------------------------------- keeping what you see (`keeping.Keeper`)
     @property
@@ -421,7 +433,10 @@ class Rot4DWidget(widgets.HBox):
 
         A file is data: a field made from a function is refused unless ``allow_code=True``
         (then the module the file names is imported) or the source is passed in."""
-        return Keeper.from_state(cls, path, source, allow_code=allow_code, **kwargs)
+        loaded, arguments, late = Keeper.widget_arguments(cls, path, source, allow_code=allow_code, **kwargs)
+        w = cls(loaded.source, **arguments)
+        w._keeper.apply_loaded(loaded.state, late, defaults=False)  # the view settings the constructor lacks
+        return w
 
     def release_keys(self, page_time=None) -> None:
         """Release every held key (what mouseleave and focus loss do); ``page_time``: the page's
@@ -434,15 +449,15 @@ class Rot4DWidget(widgets.HBox):
         if pump is None:  # construction failed before any child existed
             return
         with pump.lock:
-            if self._closed:
+            if pump.closed:
                 return
-            self._closed = True
+            pump.shut()
             self._repeater.clear()
         pump.close()
         try:
-            _unwire(self)
+            self._unwire()
         finally:
-            _close_children(self)
+            self._close_children()
             layout, style = getattr(self, "layout", None), getattr(self, "style", None)
             super().close()
             for w in (layout, style):
@@ -453,8 +468,112 @@ class Rot4DWidget(widgets.HBox):
         st = self.state
         return (
             f"Rot4DWidget({self.source!r}, theta0={st.theta0:.6g}, alpha={st.alpha:.6g}, c0={st.c0:.6g}"
-            f"{', closed' if self._closed else ''})"
+            f"{', closed' if self._pump.closed else ''})"
         )
+
+    # ------------------------------------------------------- building and wiring
+    def _wire(self, keypad) -> None:
+        """Connect the parts and send the initial picture (the last step of construction)."""
+        self._sync.state_traits()
+        self._sync.source_traits()
+        self._keys.send_config()
+
+        self.events.on_dom_event(self._handle_event)
+        self.companion.on_drawn(self._handle_drawn)
+        self.companion.on_focus_lost(self._keys.focus_lost)
+        self.companion.on_clock(self._keys.heartbeat)
+        self.companion.on_screenshot(self._shots.answer)
+        self.companion.on_holds(self._painter.page_holds)
+        self.companion.transfers.bar = self.progress_bar  # a field's copy on its way to the page: counted there
+        self.scene.on_view_count(self._keys.view_count)
+        self.scene.on_eye_moved(self._painter.eye_moved)
+        self._sync.observe()
+        self._renderings.observe()
+        self.observe(self._stacking.on_stack_trait, names=list(STACK_TRAITS))
+        self.observe(self._on_keypad, names="keypad")
+        self.keypad = keypad
+        self.observe(self._projection.changed, names="projection")
+        self._projection.changed()
+
+        # The initial picture is part of the models' state: not "in flight".
+        self._pump.send_now(expect_ack=False)
+        # A field is read in the background from now on (the whole of it into memory when it fits its
+        # budget, else its coarse copy for held keys), counted on the widget's own bar above the
+        # readout; its first picture above read only the chunks the cut touches.  Only with the
+        # ticker running (a live widget): scripts and tests stay deterministic.
+        if self._pump.autotick:
+            self.progress_bar.follow(inner_source(self.source), on_done=self._painter.data_read)
+
+    def _unwire(self) -> None:
+        """Drop the listeners `_wire` attached."""
+        events, companion, scene = (getattr(self, n, None) for n in ("events", "companion", "scene"))
+        if events is not None:
+            events.on_dom_event(self._handle_event, remove=True)
+        if companion is not None:
+            companion.on_drawn(self._handle_drawn, remove=True)
+            companion.on_focus_lost(self._keys.focus_lost, remove=True)
+            companion.on_clock(self._keys.heartbeat, remove=True)
+            companion.on_screenshot(self._shots.answer, remove=True)
+            companion.on_holds(self._painter.page_holds, remove=True)
+        if scene is not None:
+            scene.on_view_count(self._keys.view_count, remove=True)
+            scene.on_eye_moved(self._painter.eye_moved, remove=True)
+
+    def _close_children(self) -> None:
+        """Close every child widget; never raises.  The Events first, so their document listeners go
+        before the canvas does."""
+        self._keypad.close()
+        self._projection.close()
+        bar = getattr(self, "progress_bar", None)
+        if bar is not None:
+            bar.close_widgets()
+        for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
+            x = getattr(self, name, None)
+            if x is not None:
+                close_quietly(x)
+
+    def _build_children(self, options) -> None:
+        """The scene, companion, readout, help, errors, the canvas's Event and the boxes; each widget
+        made is closed again if a later one fails."""
+        Scene, Companion = _scene_classes()
+
+        Scene.check_display({k: v for k, v in options.items() if k in DISPLAY_TRAITS})
+
+        built = []
+        try:
+            self.scene = Scene(capacity=estimate_capacity(self.source, name=title(self.source)), **options)
+            built.append(self.scene)
+            self.companion = Companion(self.scene)
+            built.append(self.companion)
+            self.readout = markup.html_widget()
+            self.help_panel = markup.html_widget(
+                markup.help_html(help_groups(self.state.keymap), self._repeater.hold_delay, self._repeater.tick_rate),
+                layout=widgets.Layout(display="none"),
+            )
+            self.errors = self._error_area.output = widgets.Output()
+            built += [self.readout, self.help_panel, self.errors]
+            self.events = Event(
+                source=self.scene.canvas,
+                watched_events=list(_WATCHED_EVENTS),
+                prevent_default_action=True,
+                ignore_modifier_key_events=True,
+            )
+            built.append(self.events)
+            self.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
+            built += self.progress_bar.widgets
+            # the canvas keeps its size; the side panel wraps below it when narrow
+            self._canvas_box = widgets.VBox([self.scene.canvas, self.companion], layout=widgets.Layout(flex="0 0 auto"))
+            self._side_box = widgets.VBox(
+                [self.progress_bar.box, self.readout, self.help_panel, self.errors],
+                layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
+            )
+            self._side_box.add_class("rot4d-side")
+            self._side_box.add_class(f"{self.scene.canvas_class}-side")  # the page says here when it is ahead
+            built += [self._canvas_box, self._side_box]
+        except BaseException:
+            for x in reversed(built):
+                close_quietly(x)
+            raise
 
     # --------------------------------------------------------------- traits
     @traitlets.validate("theta0")
@@ -472,6 +591,14 @@ class Rot4DWidget(widgets.HBox):
             _check_alpha_beta(value, self.state.theta0, f"alpha = {value:.6g}")
         return value
 
+    def _place_projection(self, box, on: bool) -> None:
+        """The projection's box beside the slice view (`ProjectionView`), or taken away."""
+        kids = [c for c in self.children if c is not box]
+        if on:
+            kids.insert(1, box)
+        if tuple(kids) != tuple(self.children):
+            self.children = tuple(kids)
+
     def _on_keypad(self, change) -> None:
         self._keypad.show(change["new"])
 
@@ -488,8 +615,7 @@ class Rot4DWidget(widgets.HBox):
             self._report_error(exc)
 
     def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError("This Rot4DWidget is closed")
+        self._pump.check_open()
 
     def _report_error(self, exc: BaseException) -> None:
         """Show an exception in the ``errors`` area (`errors.ErrorArea.report`); never raises."""
@@ -497,112 +623,6 @@ class Rot4DWidget(widgets.HBox):
 
 
 # ------------------------------------------------------------------ helpers
-def _wire(w, keypad) -> None:
-    """Connect the parts and send the initial picture (the last step of construction)."""
-    w._sync.state_traits()
-    w._sync.source_traits()
-    w._keys.send_config()
-
-    w.events.on_dom_event(w._handle_event)
-    w.companion.on_drawn(w._handle_drawn)
-    w.companion.on_focus_lost(w._keys.focus_lost)
-    w.companion.on_clock(w._keys.heartbeat)
-    w.companion.on_screenshot(w._shots.answer)
-    w.companion.on_holds(w._painter.page_holds)
-    w.companion.transfers.bar = w.progress_bar  # a field's copy on its way to the page: counted there
-    w.scene.on_view_count(w._keys.view_count)
-    w.scene.on_eye_moved(w._painter.eye_moved)
-    w._sync.observe()
-    w._renderings.observe()
-    w.observe(w._on_keypad, names="keypad")
-    w.keypad = keypad
-    w.observe(w._projection.changed, names="projection")
-    w._projection.changed()
-
-    # The initial picture is part of the models' state: not "in flight".
-    w._pump.send_now(expect_ack=False)
-    # A field is read in the background from now on (the whole of it into memory when it fits its
-    # budget, else its coarse copy for held keys), counted on the widget's own bar above the
-    # readout; its first picture above read only the chunks the cut touches.  Only with the
-    # ticker running (a live widget): scripts and tests stay deterministic.
-    if w._pump.autotick:
-        w.progress_bar.follow(inner_source(w.source), on_done=w._painter.data_read)
-
-
-def _unwire(w) -> None:
-    """Drop the listeners `_wire` attached."""
-    events, companion, scene = (getattr(w, n, None) for n in ("events", "companion", "scene"))
-    if events is not None:
-        events.on_dom_event(w._handle_event, remove=True)
-    if companion is not None:
-        companion.on_drawn(w._handle_drawn, remove=True)
-        companion.on_focus_lost(w._keys.focus_lost, remove=True)
-        companion.on_clock(w._keys.heartbeat, remove=True)
-        companion.on_screenshot(w._shots.answer, remove=True)
-        companion.on_holds(w._painter.page_holds, remove=True)
-    if scene is not None:
-        scene.on_view_count(w._keys.view_count, remove=True)
-        scene.on_eye_moved(w._painter.eye_moved, remove=True)
-
-
-def _close_children(w) -> None:
-    """Close every child widget; never raises.  The Events first, so their document listeners go
-    before the canvas does."""
-    w._keypad.close()
-    w._projection.close()
-    bar = getattr(w, "progress_bar", None)
-    if bar is not None:
-        bar.close_widgets()
-    for name in ("events", "companion", "scene", "readout", "help_panel", "errors", "_canvas_box", "_side_box"):
-        x = getattr(w, name, None)
-        if x is not None:
-            close_quietly(x)
-
-
-def _build_children(w, options) -> None:
-    """The scene, companion, readout, help, errors, the canvas's Event and the boxes; each widget
-    made is closed again if a later one fails."""
-    Scene, Companion = _scene_classes()
-
-    Scene.check_display({k: v for k, v in options.items() if k in DISPLAY_TRAITS})
-
-    built = []
-    try:
-        w.scene = Scene(capacity=estimate_capacity(w.source, name=title(w.source)), **options)
-        built.append(w.scene)
-        w.companion = Companion(w.scene)
-        built.append(w.companion)
-        w.readout = markup.html_widget()
-        w.help_panel = markup.html_widget(
-            markup.help_html(help_groups(w.state.keymap), w._repeater.hold_delay, w._repeater.tick_rate),
-            layout=widgets.Layout(display="none"),
-        )
-        w.errors = w._error_area.output = widgets.Output()
-        built += [w.readout, w.help_panel, w.errors]
-        w.events = Event(
-            source=w.scene.canvas,
-            watched_events=list(_WATCHED_EVENTS),
-            prevent_default_action=True,
-            ignore_modifier_key_events=True,
-        )
-        built.append(w.events)
-        w.progress_bar = _progress.ViewBar()  # the source's background read, while it runs
-        built += w.progress_bar.widgets
-        # the canvas keeps its size; the side panel wraps below it when narrow
-        w._canvas_box = widgets.VBox([w.scene.canvas, w.companion], layout=widgets.Layout(flex="0 0 auto"))
-        w._side_box = widgets.VBox(
-            [w.progress_bar.box, w.readout, w.help_panel, w.errors],
-            layout=widgets.Layout(flex="1 1 16em", min_width="16em", padding="0 0 0 1em"),
-        )
-        w._side_box.add_class("rot4d-side")
-        w._side_box.add_class(f"{w.scene.canvas_class}-side")  # the page says here when it is ahead
-        built += [w._canvas_box, w._side_box]
-    except BaseException:
-        for x in reversed(built):
-            close_quietly(x)
-        raise
-
-
 def _check_rendering(source, rendering) -> str:
     """``rendering`` checked (`renderings.check_rendering`) and possible for ``source``: only a source that
     gives its cut on a grid (``sample``) has more than the surface."""
@@ -636,13 +656,6 @@ def _source_and_state(source, theta0, alpha, c0, keymap, c0_step, levels, slices
     state = RotationState(theta0, alpha, origin if c0 is None else c0, keymap=keymap, c0_step=c0_step,
                           c0_limit=C0_LIMIT_SIZES * float(src.size) * per, c0_origin=origin)
     return src, state, actions
-
-
-def _fit_c0_range(state, source) -> None:
-    """The l / h range of ``state`` from ``source``'s w frame: twice its size about its centre."""
-    origin, per = w_frame(source)
-    state.c0_origin = origin
-    state.c0_limit = C0_LIMIT_SIZES * float(source.size) * per
 
 
 def _default_ball_radius(source, scale, state) -> float:

@@ -158,10 +158,10 @@ def test_the_page_s_picture_of_a_field_state_is_the_kernel_s(jupyter_server, pag
         page_t = np.where(q < 16777215, q / 16777215.0 * cam["scale"], np.inf)
         h, wd = page_t.shape
         eye, dirs = _rays(cam, wd, h)
-        pts = np.asarray(jp.kernel_json("(w.slice.points * w._scale).tolist()"), dtype=np.float64)
+        pts = np.asarray(jp.kernel_json("(w.slice.points * w._showing.scale).tolist()"), dtype=np.float64)
         tri = np.asarray(jp.kernel_json("w.slice.triangles.tolist()"), dtype=np.intp)
         kern_t = kernel_depth(pts, tri, eye, dirs)
-        cell = float(jp.kernel("print(w._scale * 2.0 / 63.0)"))
+        cell = float(jp.kernel("print(w._showing.scale * 2.0 / 63.0)"))
         both = np.isfinite(page_t) & np.isfinite(kern_t)
         either = np.isfinite(page_t) | np.isfinite(kern_t)
         dt = np.abs(page_t[both] - kern_t[both])  # the pixels both hit (no inf - inf)

@@ -78,7 +78,7 @@ def _check_page_projection(jp):
     assert jp.wait_for(current, timeout=15), f"the page's projection is not of the kernel's rotation: {got}"
     want = jp.kernel_json(
         "{k: v.tolist() for k, v in __import__('rot4d_widget.view.projection', fromlist=['x'])"
-        ".projection_arrays(w.source, w.state.matrix, w.state.c0, w._scale).items() if k != 'distance'}")
+        ".projection_arrays(w.source, w.state.matrix, w.state.c0, w._showing.scale).items() if k != 'distance'}")
     np.testing.assert_allclose(np.reshape(got["positions"], (-1, 3)), want["positions"], rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(np.reshape(got["rgb"], (-1, 3)), want["rgb"], rtol=1e-6, atol=1e-6)
     assert got["index"] == want["index"]
