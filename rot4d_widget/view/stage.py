@@ -37,7 +37,6 @@ LAYERS = {
 }
 
 
-
 def light_uniforms() -> dict:
     """The lights every ShaderMaterial of a stage shades with (a new dict of uniforms)."""
     return {
