@@ -130,7 +130,7 @@ def bench(label, make, presses, rng):
                 if i >= WARMUP:
                     times[flag].append(dt)
                     sizes[flag].append(n)
-            states.append(dict(on.scene._buffer._rot4d_project))
+            states.append(dict(on.scene.buffer.projection))
         page = page_times(on, states)
     finally:
         on.close()

@@ -53,11 +53,11 @@ def turned(steps=32):
 def test_every_rendering_labels_the_data_extent_after_a_turn(make, rendering):
     f = flame()
     w = make(f, rendering=rendering)
-    texts = [lab["text"] for lab in w.scene._buffer._rot4d_labels]
+    texts = [lab["text"] for lab in w.scene.buffer.labels]
     assert texts[1:] == ["x 0.01 \u2192 0.05 m", "y 0.01 \u2192 0.05 m", "z 0.01 \u2192 0.05 m"], texts
     w.state.matrix = turned().matrix
     w.refresh()
-    labels = w.scene._buffer._rot4d_labels
+    labels = w.scene.buffer.labels
     texts = [lab["text"] for lab in labels]
     # the horizontal edge is now time, running backwards from the corner; y and z as before
     assert texts[1] == "time 0.004 \u2192 0.001 s" or texts[1] == "w 0.004 \u2192 0.001 s", texts
@@ -67,7 +67,7 @@ def test_every_rendering_labels_the_data_extent_after_a_turn(make, rendering):
     box = f.outline(w.state.matrix, w.c0)
     seg = np.unique(np.asarray(box.segments))
     want = np.asarray(box.points)[seg] * w.scene.scale
-    got = np.asarray(w.scene._buffer._rot4d_label_extent)
+    got = np.asarray(w.scene.buffer.label_extent)
     np.testing.assert_allclose(np.sort(got, axis=0), np.sort(want, axis=0), atol=1e-12)
 
 

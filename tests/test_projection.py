@@ -151,8 +151,8 @@ def test_both_views_update_from_one_message(widgets, recording_comms):
     The skeleton went once, with the first picture."""
     log = recording_comms
     w = widgets("24-cell", projection=True)
-    buf = w.scene._buffer
-    sk = buf._rot4d_skeleton
+    buf = w.scene.buffer
+    sk = buf.skeleton
     vertices, edges = pj.skeleton(w.source)
     np.testing.assert_array_equal(np.frombuffer(sk["vertices"], "<f8").reshape(-1, 4), vertices)
     np.testing.assert_array_equal(np.frombuffer(sk["edges"], "<u4").reshape(-1, 2), edges)
@@ -176,7 +176,7 @@ def test_both_views_update_from_one_message(widgets, recording_comms):
 def test_turned_on_later_sends_skeleton_and_state_once(widgets, recording_comms):
     w = widgets("5-cell")
     press(w, "4")
-    assert w.scene._buffer._rot4d_project == {}  # off: the slice's messages carry nothing for it
+    assert w.scene.buffer.projection == {}  # off: the slice's messages carry nothing for it
     recording_comms.clear()
     w.projection = True
     sent = [d for cid, d, n, b in recording_comms if cid == w.scene.buffer_model_id]
@@ -312,7 +312,7 @@ def test_off_by_default_changes_nothing(widgets):
     for w in (plain, shown):
         press(w, "4")
         press(w, "c")
-    np.testing.assert_array_equal(plain.scene._buffer.array, shown.scene._buffer.array)
+    np.testing.assert_array_equal(plain.scene.buffer.array, shown.scene.buffer.array)
     assert "views" not in plain.readout.value and "views" in shown.readout.value
 
 

@@ -118,7 +118,7 @@ def test_datetime64_times_are_dates_and_c0_steps_in_seconds(make):
     da = flame_da().assign_coords(time=pd.date_range("2021-03-04T12:00", periods=12, freq="5min"))
     field = Field4D.from_xarray(da)
     w = make(field, c0=1800.0)
-    corner = w.scene._buffer._rot4d_labels[0]["text"]
+    corner = w.scene.buffer.labels[0]["text"]
     assert corner.endswith("time 2021-03-04 12:30:00"), corner
     rows = readout_rows(w)
     assert rows["c0"].startswith("2021-03-04 12:30:00 (c0 = 1800 s)"), rows["c0"]
@@ -126,7 +126,7 @@ def test_datetime64_times_are_dates_and_c0_steps_in_seconds(make):
                                     "2021-03-04 12:55:00)"), rows["w cut"]
     w.slices = 3
     w.spacing = 600.0  # seconds
-    assert [lab["text"] for lab in w.scene._buffer._rot4d_labels] == [
+    assert [lab["text"] for lab in w.scene.buffer.labels] == [
         "time 2021-03-04 12:20:00", "time 2021-03-04 12:30:00", "time 2021-03-04 12:40:00"]
     step = w.state.c0_step  # seconds: l / h move c0 by it
     w.press("h")

@@ -70,11 +70,11 @@ def test_the_default_is_spread_when_n_changes_not_when_first_read():
 
 def test_every_slice_carries_its_time_and_one_outside_the_data_says_so(make):
     w = make(flame(), slices=5, arrangement="grid")
-    labels = w.scene._buffer._rot4d_labels
+    labels = w.scene.buffer.labels
     assert [lab["kind"] for lab in labels] == ["slice"] * 5
     assert [lab["text"] for lab in labels] == ["w 0.0013 s", "w 0.0019 s", "w 0.0025 s", "w 0.0031 s", "w 0.0037 s"]
     w.c0 = 0.9 * MS  # the lowest slices now lie before the record
-    texts = [lab["text"] for lab in w.scene._buffer._rot4d_labels]
+    texts = [lab["text"] for lab in w.scene.buffer.labels]
     assert texts[0] == "w -0.0003 s (outside the data)" and texts[2] == "w 0.0009 s (outside the data)", texts
     assert texts[3] == "w 0.0015 s", texts
     assert "w -0.0003 s (outside the data)" in w.readout.value

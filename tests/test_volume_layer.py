@@ -84,7 +84,7 @@ def test_a_mip_view_sends_the_cut_grid_with_the_rows_in_one_message(make, record
             and "state" in d.get("data", d)]
     states = [d.get("data", d)["state"] for d in msgs]
     assert len(states) == 1 and {"array", "_rot4d_volume", "_rot4d_seq"} <= set(states[0])
-    v = w.scene._buffer._rot4d_volume
+    v = w.scene.buffer.volume
     assert v["n_boxes"] == 1 and v["mode"] == vl.MODES["mip"]
     # the grid is the field's cut at this state, placed at the view's scale
     g = f.sample(w.state.matrix, w.c0)
@@ -104,9 +104,9 @@ def test_a_mip_view_sends_the_cut_grid_with_the_rows_in_one_message(make, record
 
 def test_back_to_surface_hides_the_volume_in_the_same_message(make):
     w = make(blob(), rendering="volume")
-    assert w.scene._buffer._rot4d_volume["n_boxes"] == 1 and w.scene.surface == {}
+    assert w.scene.buffer.volume["n_boxes"] == 1 and w.scene.surface == {}
     w.rendering = "surface"
-    assert w.scene._buffer._rot4d_volume == {} and w.scene.surface["n_indices"] > 0
+    assert w.scene.buffer.volume == {} and w.scene.surface["n_indices"] > 0
 
 
 def test_default_clim_is_the_cuts_1st_to_99th_percentile(make):
@@ -123,21 +123,21 @@ def test_default_clim_is_the_cuts_1st_to_99th_percentile(make):
 def test_held_keys_cast_the_coarse_grid_and_rest_the_full_one(make, clock):
     f = blob()
     w = make(f, rendering="mip")
-    full = w.scene._buffer._rot4d_volume["boxes"]
+    full = w.scene.buffer.volume["boxes"]
     full_shape = tuple(np.frombuffer(full, dtype="<f4")[6:9])
     down(w, "4")
     settle(w, clock, 0.6)
-    held = tuple(np.frombuffer(w.scene._buffer._rot4d_volume["boxes"], dtype="<f4")[6:9])
+    held = tuple(np.frombuffer(w.scene.buffer.volume["boxes"], dtype="<f4")[6:9])
     assert max(held) < max(full_shape)  # coarse while held
     up(w, "4")
     settle(w, clock, 0.5)
-    rest = tuple(np.frombuffer(w.scene._buffer._rot4d_volume["boxes"], dtype="<f4")[6:9])
+    rest = tuple(np.frombuffer(w.scene.buffer.volume["boxes"], dtype="<f4")[6:9])
     assert max(rest) == max(full_shape) and w._painter.shown.coarse is False
 
 
 def test_a_stack_casts_every_slice(make):
     w = make(blob(), rendering="mip", slices=3, spacing=0.5)
-    v = w.scene._buffer._rot4d_volume
+    v = w.scene.buffer.volume
     assert v["n_boxes"] == 3
     boxes = np.frombuffer(v["boxes"], dtype="<f4").reshape(-1, 12)
     assert len({tuple(b[0:3]) for b in boxes}) == 3  # each slice at its own place
@@ -153,7 +153,7 @@ def test_v_cycles_the_renderings_and_shift_goes_back(make):
     assert seen == ["surface", "volume", "mip", "sections", "surface"]
     w.press("V")
     assert w.rendering == "sections"
-    assert w.scene._buffer._rot4d_volume["mode"] == vl.MODES["sections"]
+    assert w.scene.buffer.volume["mode"] == vl.MODES["sections"]
 
 
 def test_section_keys_move_their_plane_and_stop_at_the_edge(make):
@@ -161,7 +161,7 @@ def test_section_keys_move_their_plane_and_stop_at_the_edge(make):
     w.press("a")
     w.press("S")
     assert w.sections == (0.5 + 1 / 32, 0.5 - 1 / 32, 0.5)
-    assert w.scene._buffer._rot4d_volume["sections"] == list(w.sections)
+    assert w.scene.buffer.volume["sections"] == list(w.sections)
     for _ in range(40):
         w.press("d")
     assert w.sections[2] == 1.0
@@ -208,9 +208,9 @@ def test_the_default_sections_are_the_middle():
 def test_a_cut_that_misses_the_data_shows_no_volume_and_no_error(make):
     w = make(blob(), rendering="volume")
     w.c0 = 5.0  # w = 5 is beyond the data's box [-1, 1]
-    assert w.scene._buffer._rot4d_volume == {} and len(w.errors.outputs) == 0
+    assert w.scene.buffer.volume == {} and len(w.errors.outputs) == 0
     w.c0 = 0.0
-    assert w.scene._buffer._rot4d_volume["n_boxes"] == 1
+    assert w.scene.buffer.volume["n_boxes"] == 1
 
 
 def test_the_colour_bar_spans_the_limits_the_ray_cast_colours_used(make):
@@ -231,7 +231,7 @@ def test_a_single_field_labels_its_box_with_data_coordinates(make):
 
     f = blob()
     w = make(f, rendering="mip")
-    labels = w.scene._buffer._rot4d_labels
+    labels = w.scene.buffer.labels
     # the data's extent (the box's cut), not the ray-cast grid's padding (issue 37)
     pts, _ = f.sample(w.state.matrix, w.c0).outline
     box = SimpleNamespace(origin=pts.min(axis=0), extent=tuple(zip(pts.min(axis=0), pts.max(axis=0))))
@@ -239,8 +239,8 @@ def test_a_single_field_labels_its_box_with_data_coordinates(make):
     assert [lab["text"] for lab in labels] == [t for _, t in want] and len(labels) == 4
     np.testing.assert_allclose([lab["p"] for lab in labels], [w.scene.scale * np.asarray(p) for p, _ in want])
     w.press("4")  # x and w mix: the edge labels name both
-    assert any("w " in lab["text"] and "x " in lab["text"] for lab in w.scene._buffer._rot4d_labels[1:])
+    assert any("w " in lab["text"] and "x " in lab["text"] for lab in w.scene.buffer.labels[1:])
     w.rendering = "surface"
-    assert len(w.scene._buffer._rot4d_labels) == 4  # the surface view is labelled too
+    assert len(w.scene.buffer.labels) == 4  # the surface view is labelled too
     p = make("24-cell")
-    assert p.scene._buffer._rot4d_labels == []
+    assert p.scene.buffer.labels == []

@@ -2,7 +2,9 @@
 
 The rows (balls, bars, faces) are one float32 array shared by the three instanced layers; the
 traits here travel in the same comm message as the array (or alone, for a turn), so the page
-applies a picture whole.  `rot4d_widget.view.scene.Scene` makes one and fills it.
+applies a picture whole.  `rot4d_widget.view.scene.Scene` makes one and fills it through the
+methods below (inside its ``hold_sync``); the traits' names are the wire protocol the page's
+``companion.js`` reads, so only this class touches them.
 """
 
 from __future__ import annotations
@@ -46,3 +48,86 @@ class RowBuffer(p3.InstancedInterleavedBuffer):
     #: The projection's state, with every update while it is shown (`projection.state_message`).
     _rot4d_project = Dict().tag(sync=True)
     version = CInt(0).tag(sync=True, echo_update=False)
+
+    # -- what the page holds, as the kernel last set it --------------------
+    @property
+    def seq(self) -> int:
+        """The id of the update last sent."""
+        return self._rot4d_seq
+
+    @property
+    def counts(self) -> list:
+        """The rows each layer draws: [balls, bars, faces]."""
+        return self._rot4d_counts
+
+    @property
+    def turn(self) -> list:
+        """The view's 3-D turn, a column-major 4x4 (`NO_TURN` when not turned)."""
+        return self._rot4d_turn
+
+    @property
+    def turned(self) -> bool:
+        return self._rot4d_turn != NO_TURN
+
+    @property
+    def surface(self) -> dict:
+        """The smooth surface last sent ({} = none)."""
+        return self._rot4d_surface
+
+    @property
+    def volume(self) -> dict:
+        """The cut(s) last sent for the ray-cast renderings ({} = none)."""
+        return self._rot4d_volume
+
+    @property
+    def labels(self) -> list:
+        """The texts pinned to points of the view (`CutLabels.traits`' first part)."""
+        return self._rot4d_labels
+
+    @property
+    def label_extent(self) -> list:
+        """The data's extent the box labels keep clear of (`CutLabels.traits`' second part)."""
+        return self._rot4d_label_extent
+
+    @property
+    def skeleton(self) -> dict:
+        """The projection's skeleton last sent ({} = none)."""
+        return self._rot4d_skeleton
+
+    @property
+    def projection(self) -> dict:
+        """The projection's state last sent ({} = none)."""
+        return self._rot4d_project
+
+    # -- setting it (the caller holds the sync: one message) ---------------
+    def projection_news(self, projection):
+        """``projection`` (`Scene.show`'s ``{"state": ..., "skeleton": ...}``) if it changes what the
+        page holds, else None."""
+        if projection is None or "skeleton" in projection or projection["state"] != self._rot4d_project:
+            return projection
+        return None
+
+    def put_projection(self, projection) -> None:
+        if "skeleton" in projection:
+            self._rot4d_skeleton = projection["skeleton"]
+        self._rot4d_project = projection["state"]
+
+    def put_turn(self, turn, seq) -> None:
+        """A turn of the whole view (no rows) as update ``seq``."""
+        self._rot4d_turn = turn
+        self._rot4d_seq = seq
+
+    def put_picture(self, rows, seq, counts=None, surface=None, volume=None, labels=None) -> None:
+        """New rows as update ``seq``, with what travels with them (None: unchanged); resets the turn."""
+        if labels is not None:
+            self._rot4d_label_extent, self._rot4d_labels = labels[1], labels[0]
+        if surface is not None:
+            self._rot4d_surface = surface
+        if volume is not None:
+            self._rot4d_volume = volume
+        self.array = rows
+        self._rot4d_seq = seq
+        if counts is not None:
+            self._rot4d_counts = [int(c) for c in counts]
+        if self._rot4d_turn != NO_TURN:
+            self._rot4d_turn = list(NO_TURN)

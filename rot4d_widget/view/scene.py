@@ -1,6 +1,7 @@
 """The 3-D view: a pythreejs scene built once, updated by assigning ONE new array.
 
-The only module that imports pythreejs.  The widget talks to it through a
+Its pythreejs objects are a `rot4d_widget.view.stage.Stage` it holds; what goes into the
+row buffer and when is decided here.  The widget talks to it through a
 small interface: `Scene.canvas` (the element ipyevents watches), `view_count`
 and `on_view_count`, `eye` and `on_eye_moved`, `show` (returns whether it
 sent an update) and `set_display`.  The reasons for the choices below are in
@@ -61,36 +62,19 @@ kernel does not echo it back again.
 from __future__ import annotations
 
 import contextlib
-import functools
-import pathlib
-import re
 import uuid
 
 import numpy as np
-import pythreejs as p3
 
-from ..core import camera, colours
+from ..core import colours
 from . import buffers as bf
 from .cuts import NO_LABELS, CutLabels
-from .field_layer import FieldLayer
-from .keypad import close_quietly
-from .rowbuffer import NO_TURN, RowBuffer
+from .stage import Stage, shader_source
 from .traits import check_flag as _flag
 from .traits import check_fraction as _unit
 from .traits import check_positive as _positive
-from .volume_layer import VolumeLayer
 
 __all__ = ["Scene", "shader_source"]
-
-_GLSL = pathlib.Path(__file__).with_name("glsl")
-_INCLUDE = re.compile(r"^// @include (\S+)$", re.M)
-
-
-@functools.lru_cache(maxsize=None)
-def shader_source(name: str) -> str:
-    """The GLSL of ``rot4d_widget/view/glsl/<name>`` with its ``// @include FILE`` lines expanded."""
-    text = (_GLSL / name).read_text()
-    return _INCLUDE.sub(lambda m: shader_source(m.group(1)), text)
 
 
 # -- option validation -------------------------------------------------------
@@ -156,6 +140,7 @@ class Scene:
         ``rot4d-canvas`` and `canvas_class` (unique per scene)
     update_id : int -- sequence number of the last update sent (0 = none yet)
     buffer_model_id, scene_model_id : str -- for the companion
+    buffer : the `RowBuffer` -- what the page holds (counts, turn, surface, volume, labels, ...)
     capacity : int -- rows per update
     """
 
@@ -197,38 +182,33 @@ class Scene:
         self._unsent = False  # a send of the buffer failed and none succeeded since
         self.canvas_class = f"rot4d-canvas-{uuid.uuid4().hex[:12]}"
         self._closed = False
-        self._display = {}
         display = self.check_display(
             dict(ball_radius=ball_radius, bar_radius=bar_radius, face_opacity=face_opacity, background=background,
                  show_balls=show_balls, show_bars=show_bars, show_faces=show_faces)
         )
         self._view_callbacks = []
         self._eye_callbacks = []
-        self._build(antialias, display)
-
-    # -- construction ------------------------------------------------------
-    def _build(self, antialias, display):
-        _build_three(self, antialias, display)
-
-    def _ball_uniforms(self, radius):
-        return dict(self._light, u_ball_radius={"value": radius}, u_ball_color={"value": list(self.ball_color)})
-
-    def _bar_uniforms(self, radius):
-        return dict(self._light, u_bar_radius={"value": radius}, u_bar_color={"value": list(self.bar_color)})
-
-    def _face_uniforms(self, opacity):
-        return dict(self._light, u_opacity={"value": opacity})
-
-    def _surface_uniforms(self):
-        # u_lo, u_span, u_opacity: set by the companion with each surface
-        return dict(self._light, u_lo={"value": [0.0, 0.0, 0.0]}, u_span={"value": [1.0, 1.0, 1.0]},
-                    u_opacity={"value": 1.0})
+        # the pythreejs objects: one row buffer read by balls, bars and faces, the smooth surface,
+        # camera, controls, renderer (built once; updates assign new arrays)
+        self._rows = np.zeros((self.capacity, bf.ROW_FLOATS), dtype=np.float32)
+        self._stage = Stage(rows=self._rows, width=self.width, height=self.height, antialias=antialias,
+                            display=display, ball_color=self.ball_color, bar_color=self.bar_color,
+                            canvas_class=self.canvas_class)
+        self._buffer = self._stage.buffer
+        self._display = display
+        self._stage.canvas.watch_views(self._view_count_changed)
+        self._stage.camera.observe(self._camera_moved, names="position")
 
     # -- what the widget needs ---------------------------------------------
     @property
     def canvas(self):
         """The displayable canvas widget (ipyevents watches it)."""
-        return self._renderer
+        return self._stage.canvas
+
+    @property
+    def buffer(self):
+        """The shared `RowBuffer`: what the page holds of the view, as last sent (read it only)."""
+        return self._buffer
 
     @property
     def buffer_model_id(self) -> str:
@@ -238,23 +218,23 @@ class Scene:
     @property
     def geometry_model_ids(self) -> list:
         """Model ids of the ball, bar and face geometries (the companion sets their drawn counts)."""
-        return [self._geometries[k].model_id for k in ("ball", "bar", "face")]
+        return [self._stage.geometries[k].model_id for k in ("ball", "bar", "face")]
 
     @property
     def mesh_model_ids(self) -> list:
         """Model ids of the ball, bar, face, surface, volume and field meshes (the companion turns them)."""
-        return [self._meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume", "field")]
+        return [self._stage.meshes[k].model_id for k in ("ball", "bar", "face", "surface", "volume", "field")]
 
     @property
     def texture_model_ids(self) -> list:
         """Model ids of the volume layer's atlas and colour-table textures (the companion fills them) and
         the field layer's placeholder 3-D texture (the page takes its class)."""
-        return [*self._volume.texture_model_ids, self._field.texture_model_id]
+        return [*self._stage.volume.texture_model_ids, self._stage.field.texture_model_id]
 
     @property
     def scene_model_id(self) -> str:
         """Model id of the pythreejs Scene (it fires ``afterRender`` on the page)."""
-        return self._three_scene.model_id
+        return self._stage.three_scene.model_id
 
     @property
     def rows(self) -> np.ndarray:
@@ -266,13 +246,12 @@ class Scene:
     @property
     def eye(self) -> tuple:
         """The camera's position as the kernel knows it (OrbitControls syncs it after a drag)."""
-        return tuple(float(x) for x in self._camera.position)
+        return tuple(float(x) for x in self._stage.camera.position)
 
     @property
     def view_count(self) -> int:
         """How many views of the canvas the front end reports (0 before any, or if it does not count)."""
-        n = self._renderer._view_count
-        return n if isinstance(n, int) else 0
+        return self._stage.canvas.view_count
 
     def on_view_count(self, callback, remove=False) -> None:
         """Call ``callback(n)`` when the number of displayed views of the canvas changes."""
@@ -283,9 +262,9 @@ class Scene:
         _register(self._eye_callbacks, callback, remove)
 
     def _view_count_changed(self, change):
-        n = change["new"]
+        n = self.view_count
         for cb in list(self._view_callbacks):
-            cb(n if isinstance(n, int) else 0)
+            cb(n)
 
     def _camera_moved(self, change):
         eye = self.eye
@@ -319,21 +298,7 @@ class Scene:
         """Change display options live (each one synced trait: no new rows are sent)."""
         new = self.check_display(options)
         for name, value in new.items():
-            if name == "ball_radius":
-                self._materials["ball"].uniforms = self._ball_uniforms(value)
-            elif name == "bar_radius":
-                self._materials["bar"].uniforms = self._bar_uniforms(value)
-            elif name == "face_opacity":
-                self._materials["face"].uniforms = self._face_uniforms(value)
-            elif name == "background":
-                h = colours.hex_color(colours.as_rgb(value, "background"))
-                with self._renderer.hold_sync():
-                    self._renderer.background = h
-                    self._renderer.clearColor = h
-            else:
-                self._meshes[{"show_balls": "ball", "show_bars": "bar", "show_faces": "face"}[name]].visible = value
-                if name == "show_faces":
-                    self._meshes["surface"].visible = value
+            self._stage.apply_display(name, value)
             self._display[name] = value
 
     def palette(self, n_groups: int) -> np.ndarray:
@@ -377,12 +342,12 @@ class Scene:
             n_levels = len(np.unique(np.asarray(data.groups))) if len(data.groups) else 0
             surface = bf.surface_message(arrays, 1.0 if n_levels <= 1 else colours.SURFACE_OPACITY)
             data = bf.without_triangles(data)
-        elif self._surface_shown or volume is not None:
+        elif self._buffer.surface or volume is not None:
             surface = {}
-        if volume is None and self._volume_shown:
+        if volume is None and self._buffer.volume:
             volume = {}
         pinned = labels.traits(self.scale)
-        pinned = None if pinned == (self._buffer._rot4d_labels, self._buffer._rot4d_label_extent) else pinned
+        pinned = None if pinned == (self._buffer.labels, self._buffer.label_extent) else pinned
         need = bf.rows_needed(data)
         if need > self.capacity:
             self._grow(bf.capacity_for(need))
@@ -390,10 +355,10 @@ class Scene:
             data, scale=self.scale, group_rgb=self.group_rgb if group_rgb is None else group_rgb,
             capacity=self.capacity, eye=self.eye, single_rgb=single_rgb,
         )
-        projection = _projection_news(self._buffer, projection)
+        projection = self._buffer.projection_news(projection)
         if (not force and not self._unsent and surface is None and volume is None and pinned is None
                 and projection is None and np.array_equal(rows, self._rows)
-                and self._buffer._rot4d_turn == NO_TURN):
+                and not self._buffer.turned):
             return False
         self.update_id += 1
         counts = [bf.ball_count(data), len(data.segments), len(data.triangles)]
@@ -405,16 +370,16 @@ class Scene:
         """`show`'s ``projection`` alone (the projection turned on, the slice unchanged: no `update_id`)."""
         if self._closed:
             raise RuntimeError("this Scene is closed")
-        projection = _projection_news(self._buffer, projection)
+        projection = self._buffer.projection_news(projection)
         if projection is not None:
             with self._sending():
-                _put_projection(self._buffer, projection)
+                self._buffer.put_projection(projection)
         return projection is not None
 
     @property
     def surface(self) -> dict:
         """The smooth surface last sent: its quantised arrays and box (empty dict if none)."""
-        return dict(self._buffer._rot4d_surface)
+        return dict(self._buffer.surface)
 
     def turn(self, rotation, projection=None) -> bool:
         """Turn the whole view by the 3-D ``rotation`` (3, 3) relative to the rows shown; True if sent.
@@ -432,15 +397,14 @@ class Scene:
         m4 = np.eye(4)
         m4[:3, :3] = r
         turn = [float(x) for x in m4.flatten(order="F")]
-        projection = _projection_news(self._buffer, projection)
-        if turn == self._buffer._rot4d_turn and not self._unsent and projection is None:
+        projection = self._buffer.projection_news(projection)
+        if turn == self._buffer.turn and not self._unsent and projection is None:
             return False
         self.update_id += 1
         with self._sending():
             if projection is not None:
-                _put_projection(self._buffer, projection)
-            self._buffer._rot4d_turn = turn
-            self._buffer._rot4d_seq = self.update_id
+                self._buffer.put_projection(projection)
+            self._buffer.put_turn(turn, self.update_id)
         return True
 
     @contextlib.contextmanager
@@ -462,32 +426,18 @@ class Scene:
     @property
     def counts(self) -> list:
         """Rows each layer draws now: [balls, bars, faces] (the rest of the capacity is skipped)."""
-        return list(self._buffer._rot4d_counts)
+        return list(self._buffer.counts)
 
     @property
     def turned(self) -> bool:
         """True while the view shows its rows turned by `turn` (the faces' order may be stale)."""
-        return self._buffer._rot4d_turn != NO_TURN
+        return self._buffer.turned
 
     def _assign(self, rows, seq, counts=None, surface=None, volume=None, labels=None, projection=None):
-        buf = self._buffer
         with self._sending():
             if projection is not None:
-                _put_projection(self._buffer, projection)
-            if labels is not None:
-                buf._rot4d_label_extent, buf._rot4d_labels = labels[1], labels[0]
-            if surface is not None:
-                buf._rot4d_surface = surface
-                self._surface_shown = bool(surface)
-            if volume is not None:
-                buf._rot4d_volume = volume
-                self._volume_shown = bool(volume)
-            buf.array = rows
-            buf._rot4d_seq = seq
-            if counts is not None:
-                buf._rot4d_counts = [int(c) for c in counts]
-            if buf._rot4d_turn != NO_TURN:
-                buf._rot4d_turn = list(NO_TURN)
+                self._buffer.put_projection(projection)
+            self._buffer.put_picture(rows, seq, counts, surface=surface, volume=volume, labels=labels)
         self._rows = rows
 
     def _grow(self, capacity):
@@ -495,10 +445,9 @@ class Scene:
         capacity = max(int(capacity), len(self._rows))
         padded = np.zeros((capacity, bf.ROW_FLOATS), dtype=np.float32)
         padded[: len(self._rows)] = self._rows  # the rows assigned last (a failed send may have left them longer)
-        self._assign(padded, self.update_id, self._buffer._rot4d_counts)  # (a) same picture, more (hidden) rows
+        self._assign(padded, self.update_id, self._buffer.counts)  # (a) same picture, more (hidden) rows
         self.capacity = capacity  # the rows are that long now, whatever (b) does
-        for g in self._geometries.values():  # (b) draw them
-            g.maxInstancedCount = capacity
+        self._stage.draw_rows(capacity)  # (b) draw them
         # (c) is the caller's normal update
 
     # -- teardown ----------------------------------------------------------
@@ -510,156 +459,14 @@ class Scene:
         self._view_callbacks.clear()
         self._eye_callbacks.clear()
         try:
-            self._renderer.unobserve(self._view_count_changed, names="_view_count")
-            self._camera.unobserve(self._camera_moved, names="position")
+            self._stage.canvas.watch_views(self._view_count_changed, remove=True)
+            self._stage.camera.unobserve(self._camera_moved, names="position")
         except ValueError:
             pass
-        for w in self._widgets:  # with the Layout / Style / shadow map each one made for itself
-            close_quietly(w)
+        self._stage.close()
 
     def __repr__(self) -> str:
         return f"Scene(capacity={self.capacity}, scale={self.scale:.4g}, update_id={self.update_id})"
-
-
-def _build_three(scene, antialias, display):
-    """The pythreejs objects of ``scene``: one row buffer read by balls, bars and faces, the smooth
-    surface, camera, controls, renderer (built once; updates assign new arrays)."""
-    scene._rows = np.zeros((scene.capacity, bf.ROW_FLOATS), dtype=np.float32)
-    scene._buffer = RowBuffer(array=scene._rows, meshPerAttribute=1)
-    attrs = {
-        name: p3.InterleavedBufferAttribute(data=scene._buffer, itemSize=size, offset=col)
-        for name, (col, size) in bf.COLUMNS.items()
-    }
-    templates = {
-        "ball": {"position": p3.BufferAttribute(array=bf.quad_template())},
-        "bar": {"position": p3.BufferAttribute(array=bf.quad_template())},
-        "face": {"position": p3.BufferAttribute(array=bf.triangle_template())},
-    }
-    uses = {
-        "ball": ("ball",),
-        "bar": ("bar_a", "bar_b"),
-        "face": ("tri_a", "tri_b", "tri_c", "tri_rgb"),
-    }
-    scene._geometries = {}
-    for part, names in uses.items():
-        a = dict(templates[part])
-        a.update({n: attrs[n] for n in names})
-        scene._geometries[part] = p3.InstancedBufferGeometry(attributes=a, maxInstancedCount=scene.capacity)
-
-    scene._light = {
-        "u_ambient": {"value": [0.28, 0.28, 0.28]},
-        "u_sky": {"value": [0.30, 0.30, 0.32]},
-        "u_ground": {"value": [0.08, 0.07, 0.06]},
-        "u_light_color": {"value": [0.62, 0.62, 0.60]},
-        "u_light_position": {"value": [-3.0, 4.0, 2.0]},
-        "u_specular": {"value": 0.35},
-    }
-    scene._materials = {
-        "ball": p3.ShaderMaterial(
-            vertexShader=shader_source("ball.vert"),
-            fragmentShader=shader_source("ball.frag"),
-            uniforms=scene._ball_uniforms(display["ball_radius"]),
-            extensions={"fragDepth": True},
-            side="DoubleSide",
-        ),
-        "bar": p3.ShaderMaterial(
-            vertexShader=shader_source("bar.vert"),
-            fragmentShader=shader_source("bar.frag"),
-            uniforms=scene._bar_uniforms(display["bar_radius"]),
-            extensions={"fragDepth": True},
-            side="DoubleSide",
-        ),
-        "face": p3.ShaderMaterial(
-            vertexShader=shader_source("face.vert"),
-            fragmentShader=shader_source("face.frag"),
-            uniforms=scene._face_uniforms(display["face_opacity"]),
-            side="DoubleSide",
-            transparent=True,
-            depthWrite=False,
-        ),
-    }
-    # the smooth surface (a field's isosurfaces): indexed, quantised; the companion
-    # replaces these placeholder arrays (their types stay) as it applies an update
-    scene._surface_attrs = {
-        "position": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint16), normalized=True),
-        "normal": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.int8), normalized=True),
-        "a_rgb": p3.BufferAttribute(array=np.zeros((3, 3), dtype=np.uint8), normalized=True),
-    }
-    scene._surface_index = p3.BufferAttribute(array=np.zeros(0, dtype=np.uint32))
-    scene._surface_geometry = p3.BufferGeometry(attributes=scene._surface_attrs, index=scene._surface_index)
-    scene._materials["surface"] = p3.ShaderMaterial(
-        vertexShader=shader_source("surface.vert"),
-        fragmentShader=shader_source("surface.frag"),
-        uniforms=scene._surface_uniforms(),
-        side="DoubleSide",
-        transparent=True,
-        depthWrite=True,
-    )
-    names = {"ball": "balls", "bar": "bars", "face": "faces"}
-    scene._meshes = {
-        part: p3.Mesh(
-            geometry=scene._geometries[part], material=scene._materials[part], frustumCulled=False,
-            name=names[part], visible=display[f"show_{names[part]}"],
-        )
-        for part in ("ball", "bar", "face")
-    }
-    scene._meshes["surface"] = p3.Mesh(
-        geometry=scene._surface_geometry, material=scene._materials["surface"], frustumCulled=False,
-        name="surface", visible=display["show_faces"],
-    )
-    scene._volume = VolumeLayer()  # a field's cut ray-cast: hidden until a volume arrives
-    scene._meshes["volume"] = scene._volume.build(shader_source)
-    scene._field = FieldLayer(scene._light)  # the page's own picture of a field (issue 36): hidden
-    scene._meshes["field"] = scene._field.build(shader_source)
-    scene._camera = p3.PerspectiveCamera(
-        position=list(camera.CAMERA_POSITION), fov=camera.CAMERA_FOV, aspect=scene.width / scene.height,
-        near=camera.CAMERA_NEAR, far=camera.CAMERA_FAR,
-    )
-    scene._three_scene = p3.Scene(children=[*scene._meshes.values(), scene._camera], background=None)
-    scene._controls = p3.OrbitControls(controlling=scene._camera, enableKeys=False)
-    background = colours.hex_color(colours.as_rgb(display["background"], "background"))
-    scene._renderer = p3.Renderer(
-        camera=scene._camera,
-        scene=scene._three_scene,
-        controls=[scene._controls],
-        width=scene.width,
-        height=scene.height,
-        antialias=antialias,
-        background=background,
-        background_opacity=1.0,
-        clearColor=background,
-    )
-    scene._renderer.add_class("rot4d-canvas")
-    scene._renderer.add_class(scene.canvas_class)
-    scene._display = display
-    scene._widgets = [
-        scene._renderer, scene._controls, scene._three_scene, scene._camera, *scene._meshes.values(),
-        *scene._materials.values(), *scene._geometries.values(), *attrs.values(), scene._buffer,
-        *(a for t in templates.values() for a in t.values()),
-        scene._surface_geometry, *scene._surface_attrs.values(), scene._surface_index,
-        *(w for w in scene._volume.widgets if w is not scene._meshes["volume"]),
-        *(w for w in scene._field.widgets if w is not scene._meshes["field"]),
-    ]  # fmt: skip
-    scene._surface_shown = False
-    scene._volume_shown = False
-    # ipywidgets' view count, kept by the front end on request (None: not requested)
-    if scene._renderer._view_count is None:
-        scene._renderer._view_count = 0
-    scene._renderer.observe(scene._view_count_changed, names="_view_count")
-    scene._camera.observe(scene._camera_moved, names="position")
-
-
-def _projection_news(buffer, projection):
-    """``projection`` (`Scene.show`'s) if it changes what the page holds, else None."""
-    if projection is None or "skeleton" in projection or projection["state"] != buffer._rot4d_project:
-        return projection
-    return None
-
-
-def _put_projection(buffer, projection):
-    if "skeleton" in projection:
-        buffer._rot4d_skeleton = projection["skeleton"]
-    buffer._rot4d_project = projection["state"]
 
 
 def _register(callbacks, callback, remove):

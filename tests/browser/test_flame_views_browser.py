@@ -50,7 +50,7 @@ def _shot(jp, var, name, artifacts, index):
     page = jp.page
     sel = _canvas(jp, var)
     page.locator(sel).scroll_into_view_if_needed()
-    want = jp.kernel_json(f"[lab['text'] for lab in {var}.scene._buffer._rot4d_labels]")
+    want = jp.kernel_json(f"[lab['text'] for lab in {var}.scene.buffer.labels]")
     got = {}
 
     def shown():

@@ -68,7 +68,7 @@ def projected_rect(points, width, height, distance=5.0, fov=40.0):
 
 
 def check_labels(jp, sel, name, artifacts):
-    want = jp.kernel_json("[lab['text'] for lab in w.scene._buffer._rot4d_labels]")
+    want = jp.kernel_json("[lab['text'] for lab in w.scene.buffer.labels]")
     assert len(want) == 4, want
     got = {}
 
@@ -147,7 +147,7 @@ def test_every_slice_of_a_grid_carries_its_time(jupyter_server, page, artifacts)
     jp.run_all(timeout=300)
     sel = _canvas(jp, "s")
     page.locator(sel).scroll_into_view_if_needed()
-    want = jp.kernel_json("[lab['text'] for lab in s.scene._buffer._rot4d_labels]")
+    want = jp.kernel_json("[lab['text'] for lab in s.scene.buffer.labels]")
     assert want == ["time 0.0013 s", "time 0.0019 s", "time 0.0025 s", "time 0.0031 s", "time 0.0037 s"], want
     got = {}
 

@@ -126,7 +126,7 @@ def test_volume_mip_sections_in_the_page_agree_with_the_static_render(jupyter_se
     labels = host.locator(".rot4d-label")
     assert jp.wait_for(lambda: labels.count() == 4, timeout=10), labels.count()
     texts = labels.all_inner_texts()
-    want = jp.kernel_json("[lab['text'] for lab in w.scene._buffer._rot4d_labels]")
+    want = jp.kernel_json("[lab['text'] for lab in w.scene.buffer.labels]")
     assert [t.strip("\u25cf ") for t in texts] == want, (texts, want)
     assert texts[0].strip("\u25cf ").startswith("x ") and " \u2192 " in texts[1], texts  # the corner; an edge
     host.screenshot(path=str(artifacts / f"volume-labelled-{jupyter_server.kind}.png"))
