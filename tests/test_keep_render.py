@@ -158,7 +158,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
         np.testing.assert_allclose(coll.get_edgecolor()[k], edge, atol=1e-12)
         lw = patch.get_linewidth() if patch.get_edgecolor()[3] else 0.0
         assert coll.get_linewidth()[k] == pytest.approx(lw)
-    np.testing.assert_allclose(coll._items_zorder, [a.get_zorder() for a in patches], atol=1e-9)
+    np.testing.assert_allclose(coll.items_zorder, [a.get_zorder() for a in patches], atol=1e-9)
 
 
 @pytest.mark.parametrize("source", ["24-cell", "field"])

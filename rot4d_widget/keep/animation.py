@@ -83,7 +83,7 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
 
     setter = None if src is None else set_source
     if src is not None:
-        for e in recording._start_settings():
+        for e in recording.start_settings():
             set_source(e.name, e.value)
     view = recording.initial_view
     set_view = view.__setitem__

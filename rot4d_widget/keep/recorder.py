@@ -522,14 +522,15 @@ class Recording:
             d.pop("keymap", None)
             state.restore(d)  # with the recorded reset point ("initial")
         if restart:
-            for e in self._start_settings() + self._start_view():
+            for e in self.start_settings() + self._start_view():
                 apply_event(state, e, source, set_source, set_view)
         for e in self.events:
             apply_event(state, e, source, set_source, set_view)
         return state
 
-    def _start_settings(self) -> list:
-        """`initial_source` as `SourceSetting` events at t = 0."""
+    def start_settings(self) -> list:
+        """`initial_source` as `SourceSetting` events at t = 0: what replaying from the start sets
+        on the source first (`replay`, and an animation's frames)."""
         return [SourceSetting(0.0, name, value) for name, value in self.initial_source.items()]
 
     def _start_view(self) -> list:

@@ -33,6 +33,7 @@ from numbers import Integral, Real
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import PathCollection
 from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
@@ -399,8 +400,7 @@ def slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radi
     as ONE `PathCollection` (gid "slice"), drawn by a single renderer call.  For animations:
     a frame of the 24-cell is ~100 patches, whose building and drawing was most of its time.
     ``cmap`` a Colormap or None; radii and sizes already checked.  None when nothing is drawn."""
-    # matplotlib collections: imported when a slice is drawn as one collection
-    from matplotlib.collections import PathCollection
+    # matplotlib paths: imported when a slice is drawn as one collection
     from matplotlib.path import Path
 
     global _CIRCLE
@@ -492,11 +492,19 @@ def slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radi
         return None
     zo = np.asarray(zo) + z_shift
     order = np.argsort(zo, kind="stable")  # matplotlib sorts artists by zorder, stably
-    coll = PathCollection([paths[i] for i in order], facecolors=np.asarray(face)[order],
-                          edgecolors=np.asarray(edge)[order], linewidths=np.asarray(width)[order],
-                          joinstyle="miter", capstyle="butt", zorder=float(zo.min()), gid="slice")
-    coll._items_zorder = zo[order]
-    return coll
+    return SliceCollection([paths[i] for i in order], zo[order], facecolors=np.asarray(face)[order],
+                           edgecolors=np.asarray(edge)[order], linewidths=np.asarray(width)[order],
+                           joinstyle="miter", capstyle="butt", zorder=float(zo.min()), gid="slice")
+
+
+class SliceCollection(PathCollection):
+    """`slice_collection`'s one collection of paths, painted in order; ``items_zorder``: the
+    zorder each path would have as draw_slice's patch (ascending), which the collection's own
+    zorder (their least) stands for."""
+
+    def __init__(self, paths, items_zorder, **kwargs):
+        super().__init__(paths, **kwargs)
+        self.items_zorder = items_zorder
 
 
 # --------------------------------------------------------------------------- grids of panels
