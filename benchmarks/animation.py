@@ -9,8 +9,8 @@ the package at commit 7ba6e62, checked out with ``git worktree add /tmp/old-anim
 machine falls on both alike.  Prints a table of medians (seconds) and the speed-up.
 
 ``--parts`` adds, for the new code, where each render's time went (medians, seconds): slicing
-(the framing pass's ``state_picture._prepare``, every frame's slice), building the frame's artists
-(``render_state``), Agg drawing them (``_FrameCanvas.rgba``), the encoder's work after the last
+(the framing pass's ``state_picture.prepare_render``, every frame's slice), building the frame's artists
+(``render_state``), Agg drawing them (``FrameCanvas.rgba``), the encoder's work after the last
 frame (``_Encoder.finish``: x264's lookahead, the GIF's last frames) and the rest.
 
     python benchmarks/animation.py [--repeats 3] [--old /tmp/old-anim] [--parts]
@@ -76,9 +76,9 @@ def _time_parts(spent: dict) -> None:
     from rot4d_widget.keep import animation
     from rot4d_widget.keep.pictures import canvas, state_picture
 
-    _timed(state_picture, "_prepare", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
+    _timed(state_picture, "prepare_render", "slicing", spent, lambda args, kwargs: kwargs.get("data") is None)
     _timed(state_picture, "render_state", "building", spent)
-    _timed(canvas._FrameCanvas, "rgba", "drawing", spent)
+    _timed(canvas.FrameCanvas, "rgba", "drawing", spent)
     _timed(animation._Encoder, "finish", "encoder tail", spent)
 
 

@@ -56,14 +56,14 @@ def main() -> None:
     warnings.simplefilter("ignore")
     z = zarr.open_group(store(args.size, args.chunk), mode="r")["f"]
     fetched: list = []
-    original = chunks._ChunkReader.read
+    original = chunks.ChunkReader.read
 
     def counting_read(self, wanted):
         with self._lock:
             fetched.extend(i for i in wanted if i not in self._cache)
         return original(self, wanted)
 
-    chunks._ChunkReader.read = counting_read
+    chunks.ChunkReader.read = counting_read
     print(f"store {args.size}^4 float32, {args.chunk}^4 chunks ({args.chunk ** 4 * 4 / 2**20:.0f} MiB each)")
     print(f"{'cache MiB':>9} {'seed':>4} {'distinct':>8} {'grid order':>10} {'by chunk':>8} {'time grid s':>11} {'time chunk s':>12}")
     for mb in (int(v) for v in args.cache_mb.split(",")):

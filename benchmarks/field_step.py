@@ -19,7 +19,7 @@ the median over orientations:
 * map_coordinates: ``scipy.ndimage.map_coordinates(order=1, prefilter=False)`` on the
   same grid points (all of them, as a resampler without the box test would do; and
   only those inside the box, which is all the kernel interpolates);
-* marching cubes: `_surface` for the one level (min with the box distance, skimage
+* marching cubes: `level_surface` for the one level (min with the box distance, skimage
   Lewiner, winding, normals, volume);
 * whole step: `Field4D.slice` (the above plus the box's cut as bars, readout, `SliceData`);
 * bytes: what the slice would send as float32 positions + normals and uint32 indices.
@@ -37,10 +37,10 @@ import numba
 import numpy as np
 from scipy.ndimage import gaussian_filter, map_coordinates
 
-from rot4d_widget.sources.field.kernels import PARALLEL_MIN_POINTS, _get_kernels, _resample_affine
+from rot4d_widget.sources.field.kernels import PARALLEL_MIN_POINTS, _get_kernels, resample_affine
 from rot4d_widget.sources.field.container import Field4D
-from rot4d_widget.sources.field.slicing import _sample
-from rot4d_widget.sources.field.surface import _surface
+from rot4d_widget.sources.field.slicing import slice_samples
+from rot4d_widget.sources.field.surface import level_surface
 from rot4d_widget.core.rotation import random_rotation
 
 
@@ -87,7 +87,7 @@ def best(fn, repeats: int):
 
 
 def kernel_inputs(field, m, c0, s):
-    """The affine-grid arguments `_sample` gives the kernel (numpy arrays: no block offset)."""
+    """The affine-grid arguments `slice_samples` gives the kernel (numpy arrays: no block offset)."""
     hw = field._hw
     sc = np.array([(field.shape[j] - 1) / (2 * hw[j]) for j in range(4)])
     base_d = (m.T @ np.array([*s.origin, c0]) + hw) * sc
@@ -116,9 +116,9 @@ def measure(field: Field4D, res: int, orientations: int, repeats: int, c0: float
     arr = field.values
     for _ in range(orientations):
         m = random_rotation(rng)
-        s, t_res = best(lambda: _sample(field, m, c0, res), repeats)
+        s, t_res = best(lambda: slice_samples(field, m, c0, res), repeats)
         base, step, centre, inv_s = kernel_inputs(field, m, c0, s)
-        (f, g), t_k = best(lambda: _resample_affine(arr, base, step, s.f.shape, centre, centre, inv_s), repeats)
+        (f, g), t_k = best(lambda: resample_affine(arr, base, step, s.f.shape, centre, centre, inv_s), repeats)
         assert np.array_equal(f, s.f)
         serial = _get_kernels(False)[0]
         fo, go, nn = np.empty(s.f.shape), np.empty(s.f.shape), np.array(s.f.shape, dtype=np.int64)
@@ -129,7 +129,7 @@ def measure(field: Field4D, res: int, orientations: int, repeats: int, c0: float
         idx_in = np.ascontiguousarray(idx[:, inside])
         _, t_in = best(lambda: map_coordinates(arr, idx_in, order=1, prefilter=False, mode="nearest"), repeats)
         err = float(np.abs(ref[inside] - f.ravel()[inside]).max())
-        surf, t_mc = best(lambda: _surface(s, field.levels[0]), repeats)
+        surf, t_mc = best(lambda: level_surface(s, field.levels[0]), repeats)
         _, t_step = best(lambda: slice_step(field, m, c0, res), repeats)
         nv, nt = len(surf.vertices), len(surf.triangles)
         rows.append(dict(step=t_step, res=t_res, kernel=t_k, serial=t_ser, all=t_all, inside_t=t_in, mc=t_mc, grid=s.f.size,

@@ -36,9 +36,9 @@ t3 = time.perf_counter()
 from rot4d_widget.sources.field import kernels as fk
 a, idx, inside = np.zeros((3, 3, 3, 3)), np.zeros((4, 4)), np.ones(4, bool)
 t4 = time.perf_counter()
-fk._resample_points(a, idx, inside)
+fk.resample_points(a, idx, inside)
 t5 = time.perf_counter()
-fk._resample_points(a, idx, inside)
+fk.resample_points(a, idx, inside)
 t6 = time.perf_counter()
 print(json.dumps({"import": t1 - t0, "load600": t3 - t2, "first": t5 - t4, "second": t6 - t5}))
 """

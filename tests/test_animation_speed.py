@@ -13,7 +13,7 @@ from matplotlib.font_manager import FontProperties
 
 from rot4d_widget.core import colours, sizes
 from rot4d_widget.keep.pictures import framing, slice_drawing, state_picture
-from rot4d_widget.keep.pictures.canvas import _FrameCanvas, _glyph_caching_renderer
+from rot4d_widget.keep.pictures.canvas import FrameCanvas, _glyph_caching_renderer
 from rot4d_widget.sources import datasets
 from rot4d_widget.keep.recorder import Recorder
 from rot4d_widget.keep.animation import render_frames
@@ -98,8 +98,8 @@ def test_animation_frames_with_and_without_kept_glyphs_are_identical(monkeypatch
 
 
 def _surface_collection(state, source):
-    stack, data, _, box = state_picture._prepare(state, source)
-    canvas = _FrameCanvas()
+    stack, data, _, box = state_picture.prepare_render(state, source)
+    canvas = FrameCanvas()
     state_picture.render_state(state, stack, frame=box, _canvas=canvas, _prepared=(stack, data, None, box))
     (coll,) = [c for c in canvas.ax.collections if c.get_gid() == "surface"]
     return stack, data, coll

@@ -15,7 +15,7 @@ from scipy.ndimage import gaussian_filter, map_coordinates
 
 from rot4d_widget.sources.field.container import Field4D, slice_field
 from rot4d_widget.sources.field.surface import FieldSlice
-from rot4d_widget.sources.field.slicing import _box_slice, _sample
+from rot4d_widget.sources.field.slicing import box_slice, slice_samples
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.sources.protocol import SliceData, as_source
 
@@ -177,11 +177,11 @@ def test_constant_field_slices_fill_the_box():
     m = random_rotation(3)
     for c0 in (0.0, 0.5):
         s = slice_field(field, m, c0, 1.0, 48)
-        assert s.volume == pytest.approx(_box_slice(field, m, c0).volume, rel=0.01)  # caps ON the faces
+        assert s.volume == pytest.approx(box_slice(field, m, c0).volume, rel=0.01)  # caps ON the faces
     for m, c0 in ((np.eye(4), 0.0), (np.eye(4), 0.6 - 1e-9), (random_rotation(4), 0.3)):  # faces on grid planes too
         s = slice_field(field, m, c0, 1.0, 33)
         assert len(s.triangles) and open_edges(s) == 0
-        assert s.volume == pytest.approx(_box_slice(field, m, c0).volume, rel=0.02)
+        assert s.volume == pytest.approx(box_slice(field, m, c0).volume, rel=0.02)
     total = cavalieri(field, m, 1.0, res=32)
     assert total == pytest.approx(np.prod([hi - lo for lo, hi in extent]), rel=0.01)
 
@@ -206,7 +206,7 @@ def test_interpolation_equals_map_coordinates_order_1():
     field = Field4D(a, axes="wzxy", extent=((-1, 2), (0, 1), (-0.5, 0.5), (3, 5)), w_per_unit=2.5)
     for _ in range(3):
         m, c0 = random_rotation(rng), rng.uniform(-0.3, 0.3)
-        s = _sample(field, m, c0, 24)
+        s = slice_samples(field, m, c0, 24)
         idx = grid_index_points(field, m, c0, s)
         ref = map_coordinates(a, idx, order=1, prefilter=False, mode="nearest")
         inside = s.g.ravel() >= 0
@@ -391,7 +391,7 @@ def test_field_is_a_source():
     assert [s.level for s in levels] == [0.3, 0.6]
     assert np.bincount(d.groups).tolist() == [len(s.triangles) for s in levels]
     assert levels[0].volume > levels[1].volume > 0  # nested
-    box = _box_slice(field, m, 0.1)
+    box = box_slice(field, m, 0.1)
     assert len(d.segments) == len(box.edges) and len(d.points) == sum(len(s.vertices) for s in levels) + len(box.vertices)
     rows = dict(d.readout)
     assert rows["field"] == "density [kg/m3]" and rows["levels"].startswith("0.3, 0.6 of ")
@@ -426,7 +426,7 @@ def test_field_is_a_source():
         field.actions["i"].run(1)
     below = field.slice(m, at(field, 0.0))
     assert "the whole box" in dict(below.readout)["level"]
-    assert below.volume == pytest.approx(_box_slice(field, m, 0.0).volume, rel=0.03)
+    assert below.volume == pytest.approx(box_slice(field, m, 0.0).volume, rel=0.03)
     assert field.slice(m, at(field, 0.0), coarse=True).readout[-1] == ("resolution", "32 (coarse copy)")
     # turned in 3-D = sliced at the turned orientation (what the widget shows at rest without resampling)
     from rot4d_widget.core.rotation import simple_rotation

@@ -13,7 +13,7 @@ import pytest  # noqa: E402
 
 from rot4d_widget import polytope, slice_polytope  # noqa: E402
 from rot4d_widget.core.rotation import random_rotation  # noqa: E402
-from rot4d_widget.keep.pictures.slice_drawing import _slice_collection, draw_slice  # noqa: E402
+from rot4d_widget.keep.pictures.slice_drawing import slice_collection, draw_slice  # noqa: E402
 from rot4d_widget.sources.protocol import PolytopeSource  # noqa: E402
 from rot4d_widget.sources.tomography import StackSource  # noqa: E402
 from rot4d_widget.view.buffers import ball_count, slice_rows  # noqa: E402
@@ -99,7 +99,7 @@ def test_static_pictures_draw_no_ball_at_a_fill_corner_and_fill_from_triangles(c
         drawing = draw_slice(ax, s, fov=None, radius=p.circumradius, ball_radius=0.05, bar_radius=0.01)
         assert len(drawing.balls) == len(s.vertices) - s.n_fill == len(_crossings(p, m, 0.0))
         assert len(drawing.faces) == len(s.triangles)  # the even-odd fill, not angle-ordered polygons
-        coll = _slice_collection(s, scale=1.0, ball_radius=0.05, bar_radius=0.01, face_alpha=0.3)
+        coll = slice_collection(s, scale=1.0, ball_radius=0.05, bar_radius=0.01, face_alpha=0.3)
         n_paths = len(coll.get_paths())
         assert n_paths == len(s.triangles) + len(s.edges) + 2 * (len(s.vertices) - s.n_fill)
     finally:

@@ -129,7 +129,7 @@ def test_progress_does_not_import_pythreejs():
 # -- the animation's fast path draws what render_state draws ----------------------------------------------
 
 def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
-    """`slice_drawing._slice_collection` (animations) has draw_slice's paths, colours and edges, in the
+    """`slice_drawing.slice_collection` (animations) has draw_slice's paths, colours and edges, in the
     order matplotlib would paint draw_slice's patches (by zorder, ties in the order added)."""
     from matplotlib.figure import Figure
 
@@ -146,7 +146,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
     d = slice_drawing.draw_slice(ax, s, **style)
     patches = [a for a in ax.get_children() if a in {*d.faces, *d.bars, *d.balls, *d.highlights}]
     patches.sort(key=lambda a: a.get_zorder())  # stable: matplotlib's painting order
-    coll = slice_drawing._slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
+    coll = slice_drawing.slice_collection(s, scale=style["scale"], ball_radius=style["ball_radius"],
                                      bar_radius=style["bar_radius"], face_alpha=colours.FACE_OPACITY)
     paths = coll.get_paths()
     assert len(paths) == len(patches) == len(s.polygons) + len(s.edges) + 2 * len(s.vertices)
@@ -158,7 +158,7 @@ def test_one_collection_per_slice_holds_draw_slices_patches_in_their_order():
         np.testing.assert_allclose(coll.get_edgecolor()[k], edge, atol=1e-12)
         lw = patch.get_linewidth() if patch.get_edgecolor()[3] else 0.0
         assert coll.get_linewidth()[k] == pytest.approx(lw)
-    np.testing.assert_allclose(coll._items_zorder, [a.get_zorder() for a in patches], atol=1e-9)
+    np.testing.assert_allclose(coll.items_zorder, [a.get_zorder() for a in patches], atol=1e-9)
 
 
 @pytest.mark.parametrize("source", ["24-cell", "field"])
@@ -174,7 +174,7 @@ def test_animation_frames_are_render_states_pictures(source):
     rec = _held_4(4)
     src = datasets.moving_sphere(resolution=16) if source == "field" else source
     frames = list(render_frames(rec, None, src, size=(240, 200), dpi=40, titles=lambda k, t, s: f"frame {k}"))
-    boxes = [state_picture._prepare(st, s if s is not None else src)[3]
+    boxes = [state_picture.prepare_render(st, s if s is not None else src)[3]
              for _, st, s in animation_states(rec, None, src)]
     box = framing.union_extent(boxes)
     for k, (t, st, s) in enumerate(animation_states(rec, None, src)):

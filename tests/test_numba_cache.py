@@ -34,7 +34,7 @@ a = np.zeros((3, 3, 3, 3))
 out = {}
 for parallel in (False, True):
     affine, points = fk._get_kernels(parallel)
-    fk._resample_points(a, np.ones((2, 4)), np.ones(2, bool)) if not parallel else None
+    fk.resample_points(a, np.ones((2, 4)), np.ones(2, bool)) if not parallel else None
     n = np.array((2, 2, 2))
     affine(a, np.zeros(4), np.eye(3, 4), n, np.ones(4), np.ones(4), np.ones(4), np.empty((2, 2, 2)), np.empty((2, 2, 2)))
     points(a, np.ones((2, 4)), np.ones(2, bool), np.empty(2))

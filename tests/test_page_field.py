@@ -13,7 +13,7 @@ from test_companion import FakeScene, from_page
 
 from rot4d_widget import Field4D
 from rot4d_widget.core.rotation import random_rotation
-from rot4d_widget.sources.field.slicing import _box_polytope
+from rot4d_widget.sources.field.slicing import box_polytope
 from rot4d_widget.view import pagefield as pf
 from rot4d_widget.view import transfer as tr
 from rot4d_widget.view.companion import Companion
@@ -182,7 +182,7 @@ console.log(JSON.stringify(out));
 def _box_message(hw):
     import base64
 
-    msg = polytope_message(_box_polytope(hw))
+    msg = polytope_message(box_polytope(hw))
     return {k: base64.b64encode(bytes(v)).decode() if isinstance(v, memoryview) else v for k, v in msg.items()}
 
 

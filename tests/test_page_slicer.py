@@ -213,7 +213,7 @@ def test_nonconvex_polytopes_with_convex_cells(monkeypatch):
 
 def test_faces_almost_parallel_to_h_are_cut_with_exact_signs(monkeypatch):
     """A pentagon tilted by less than the tolerance: its chord has three ends under the tolerance,
-    so the kernel cuts again by exact signs (`_Inconsistent`); the page does the same."""
+    so the kernel cuts again by exact signs (`Inconsistent`); the page does the same."""
     p = polytope("dodecahedral prism")
     top = float(np.asarray(p.vertices)[:, 3].max())
     tol = 1e-9 * p.circumradius

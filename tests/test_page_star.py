@@ -148,7 +148,7 @@ def test_scaled_by_powers_of_ten():
 
 def test_the_kernels_paths_are_reached(monkeypatch):
     """The compared cases reach slice_star's every outcome: a cut with no polygon left (H touching
-    at a top vertex: `_touching`'s slice), a cell lying in H cut from the side of the larger volume
+    at a top vertex: `touching`'s slice), a cell lying in H cut from the side of the larger volume
     (and two sides of exactly equal volume, the first kept: 17-tho at c0 = 0, whose points and
     segments are the same from either side), points at equal places along a face's line (ordered
     by how they move: numpy's lexsort).  The page's slices there are the kernel's."""

@@ -26,7 +26,13 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PKG = ROOT / "rot4d_widget"
 #: ``(module path, member)``: a private member of a third-party object the package uses, and why.
-THIRD_PARTY_PRIVATE: dict = {}
+THIRD_PARTY_PRIVATE = {
+    ("keep/pictures/canvas.py", "_set_transform"):
+        "matplotlib's FT2Font has no public way to render a glyph at a sub-pixel origin with the "
+        "slant/extend transform; the glyph cache repeats backend_agg's own text drawing (matplotlib "
+        "3.11), which calls these same two, so that its pixels are matplotlib's",
+    ("keep/pictures/canvas.py", "_render_glyph"): "the same: backend_agg renders each glyph with it",
+}
 #: What a unit may do with the widget it holds as its ``traits``, besides reading and setting traits.
 TRAITS_API = frozenset({"observe", "unobserve", "set_trait", "has_trait", "hold_trait_notifications", "trait_names"})
 

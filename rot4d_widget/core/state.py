@@ -91,7 +91,7 @@ THETA0_MIN = math.pi / 2**20
 ALPHA_MAX = math.pi
 
 
-def _check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
+def check_alpha_beta(alpha: float, theta0: float, what: str) -> None:
     """ValueError unless |alpha| and |beta| = |theta0 - alpha| are within `ALPHA_MAX`."""
     if not (abs(alpha) <= ALPHA_MAX and abs(theta0 - alpha) <= ALPHA_MAX):
         raise ValueError(f"{what} gives alpha = {alpha:.6g}, beta = {theta0 - alpha:.6g}: expected both "
@@ -154,7 +154,7 @@ class RotationState:
         self.keymap = keymap
         self._theta0 = check_theta0(theta0)
         self._alpha = self._theta0 * PAPER_ALPHA_RATIO if alpha is None else real(alpha, "alpha")
-        _check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
+        check_alpha_beta(self._alpha, self._theta0, f"alpha = {self._alpha:.6g}")
         self._c0 = real(c0, "c0")
         self.c0_step = c0_step  # checks that the step can move c0 (`_check_c0_steps`)
         self.c0_limit = c0_limit
@@ -184,7 +184,7 @@ class RotationState:
     def theta0(self, value) -> None:
         value = check_theta0(value)
         alpha = self._alpha * (value / self._theta0)  # keep alpha/theta0
-        _check_alpha_beta(alpha, value, f"theta0 = {value:.6g} (alpha keeps its ratio to theta0)")
+        check_alpha_beta(alpha, value, f"theta0 = {value:.6g} (alpha keeps its ratio to theta0)")
         self._alpha = alpha
         self._theta0 = value
         self._steps.clear()
@@ -196,7 +196,7 @@ class RotationState:
     @alpha.setter
     def alpha(self, value) -> None:
         value = real(value, "alpha")
-        _check_alpha_beta(value, self._theta0, f"alpha = {value:.6g}")
+        check_alpha_beta(value, self._theta0, f"alpha = {value:.6g}")
         self._alpha = value
         self._steps.clear()
 

@@ -20,7 +20,7 @@ from scipy.spatial import ConvexHull
 from ..core import tolerances as tol_
 from .mesh import order_cycle
 from .regular import named
-from .wythoff import Combinatorics, _group, _prism_cell, wythoff
+from .wythoff import Combinatorics, prism_cell_name, reflection_group, wythoff
 
 __all__ = ["polyhedron"]
 
@@ -69,7 +69,7 @@ def _edges_of(faces) -> np.ndarray:
     return np.unique(e, axis=0)
 
 
-def _snub_24_cell() -> Combinatorics:
+def snub_24_cell() -> Combinatorics:
     """The 600-cell without the 24 vertices of an inscribed 24-cell: 96 vertices, 24 icosahedra, 120 tetrahedra."""
     v = named("600-cell").vertices
     # the inscribed 24-cell: the 24 vertices that are permutations of (±1,0,0,0), (±½,±½,±½,±½)
@@ -81,7 +81,7 @@ def _snub_24_cell() -> Combinatorics:
     return _hull_combinatorics(v[~in24], {4: "tetrahedron", 20: "icosahedron"}.get)
 
 
-def _grand_antiprism() -> Combinatorics:
+def grand_antiprism() -> Combinatorics:
     """The 600-cell without two great decagons in completely orthogonal planes: 100 vertices,
     20 pentagonal antiprisms, 300 tetrahedra."""
     v = named("600-cell").vertices
@@ -101,7 +101,7 @@ def _grand_antiprism() -> Combinatorics:
 # ---------------------------------------------------------------------------------------------
 
 #: polyhedron name -> (Dynkin symbol, labels, rings) or ("snub", labels)
-_POLYHEDRA = {
+POLYHEDRA = {
     "tetrahedron": ("x3o3o", (3, 3), (1, 0, 0)),
     "cube": ("x4o3o", (4, 3), (1, 0, 0)),
     "octahedron": ("o4o3x", (4, 3), (0, 0, 1)),
@@ -122,7 +122,7 @@ _POLYHEDRA = {
     "snub dodecahedron": ("s5s3s", (5, 3), None),
 }
 #: adjective of each polyhedron, for the prism's name ("truncated cubic prism")
-_ADJECTIVE = {
+ADJECTIVE = {
     "tetrahedron": "tetrahedral", "cube": "cubic", "octahedron": "octahedral", "dodecahedron": "dodecahedral",
     "icosahedron": "icosahedral", "truncated tetrahedron": "truncated tetrahedral",
     "cuboctahedron": "cuboctahedral", "truncated cube": "truncated cubic",
@@ -140,7 +140,7 @@ def _snub_polyhedron(labels) -> Combinatorics:
     # scipy.optimize (~0.1 s more than scipy.spatial): only the two snub solids solve for a point
     from scipy.optimize import fsolve
 
-    g = _group(tuple(labels))
+    g = reflection_group(tuple(labels))
     r = g.reflections
     rot = [r[0] @ r[1], r[1] @ r[2], r[0] @ r[2]]
 
@@ -158,7 +158,7 @@ def _snub_polyhedron(labels) -> Combinatorics:
 @functools.lru_cache(maxsize=None)
 def polyhedron(name: str) -> Combinatorics:
     """A Platonic or Archimedean solid with edge 2, centred: vertices, edges, faces (cycles)."""
-    _, labels, rings = _POLYHEDRA[name]
+    _, labels, rings = POLYHEDRA[name]
     if rings is None:
         return _snub_polyhedron(labels)
     return wythoff(labels, rings)
@@ -169,7 +169,7 @@ def polyhedron(name: str) -> Combinatorics:
 # ---------------------------------------------------------------------------------------------
 
 
-def _prism(base: Combinatorics, base_name: str) -> Combinatorics:
+def prism(base: Combinatorics, base_name: str) -> Combinatorics:
     """The prism over a polyhedron with edge 2: two copies at w = -1 and w = +1 joined by squares."""
     n = len(base.vertices)
     vertices = np.concatenate([np.c_[base.vertices, -np.ones(n)], np.c_[base.vertices, np.ones(n)]])
@@ -183,7 +183,7 @@ def _prism(base: Combinatorics, base_name: str) -> Combinatorics:
     for k, f in enumerate(bf):
         sq = [2 * nf + edge_index[(min(a, b), max(a, b))] for a, b in zip(f.tolist(), np.roll(f, -1).tolist())]
         cells.append(np.array([k, k + nf] + sq))
-        nm = _prism_cell(len(f))
+        nm = prism_cell_name(len(f))
         if nm not in names:
             names.append(nm)
         types.append(names.index(nm))
@@ -193,7 +193,7 @@ def _prism(base: Combinatorics, base_name: str) -> Combinatorics:
     return Combinatorics(vertices, edges, faces, cells, [fk.index(s) for s in ftypes], types, names)
 
 
-def _antiprism(p: int) -> Combinatorics:
+def antiprism(p: int) -> Combinatorics:
     """The uniform p-gonal antiprism with edge 2, centred (3-D)."""
     R = 1.0 / math.sin(math.pi / p)
     h = 0.5 * math.sqrt(4.0 - (2.0 * R * math.sin(math.pi / (2 * p))) ** 2)
@@ -204,7 +204,7 @@ def _antiprism(p: int) -> Combinatorics:
     return Combinatorics(vertices, _edges_of(faces), faces, [])
 
 
-def _duoprism(p: int, q: int) -> Combinatorics:
+def duoprism(p: int, q: int) -> Combinatorics:
     """The p-q duoprism with edge 2: a regular p-gon times a regular q-gon."""
     Rp, Rq = 1.0 / math.sin(math.pi / p), 1.0 / math.sin(math.pi / q)
     i, j = np.meshgrid(np.arange(p), np.arange(q), indexing="ij")
@@ -221,7 +221,7 @@ def _duoprism(p: int, q: int) -> Combinatorics:
         cells.append(np.array([jj, (jj + 1) % q] + [sq0 + ii * q + jj for ii in range(p)]))
     for ii in range(p):  # the q-gonal prism between q-gons ii and ii+1
         cells.append(np.array([q + ii, q + (ii + 1) % p] + [sq0 + ii * q + jj for jj in range(q)]))
-    names = list(dict.fromkeys([_prism_cell(p), _prism_cell(q)]))
-    types = [names.index(_prism_cell(p))] * q + [names.index(_prism_cell(q))] * p
+    names = list(dict.fromkeys([prism_cell_name(p), prism_cell_name(q)]))
+    types = [names.index(prism_cell_name(p))] * q + [names.index(prism_cell_name(q))] * p
     ftypes = [0] * q + [1 if p != q else 0] * p + [2] * (p * q)
     return Combinatorics(vertices, _edges_of(faces), faces, cells, ftypes, types, names)

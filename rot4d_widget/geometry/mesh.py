@@ -27,7 +27,7 @@ from scipy.spatial import ConvexHull
 
 from ..core import tolerances as tol_
 from ..core._arrays import sealed as _sealed
-from ._ragged import _gather, _owner, _ptr
+from ._ragged import gather_rows, row_offsets, row_owners
 from .meshcheck import MAX_TOLERANCE, MeshError, duplicate_in_rows, index_lists, mesh_geometry
 from .offfile import read_off, write_off
 
@@ -84,7 +84,7 @@ def _all_inside(v, normals, offsets, tol, chunk: int = 256) -> bool:
     return True
 
 
-def _power_of_two_unit(amax: float) -> float:
+def power_of_two_unit(amax: float) -> float:
     """The power of two 2**k with ``1 <= amax / 2**k < 2`` (dividing by it is exact)."""
     return math.ldexp(1.0, math.frexp(amax)[1] - 1)
 
@@ -229,7 +229,7 @@ class Polytope:
         self.vertices = _sealed(v)
         # the vertices divided by a power of two (exactly) so that the largest |coordinate| is in
         # [1, 2): the hull, the mesh checks and the slicer work on these, at any scale
-        self._unit = _power_of_two_unit(amax)
+        self._unit = power_of_two_unit(amax)
         vn = v / self._unit
         self._unit_vertices = _sealed(vn)
         self.circumradius = float(np.sqrt((vn * vn).sum(axis=1)).max()) * self._unit
@@ -267,7 +267,7 @@ class Polytope:
         face_of = np.tile(np.arange(len(ci), dtype=np.intp), 2)
         cell_fidx = face_of[np.lexsort((face_of, both))]
         cell_sizes = np.bincount(both, minlength=len(first))
-        self._set_combinatorics(_ptr(face_sizes), np.concatenate(faces), _ptr(cell_sizes), cell_fidx)
+        self._set_combinatorics(row_offsets(face_sizes), np.concatenate(faces), row_offsets(cell_sizes), cell_fidx)
         self.cell_normals = _sealed(np.ascontiguousarray(normals))
         self.cell_offsets = _sealed(np.ascontiguousarray(offsets) * self._unit)
         self.face_cells = _sealed(np.stack([ci, cj], axis=1).astype(np.intp))  # (F, 2), ascending
@@ -293,17 +293,17 @@ class Polytope:
         bounds = cell_ptr.tolist()
         self.cells = tuple(tuple(cf[a:b]) for a, b in zip(bounds[:-1], bounds[1:]))
         # (cell, face corner) entries: each cell's vertices and edges, with multiplicity
-        idx, row = _gather(face_ptr, cell_fidx)
-        cell_of = _owner(cell_ptr)[row]
+        idx, row = gather_rows(face_ptr, cell_fidx)
+        cell_of = row_owners(cell_ptr)[row]
         vkey = np.unique(cell_of * V + face_vidx[idx])
         ekeys, ecount = np.unique(cell_of * E + face_eidx.reshape(-1)[idx], return_counts=True)
         self._incidence = Incidence(
             face_ptr=_sealed(face_ptr), face_vidx=_sealed(face_vidx.astype(np.intp)),
             face_eidx=_sealed(face_eidx.reshape(-1).astype(np.intp)),
             cell_ptr=_sealed(cell_ptr), cell_fidx=_sealed(cell_fidx.astype(np.intp)),
-            cell_vptr=_sealed(_ptr(np.bincount(vkey // V, minlength=C))),
+            cell_vptr=_sealed(row_offsets(np.bincount(vkey // V, minlength=C))),
             cell_vidx=_sealed((vkey % V).astype(np.intp)),
-            cell_eptr=_sealed(_ptr(np.bincount(ekeys // E, minlength=C))),
+            cell_eptr=_sealed(row_offsets(np.bincount(ekeys // E, minlength=C))),
             cell_eidx=_sealed((ekeys % E).astype(np.intp)),
             cell_ecount=_sealed(ecount.astype(np.intp)))
         self._mask = None
@@ -317,7 +317,7 @@ class Polytope:
         C = len(cell_sizes)
         if F < 10 or C < 5:
             raise ValueError(f"Expected at least 10 faces and 5 cells (a 4-polytope's least), got {F} and {C}")
-        face_ptr, cell_ptr = _ptr(face_sizes), _ptr(cell_sizes)
+        face_ptr, cell_ptr = row_offsets(face_sizes), row_offsets(cell_sizes)
         small = np.flatnonzero(face_sizes < 3)
         if len(small):
             raise MeshError(f"`faces[{small[0]}]` has {face_sizes[small[0]]} vertices; a face needs at least 3",
@@ -337,7 +337,7 @@ class Polytope:
         bad = np.flatnonzero(use != 2)
         if len(bad):
             f = int(bad[0])
-            holders = _owner(cell_ptr)[cell_fidx == f].tolist()
+            holders = row_owners(cell_ptr)[cell_fidx == f].tolist()
             raise MeshError(f"face {f} is in {use[f]} cell(s) {holders}; every face must be in exactly two "
                             f"cells (a closed boundary)", item=("face", f))
         unused = np.flatnonzero(np.bincount(face_vidx, minlength=V) == 0)
@@ -346,7 +346,7 @@ class Polytope:
                             item=("vertex", int(unused[0])))
         self._set_combinatorics(face_ptr, face_vidx, cell_ptr, cell_fidx)
         order = np.argsort(cell_fidx, kind="stable")
-        cell_of = _owner(cell_ptr)
+        cell_of = row_owners(cell_ptr)
         self.face_cells = _sealed(cell_of[order].reshape(F, 2))  # ascending (stable sort of ascending cells)
         normals, offsets, centres, ncomp, tol, star = mesh_geometry(self, validate, tolerance)  # unit scale
         self.cell_normals = _sealed(normals)
@@ -467,7 +467,7 @@ class Polytope:
         """(C, V) bool, read-only: vertex v is in cell c (built on first use)."""
         if self._mask is None:
             mask = np.zeros((len(self.cells), len(self.vertices)), dtype=bool)
-            mask[_owner(self._incidence.cell_vptr), self._incidence.cell_vidx] = True
+            mask[row_owners(self._incidence.cell_vptr), self._incidence.cell_vidx] = True
             self._mask = _sealed(mask)
         return self._mask
 

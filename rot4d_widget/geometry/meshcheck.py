@@ -20,7 +20,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ..core import tolerances as tol_
-from ._ragged import _gather, _owner, _ptr
+from ._ragged import gather_rows, row_offsets, row_owners
 
 __all__ = ["MeshError", "StarData", "index_lists", "duplicate_in_rows", "mesh_geometry"]
 
@@ -76,7 +76,7 @@ def index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.n
         flat = flat.astype(np.intp)
     bad = np.flatnonzero((flat < 0) | (flat >= n_max))
     if len(bad):
-        i = int(np.searchsorted(_ptr(sizes), bad[0], side="right") - 1)
+        i = int(np.searchsorted(row_offsets(sizes), bad[0], side="right") - 1)
         raise MeshError(f"`{what}[{i}]` has {item} index {int(flat[bad[0]])}; expected integers 0 to {n_max - 1}",
                         item=("face" if what == "faces" else "cell", i))
     return sizes, flat
@@ -84,7 +84,7 @@ def index_lists(seq, what: str, item: str, n_max: int) -> tuple[np.ndarray, np.n
 
 def duplicate_in_rows(ptr: np.ndarray, flat: np.ndarray, n: int):
     """First (row, value) that occurs twice in one row of a ragged table, or None."""
-    key = _owner(ptr) * n + flat
+    key = row_owners(ptr) * n + flat
     s = np.sort(key)
     dup = np.flatnonzero(s[1:] == s[:-1])
     if len(dup):
@@ -219,7 +219,7 @@ def mesh_geometry(p, validate: bool, tolerance: float | None = None) -> tuple:
                             item=("cell", int(cs[bad[0]])))
         g[cs] = gc
         n[cs] = normal
-    pc = _owner(cptr)  # the (cell, face) pairs, cell by cell
+    pc = row_owners(cptr)  # the (cell, face) pairs, cell by cell
     pf = cfx
     m = face_c[pf] - g[pc]
     for basis in (n[pc], face_e[pf, 0], face_e[pf, 1]):
@@ -392,7 +392,7 @@ def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_co
     C, E = len(cell_convex), len(p.edges)
     sel = np.flatnonzero(~cell_convex[pc])  # the (cell, face) entries of non-convex cells
     P = len(sel)
-    idx, row = _gather(inc.face_ptr, pf[sel])
+    idx, row = gather_rows(inc.face_ptr, pf[sel])
     nxt = idx + 1
     ends = np.isin(nxt, inc.face_ptr[1:])
     nxt[ends] = inc.face_ptr[:-1][np.searchsorted(inc.face_ptr, idx[ends], side="right") - 1]
@@ -428,7 +428,7 @@ def _orient_cells(p, v, tol, n, g, pc, pf, m, face_e, face_c, face_area, cell_co
     fptr = inc.face_ptr
     size = fptr[fs + 1] - fptr[fs]
     tri_row = np.repeat(np.arange(P), size - 2)
-    first = _ptr(size - 2)
+    first = row_offsets(size - 2)
     kk = np.arange(first[-1]) - first[tri_row] + 1
     base = fptr[fs][tri_row]
     q0, q1, q2 = (v[inc.face_vidx[base + o]] - g[cs][tri_row] for o in (0 * kk, kk, kk + 1))

@@ -12,7 +12,7 @@ name      Schläfli    vertices before scaling
 24-cell   {3,4,3}     permutations of (±1, ±1, 0, 0)
 600-cell  {3,3,5}     permutations of (±1,0,0,0), (±½,±½,±½,±½), even
                       permutations of ½(±φ, ±1, ±1/φ, 0)
-120-cell  {5,3,3}     the 600 points of circumradius √8 (see `_cell120`)
+120-cell  {5,3,3}     the 600 points of circumradius √8 (see `cell120_vertices`)
 ========  ==========  ===================================================
 
 `regular_name` reads a name, alias or Schläfli symbol; `named` builds (once) the polytope of a
@@ -119,7 +119,7 @@ def _cell24() -> np.ndarray:
     return _unique_rows(_orbit((1, 1, 0, 0))) * math.sqrt(2.0)
 
 
-def _cell600() -> np.ndarray:
+def cell600_vertices() -> np.ndarray:
     pts = np.concatenate(
         [
             _orbit((1, 0, 0, 0)),
@@ -130,7 +130,7 @@ def _cell600() -> np.ndarray:
     return _unique_rows(pts) * (2.0 * PHI)  # edge 1/phi -> 2
 
 
-def _cell120() -> np.ndarray:
+def cell120_vertices() -> np.ndarray:
     """The 600 vertices of circumradius sqrt(8): permutations of (0,0,±2,±2),
     (±1,±1,±1,±√5), (±φ⁻²,±φ,±φ,±φ), (±φ⁻¹,±φ⁻¹,±φ⁻¹,±φ²) and even permutations
     of (0,±φ⁻²,±1,±φ²), (0,±φ⁻¹,±φ,±√5), (±φ⁻¹,±1,±φ,±2); edge 2/φ² scaled to 2."""
@@ -155,8 +155,8 @@ _BUILDERS = {
     "8-cell": _cell8,
     "16-cell": _cell16,
     "24-cell": _cell24,
-    "600-cell": _cell600,
-    "120-cell": _cell120,
+    "600-cell": cell600_vertices,
+    "120-cell": cell120_vertices,
 }
 
 

@@ -46,7 +46,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .mesh import Polytope
-from .regular import PHI, _cell120, _cell600
+from .regular import PHI, cell120_vertices, cell600_vertices
 
 __all__ = ["STAR_NAMES", "STAR_FAMILY", "StarSpec", "SPECS", "star_name", "star_arrays", "star_polytope"]
 
@@ -135,7 +135,7 @@ def _unit_vertices(which: str, dual: bool = False) -> np.ndarray:
     """The 600-cell's ("600") or 120-cell's ("120") vertices on the unit sphere (read-only), as in
     `rot4d_widget.geometry.regular`; ``dual``: the directions of the other's cells instead (its
     dual's vertices: the even permutations of regular.py's coordinates made odd by swapping x, y)."""
-    v = _unit(_cell600() if which == "600" else _cell120())
+    v = _unit(cell600_vertices() if which == "600" else cell120_vertices())
     if dual:
         v = np.ascontiguousarray(v[:, [1, 0, 2, 3]])
     v.setflags(write=False)

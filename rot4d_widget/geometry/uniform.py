@@ -50,23 +50,23 @@ import functools
 import re
 
 from .constructions import (
-    _ADJECTIVE,
-    _POLYHEDRA,
-    _antiprism,
-    _duoprism,
-    _grand_antiprism,
-    _prism,
-    _snub_24_cell,
+    ADJECTIVE,
+    POLYHEDRA,
+    antiprism,
+    duoprism,
+    grand_antiprism,
     polyhedron,
+    prism,
+    snub_24_cell,
 )
 from .mesh import Polytope
 from .regular import ALIASES, PHI, POLYTOPE_NAMES, named
-from .wythoff import _POLYGON_WORDS, Combinatorics, _Group, _group, wythoff
+from .wythoff import POLYGON_WORDS, Combinatorics, wythoff
 
 __all__ = ["build", "canonical_name", "polytope_names", "dynkin_symbol", "Combinatorics", "combinatorics"]
 
 #: ``PHI`` (the golden ratio), `wythoff`, `polyhedron`: importable here as before
-_REEXPORTED = (PHI, wythoff, polyhedron, _Group, _group)
+_REEXPORTED = (PHI, wythoff, polyhedron)
 
 MAX_P = 32  #: largest p, q of the duoprisms and antiprismatic prisms
 
@@ -95,7 +95,7 @@ _FAMILY = {"A4": "A4: 5-cell family [3,3,3]", "B4": "B4: tesseract / 16-cell fam
            "F4": "F4: 24-cell family [3,4,3]", "H4": "H4: 120-cell / 600-cell family [5,3,3]"}
 _REGULAR_DYNKIN = {"5-cell": "x3o3o3o", "8-cell": "x4o3o3o", "16-cell": "o4o3o3x", "24-cell": "x3o4o3o",
                    "120-cell": "x5o3o3o", "600-cell": "o5o3o3x"}
-_POLYGON_PREFIX = _POLYGON_WORDS
+_POLYGON_PREFIX = POLYGON_WORDS
 
 
 def _symbol(labels, pattern: str) -> str:
@@ -137,8 +137,8 @@ def _table():
     add("snub 24-cell", fam, "snub24", "s3s4o3o", "o3o4s3s", "snub icositetrachoron")
     add("grand antiprism", fam, "grand", None, "gap", "pentagonal double antiprismoid")
     fam = "prisms over the Platonic and Archimedean solids"
-    for poly, (psym, _, _) in _POLYHEDRA.items():
-        canon = f"{_ADJECTIVE[poly]} prism"
+    for poly, (psym, _, _) in POLYHEDRA.items():
+        canon = f"{ADJECTIVE[poly]} prism"
         if poly == "cube":  # the cubic prism is the tesseract
             for a in (canon, f"{poly} prism", psym + " x"):
                 alias.setdefault(_norm(a), "8-cell")
@@ -261,15 +261,15 @@ def _combinatorics(canon: str) -> Combinatorics:
     if kind == "wythoff":
         return wythoff(e["labels"], e["rings"])
     if kind == "snub24":
-        return _snub_24_cell()
+        return snub_24_cell()
     if kind == "grand":
-        return _grand_antiprism()
+        return grand_antiprism()
     if kind == "prism":
-        return _prism(polyhedron(e["base"]), e["base"])
+        return prism(polyhedron(e["base"]), e["base"])
     if kind == "duoprism":
-        return _duoprism(e["p"], e["q"])
+        return duoprism(e["p"], e["q"])
     if kind == "antiprism":
-        return _prism(_antiprism(e["p"]), f"{_POLYGON_PREFIX.get(e['p'], str(e['p']) + '-gonal')} antiprism")
+        return prism(antiprism(e["p"]), f"{_POLYGON_PREFIX.get(e['p'], str(e['p']) + '-gonal')} antiprism")
     raise AssertionError(kind)
 
 

@@ -1,6 +1,6 @@
 """The Wythoff construction of a linear Coxeter–Dynkin diagram: vertices, edges, 2-faces, cells.
 
-A finite reflection group (its elements as matrices, `_Group`) is enumerated once; the k-faces of
+A finite reflection group (its elements as matrices, `ReflectionGroup`) is enumerated once; the k-faces of
 the polytope of a ring pattern are connected components of its Cayley graph restricted to a few
 generators (see `rot4d_widget.geometry.uniform` for the whole story).  `Combinatorics` holds the
 result before it becomes a `Polytope`; the cells are named by their sub-diagrams.
@@ -40,7 +40,7 @@ def _simple_roots(labels: tuple) -> np.ndarray:
     return np.linalg.cholesky(gram)  # rows a_i with a_i . a_j = gram_ij
 
 
-class _Group:
+class ReflectionGroup:
     """A finite reflection group with a linear diagram: elements and right multiplication.
 
     ``mats`` (N, n, n) the elements as orthogonal matrices (``mats[0]`` the identity);
@@ -115,8 +115,8 @@ class _Group:
 
 
 @functools.lru_cache(maxsize=None)
-def _group(labels: tuple) -> _Group:
-    return _Group(labels)
+def reflection_group(labels: tuple) -> ReflectionGroup:
+    return ReflectionGroup(labels)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -177,7 +177,7 @@ def _split_sealed(rows) -> tuple:
 # ---------------------------------------------------------------------------------------------
 
 
-def _components_ok(group: _Group, K, rings) -> bool:
+def _components_ok(group: ReflectionGroup, K, rings) -> bool:
     """Wythoff's rule: every connected part of the sub-diagram K holds a ringed node."""
     K = sorted(K)
     parts, cur = [], [K[0]]
@@ -191,7 +191,7 @@ def _components_ok(group: _Group, K, rings) -> bool:
     return all(any(rings[i] for i in part) for part in parts)
 
 
-def _stabiliser(group: _Group, K, rings) -> list:
+def _stabiliser(group: ReflectionGroup, K, rings) -> list:
     """K plus the unringed nodes joined to no node of K (they fix the face g W_K v0 pointwise)."""
     K = set(K)
     extra = [u for u in range(group.n) if u not in K and not rings[u]
@@ -205,7 +205,7 @@ def wythoff(labels, rings) -> Combinatorics:
     ``labels`` the branch labels (e.g. ``(5, 3, 3)``), ``rings`` one bool per node.
     """
     labels, rings = tuple(labels), tuple(bool(r) for r in rings)
-    g = _group(labels)
+    g = reflection_group(labels)
     n = g.n
     if len(rings) != n or not any(rings):
         raise ValueError(f"Expected {n} ring flags with at least one ringed, got {rings}")
@@ -266,8 +266,8 @@ def wythoff(labels, rings) -> Combinatorics:
 # Names of the cells (sub-diagrams)
 # ---------------------------------------------------------------------------------------------
 
-_POLYGON_WORDS = {3: "triangular", 4: "square", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal",
-                  8: "octagonal", 9: "enneagonal", 10: "decagonal", 11: "hendecagonal", 12: "dodecagonal"}
+POLYGON_WORDS = {3: "triangular", 4: "square", 5: "pentagonal", 6: "hexagonal", 7: "heptagonal",
+                 8: "octagonal", 9: "enneagonal", 10: "decagonal", 11: "hendecagonal", 12: "dodecagonal"}
 
 _POLYHEDRON_OF = {  # (labels, rings) of a 3-node linear diagram -> name
     ((3, 3), (1, 0, 0)): "tetrahedron", ((3, 3), (0, 0, 1)): "tetrahedron",
@@ -284,9 +284,9 @@ _POLYHEDRON_OF = {  # (labels, rings) of a 3-node linear diagram -> name
 }
 
 
-def _prism_cell(m: int) -> str:
+def prism_cell_name(m: int) -> str:
     """The name of the uniform m-gonal prism (the 4-gonal one is the cube)."""
-    return "cube" if m == 4 else f"{_POLYGON_WORDS.get(m, f'{m}-gonal')} prism"
+    return "cube" if m == 4 else f"{POLYGON_WORDS.get(m, f'{m}-gonal')} prism"
 
 
 def _cell_name(labels, rings, K) -> str:
@@ -303,4 +303,4 @@ def _cell_name(labels, rings, K) -> str:
     pair = [k for k in K if any(abs(k - o) == 1 for o in K if o != k)]
     m = labels[min(pair)]
     both = all(rings[k] for k in pair)
-    return _prism_cell(2 * m if both else m)
+    return prism_cell_name(2 * m if both else m)

@@ -31,8 +31,8 @@ from .recorder import (
     Recorder,
     Recording,
     SourceSetting,
-    _apply,
-    _with_source_setting,
+    apply_event,
+    with_source_setting,
 )
 
 ANIMATION_FORMATS = (".gif", ".mp4")
@@ -78,12 +78,12 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
     def set_source(name, value):  # the copy is ours: replace it where the widget would
         nonlocal src
         note_matrix(src, state.matrix)  # as the widget tells its source: a default spacing along today's w
-        src = _with_source_setting(src, name, value)
+        src = with_source_setting(src, name, value)
         note_matrix(src, state.matrix)
 
     setter = None if src is None else set_source
     if src is not None:
-        for e in recording._start_settings():
+        for e in recording.start_settings():
             set_source(e.name, e.value)
     view = recording.initial_view
     set_view = view.__setitem__
@@ -91,7 +91,7 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
     yield 0.0, state, src, view
     if per == "step":
         for e in events:
-            _apply(state, e, src, setter, set_view)
+            apply_event(state, e, src, setter, set_view)
             yield e.t, state, src, view
         return
     n = _frame_count(recording, "time", fps)
@@ -99,7 +99,7 @@ def _steps(recording: Recording, initial_state=None, source=None, *, per: str = 
     for k in range(1, n):
         t = k / fps
         while i < len(events) and events[i].t <= t + 1e-9:
-            _apply(state, events[i], src, setter, set_view)
+            apply_event(state, events[i], src, setter, set_view)
             i += 1
         yield t, state, src, view
 
@@ -169,13 +169,13 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
             max_frames: int = 3000, titles=None, frame="fit", annotate=True, **settings) -> Iterator[np.ndarray]:
     """`render_frames`' frames as they are drawn: (H, W, 4) uint8 RGBA views of one reused canvas
     (valid until the next frame is asked for), or (H, W, 3) RGB arrays when `state_picture.render_state`
-    hands back a figure of its own.  Every frame is drawn into ONE figure (`canvas._FrameCanvas`):
+    hands back a figure of its own.  Every frame is drawn into ONE figure (`canvas.FrameCanvas`):
     its artists replaced, the annotation's text and legend kept and updated."""
     # the pictures import matplotlib: imported when a frame is drawn, not with the recordings.
-    # render_state and _prepare are looked up on their module at each call, so that replacing
+    # render_state and prepare_render are looked up on their module at each call, so that replacing
     # `state_picture.render_state` (a test) reaches every frame
     from .pictures import state_picture
-    from .pictures.canvas import _FrameCanvas
+    from .pictures.canvas import FrameCanvas
     from .pictures.framing import union_extent
     from .pictures.state_picture import state_source
 
@@ -193,11 +193,11 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
     takes = inspect.signature(state_picture.render_state).parameters  # a recorded `sections` only where taken
     prep = {k: settings[k] for k in _PREPARE_KEYS if k in settings}
     cache: list = []
-    canvas = _FrameCanvas()  # one figure for every frame
+    canvas = FrameCanvas()  # one figure for every frame
     if isinstance(frame, str) and frame == "fit":  # pass 1: every frame's slice and box
         boxes, kept = [], 0
         for _t, state, src, view in _steps(recording, initial_state, source, per=per, fps=fps):
-            _, data, _, box = state_picture._prepare(state, src if src is not None else "5-cell", **prep,
+            _, data, _, box = state_picture.prepare_render(state, src if src is not None else "5-cell", **prep,
                                                rendering={**start_view, **view}.get("rendering", "surface"),
                                                eye=settings.get("eye"))
             boxes.append(box)
@@ -211,7 +211,7 @@ def _frames(recording: Recording, initial_state=None, source="5-cell", *, per: s
         drawn = src if src is not None else "5-cell"
         extra = {}
         if k < len(cache) and cache[k] is not None:
-            extra["_prepared"] = state_picture._prepare(state, drawn, data=cache[k], **prep,
+            extra["_prepared"] = state_picture.prepare_render(state, drawn, data=cache[k], **prep,
                                                   rendering={**start_view, **view}.get("rendering", "surface"),
                                                   eye=settings.get("eye"))
             cache[k] = None  # drawn once: let it go

@@ -20,7 +20,7 @@ import numpy as np
 from ..geometry.catalogue import polytope
 from ..geometry.mesh import Polytope
 from ..sources.field.checks import UnitsWarning
-from ..sources.field.inputs import _selection_from_json
+from ..sources.field.inputs import selection_from_json
 from ..sources.protocol import PolytopeSource
 from ..sources.tomography import StackSource
 
@@ -80,7 +80,7 @@ def module_now(module: str) -> str:
     return module
 
 
-class _CannotRebuild(ValueError):
+class CannotRebuild(ValueError):
     """`rebuild_source`: the description is fine, the source just cannot be made from it."""
 
 # ============================================================================ sources
@@ -105,7 +105,7 @@ def describe_source(source) -> dict:
         kind = d.get("kind", type(source).__name__)
         d["rebuild"] = (True if kind in _KNOWN_KINDS
                         else f"a source of kind {kind!r} cannot be rebuilt from its description")
-    return _jsonable(d, "source.describe()")
+    return jsonable(d, "source.describe()")
 
 
 #: The kinds of description `rebuild_source` can make a source from.
@@ -144,11 +144,11 @@ def rebuild_source(description: Mapping, *, allow_code: bool = False, function=N
                            arrangement=description.get("arrangement", "oval"),
                            color_by=description.get("color_by", "w"))
     if why is not True:
-        raise _CannotRebuild(f"The state file's source cannot be rebuilt: {why}. "
+        raise CannotRebuild(f"The state file's source cannot be rebuilt: {why}. "
                          "Pass it in: load_state(path, source=...)")
     if kind == "field":
         return _rebuild_field(description, allow_code, function, base)
-    raise _CannotRebuild(f"Unknown source kind {kind!r}; pass the source in: load_state(path, source=...)")
+    raise CannotRebuild(f"Unknown source kind {kind!r}; pass the source in: load_state(path, source=...)")
 
 
 #: The `Field4D.from_xarray` keywords an origin's ``"kwargs"`` may carry (files written by
@@ -159,7 +159,7 @@ _ORIGIN_KWARGS = ("x", "y", "z", "w", "w_per_unit", "name", "units", "w_units", 
 
 def _origin_path(origin, base):
     """The data file an origin names: its ``"relative_path"`` beside the state file (``base``, the
-    state file's folder) when that exists, else its absolute ``"path"``; `_CannotRebuild` naming
+    state file's folder) when that exists, else its absolute ``"path"``; `CannotRebuild` naming
     both when neither exists."""
     path = origin.get("path")
     rel = origin.get("relative_path")
@@ -178,8 +178,8 @@ def _origin_path(origin, base):
         if os.path.exists(path):
             return path
         tried.append(path)
-    raise _CannotRebuild(f"the field's data are not found at {' or '.join(map(repr, tried))}; put the file "
-                         "back, or open it and pass it in: load_state(path, source=Field4D.open(...))")
+    raise CannotRebuild(f"the field's data are not found at {' or '.join(map(repr, tried))}; put the file "
+                        "back, or open it and pass it in: load_state(path, source=Field4D.open(...))")
 
 
 def _open_origin(origin, base):
@@ -209,12 +209,12 @@ def _open_origin(origin, base):
             warnings.simplefilter("ignore", category=RuntimeWarning)  # zarr: no consolidated metadata
             warnings.simplefilter("ignore", category=UnitsWarning)  # said when the field was first made
             field = Field4D.open(path, variable, engine=engine, chunks=chunks,
-                                 isel=_selection_from_json(origin.get("isel"), "isel"),
-                                 sel=_selection_from_json(origin.get("sel"), "sel"),
+                                 isel=selection_from_json(origin.get("isel"), "isel"),
+                                 sel=selection_from_json(origin.get("sel"), "sel"),
                                  load=bool(origin.get("load", False)), **kwargs)
     except (OSError, KeyError, IndexError) as exc:
-        raise _CannotRebuild(f"the field's data at {path!r} cannot be opened as saved ({type(exc).__name__}: "
-                             f"{exc}); open it and pass it in: load_state(path, source=...)") from None
+        raise CannotRebuild(f"the field's data at {path!r} cannot be opened as saved ({type(exc).__name__}: "
+                            f"{exc}); open it and pass it in: load_state(path, source=...)") from None
     return field
 
 
@@ -253,7 +253,7 @@ def _rebuild_field(d, allow_code=False, function=None, base=None):
             for part in qual.split("."):
                 obj = getattr(obj, part)
         except (ImportError, AttributeError, ValueError) as exc:
-            raise _CannotRebuild(f"The field's function {spec!r} cannot be imported ({exc}); "
+            raise CannotRebuild(f"The field's function {spec!r} cannot be imported ({exc}); "
                              "pass the source in: load_state(path, source=...)") from None
         field = Field4D.from_function(obj, d["extent"], **common)
     for attr in ("resolution", "coarse_resolution", "chunk_cache_bytes"):
@@ -268,7 +268,7 @@ def _rebuild_field(d, allow_code=False, function=None, base=None):
 
 
 def _same_data(field, d) -> None:
-    """`_CannotRebuild` when a reopened file no longer holds what was saved: another shape, axis
+    """`CannotRebuild` when a reopened file no longer holds what was saved: another shape, axis
     order or extent (the file was rewritten, or the saved field was a selection xarray's
     encoding did not show)."""
     got = {"shape": [int(n) for n in field.values.shape], "axes": field.axes,
@@ -282,9 +282,9 @@ def _same_data(field, d) -> None:
         else:
             same = want == value
         if not same:
-            raise _CannotRebuild(f"the file {field.origin.get('path')!r} no longer holds the saved field: its "
-                                 f"{key} is {value}, the state file's {want}; open the data as they were and pass "
-                                 "them in: load_state(path, source=...)")
+            raise CannotRebuild(f"the file {field.origin.get('path')!r} no longer holds the saved field: its "
+                                f"{key} is {value}, the state file's {want}; open the data as they were and pass "
+                                "them in: load_state(path, source=...)")
 
 
 def open_field(path, variable=None, *, engine=None, **kwargs):
@@ -302,14 +302,14 @@ def open_field(path, variable=None, *, engine=None, **kwargs):
     return Field4D.open(path, variable, engine=engine, **kwargs)
 
 
-def _made_by_function(d) -> bool:
+def made_by_function(d) -> bool:
     """Whether a source description is (a stack of) a field made by a function."""
     while isinstance(d, Mapping) and d.get("kind") == "stack":
         d = d.get("source")
     return isinstance(d, Mapping) and d.get("kind") == "field" and "origin" not in d and bool(d.get("function"))
 
 
-def _described_w_frame(desc):
+def described_w_frame(desc):
     """``(origin, per_unit)`` of c0 for the source a state file describes (`describe_source`): a
     field's (w at its box's centre, ``w_per_unit``), also inside stacks; None for any other (a
     polytope's c0 is its own w) or a description without them."""
@@ -328,14 +328,14 @@ def _described_w_frame(desc):
     return (lo + hi) / 2, per
 
 
-def _inner_identity(d):
+def inner_identity(d):
     while d.get("kind") == "stack":
         d = d.get("source", {})
     return d.get("kind"), d.get("name") if d.get("kind") == "polytope" else None
 
 
 # ============================================================================ state files
-def _jsonable(value, where: str):
+def jsonable(value, where: str):
     """``value`` with tuples as lists and numpy scalars/arrays as Python numbers/lists; TypeError
     naming ``where`` for anything JSON cannot hold (NaN and infinities included)."""
     if isinstance(value, Mapping):
@@ -343,12 +343,12 @@ def _jsonable(value, where: str):
         for k, v in value.items():
             if not isinstance(k, str):
                 raise TypeError(f"Expected string keys in {where}, got {k!r}")
-            out[k] = _jsonable(v, f"{where}[{k!r}]")
+            out[k] = jsonable(v, f"{where}[{k!r}]")
         return out
     if isinstance(value, (list, tuple)):
-        return [_jsonable(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return [jsonable(v, f"{where}[{i}]") for i, v in enumerate(value)]
     if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist(), where)
+        return jsonable(value.tolist(), where)
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     if isinstance(value, (int, np.integer)):

@@ -56,7 +56,7 @@ from ..sources.arrangements import ARRANGEMENTS
 from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of, w_frame
 from ..sources.tomography import StackSource
 from .jsonfile import read_json
-from .rebuild import _jsonable
+from .rebuild import jsonable
 
 RECORDING_FORMAT = "rot4d_widget recording"
 #: Version 2 adds `SourceSetting` events, version 3 `ViewSetting` events and ``initial_view``; a
@@ -206,7 +206,7 @@ def _check_source_setting(name, value):
     _check_setting_name(name)
     if name not in SOURCE_SETTINGS:
         try:
-            return _jsonable(value, f"the source setting {name!r}")
+            return jsonable(value, f"the source setting {name!r}")
         except TypeError as exc:
             raise ValueError(f"Expected a source setting's value to be JSON (numbers, strings, lists, dicts): "
                              f"{exc}") from None
@@ -312,7 +312,7 @@ def _set_on_source(source, name: str, value) -> None:
     apply_setting(source, name, value)
 
 
-def _with_source_setting(source, name: str, value):
+def with_source_setting(source, name: str, value):
     """``source`` with a source setting applied: in place, or (``slices`` of a single view) a new
     `StackSource` around it, as the widget does."""
     if name == "slices" and not _is_stack(source) and name not in settings_of(source):
@@ -321,7 +321,7 @@ def _with_source_setting(source, name: str, value):
     return source
 
 
-def _apply(state: RotationState, event, source=None, set_source=None, set_view=None) -> bool:
+def apply_event(state: RotationState, event, source=None, set_source=None, set_view=None) -> bool:
     """Apply one event to ``state`` (a source's own action and a source setting to ``source``, or
     a source setting through ``set_source(name, value)``; a view setting through
     ``set_view(name, value)``); True if applied."""
@@ -522,14 +522,15 @@ class Recording:
             d.pop("keymap", None)
             state.restore(d)  # with the recorded reset point ("initial")
         if restart:
-            for e in self._start_settings() + self._start_view():
-                _apply(state, e, source, set_source, set_view)
+            for e in self.start_settings() + self._start_view():
+                apply_event(state, e, source, set_source, set_view)
         for e in self.events:
-            _apply(state, e, source, set_source, set_view)
+            apply_event(state, e, source, set_source, set_view)
         return state
 
-    def _start_settings(self) -> list:
-        """`initial_source` as `SourceSetting` events at t = 0."""
+    def start_settings(self) -> list:
+        """`initial_source` as `SourceSetting` events at t = 0: what replaying from the start sets
+        on the source first (`replay`, and an animation's frames)."""
         return [SourceSetting(0.0, name, value) for name, value in self.initial_source.items()]
 
     def _start_view(self) -> list:
@@ -624,7 +625,7 @@ class Recorder:
                 elif isinstance(old, ViewSetting):  # folded into the starting view settings
                     self._shadow_view[old.name] = old.value
                 else:
-                    _apply(self._shadow, old)
+                    apply_event(self._shadow, old)
                 self.dropped += 1
 
     def record(self, key, shift, action, inverted: bool | None = None, t=None) -> Step:

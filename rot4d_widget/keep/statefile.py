@@ -41,14 +41,14 @@ from ..core.version import __version__
 from ..sources.protocol import as_source
 from .jsonfile import read_json
 from .rebuild import (
+    CannotRebuild,
     CodeNotAllowed,
     SourceNotRebuildable,
-    _CannotRebuild,
-    _described_w_frame,
-    _inner_identity,
-    _jsonable,
-    _made_by_function,
     describe_source,
+    described_w_frame,
+    inner_identity,
+    jsonable,
+    made_by_function,
     rebuild_source,
 )
 from .recorder import VIEW_SETTINGS, check_view_setting
@@ -75,7 +75,7 @@ def settings_of(widget) -> dict:
     src = getattr(widget, "source", None)
     if out.get("spacing") is not None and getattr(src, "spacing_is_default", False):
         out["spacing"] = None
-    return _jsonable(out, "settings")
+    return jsonable(out, "settings")
 
 
 class LoadedState(NamedTuple):
@@ -119,7 +119,7 @@ def save_state(path, state: RotationState, source=None, settings: Mapping | None
         "version": _version_needed(src),
         "state": state.to_dict(),
         "source": src,
-        "settings": _jsonable(settings, "settings"),
+        "settings": jsonable(settings, "settings"),
     }
 
     doc["rot4d_widget"] = __version__
@@ -236,7 +236,7 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     missing = [k for k in ("state", "source", "settings") if k not in doc]
     if missing:
         raise ValueError(f"{path!r} lacks {', '.join(map(repr, missing))}")
-    frame = _described_w_frame(doc.get("source"))
+    frame = described_w_frame(doc.get("source"))
     try:  # a state from before c0 followed the data's units: converted by the file's own source
         state = RotationState.from_dict(doc["state"], w_frame=frame)
     except (TypeError, ValueError) as exc:
@@ -257,15 +257,15 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
     if source is not None:
         source = as_source(source)
         if desc is not None:
-            want, got = _inner_identity(desc), _inner_identity(describe_source(source))
+            want, got = inner_identity(desc), inner_identity(describe_source(source))
             if want != got:
                 raise ValueError(f"{path!r} was saved with a source of kind {want[0]!r}"
                                  f"{'' if want[1] is None else f' ({want[1]})'}, got {got[0]!r}"
                                  f"{'' if got[1] is None else f' ({got[1]})'}")
         return LoadedState(state, source, settings)
-    if function is not None and not _made_by_function(desc):
+    if function is not None and not made_by_function(desc):
         raise ValueError(f"{path!r}: `function` rebuilds a field the file describes by a function's name; "
-                         f"its source is {_inner_identity(desc or {})[0]!r}")
+                         f"its source is {inner_identity(desc or {})[0]!r}")
     if desc is None:
         return LoadedState(state, None, settings)
     try:
@@ -273,7 +273,7 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
                                  base=os.path.dirname(os.path.abspath(path)))
     except CodeNotAllowed as exc:
         raise CodeNotAllowed(f"{path!r}: {exc}") from None
-    except _CannotRebuild as exc:
+    except CannotRebuild as exc:
         warnings.warn(str(exc), SourceNotRebuildable, stacklevel=2)
         rebuilt = None
     except (TypeError, ValueError, KeyError) as exc:

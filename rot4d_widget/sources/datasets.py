@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 from scipy.ndimage import gaussian_filter
 
-from .field.checks import _real
+from .field.checks import real_number
 from .field.container import Field4D
 
 __all__ = ["phase_separation", "moving_sphere", "default_cache_dir", "phase_separation_key", "INSTALL_HINT"]
@@ -65,7 +65,7 @@ def _int(value, name: str, lo: int, hi: int) -> int:
     return v
 
 
-_float = _real  # a finite real number, or a TypeError/ValueError naming it
+_float = real_number  # a finite real number, or a TypeError/ValueError naming it
 
 
 def _params(n, steps, t_end, interface, bias, seed) -> dict:

@@ -426,7 +426,7 @@ _POLYGON_NAMES = {
 }
 
 
-def _winding_row(polytope) -> tuple:
+def winding_row(polytope) -> tuple:
     """Readout rows for a self-intersecting polytope (`Polytope.self_intersecting`): what its
     volume means there; for one with no inside (`Polytope.volume_defined` False: hemi cells, or
     not orientable) that it has none, and why (`no_volume_row`)."""
@@ -492,7 +492,7 @@ class PolytopeSlice(SliceData):
         return f"PolytopeSlice({self.slice!r})"
 
 
-def _fill_flags(s):
+def fill_flags(s):
     """(n,) bool, read-only, True at a `Slice`'s last ``n_fill`` vertices (fill corners), or None."""
     n_fill = int(getattr(s, "n_fill", 0))
     if not n_fill:
@@ -540,10 +540,10 @@ class PolytopeSource:
             groups=s.triangle_cells,
             normals=None,
             volume=_volume_or_none(s),
-            readout=(("slice", census_text(s)),) + _winding_row(self.polytope),
+            readout=(("slice", census_text(s)),) + winding_row(self.polytope),
             convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
             extra={"slice": s},
-            corner_only=_fill_flags(s),
+            corner_only=fill_flags(s),
         )
 
     def describe(self) -> dict:

@@ -44,17 +44,17 @@ from .protocol import (
     PolytopeSource,
     SliceData,
     SourceAction,
-    _fill_flags,
-    _winding_row,
     apply_setting,
     as_source,
     census_text,
     data_w_text,
+    fill_flags,
     no_volume_row,
     settings_of,
     takes_coarse,
     w_frame,
     w_value_text,
+    winding_row,
 )
 
 __all__ = [
@@ -544,7 +544,7 @@ class _PolytopePiece:
     def __init__(self, s, polytope):
         self.slice = s
         self.convex = bool(polytope.convex)  # a convex polytope's slice is convex; a non-convex one's may not be
-        self.rows = _winding_row(polytope)  # self-intersecting; no volume, and why (hemi, not orientable)
+        self.rows = winding_row(polytope)  # self-intersecting; no volume, and why (hemi, not orientable)
 
     points = property(lambda self: self.slice.vertices)
     segments = property(lambda self: self.slice.edges)
@@ -554,7 +554,7 @@ class _PolytopePiece:
     volume = property(lambda self: None if self.slice.volume is None else float(self.slice.volume))
     readout = property(lambda self: (("slice", census_text(self.slice)),) + self.rows)
     show_points = True
-    corner_only = property(lambda self: _fill_flags(self.slice))  # as `PolytopeSource.slice` flags them
+    corner_only = property(lambda self: fill_flags(self.slice))  # as `PolytopeSource.slice` flags them
     data = property(lambda self: self.slice)
 
 

@@ -46,7 +46,7 @@ import uuid
 import numpy as np
 
 from ..sources.field.container import Field4D
-from ..sources.field.slicing import _box_polytope
+from ..sources.field.slicing import box_polytope
 from ..sources.protocol import inner_source
 from .fieldview import copy_clim
 from .pagecut import polytope_transfer
@@ -222,7 +222,7 @@ class PageField:
         hw = tuple(float(h) for h in field.half_widths)
         if self._box is None or self._box[0] != hw:
             key = uuid.uuid4().hex
-            transfers.offer("field_box", key, *polytope_transfer(_box_polytope(hw)))
+            transfers.offer("field_box", key, *polytope_transfer(box_polytope(hw)))
             self._box = (hw, key)
         if self._offered is not None and self._offered[2] is field:
             return

@@ -56,7 +56,7 @@ from ipyevents import Event
 
 from ..core import colours, renderings, sizes
 from ..core.keymap import DEFAULT_KEYMAP, Keymap
-from ..core.state import DEFAULT_THETA0, RotationState, _check_alpha_beta
+from ..core.state import DEFAULT_THETA0, RotationState, check_alpha_beta
 from ..sources.arrangements import ARRANGEMENTS
 from ..sources.protocol import as_source, inner_source, takes_coarse, w_frame
 from . import markup
@@ -581,14 +581,14 @@ class Rot4DWidget(widgets.HBox):
         value = proposal["value"]  # an angle in (0, pi] (`traits.Angle`)
         if not self._sync.syncing:  # alpha keeps its ratio: refused here, before the trait changes
             st = self.state
-            _check_alpha_beta(st.alpha * (value / st.theta0), value, f"theta0 = {value:.6g} (alpha keeps its ratio)")
+            check_alpha_beta(st.alpha * (value / st.theta0), value, f"theta0 = {value:.6g} (alpha keeps its ratio)")
         return value
 
     @traitlets.validate("alpha")
     def _valid_alpha(self, proposal):
         value = proposal["value"]  # finite (`traits.Finite`)
         if not self._sync.syncing:
-            _check_alpha_beta(value, self.state.theta0, f"alpha = {value:.6g}")
+            check_alpha_beta(value, self.state.theta0, f"alpha = {value:.6g}")
         return value
 
     def _place_projection(self, box, on: bool) -> None:

@@ -39,8 +39,8 @@ import functools
 
 import numpy as np
 
-from .._ragged import _ptr
-from .tables import _inplane_axes
+from .._ragged import row_offsets
+from .tables import inplane_axes
 
 __all__: list = []
 
@@ -49,7 +49,7 @@ _EPS = 1e-9  # a crossing this close (in segment parameter) to a segment's end: 
 
 
 @functools.lru_cache(maxsize=64)
-def _upper(n: int) -> tuple:
+def upper_pairs(n: int) -> tuple:
     """``np.triu_indices(n, 1)``, read-only and kept (it costs more than the table it indexes)."""
     iu, ju = np.triu_indices(n, 1)
     iu.flags.writeable = False
@@ -61,10 +61,10 @@ def _pairs(rcell, n_cells):
     """Every pair of records of one cell: ((k,) i, (k,) j), i before j in the cell's row of a padded table."""
     o = np.argsort(rcell.astype(np.uint16) if n_cells < 65536 else rcell, kind="stable")
     cnt = np.bincount(rcell, minlength=n_cells)
-    start = _ptr(cnt)[:-1]
+    start = row_offsets(cnt)[:-1]
     table = np.full((n_cells, int(cnt.max(initial=0))), -1, dtype=np.intp)
     table[rcell[o], np.arange(len(o)) - start[rcell[o]]] = o
-    iu, ju = _upper(table.shape[1])
+    iu, ju = upper_pairs(table.shape[1])
     i, j = table[:, iu].ravel(), table[:, ju].ravel()
     ok = j >= 0  # (a row's entries are packed to the left)
     return i[ok], j[ok]
@@ -81,14 +81,14 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
 
     Returns ((k, 3) triangles, (k,) their cells, (x, 3) new corners numbered from ``n_vertices``,
     (r,) bool: the records whose cell was not filled here, ((m,) cells, (m,) heights v): where
-    those cells' segments cross, in `star._slabs`' frame (`_inplane_axes` about ``anchor``)).
+    those cells' segments cross, in `star._slabs`' frame (`inplane_axes` about ``anchor``)).
     """
     nr = len(rec)
     C = len(normals)
     loc = np.full(len(partner) // 2, -1, dtype=np.intp)
     loc[rec] = np.arange(nr)
     p0, p1 = end_pt[2 * rec], end_pt[2 * rec + 1]
-    uv = _inplane_axes(normals)[rcell]
+    uv = inplane_axes(normals)[rcell]
     rel0 = pts[p0] - anchor[rcell]
     rel1 = pts[p1] - anchor[rcell]
     X0 = rel0[:, 0] * uv[:, 0] + rel0[:, 1] * uv[:, 1] + rel0[:, 2] * uv[:, 2]
@@ -141,8 +141,8 @@ def arrangement_fill(rec, rcell, end_pt, partner, pts, vid, normals, anchor, n_v
     other[pos[:X]] = pos[X:]
     other[pos[X:]] = pos[:X]
     k = np.bincount(occ_rec, minlength=nr)
-    optr = _ptr(k)
-    base = _ptr(k + 1)  # record r's pieces base[r] .. base[r] + k[r]
+    optr = row_offsets(k)
+    base = row_offsets(k + 1)  # record r's pieces base[r] .. base[r] + k[r]
     n_sub = int(base[-1])
     sub_rec = np.repeat(np.arange(nr), k + 1)
     sub_t = np.arange(n_sub) - base[sub_rec]

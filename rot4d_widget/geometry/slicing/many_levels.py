@@ -14,7 +14,7 @@ import numpy as np
 
 from ...core._arrays import sealed as _sealed
 from .single_level import slice_level
-from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from .tables import Inconsistent, Slice, SliceTables, fan, inplane_axes, scaled, scaled_volume
 
 __all__: list = []
 
@@ -27,7 +27,7 @@ class _NoCrossing(Exception):
         self.levels = levels
 
 
-def _slice_many(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, radius: float) -> tuple:
+def slice_many(t: SliceTables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, radius: float) -> tuple:
     """Every level of ``levels`` in one pass; see `slice_polytope`."""
     L = len(levels)
     out = [None] * L
@@ -46,7 +46,7 @@ def _slice_many(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, ra
         try:
             for i, s in zip(gi, _slice_generic(t, x, m, levels[gi], h[gi], pos[gi])):
                 out[i] = s
-        except _Inconsistent:
+        except Inconsistent:
             for i in gi:
                 out[i] = slice_level(t, x, m, float(levels[i]), radius)
         except _NoCrossing as exc:  # pieces on both sides, none crossing: single path for those
@@ -66,7 +66,7 @@ def _nonzero2(a: np.ndarray) -> tuple:
     return row, k - row * a.shape[1]
 
 
-def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, h: np.ndarray,
+def _slice_generic(t: SliceTables, x: np.ndarray, m: np.ndarray, levels: np.ndarray, h: np.ndarray,
                    pos: np.ndarray) -> list:
     """Slices of G levels whose vertices are all strictly above or below H, some on each side.
 
@@ -110,7 +110,7 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     hit = np.take(flat_cross, fe + (lf * stride)[:, None])
     rr, kk = _nonzero2(hit)
     if len(rr) != 2 * len(fc) or (rr[0::2] != rr[1::2]).any():
-        raise _Inconsistent
+        raise Inconsistent
     seg = edge_sv[lf[rr], fe[rr, kk]]
     seg -= voff[lf[rr]]
     edges = _sealed(seg).reshape(-1, 2)
@@ -140,7 +140,7 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     cz = np.bincount(rank, weights=pz) / counts
     # in-plane axes u, v of every cell's outward normal restricted to H (`_slice`'s formulas),
     # computed once per cell for all levels
-    uv = _inplane_axes(t.cell_normals @ m[:3].T)
+    uv = inplane_axes(t.cell_normals @ m[:3].T)
     uvr = np.take(uv, cell_of, axis=0)
     # d . u and d . v with `_slice`'s very expressions (the same rounding, so a corner on the
     # branch cut of the angle lands on the same side of it)
@@ -168,7 +168,7 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     np.cumsum(counts, out=offsets[1:])
 
     prank = rank[order]
-    triangles, poly_of = _fan(flat, prank, offsets, counts)
+    triangles, poly_of = fan(flat, prank, offsets, counts)
     t_level = p_level[poly_of]
     triangle_cells = _sealed(cell_ids[poly_of])
 
@@ -195,8 +195,8 @@ def _slice_generic(t: _Tables, x: np.ndarray, m: np.ndarray, levels: np.ndarray,
     toff = np.zeros(G + 1, dtype=np.intp)
     np.cumsum(np.bincount(t_level, minlength=G), out=toff[1:])
     if t.unit != 1.0:
-        vertices = _sealed(_scaled(t, vertices))
-        volumes = _scaled_volume(t, volumes)
+        vertices = _sealed(scaled(t, vertices))
+        volumes = scaled_volume(t, volumes)
     out = []
     new = object.__new__
     for g in range(G):

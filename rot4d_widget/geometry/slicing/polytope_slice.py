@@ -101,7 +101,7 @@ from ...core import tolerances as tol_
 from ...core.rotation import as_rotation_matrix
 from ...core.validate import is_real
 from ..catalogue import polytope as _get_polytope
-from .many_levels import _slice_many
+from .many_levels import slice_many
 from .single_level import slice_level as _slice_level
 from .star import slice_star
 from .tables import tables as _tables
@@ -143,7 +143,7 @@ def slice_polytope(polytope, matrix, c0=0.0):
         return out if many else out[0]
     if not many:
         return _slice_level(t, x, m, float(levels[0]), t.radius)
-    return _slice_many(t, x, m, levels, t.radius)
+    return slice_many(t, x, m, levels, t.radius)
 
 
 _LEVELS = "a real number or a 1-D array of levels"

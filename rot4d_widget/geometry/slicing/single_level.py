@@ -10,28 +10,28 @@ from __future__ import annotations
 import numpy as np
 
 from ...core import tolerances as tol_
-from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from .tables import Inconsistent, Slice, SliceTables, fan, inplane_axes, scaled, scaled_volume
 
 __all__: list = []
 
 _TWO_PI_PLUS = 8.0  # > 2*pi: spacing of per-polygon sort keys
 
 
-def slice_level(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, radius: float) -> Slice:
+def slice_level(t: SliceTables, x: np.ndarray, m: np.ndarray, c0: float, radius: float) -> Slice:
     """One level, with the fallbacks for near-degenerate classifications."""
     try:
         return _slice(t, x, m, c0, t.tol)
-    except _Inconsistent:
+    except Inconsistent:
         pass
     # A face almost parallel to H but not within the tolerance: classify by exact
     # sign instead, then (never seen) nudge the hyperplane by a hair.
     try:
         return _slice(t, x, m, c0, 0.0)
-    except _Inconsistent:
+    except Inconsistent:
         return _slice(t, x, m, c0 + tol_.NUDGE * radius, t.tol)
 
 
-def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> Slice:
+def _slice(t: SliceTables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> Slice:
     h = x[:, 3] - c0
     pos = h > tol
     neg = h < -tol
@@ -75,14 +75,14 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         order = np.argsort(seg_face, kind="stable")
         sf = seg_face[order]
         if len(sf) % 2 or (sf[0::2] != sf[1::2]).any():
-            raise _Inconsistent
+            raise Inconsistent
         edges = np.concatenate([seg_sv[order].reshape(-1, 2), in_h_edges])
     else:
         edges = in_h_edges
 
     f_on = np.logical_and.reduceat(fv_on, t.f_starts) if len(on_idx) else None  # faces lying in H
     if not solid:
-        return _touching(t, vertices, edges, on_idx, f_on)
+        return touching(t, vertices, edges, on_idx, f_on)
 
     # polygons of S: one per crossing cell, one per 2-face lying in H on the boundary of S
     C = t.C
@@ -114,7 +114,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         poly_sv = vert_sv[t.fv_vert[k3]]
         normals = np.empty((C + t.F, 3))
     if not len(poly_id):  # no cell crosses H and no face in H bounds a solid part
-        return _touching(t, vertices, edges, on_idx, f_on)
+        return touching(t, vertices, edges, on_idx, f_on)
     normals[C + face_ids] = fn
 
     present = np.bincount(poly_id, minlength=C + t.F)
@@ -135,7 +135,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
     centres[:, 1] = np.bincount(rank, weights=pts[:, 1])
     centres[:, 2] = np.bincount(rank, weights=pts[:, 2])
     centres /= counts[:, None]
-    uv = _inplane_axes(normals[ids])
+    uv = inplane_axes(normals[ids])
     d = pts - centres[rank]
     uvr = uv[rank]
     ang = np.arctan2(
@@ -153,7 +153,7 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
         # prefer a cell lying in H (the whole-cell case), else the lower-numbered one
         cell_ids[is_face] = np.where(c_on[fc[:, 1]] & ~c_on[fc[:, 0]], fc[:, 1], fc[:, 0])
 
-    triangles, poly_of = _fan(flat, rank[order], offsets, counts)
+    triangles, poly_of = fan(flat, rank[order], offsets, counts)
     triangle_cells = cell_ids[poly_of]
 
     # volume by the divergence theorem, about the vertex centroid (keeps slivers exact)
@@ -167,20 +167,20 @@ def _slice(t: _Tables, x: np.ndarray, m: np.ndarray, c0: float, tol: float) -> S
             + A[:, 2] * (B[:, 0] * D[:, 1] - B[:, 1] * D[:, 0])
         ).sum()
     ) / 6.0
-    return Slice(_scaled(t, vertices), edges, flat, offsets, cell_ids, triangles, triangle_cells,
-                 _scaled_volume(t, volume), 3)
+    return Slice(scaled(t, vertices), edges, flat, offsets, cell_ids, triangles, triangle_cells,
+                 scaled_volume(t, volume), 3)
 
 
-def _touching(t: _Tables, vertices, edges, on_idx, f_on) -> Slice:
+def touching(t: SliceTables, vertices, edges, on_idx, f_on) -> Slice:
     """A slice with no polygons: H touches P in faces (dim 2), edges (1) or vertices (0), or misses it."""
     if not len(on_idx):
         dim = -1
     else:
         dim = 2 if f_on.any() else (1 if len(edges) else 0)
-    return Slice(_scaled(t, vertices), edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
+    return Slice(scaled(t, vertices), edges, t.empty_i, t.offsets0, t.empty_i, t.empty_i3, t.empty_i, 0.0, dim)
 
 
-def _faces_in_h(t: _Tables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, fn: np.ndarray, c_on: np.ndarray):
+def _faces_in_h(t: SliceTables, x: np.ndarray, m: np.ndarray, face_ids: np.ndarray, fn: np.ndarray, c_on: np.ndarray):
     """Which 2-faces lying in H bound the solid slice, and on which side of each is the outside.
 
     Seen in the plane orthogonal to face f (axes: its normal ``fn`` within H, and w), each of

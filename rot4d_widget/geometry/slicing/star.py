@@ -53,18 +53,18 @@ import weakref
 import numpy as np
 
 from ...core import tolerances as tol_
-from .._ragged import _ptr
-from .even_odd_fill import _upper, arrangement_fill
-from .single_level import _touching
-from .tables import Slice, _fan, _Inconsistent, _inplane_axes, _scaled, _scaled_volume, _Tables
+from .._ragged import row_offsets
+from .even_odd_fill import arrangement_fill, upper_pairs
+from .single_level import touching
+from .tables import Inconsistent, Slice, SliceTables, fan, inplane_axes, scaled, scaled_volume
 
 __all__: list = []
 
 
 class _StarTables:
-    """What the general slicer adds to `tables._Tables`, once per polytope."""
+    """What the general slicer adds to `tables.SliceTables`, once per polytope."""
 
-    def __init__(self, p, t: _Tables):
+    def __init__(self, p, t: SliceTables):
         st = p.star
         inc = p.incidence
         n = len(inc.face_vidx)
@@ -95,14 +95,14 @@ class _StarTables:
 _STAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-def star_tables(p, t: _Tables) -> _StarTables:
+def star_tables(p, t: SliceTables) -> _StarTables:
     s = _STAR.get(p)
     if s is None:
         s = _STAR[p] = _StarTables(p, t)
     return s
 
 
-def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
+def slice_star(p, t: SliceTables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
     st = star_tables(p, t)
     h = x[:, 3] - c0
@@ -119,7 +119,7 @@ def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
                 if other is not None and (out is None or abs(other.volume) > abs(out.volume)):
                     out = other
             break
-        except _Inconsistent:
+        except Inconsistent:
             continue
     if out is not None:
         return out
@@ -129,10 +129,10 @@ def slice_star(p, t: _Tables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
     e_on = on[t.ea] & on[t.eb]
     edges = np.stack([vert[t.ea[e_on]], vert[t.eb[e_on]]], axis=1) if e_on.any() else t.empty_i2
     f_on = np.logical_and.reduceat(on[t.fv_vert], t.f_starts)
-    return _touching(t, x[on_idx, :3], edges, on_idx, f_on)
+    return touching(t, x[on_idx, :3], edges, on_idx, f_on)
 
 
-def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
+def _cut(st: _StarTables, t: SliceTables, x, m, h, on, side: int):
     """The slice with the vertices on H counted above (``side`` 1) or below (-1); None if no edge crosses."""
     above = (h > 0) & ~on if side < 0 else (h > 0) | on
     cross = above[t.ea] != above[t.eb]
@@ -176,7 +176,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     uf = fk[newf]
     cnt = np.diff(np.append(np.flatnonzero(newf), len(fk)))
     if (cnt % 2).any():
-        raise _Inconsistent
+        raise Inconsistent
     rb = (st.face_basis[uf].reshape(-1, 4) @ m.T).reshape(-1, 2, 4)  # (nf, 2, 4) each face's plane, rotated
     d = rb[:, 1, :3] * rb[:, 0, 3:4] - rb[:, 0, :3] * rb[:, 1, 3:4]  # the line's direction (J grad w)
     two = len(fk) == 2 * len(uf)  # every face cut twice (convex faces always are)
@@ -211,7 +211,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
         fi, P, Q = seg_face, pts[seg[:, 0]], pts[seg[:, 1]]
     else:
         W = np.cumsum(delta)
-        ptr = _ptr(cnt)
+        ptr = row_offsets(cnt)
         base = np.zeros(len(uf), dtype=W.dtype)
         base[1:] = W[ptr[1:-1] - 1]
         W = W - base[fr]
@@ -244,7 +244,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     q2 = at[mate >> 1]
     partner = 4 * (q2 >> 1) + 2 * (mate & 1) + (q2 & 1)
     if (mate < 0).any() or (q2 < 0).any() or (partner == q).any() or (partner[partner] != q).any():
-        raise _Inconsistent
+        raise Inconsistent
     nxt = partner ^ 1  # along the other segment at this point, to its far end
     lab = np.arange(n_end)
     J = nxt.copy()
@@ -280,7 +280,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     # each kept orbit's ends in cycle order, orbits by their first end: placed, not sorted
     kept = np.flatnonzero(keep)
     size = np.bincount(lab[kept], minlength=n_end)
-    start = _ptr(size)[:-1]
+    start = row_offsets(size)[:-1]
     place = np.empty(len(kept), dtype=np.intp)
     place[start[lab[kept]] + size[lab[kept]] - 1 - dist[kept]] = np.arange(len(kept))
     kept = kept[place]
@@ -304,7 +304,7 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     pid = prank[pid]
     if not len(counts):  # every cycle shrank to a vertex or an edge on H: H only touches
         return None
-    offsets = _ptr(counts)
+    offsets = row_offsets(counts)
     cell_ids = kcell[offsets[:-1]]
 
     # triangles: a convex cell's cycle fanned; a non-convex cell's section that is one cycle
@@ -313,8 +313,8 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
     # the normal as the slabs are; every other section filled even-odd by slabs
     conv = st.cell_convex[cell_ids]
     pconv = conv[pid]
-    fo = _ptr(counts[conv])
-    ftri, fpoly = _fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
+    fo = row_offsets(counts[conv])
+    ftri, fpoly = fan(flat[pconv], (np.cumsum(conv) - 1)[pid[pconv]], fo, counts[conv])
     tri = [ftri]
     tcell = [cell_ids[conv][fpoly]]
     # the sections of crossing cycles by the segments' arrangement, the others star-shaped round
@@ -375,8 +375,8 @@ def _cut(st: _StarTables, t: _Tables, x, m, h, on, side: int):
         lo_hi = np.sort(ev, axis=1)
         ev = lo_hi[np.unique(lo_hi[:, 0] * len(vertices) + lo_hi[:, 1], return_index=True)[1]]
     edges = ev if len(ev) else t.empty_i2
-    return Slice(_scaled(t, all_v), edges, flat, offsets, cell_ids, triangles, triangle_cells,
-                 _scaled_volume(t, volume), 3, len(extra))
+    return Slice(scaled(t, all_v), edges, flat, offsets, cell_ids, triangles, triangle_cells,
+                 scaled_volume(t, volume), 3, len(extra))
 
 
 def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, conv):
@@ -395,7 +395,7 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
     sel = cand[pid]
     q = (np.cumsum(cand) - 1)[pid[sel]]
     cnt = counts[cand]
-    off = _ptr(cnt)
+    off = row_offsets(cnt)
     P = vertices[flat[sel]]
     cen = np.add.reduceat(P, off[:-1], axis=0) / cnt[:, None]  # (each polygon's corners are together)
     nxt = np.arange(1, len(q) + 1)
@@ -418,8 +418,8 @@ def _star_alone(vertices, flat, pid, counts, cell_ids, normals, rec_cell, C, con
         o = np.argsort(mc, kind="stable")
         k = np.bincount(mc, minlength=C)
         table = np.full((C, int(k.max())), -1, dtype=np.intp)
-        table[mc[o], np.arange(len(o)) - _ptr(k)[:-1][mc[o]]] = o
-        iu, ju = _upper(table.shape[1])
+        table[mc[o], np.arange(len(o)) - row_offsets(k)[:-1][mc[o]]] = o
+        iu, ju = upper_pairs(table.shape[1])
         i, j = table[:, iu].ravel(), table[:, ju].ravel()
         i, j = i[j >= 0], j[j >= 0]
         meet = ((lo[i] <= hi[j]) & (lo[j] <= hi[i])).all(axis=1)
@@ -434,11 +434,11 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices, crossings=None):
     (n, 3) extra vertices numbered from ``n_vertices``).  ``crossings``: ((k,) cells, (k,) heights
     v) where the cells' segments cross, if known (`even_odd_fill.arrangement_fill` gives them).
 
-    In each cell's plane (axes u, v of `_inplane_axes`, right-handed about the outward normal),
+    In each cell's plane (axes u, v of `inplane_axes`, right-handed about the outward normal),
     the segments are cut at every corner's height v; within each slab the segments crossing it,
     sorted by u, pair 1st-2nd, 3rd-4th, ... into trapezoids (even-odd), each two triangles wound
     counter-clockwise about the normal."""
-    uv = _inplane_axes(normals)[rcell]  # (r, 6)
+    uv = inplane_axes(normals)[rcell]  # (r, 6)
     rel0 = pts[rseg[:, 0]] - anchor[rcell]
     rel1 = pts[rseg[:, 1]] - anchor[rcell]
     X0 = rel0[:, 0] * uv[:, 0] + rel0[:, 1] * uv[:, 1] + rel0[:, 2] * uv[:, 2]
@@ -468,7 +468,7 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices, crossings=None):
     # pieces: each segment cut at the slab lines it spans, numbered segment by segment, slab by slab
     n = int(span.sum())
     r = np.repeat(np.arange(nr), span)
-    pstart = _ptr(span)[:-1]
+    pstart = row_offsets(span)[:-1]
     slab = ylo[r] + np.arange(n) - pstart[r]
     slope = (Xh - Xl) / (Yh - Yl)
     xa = Xl[r] + (uy[slab] - Yl[r]) * slope[r]
@@ -476,7 +476,7 @@ def _slabs(rcell, rseg, pts, vid, normals, anchor, n_vertices, crossings=None):
     o = np.argsort(xa + xb)  # by slab, then left to right: a float sort, then a stable (radix) one by slab
     o = o[np.argsort(slab[o].astype(np.uint16) if len(uy) < 65536 else slab[o], kind="stable")]
     if (np.bincount(slab) % 2).any():
-        raise _Inconsistent
+        raise Inconsistent
     # a trapezoid goes on up while the same two segments bound it in the next slab (nothing
     # happens between them there): merged, it needs corners only where it starts and ends.  It
     # goes on from left piece q to q + 1 (the same segment's next slab) when that is a left piece
@@ -520,10 +520,10 @@ def _crossings(rcell, Xl, Yl, Xh, Yh):
     cells' segments in the rows of a padded table, its pairs of columns taken at once."""
     o = np.argsort(rcell.astype(np.uint16) if rcell.max(initial=0) < 65536 else rcell, kind="stable")
     cnt = np.bincount(rcell)
-    start = _ptr(cnt)[:-1]
+    start = row_offsets(cnt)[:-1]
     table = np.full((len(cnt), int(cnt.max(initial=0))), -1, dtype=np.intp)
     table[rcell[o], np.arange(len(o)) - start[rcell[o]]] = o
-    iu, ju = _upper(table.shape[1])
+    iu, ju = upper_pairs(table.shape[1])
     i, j = table[:, iu].ravel(), table[:, ju].ravel()
     ok = j >= 0  # (a row's entries are packed to the left)
     i, j = i[ok], j[ok]

@@ -15,13 +15,13 @@ import numpy as np
 
 from ...core import tolerances as tol_
 from ...core._arrays import sealed as _sealed
-from .._ragged import _owner
+from .._ragged import row_owners
 from ..mesh import Polytope
 
 __all__ = ["Slice"]
 
 
-class _Tables:
+class SliceTables:
     """Incidence arrays for vectorised slicing, built once per polytope."""
 
     def __init__(self, p: Polytope):
@@ -33,14 +33,14 @@ class _Tables:
         # the polytope's flat incidence tables (`Polytope.incidence`): each face's corners and
         # sides in cycle order, each cell's vertices and edges ascending
         inc = p.incidence
-        self.fv_face = _owner(inc.face_ptr)
+        self.fv_face = row_owners(inc.face_ptr)
         self.fv_vert = inc.face_vidx
         self.fe_face = self.fv_face
         self.fe_edge = inc.face_eidx
         self.f_starts = inc.face_ptr[:-1]
-        self.cv_cell = _owner(inc.cell_vptr)
+        self.cv_cell = row_owners(inc.cell_vptr)
         self.cv_vert = inc.cell_vidx
-        self.ce_cell = _owner(inc.cell_eptr)
+        self.ce_cell = row_owners(inc.cell_eptr)
         self.ce_edge = inc.cell_eidx
         self.c_starts = inc.cell_vptr[:-1]
         # first three vertices of each face cycle: two non-parallel edge vectors
@@ -51,7 +51,7 @@ class _Tables:
         nv = np.diff(np.append(self.c_starts, len(self.cv_vert)))
         # everything here is in the scale of the polytope's unit vertices (its vertices divided by
         # the power of two `unit`, largest |coordinate| in [1, 2)): a slice is cut there and its
-        # vertices and volume are scaled back (`_scaled`), so any scale in COORDINATE_RANGE slices alike
+        # vertices and volume are scaled back (`scaled`), so any scale in COORDINATE_RANGE slices alike
         self.unit = float(p.unit)
         self.vertices = p.unit_vertices
         self.radius = p.circumradius / self.unit
@@ -83,13 +83,13 @@ def _padded(owner: np.ndarray, item: np.ndarray, n: int, pad: int) -> np.ndarray
     return table
 
 
-_TABLES: "weakref.WeakKeyDictionary[Polytope, _Tables]" = weakref.WeakKeyDictionary()
+_TABLES: "weakref.WeakKeyDictionary[Polytope, SliceTables]" = weakref.WeakKeyDictionary()
 
 
-def tables(p: Polytope) -> _Tables:
+def tables(p: Polytope) -> SliceTables:
     t = _TABLES.get(p)
     if t is None:
-        t = _TABLES[p] = _Tables(p)
+        t = _TABLES[p] = SliceTables(p)
     return t
 
 
@@ -158,16 +158,16 @@ class Slice:
         )
 
 
-class _Inconsistent(Exception):
+class Inconsistent(Exception):
     """A face chord without exactly two ends: classification hit a near-degenerate case."""
 
 
-def _scaled(t: _Tables, vertices: np.ndarray) -> np.ndarray:
+def scaled(t: SliceTables, vertices: np.ndarray) -> np.ndarray:
     """Slice vertices from the unit vertices' scale back to the polytope's (exact: a power of 2)."""
     return vertices if t.unit == 1.0 else vertices * t.unit
 
 
-def _scaled_volume(t: _Tables, volume):
+def scaled_volume(t: SliceTables, volume):
     """A volume from the unit vertices' scale back to the polytope's: times unit**3, one factor at
     a time (a volume beyond float64's range becomes inf, or 0 below it; never nan)."""
     if t.unit == 1.0:
@@ -177,7 +177,7 @@ def _scaled_volume(t: _Tables, volume):
         return volume * u * u * u
 
 
-def _fan(flat, prank, offsets, counts):
+def fan(flat, prank, offsets, counts):
     """Fan triangulation of polygons stored back to back: corners 1..k-2 of each open a triangle.
 
     ``flat`` the corners in order, ``prank`` the polygon of each, ``offsets`` where each
@@ -192,7 +192,7 @@ def _fan(flat, prank, offsets, counts):
     triangles[:, 2] = flat[j + 1]
     return triangles, prank[j]
 
-def _inplane_axes(n):
+def inplane_axes(n):
     """(k, 3) plane normals -> (k, 6): two in-plane axes u (columns 0-2) and v (3-5) per plane.
 
     u is n crossed with the coordinate axis least aligned with n, v = n x u; neither is unit

@@ -1,7 +1,7 @@
 """The figures pictures are drawn in: text as written, and the animation frame canvas (one reused
 figure, text drawn from kept glyph bitmaps).
 
-`_FrameCanvas` is what `render_state(..., _canvas=)` draws an animation's frames into.
+`FrameCanvas` is what `render_state(..., _canvas=)` draws an animation's frames into.
 """
 
 from __future__ import annotations
@@ -176,13 +176,13 @@ def _text_caching_canvas(fig):
     return TextCachingCanvas(fig)
 
 
-class _FrameCanvas:
+class FrameCanvas:
     """One figure, axes and Agg canvas that an animation's frames are drawn into in turn
     (`render_state(..., _canvas=)`): building a figure and its axes was a third of a frame's time.
     `begin` takes the figure (a new one when the size, dpi, title or colour bar strip or background change)
     and removes what the frame before added; the annotation, its legend and the title are kept
-    and given the new frame's text (`_draw_annotation`), and removed when a frame has none.
-    A polytope's slice is drawn as one collection (`_slice_collection`) instead of a patch per
+    and given the new frame's text (`draw_annotation`), and removed when a frame has none.
+    A polytope's slice is drawn as one collection (`slice_collection`) instead of a patch per
     ball, highlight, bar and face.  `rgb()` draws the frame and returns its pixels."""
 
     def __init__(self):

@@ -16,7 +16,7 @@ from ...core import colours
 from ...core.sizes import REFERENCE_RADIUS
 from ...sources.field_labels import axis_names
 from ...sources.protocol import c0_text
-from .slice_drawing import _Z_LABEL, CAMERA_DISTANCE, CAMERA_FOV, perspective
+from .slice_drawing import CAMERA_DISTANCE, CAMERA_FOV, Z_LABEL, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
 #: With ``frame="fit"`` the bounding box of what is drawn spans this fraction of the picture's
@@ -47,7 +47,7 @@ def union_extent(boxes):
     return (float(b[:, 0].min()), float(b[:, 1].max()), float(b[:, 2].min()), float(b[:, 3].max()))
 
 
-def _as_box(frame):
+def as_box(frame):
     try:
         box = tuple(float(v) for v in frame)
     except (TypeError, ValueError):
@@ -58,7 +58,7 @@ def _as_box(frame):
     return box
 
 
-def _frame_limits(box, aspect: float):
+def frame_limits(box, aspect: float):
     """``((x0, x1), (y0, y1))`` axes limits: the camera's frustum for ``box`` None, else ``box``
     centred and grown to the picture's ``aspect`` so that it fills `FIT_FILL` of it."""
     if box is None:
@@ -180,7 +180,7 @@ def turn_text(matrix, names=("x", "y", "z", "w")) -> str:
 
 
 def annotation_boxes(lines, legend, height: float, dpi: float, size_px) -> list:
-    """Where `_draw_annotation` puts its text and legend in a picture of ``size_px`` (width,
+    """Where `draw_annotation` puts its text and legend in a picture of ``size_px`` (width,
     height) pixels ``height`` inches high: ``[(left, top, w, h), ...]`` in pixels, y down (what the
     box labels keep clear of), from the text's measured size; generous by a few pixels."""
     fs = max(6.0, min(10.0, 1.7 * height))
@@ -196,9 +196,9 @@ def annotation_boxes(lines, legend, height: float, dpi: float, size_px) -> list:
     return out
 
 
-def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
+def draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
     """``lines`` in the upper left corner, ``legend`` swatches in the lower left (gid "annotation").
-    With a `_FrameCanvas`, the previous frame's text is given the new lines and its legend is
+    With a `FrameCanvas`, the previous frame's text is given the new lines and its legend is
     kept when the swatches are the same."""
     # matplotlib patches: imported when a legend is drawn
     from matplotlib.patches import Patch
@@ -213,7 +213,7 @@ def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
             canvas.note.remove()
         box = dict(facecolor="white", alpha=0.75, edgecolor="none", pad=2.0)
         note = ax.text(0.015, 0.985, text, transform=ax.transAxes, ha="left", va="top", fontsize=fs,
-                       zorder=_Z_LABEL, gid="annotation", bbox=box)
+                       zorder=Z_LABEL, gid="annotation", bbox=box)
         if canvas is not None:
             canvas.note = note
             canvas.keep.add(note)
@@ -228,7 +228,7 @@ def _draw_annotation(ax, lines, legend, height: float, canvas=None) -> None:
         handles = [Patch(facecolor=rgb, edgecolor="none", label=label) for rgb, label in legend]
         leg = ax.legend(handles=handles, loc="lower left", fontsize=fs, framealpha=0.75, edgecolor="none",
                         handlelength=1.0, borderaxespad=0.3)
-        leg.set_zorder(_Z_LABEL)
+        leg.set_zorder(Z_LABEL)
         leg.set_gid("legend")
         if canvas is not None:
             canvas.as_picture(leg)
@@ -257,7 +257,7 @@ def value_label(inner) -> str:
     return f"{name} [{units}]" if units else str(name)
 
 
-def _draw_colorbar(fig, rect, cmap: str, clim, label: str, marks=(), fontsize: float = 8.0):
+def draw_colorbar(fig, rect, cmap: str, clim, label: str, marks=(), fontsize: float = 8.0):
     """A colour bar in a new axes at ``rect`` (figure fraction): ``cmap``'s gradient from
     ``clim[0]`` (bottom) to ``clim[1]`` (top), ticks on its right in the data's values, ``label``
     beside them, and each of ``marks`` -- ``(value, rgb)``, an iso level in its surface's colour --
@@ -367,7 +367,7 @@ def text_size(text: str, fontsize: float, linespacing: float = 1.2) -> tuple:
 
 def box_label_layout(xlim, ylim, labels, scale: float, extent, fontsize: float, height: float, dpi: float,
                      placed=(), view=None):
-    """Where `_draw_box_labels` puts ``labels`` in axes with limits ``xlim``, ``ylim`` (a picture
+    """Where `draw_box_labels` puts ``labels`` in axes with limits ``xlim``, ``ylim`` (a picture
     ``height`` inches high at ``dpi``): ``(xy, shown, items, boxes)`` -- the projected label points,
     the ``((u, v) pixel point, text)`` of each label drawn, their `place_labels` items and places
     (``free`` False where none was free).  Nothing is drawn: `render_tomography` zooms a fitted
@@ -400,8 +400,8 @@ def box_label_layout(xlim, ylim, labels, scale: float, extent, fontsize: float, 
 _LABEL_PAD = 1.0  # a box label's text box, points
 
 
-def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, height: float = 5.0,
-                     placed=(), view=None) -> list:
+def draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, height: float = 5.0,
+                    placed=(), view=None) -> list:
     """``labels`` (`rot4d_widget.sources.field_labels.box_labels`: the origin corner first, then the
     far ends of the three edges leaving it, in slice coordinates) drawn at the points placed at
     ``scale * p`` and projected: the three edges as thin dashed lines (what the texts label), each
@@ -421,7 +421,7 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
     xy, shown, items, boxes = box_label_layout((x0, x1), (y0, y1), labels, scale, extent, fontsize, height, dpi,
                                                placed, view)
     edges = LineCollection([[xy[0], xy[k]] for k in range(1, len(xy))], colors="#777777", linewidths=0.6,
-                           linestyles=(0, (3, 2)), zorder=_Z_LABEL - 2.0, gid="box-edge")
+                           linestyles=(0, (3, 2)), zorder=Z_LABEL - 2.0, gid="box-edge")
     ax.add_collection(edges, autolim=False)
     hpx = float(height) * dpi
     wpx = hpx * (x1 - x0) / (y1 - y0)
@@ -435,13 +435,13 @@ def _draw_box_labels(ax, labels, scale: float, extent, fontsize: float = 7.0, he
     for ((u, v), text), (left, top, _free), item in zip(shown, boxes, items):
         tx, ty = to_data(left + _LABEL_PAD * px, top + _LABEL_PAD * px)
         out.append(ax.text(tx, ty, text, ha="left", va="top", fontsize=fontsize, color="#333333",
-                           zorder=_Z_LABEL - 1.0, gid="box-label", bbox=box, linespacing=1.1))
+                           zorder=Z_LABEL - 1.0, gid="box-label", bbox=box, linespacing=1.1))
         nu, nv = min(max(u, left), left + item[2]), min(max(v, top), top + item[3])
         if math.hypot(nu - u, nv - v) > 3.0:
             leaders.append([to_data(u, v), to_data(nu, nv)])
     if leaders:
         ax.add_collection(LineCollection(leaders, colors="#777777", linewidths=0.5, linestyles=(0, (1.5, 1.5)),
-                                         zorder=_Z_LABEL - 2.0, gid="label-leader"), autolim=False)
+                                         zorder=Z_LABEL - 2.0, gid="label-leader"), autolim=False)
     return out
 
 

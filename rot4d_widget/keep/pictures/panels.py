@@ -24,11 +24,11 @@ from .slice_drawing import (
     FIG4_ALPHA,
     FIG4_THETA0,
     TITLE_HEIGHT,
-    _as_polytope,
-    _count,
-    _real,
-    _save,
+    as_polytope,
+    checked_count,
+    checked_real,
     draw_slice,
+    save_figure,
 )
 
 
@@ -58,9 +58,9 @@ def _grid_figure(n_panels: int, ncols: int, panel_size: float, dpi: float, title
 
 
 def _check_grid_args(ncols, panel_size, dpi, title):
-    ncols = _count("ncols", ncols)
-    panel_size = _real("panel_size", panel_size, minimum=0.0, inclusive=False)
-    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    ncols = checked_count("ncols", ncols)
+    panel_size = checked_real("panel_size", panel_size, minimum=0.0, inclusive=False)
+    dpi = checked_real("dpi", dpi, minimum=0.0, inclusive=False)
     if title is not None and not isinstance(title, str):
         raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
     return ncols, panel_size, dpi
@@ -69,7 +69,7 @@ def _check_grid_args(ncols, panel_size, dpi, title):
 def _default_scale(poly: Polytope, scale):
     if scale is None:
         return REFERENCE_RADIUS / float(poly.circumradius)
-    return _real("scale", scale, minimum=0.0, inclusive=False)
+    return checked_real("scale", scale, minimum=0.0, inclusive=False)
 
 
 def panel_style(polytope, scale: float | None = None) -> dict:
@@ -81,7 +81,7 @@ def panel_style(polytope, scale: float | None = None) -> dict:
     the pentachoron's 0.07 and 0.028 at most, so that the 600 vertices of the 120-cell do not
     merge).  Use as ``draw_slice(ax, s, **panel_style(p))``.
     """
-    poly = _as_polytope(polytope)
+    poly = as_polytope(polytope)
     s = _default_scale(poly, scale)
     e = np.asarray(poly.edges, dtype=np.int64).reshape(-1, 2)
     edge = float(np.linalg.norm(poly.vertices[e[:, 0]] - poly.vertices[e[:, 1]], axis=1).mean()) if len(e) else 1.0
@@ -107,9 +107,9 @@ def render_slice(
     ``REFERENCE_RADIUS / circumradius`` (every polytope appears the size of the paper's
     pentachoron), sizes to :func:`panel_style`.  Other keywords go to :func:`draw_slice`.
     """
-    poly = _as_polytope(polytope)
+    poly = as_polytope(polytope)
     matrix = np.eye(4) if matrix is None else matrix
-    c0 = _real("c0", c0)
+    c0 = checked_real("c0", c0)
     s = _default_scale(poly, scale)
     _, panel_size, dpi = _check_grid_args(1, panel_size, dpi, title)
     fig, (ax,) = _grid_figure(1, 1, panel_size, dpi, title)
@@ -144,7 +144,7 @@ def render_key_sequence(
     """
     if not isinstance(key, str):
         raise TypeError(f"Expected `key` to be a string such as '4' or 'z', got {type(key).__name__}")
-    n_panels = _count("n_panels", n_panels)
+    n_panels = checked_count("n_panels", n_panels)
     ncols, panel_size, dpi = _check_grid_args(ncols, panel_size, dpi, title)
     if state is None:
         state = RotationState()
@@ -154,7 +154,7 @@ def render_key_sequence(
     if state.keymap.resolve(key, bool(shift)) is None:
         bound = " ".join(sorted(k for k in state.keymap if len(k) == 1))
         raise ValueError(f"Key {key!r} is not bound to an action; bound keys: {bound}")
-    poly = _as_polytope(polytope)
+    poly = as_polytope(polytope)
     kwargs = {**panel_style(poly, scale), **draw_kwargs}
 
     fig, axes = _grid_figure(n_panels, ncols, panel_size, dpi, title)
@@ -180,7 +180,7 @@ def paper_figure_3(path=None, *, panel_size: float = 2.0, dpi: float = 100, titl
         title="Fig. 3: key \u201c4\u201d, R_xw(\u03c0/16) per panel; pentachoron a = 2, slice w = 0"
         if title else None,
     )
-    _save(fig, path)
+    save_figure(fig, path)
     return fig
 
 
@@ -196,5 +196,5 @@ def paper_figure_4(path=None, *, panel_size: float = 2.0, dpi: float = 100, titl
         title="Fig. 4: key \u201cz\u201d, R_xz,yw(\u03b1, \u03b2), \u03b1 = \u03c0\u221a2/(8\u221a3), "
         "\u03b2 = 1 \u2212 \u03b1; w = 0" if title else None,
     )
-    _save(fig, path)
+    save_figure(fig, path)
     return fig

@@ -420,11 +420,11 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         close()
     if not images:
         return None
-    from .slice_drawing import _Z_BASE  # matplotlib's side: imported when a figure is drawn
+    from .slice_drawing import Z_BASE  # matplotlib's side: imported when a figure is drawn
 
     (x0, x1), (y0, y1) = limits
     image = ax.imshow(composite(images), extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",
-                      aspect="auto", zorder=_Z_BASE - 5.0)
+                      aspect="auto", zorder=Z_BASE - 5.0)
     image.set_gid(rendering)
     image.set_clim(*clim)  # what its colours stand for (an RGBA image draws without its norm)
     ax.set_xlim(x0, x1)

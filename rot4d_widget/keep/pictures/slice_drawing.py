@@ -33,6 +33,7 @@ from numbers import Integral, Real
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import PathCollection
 from matplotlib.colors import Colormap, ListedColormap, to_rgba
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
@@ -52,7 +53,7 @@ CAMERA_FOV = float(camera.CAMERA_FOV)
 # Other polytopes are scaled to it by default so that they appear the same size.
 #: Edge of the pentachoron of circumradius REFERENCE_RADIUS: the default ball and bar radii of
 #: :func:`draw_slice` are this edge's (``sizes.default_ball_radius(2.0)`` = 0.07).
-_REFERENCE_EDGE = REFERENCE_RADIUS / math.sqrt(2.0 / 5.0)
+REFERENCE_EDGE = REFERENCE_RADIUS / math.sqrt(2.0 / 5.0)
 #: Fig. 3: key "4" (R_xw) with theta0 = pi/16.
 FIG3_THETA0 = math.pi / 16
 #: Fig. 4: key "z" (R_xz,yw) with alpha = pi sqrt2 / (8 sqrt3) and "beta = 1 - alpha",
@@ -64,15 +65,15 @@ FIG4_ALPHA = PAPER_ALPHA_RATIO * FIG4_THETA0
 TITLE_HEIGHT = 0.4
 _SAVE_FORMATS = (".png", ".pdf", ".svg")
 
-# Painter's order: zorder = _Z_BASE + depth + a tiny offset per kind, so at equal depth a ball is
+# Painter's order: zorder = Z_BASE + depth + a tiny offset per kind, so at equal depth a ball is
 # drawn over a bar, and a bar over a face.  Labels stay above everything.
-_Z_BASE = 10.0
+Z_BASE = 10.0
 _Z_KIND = {"face": 0.0, "bar": 1e-4, "ball": 2e-4}
-_Z_LABEL = 1e6
+Z_LABEL = 1e6
 
 
 # --------------------------------------------------------------------------- validation helpers
-def _real(name: str, value, *, minimum=None, inclusive=True, maximum=None) -> float:
+def checked_real(name: str, value, *, minimum=None, inclusive=True, maximum=None) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real):
         raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
     value = float(value)
@@ -87,7 +88,7 @@ def _real(name: str, value, *, minimum=None, inclusive=True, maximum=None) -> fl
     return value
 
 
-def _count(name: str, value, *, minimum: int = 1) -> int:
+def checked_count(name: str, value, *, minimum: int = 1) -> int:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral):
         raise TypeError(f"Expected `{name}` to be an integer, got {type(value).__name__}")
     value = int(value)
@@ -96,7 +97,7 @@ def _count(name: str, value, *, minimum: int = 1) -> int:
     return value
 
 
-def _as_polytope(value) -> Polytope:
+def as_polytope(value) -> Polytope:
     if isinstance(value, str):
         return _named_polytope(value)
     if isinstance(value, Polytope):
@@ -145,7 +146,7 @@ def perspective(points, distance: float = CAMERA_DISTANCE):
     magnification of anything of size 1 at that point.  Raises ``ValueError`` if a point is at or
     behind the eye (z >= distance).
     """
-    d = _real("distance", distance, minimum=0.0, inclusive=False)
+    d = checked_real("distance", distance, minimum=0.0, inclusive=False)
     try:
         p = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -181,7 +182,7 @@ def _axes_aspect(ax) -> float:
     return box.width / box.height if box.width > 0 and box.height > 0 else 1.0
 
 
-def _add_patch(ax, patch):
+def add_patch(ax, patch):
     """``ax.add_patch`` without updating the data limits (every frame here sets its limits itself;
     matplotlib's per-patch limit update was most of the time of a frame)."""
     return ax.add_artist(patch)
@@ -243,21 +244,21 @@ def draw_slice(
         raise TypeError(f"Expected `ax` to be a matplotlib Axes, got {type(ax).__name__}")
     if not isinstance(slice, Slice):
         raise TypeError(f"Expected `slice` to be a rot4d_widget.Slice, got {type(slice).__name__}")
-    scale = _real("scale", scale, minimum=0.0, inclusive=False)
-    d = _real("distance", distance, minimum=0.0, inclusive=False)
+    scale = checked_real("scale", scale, minimum=0.0, inclusive=False)
+    d = checked_real("distance", distance, minimum=0.0, inclusive=False)
     if fov is not None:
-        fov = _real("fov", fov, minimum=0.0, inclusive=False)
+        fov = checked_real("fov", fov, minimum=0.0, inclusive=False)
         if fov >= 180.0:
             raise ValueError(f"Expected `fov` < 180 degrees, got {fov:g}")
     if ball_radius is None:
-        ball_radius = sizes.default_ball_radius(_REFERENCE_EDGE)
-    ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+        ball_radius = sizes.default_ball_radius(REFERENCE_EDGE)
+    ball_radius = checked_real("ball_radius", ball_radius, minimum=0.0)
     if bar_radius is None:
         bar_radius = sizes.default_bar_radius(ball_radius)
-    bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
-    face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    bar_radius = checked_real("bar_radius", bar_radius, minimum=0.0)
+    face_alpha = checked_real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
     if radius is not None:
-        radius = _real("radius", radius, minimum=0.0, inclusive=False)
+        radius = checked_real("radius", radius, minimum=0.0, inclusive=False)
         if radius >= d:
             raise ValueError(
                 f"Expected `radius` < `distance` ({d:g}) so the eye is outside the scene, got {radius:g}"
@@ -279,9 +280,9 @@ def draw_slice(
     for corners, rgba, depth in _face_patches(slice, xy, z, colormap):
         patch = Polygon(
             corners, closed=True, facecolor=(*rgba[:3], face_alpha), edgecolor="none",
-            zorder=_Z_BASE + depth + _Z_KIND["face"], gid="face",
+            zorder=Z_BASE + depth + _Z_KIND["face"], gid="face",
         )
-        _add_patch(ax, patch)
+        add_patch(ax, patch)
         drawing.faces.append(patch)
 
     # bars: a trapezoid from end a to end b, half-width bar_radius * factor at each end
@@ -292,7 +293,7 @@ def draw_slice(
             ra, rb = bar_radius * fac[a], bar_radius * fac[b]
             u = pb - pa
             length = math.hypot(*u)
-            zo = _Z_BASE + 0.5 * (z[a] + z[b]) + _Z_KIND["bar"]
+            zo = Z_BASE + 0.5 * (z[a] + z[b]) + _Z_KIND["bar"]
             if length <= 1e-12:  # edge along the line of sight: its end-on disc
                 patch = Circle(pa, max(ra, rb), facecolor=bar_rgba, edgecolor="none", zorder=zo, gid="bar")
             else:
@@ -300,7 +301,7 @@ def draw_slice(
                 corners = [pa + n * ra, pb + n * rb, pb - n * rb, pa - n * ra]
                 patch = Polygon(corners, closed=True, facecolor=bar_rgba, edgecolor=edge_rgba,
                                 linewidth=0.3, zorder=zo, gid="bar")
-            _add_patch(ax, patch)
+            add_patch(ax, patch)
             drawing.bars.append(patch)
 
     # balls: circles of radius ball_radius * factor, with a highlight towards the upper left
@@ -308,12 +309,12 @@ def draw_slice(
         dark = tuple(0.55 * np.asarray(ball_rgba[:3])) + (ball_rgba[3],)
         for i in range(_n_balls(slice, len(pts))):
             r = ball_radius * fac[i]
-            zo = _Z_BASE + z[i] + _Z_KIND["ball"]
+            zo = Z_BASE + z[i] + _Z_KIND["ball"]
             ball = Circle(xy[i], r, facecolor=ball_rgba, edgecolor=dark, linewidth=0.4, zorder=zo, gid="ball")
             shine = Circle(xy[i] + np.array([-0.35, 0.35]) * r, 0.3 * r, facecolor=(1, 1, 1, 0.55),
                            edgecolor="none", zorder=zo + 1e-5, gid="highlight")
-            _add_patch(ax, ball)
-            _add_patch(ax, shine)
+            add_patch(ax, ball)
+            add_patch(ax, shine)
             drawing.balls.append(ball)
             drawing.highlights.append(shine)
 
@@ -339,7 +340,7 @@ def draw_slice(
     drawing.limit = limit
     if label:
         ax.text(0.03, 0.97, label, transform=ax.transAxes, ha="left", va="top", fontsize=10,
-                zorder=_Z_LABEL)
+                zorder=Z_LABEL)
     return drawing
 
 
@@ -391,16 +392,15 @@ def _closed_codes(n: int) -> np.ndarray:
     return codes
 
 
-def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radius: float, face_alpha: float,
-                      cmap=None, ball_color=colours.BALL_COLOR, bar_color=colours.BAR_COLOR, z_shift: float = 0.0,
-                      distance: float = CAMERA_DISTANCE):
+def slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radius: float, face_alpha: float,
+                     cmap=None, ball_color=colours.BALL_COLOR, bar_color=colours.BAR_COLOR, z_shift: float = 0.0,
+                     distance: float = CAMERA_DISTANCE):
     """What `draw_slice` draws -- the same faces, bars, balls and highlights, with the same paths,
     colours, edges and painter's order (zorders plus ``z_shift``, ties in draw_slice's order) --
     as ONE `PathCollection` (gid "slice"), drawn by a single renderer call.  For animations:
     a frame of the 24-cell is ~100 patches, whose building and drawing was most of its time.
     ``cmap`` a Colormap or None; radii and sizes already checked.  None when nothing is drawn."""
-    # matplotlib collections: imported when a slice is drawn as one collection
-    from matplotlib.collections import PathCollection
+    # matplotlib paths: imported when a slice is drawn as one collection
     from matplotlib.path import Path
 
     global _CIRCLE
@@ -426,7 +426,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
             face.append((*rgba[:3], face_alpha))
             edge.append(none)
             width.append(0.0)
-            zo.append(_Z_BASE + depth + _Z_KIND["face"])
+            zo.append(Z_BASE + depth + _Z_KIND["face"])
         lens = lens[:0]
     if len(lens):
         rgba = _cell_colors(np.asarray(slice.cell_ids), cmap)
@@ -445,7 +445,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
             face.append((*rgba[k][:3], face_alpha))
             edge.append(none)
             width.append(0.0)
-            zo.append(_Z_BASE + depth[k] + _Z_KIND["face"])
+            zo.append(Z_BASE + depth[k] + _Z_KIND["face"])
 
     # bars: trapezoids, half-width bar_radius * factor at each end; an end-on edge is a disc
     e = np.asarray(slice.edges, dtype=np.int64).reshape(-1, 2)
@@ -460,7 +460,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
         n = np.stack([-u[:, 1], u[:, 0]], axis=1) / np.where(flat_end, 1.0, length)[:, None]
         quad = np.stack([pa + n * ra[:, None], pb + n * rb[:, None], pb - n * rb[:, None], pa - n * ra[:, None],
                          pa + n * ra[:, None]], axis=1)
-        zb = _Z_BASE + 0.5 * (z[e[:, 0]] + z[e[:, 1]]) + _Z_KIND["bar"]
+        zb = Z_BASE + 0.5 * (z[e[:, 0]] + z[e[:, 1]]) + _Z_KIND["bar"]
         codes = _closed_codes(4)
         for j in range(len(e)):
             if flat_end[j]:
@@ -479,7 +479,7 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
         ball_rgba = to_rgba(ball_color)
         dark = tuple(0.55 * np.asarray(ball_rgba[:3])) + (ball_rgba[3],)
         r = ball_radius * fac
-        zb = _Z_BASE + z + _Z_KIND["ball"]
+        zb = Z_BASE + z + _Z_KIND["ball"]
         shine = xy + np.array([-0.35, 0.35]) * r[:, None]
         for i in range(_n_balls(slice, len(pts))):
             paths.append(Path(circ_v * r[i] + xy[i], circ_c))
@@ -492,15 +492,23 @@ def _slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_rad
         return None
     zo = np.asarray(zo) + z_shift
     order = np.argsort(zo, kind="stable")  # matplotlib sorts artists by zorder, stably
-    coll = PathCollection([paths[i] for i in order], facecolors=np.asarray(face)[order],
-                          edgecolors=np.asarray(edge)[order], linewidths=np.asarray(width)[order],
-                          joinstyle="miter", capstyle="butt", zorder=float(zo.min()), gid="slice")
-    coll._items_zorder = zo[order]
-    return coll
+    return SliceCollection([paths[i] for i in order], zo[order], facecolors=np.asarray(face)[order],
+                           edgecolors=np.asarray(edge)[order], linewidths=np.asarray(width)[order],
+                           joinstyle="miter", capstyle="butt", zorder=float(zo.min()), gid="slice")
+
+
+class SliceCollection(PathCollection):
+    """`slice_collection`'s one collection of paths, painted in order; ``items_zorder``: the
+    zorder each path would have as draw_slice's patch (ascending), which the collection's own
+    zorder (their least) stands for."""
+
+    def __init__(self, paths, items_zorder, **kwargs):
+        super().__init__(paths, **kwargs)
+        self.items_zorder = items_zorder
 
 
 # --------------------------------------------------------------------------- grids of panels
-def _save(fig: Figure, path) -> None:
+def save_figure(fig: Figure, path) -> None:
     if path is None:
         return
     if not isinstance(path, (str, os.PathLike)):

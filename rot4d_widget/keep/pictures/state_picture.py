@@ -26,16 +26,16 @@ from ...sources.protocol import apply_setting, as_source, data_w_text, inner_sou
 from ...sources.tomography import StackSource
 from .canvas import LiteralTextFigure
 from .framing import (
-    _as_box,
-    _draw_annotation,
-    _draw_box_labels,
-    _draw_colorbar,
-    _frame_limits,
     annotation,
     annotation_boxes,
+    as_box,
     below_notes,
     colorbar_width,
+    draw_annotation,
+    draw_box_labels,
+    draw_colorbar,
     frame_extent,
+    frame_limits,
     level_rgb,
     room_for_labels,
     seen_from,
@@ -44,16 +44,16 @@ from .framing import (
 )
 from .ray_caster import cut_grids, draw_volume
 from .slice_drawing import (
-    _REFERENCE_EDGE,
-    _Z_BASE,
     CAMERA_FOV,
+    REFERENCE_EDGE,
     TITLE_HEIGHT,
-    _add_patch,
-    _real,
-    _save,
-    _slice_collection,
+    Z_BASE,
+    add_patch,
+    checked_real,
     draw_slice,
     perspective,
+    save_figure,
+    slice_collection,
 )
 
 
@@ -148,15 +148,15 @@ def render_tomography(
         inner = as_source(source)
         src = StackSource(inner, slices=slices, spacing=spacing, arrangement=arrangement, color_by=color_by)
     matrix = np.eye(4) if matrix is None else matrix
-    c0 = _real("c0", c0)
-    width = _real("width", width, minimum=0.0, inclusive=False)
-    height = _real("height", height, minimum=0.0, inclusive=False)
-    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
-    face_alpha = _real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
+    c0 = checked_real("c0", c0)
+    width = checked_real("width", width, minimum=0.0, inclusive=False)
+    height = checked_real("height", height, minimum=0.0, inclusive=False)
+    dpi = checked_real("dpi", dpi, minimum=0.0, inclusive=False)
+    face_alpha = checked_real("face_alpha", face_alpha, minimum=0.0, maximum=1.0)
     if ball_radius is not None:
-        ball_radius = _real("ball_radius", ball_radius, minimum=0.0)
+        ball_radius = checked_real("ball_radius", ball_radius, minimum=0.0)
     if bar_radius is not None:
-        bar_radius = _real("bar_radius", bar_radius, minimum=0.0)
+        bar_radius = checked_real("bar_radius", bar_radius, minimum=0.0)
     palette = None  # an override of the group colours: one colour, or the caller's
     if face_color is not None:
         palette = np.asarray([colours.as_rgb(face_color, "face_color")], dtype=np.float64)
@@ -196,15 +196,15 @@ def render_tomography(
         fig, ax = _canvas.begin(width, height, top, dpi, background, right)
     aspect = width / height
     edge = getattr(src.source, "edge_length", None)
-    base_ball = sizes.default_ball_radius(edge * scale) if edge else sizes.default_ball_radius(_REFERENCE_EDGE)
+    base_ball = sizes.default_ball_radius(edge * scale) if edge else sizes.default_ball_radius(REFERENCE_EDGE)
     if isinstance(frame, str) and frame == "fit":
         box = frame_extent(data, src, ball_radius=(ball_radius if ball_radius is not None else base_ball)
                            if show_balls else 0.0)
     elif isinstance(frame, str) and frame == "camera":
         box = None
     else:
-        box = _as_box(frame)
-    (x0, x1), (y0, y1) = _frame_limits(box, aspect)
+        box = as_box(frame)
+    (x0, x1), (y0, y1) = frame_limits(box, aspect)
     notes = None  # the annotation's lines and legend, and where they go (pixels, y down)
     if annotate:
         lines, legend = annotation(src, cut, c0, theta0=_theta0, cmap=cmap, clim=clim, matrix=matrix)
@@ -257,9 +257,9 @@ def render_tomography(
                                placed.cell_ids[:0], placed.triangles[:0], placed.triangle_cells[:0], placed.volume,
                                placed.dim, n_fill=placed.n_fill)
             if _canvas is not None:  # one collection per slice, in draw_slice's painter's order
-                coll = _slice_collection(placed, scale=scale, ball_radius=ball if show_balls else 0.0,
-                                         bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap,
-                                         z_shift=z_shift)
+                coll = slice_collection(placed, scale=scale, ball_radius=ball if show_balls else 0.0,
+                                        bar_radius=bar if show_bars else 0.0, face_alpha=face_alpha, cmap=cmap,
+                                        z_shift=z_shift)
                 if coll is not None:
                     ax.add_collection(coll, autolim=False)
             else:
@@ -293,11 +293,11 @@ def render_tomography(
         _field_colorbar(fig, inner, rendering, cmap, clim, used, width, height, top, right)
     taken = []  # what the box labels keep clear of besides the data: the annotation
     if notes is not None:
-        _draw_annotation(ax, notes[0], notes[1], height, _canvas)
+        draw_annotation(ax, notes[0], notes[1], height, _canvas)
         taken = notes[2]
     if box_text is not None:
-        _draw_box_labels(ax, box_text[0], scale, box_text[1], small_font(height) - 0.5, height, placed=taken,
-                         view=view)
+        draw_box_labels(ax, box_text[0], scale, box_text[1], small_font(height) - 0.5, height, placed=taken,
+                        view=view)
     if title:
         name = getattr(src.source, "name", None) or type(src.source).__name__
         text = title if isinstance(title, str) else (
@@ -314,7 +314,7 @@ def render_tomography(
             _canvas.keep.add(_canvas.title)
     if _canvas is not None:
         _canvas.end()
-    _save(fig, path)
+    save_figure(fig, path)
     return fig
 
 
@@ -338,7 +338,7 @@ def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top
             marks = tuple(zip(tuple(getattr(inner, "levels", ())), rgb))
     total_w, total_h = width + right, height + top
     rect = ((width + 0.12) / total_w, 0.15 * height / total_h, 0.14 / total_w, 0.7 * height / total_h)
-    _draw_colorbar(fig, rect, cmap, clim, value_label(inner), marks, small_font(height))
+    draw_colorbar(fig, rect, cmap, clim, value_label(inner), marks, small_font(height))
 
 
 def _slice_box(data, offs, soff):
@@ -363,7 +363,7 @@ def _label_slice(ax, centre, radius, text, highlighted, z_shift, *, point=None, 
     (xy,), (f,) = perspective(np.asarray(centre, dtype=np.float64)[None, :])
     r = radius * f
     fs = max(5.0, min(9.0, 30.0 * r))
-    z = _Z_BASE + float(centre[2]) + z_shift + 0.5e3
+    z = Z_BASE + float(centre[2]) + z_shift + 0.5e3
     x0, y1 = xy[0] - 0.98 * r, xy[1] + 0.98 * r
     if point is not None and placed is not None:
         # the upper left corner of the slice's square, else its upper right, else just above it
@@ -381,7 +381,7 @@ def _label_slice(ax, centre, radius, text, highlighted, z_shift, *, point=None, 
     ax.text(x0, y1, text, ha="left", va="top", fontsize=fs,
             fontweight="bold" if highlighted else "normal", zorder=z, gid="label")
     if highlighted:
-        _add_patch(ax, Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
+        add_patch(ax, Circle(xy, r, facecolor="none", edgecolor="#333333", linewidth=0.8, linestyle="--",
                             zorder=z, gid="highlight-ring"))
 
 
@@ -446,7 +446,7 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
     if not len(pts):
         return
     xy, _ = perspective(pts)
-    z_base = _Z_BASE + float(pts[:, 2].mean()) + z_shift
+    z_base = Z_BASE + float(pts[:, 2].mean()) + z_shift
     if len(tri) and show_faces:
         groups = np.asarray(data.groups[toff[k]:toff[k + 1]])
         if group_rgb is not None:
@@ -607,18 +607,18 @@ def render_state(
         w_px, h_px = (float(v) for v in size)
     except (TypeError, ValueError):
         raise TypeError(f"Expected `size` to be (width, height) in pixels, got {size!r}") from None
-    w_px = _real("size[0]", w_px, minimum=1.0)
-    h_px = _real("size[1]", h_px, minimum=1.0)
-    dpi = _real("dpi", dpi, minimum=0.0, inclusive=False)
+    w_px = checked_real("size[0]", w_px, minimum=1.0)
+    h_px = checked_real("size[1]", h_px, minimum=1.0)
+    dpi = checked_real("dpi", dpi, minimum=0.0, inclusive=False)
     if title is not None and not isinstance(title, str):
         raise TypeError(f"Expected `title` to be a string or None, got {type(title).__name__}")
     face_color = None
     if color_by != "group":
         face_color = colours.as_rgb(color_by, "color_by")
     if _prepared is None:
-        _prepared = _prepare(state, source, levels=levels, slices=slices, spacing=spacing, arrangement=arrangement,
-                             ball_radius=ball_radius, show_balls=show_balls, inside=inside, caps=caps,
-                             rendering=rendering, eye=eye)
+        _prepared = prepare_render(state, source, levels=levels, slices=slices, spacing=spacing,
+                                   arrangement=arrangement, ball_radius=ball_radius, show_balls=show_balls,
+                                   inside=inside, caps=caps, rendering=rendering, eye=eye)
     stack, data, ball_radius, box = _prepared
     if isinstance(frame, str) and frame == "fit":
         frame = "camera" if box is None else box
@@ -633,8 +633,8 @@ def render_state(
     )
 
 
-def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
-             show_balls=True, data=None, inside=None, caps=None, rendering="surface", eye=None, **_ignored):
+def prepare_render(state, source, *, levels=None, slices=None, spacing=None, arrangement=None, ball_radius=None,
+                   show_balls=True, data=None, inside=None, caps=None, rendering="surface", eye=None, **_ignored):
     """What `render_state` draws before drawing it: ``(stack, data, ball_radius, box)`` -- the
     source with the settings applied (`state_source`), its slice at ``state``, the ball radius
     in displayed units (None: the stack's default) and the projected bounding box of the
@@ -652,7 +652,7 @@ def _prepare(state, source, *, levels=None, slices=None, spacing=None, arrangeme
     if data is None:
         data = stack.slice(state.matrix, state.c0)
     if show_balls:
-        ball = ball_radius if ball_radius is not None else sizes.default_ball_radius(_REFERENCE_EDGE)
+        ball = ball_radius if ball_radius is not None else sizes.default_ball_radius(REFERENCE_EDGE)
     else:
         ball = 0.0
     seen = seen_from(data, view_rotation(camera.default_eye(rendering) if eye is None else eye))

@@ -16,7 +16,7 @@ __all__ = ["AxesWarning", "NonFiniteWarning", "MAX_SAMPLE_BYTES", "BYTES_PER_SAM
 MAX_SAMPLE_BYTES = 2 * 1024**3
 #: Working bytes per grid point: f and g (float64), v (float32), marching cubes' own.
 BYTES_PER_SAMPLE = 24
-_AXES = "xyzw"
+AXES = "xyzw"
 
 
 class AxesWarning(UserWarning):
@@ -32,12 +32,12 @@ class UnitsWarning(UserWarning):
     to set (once per field)."""
 
 
-def _axes_text(axes: str) -> str:
+def axes_text(axes: str) -> str:
     """'wzyx' -> 'f[w, z, y, x]': which of x, y, z, w each array axis is."""
     return "f[" + ", ".join(axes) + "]"
 
 
-def _real(value, name: str) -> float:
+def real_number(value, name: str) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
         raise TypeError(f"Expected `{name}` to be a real number, got {type(value).__name__}")
     v = float(value)
@@ -46,20 +46,20 @@ def _real(value, name: str) -> float:
     return v
 
 
-def _as_levels(level) -> tuple:
+def as_levels(level) -> tuple:
     """A number or a non-empty sequence of numbers -> tuple of finite floats."""
     if isinstance(level, (numbers.Real, np.integer, np.floating)) and not isinstance(level, (bool, np.bool_)):
-        return (_real(level, "level"),)
+        return (real_number(level, "level"),)
     try:
         items = list(np.asarray(level, dtype=object).ravel()) if not isinstance(level, (str, bytes)) else None
     except Exception:
         items = None
     if not items:
         raise TypeError(f"Expected `level` to be a real number or a non-empty sequence of them, got {level!r}")
-    return tuple(_real(v, f"level[{i}]") for i, v in enumerate(items))
+    return tuple(real_number(v, f"level[{i}]") for i, v in enumerate(items))
 
 
-def _check_resolution(resolution, name: str = "resolution") -> int:
+def check_resolution(resolution, name: str = "resolution") -> int:
     if isinstance(resolution, (bool, np.bool_)) or not isinstance(resolution, (numbers.Integral, np.integer)):
         raise TypeError(f"Expected `{name}` to be an int >= 2, got {type(resolution).__name__}")
     r = int(resolution)
@@ -84,7 +84,7 @@ def _bytes_text(n: float) -> str:
     return f"{n:.3g} TiB"  # pragma: no cover
 
 
-def _check_extent(extent) -> tuple:
+def check_extent(extent) -> tuple:
     try:
         e = np.array(extent, dtype=np.float64)
     except (TypeError, ValueError):
@@ -94,29 +94,29 @@ def _check_extent(extent) -> tuple:
         raise ValueError(f"Expected `extent` to have shape (4, 2): ((xmin, xmax), ..., (wmin, wmax)), got {e.shape}")
     if not np.all(np.isfinite(e)):
         raise ValueError(f"Expected `extent` to be finite, got {e.tolist()}")
-    bad = [_AXES[d] for d in range(4) if not e[d, 0] < e[d, 1]]
+    bad = [AXES[d] for d in range(4) if not e[d, 0] < e[d, 1]]
     if bad:
         raise ValueError(f"Expected min < max in `extent` for every axis; not so for {', '.join(bad)}: {e.tolist()}")
     lo, hi = COORDINATE_RANGE
     for d in range(4):
         end = float(np.abs(e[d]).max())
         if end > hi:
-            raise ValueError(f"`extent` of {_AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
+            raise ValueError(f"`extent` of {AXES[d]} reaches {end:.3g}; expected |ends| <= {hi:g} and half widths "
                              f"{lo:g} to {hi:g} (rot4d_widget.geometry.mesh.COORDINATE_RANGE; "
                              f"rescale the coordinates, "
                              f"e.g. to other units)")
-        check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {_AXES[d]}")
+        check_scale(float(e[d, 1] - e[d, 0]) / 2, f"The half width of `extent` along {AXES[d]}")
     return tuple((float(a), float(b)) for a, b in e)
 
 
-def _check_positive(value, name: str) -> float:
-    v = _real(value, name)
+def check_positive(value, name: str) -> float:
+    v = real_number(value, name)
     if v <= 0:
         raise ValueError(f"Expected `{name}` > 0, got {v}")
     return v
 
 
-def _call(f, *arrays) -> np.ndarray:
+def checked_call(f, *arrays) -> np.ndarray:
     """``f(*arrays)`` validated: same shape as the inputs, real numbers -> float64."""
     out = f(*arrays)
     try:

@@ -1,7 +1,7 @@
 """Chunked and lazy 4-D arrays (dask, zarr, an xarray backend's lazy array): read chunk by chunk.
 
-`_ChunkReader` reads the chunks a step needs, keeping recent ones up to a byte budget;
-`_chunked_values` interpolates at index points from those chunks alone (the array is never
+`ChunkReader` reads the chunks a step needs, keeping recent ones up to a byte budget;
+`chunked_values` interpolates at index points from those chunks alone (the array is never
 assembled), the same numbers as the resampling kernels.
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 __all__ = ["CHUNKED_POINTS", "CHUNK_BATCH"]
 
 
-def _array_kind(values) -> str:
+def array_kind(values) -> str:
     if isinstance(values, np.ndarray):
         return "numpy"
     mod = type(values).__module__ or ""
@@ -27,7 +27,7 @@ def _array_kind(values) -> str:
     return "lazy"
 
 
-class _ChunkReader:
+class ChunkReader:
     """Reads chunks of a lazy 4-D array (dask, zarr, anything sliceable) and keeps recent ones.
 
     The chunks are the array's own (dask's chunks, a zarr array's chunk shape; ``chunked`` True),
@@ -36,7 +36,7 @@ class _ChunkReader:
 
     def __init__(self, values, cache_bytes: int, block=None):
         self.values = values
-        self.kind = _array_kind(values)
+        self.kind = array_kind(values)
         shape = tuple(int(s) for s in values.shape)
         chunks = getattr(values, "chunks", None)
         bounds = None
@@ -113,14 +113,14 @@ class _ChunkReader:
             self._cached = 0
 
 
-#: Points interpolated per pass of `_chunked_values` (its tables take ~2 KB per point).
+#: Points interpolated per pass of `chunked_values` (its tables take ~2 KB per point).
 CHUNKED_POINTS = 16384
 #: Chunks read per call of the reader (one dask.compute: a distributed Client reads them in parallel).
 CHUNK_BATCH = 32
 _CORNERS = np.array([(a, b, c, d) for a in (0, 1) for b in (0, 1) for c in (0, 1) for d in (0, 1)], dtype=np.int64)
 
 
-def _chunked_values(rd: _ChunkReader, x, inside, sort_passes: bool = True):
+def chunked_values(rd: ChunkReader, x, inside, sort_passes: bool = True):
     """Quadrilinear values of a chunked or lazy array at index points ``x`` (N, 4), where ``inside``.
 
     The same numbers as the kernels (clamped into the array, the last cell closed), but the

@@ -20,8 +20,8 @@ import numpy as np
 
 from ...core._arrays import sealed as _sealed
 from ...core.progress import progress
-from .checks import _AXES
-from .chunks import CHUNK_BATCH, _ChunkReader
+from .checks import AXES
+from .chunks import CHUNK_BATCH, ChunkReader
 
 __all__ = ["COARSE_SAMPLES", "MEMORY_BUDGET", "CoarseCopy"]
 
@@ -159,7 +159,7 @@ class CoarseCopy:
         return self._by_chunks(counter, _reader(f.values, False), report=f.kind != "numpy")
 
     def _by_chunks(self, counter, rd, into=None, coarse: bool = True, report: bool = False):
-        """The coarse copy of the field's array read chunk by chunk through ``rd`` (a `_ChunkReader`
+        """The coarse copy of the field's array read chunk by chunk through ``rd`` (a `ChunkReader`
         without cache): each chunk's share of the linear resampling (evenly spaced fractional
         indices, axis by axis, the biggest reduction first) is added into the copy and the chunk
         dropped -- or first copied into ``into`` (the whole array, being loaded).  The +-inf counts
@@ -235,7 +235,7 @@ class CoarseCopy:
         x.flags.writeable = False
         coords = list(f.coords)
         for a, (n, m) in enumerate(zip(nshape, target)):
-            di = _AXES.index(f.axes[a])
+            di = AXES.index(f.axes[a])
             if m != n and coords[di] is not None:
                 coords[di] = _sealed(np.interp(np.linspace(0.0, n - 1.0, m), np.arange(n), coords[di]))
         return self._copy(x, coords)
@@ -261,19 +261,19 @@ def _add_share(out, x, idx, plans, order) -> None:
         out[np.ix_(*rows)] += x
 
 
-def _count(rd: _ChunkReader) -> int:
+def _count(rd: ChunkReader) -> int:
     return math.prod(len(b) - 1 for b in rd.bounds)
 
 
-def _reader(values, load: bool) -> _ChunkReader:
+def _reader(values, load: bool) -> ChunkReader:
     """A reader without cache for one pass over ``values``: the array's own chunks; for an array in
     memory blocks of `_BLOCK` samples a side; for a lazy array without a chunk grid that is being
     loaded, slabs along its first axis of about 16 MB (fewer, larger reads of the file)."""
     if isinstance(values, np.ndarray):
-        return _ChunkReader(values, 0, block=(_BLOCK,) * 4)
-    rd = _ChunkReader(values, 0)
+        return ChunkReader(values, 0, block=(_BLOCK,) * 4)
+    rd = ChunkReader(values, 0)
     if load and not rd.chunked:
         shape = tuple(int(n) for n in values.shape)
         per = max(1, (16 * 1024**2) // max(1, math.prod(shape[1:]) * rd.dtype.itemsize))
-        rd = _ChunkReader(values, 0, block=(min(per, shape[0]),) + shape[1:])
+        rd = ChunkReader(values, 0, block=(min(per, shape[0]),) + shape[1:])
     return rd

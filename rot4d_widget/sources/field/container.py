@@ -64,24 +64,24 @@ from ...core._arrays import sealed as _sealed
 from ...core.rotation import as_rotation_matrix
 from ...geometry.mesh import check_scale
 from .checks import (
-    _AXES,
-    _as_levels,
-    _check_extent,
-    _check_positive,
-    _check_resolution,
-    _real,
+    AXES,
+    as_levels,
+    check_extent,
+    check_positive,
+    check_resolution,
+    real_number,
 )
-from .chunks import _chunked_values, _ChunkReader
+from .chunks import ChunkReader, chunked_values
 from .coarse import MEMORY_BUDGET, CoarseCopy
 from .grid import field_sample
-from .inputs import _as_array, _metadata_range, _open_dataarray, _xarray_arguments, _zarr_attrs
-from .kernels import _resample_points
+from .inputs import as_array, metadata_range, open_dataarray, xarray_arguments, zarr_attrs
+from .kernels import resample_points
 from .levels import FieldLevels
 from .memory import FieldMemory
-from .readout import _describe, _order_text, _outline_readout, _readout
-from .slicing import LastCut, _box_slice, _sample, _slice_offset
+from .readout import describe_field, field_readout, order_text, outline_readout
+from .slicing import LastCut, box_slice, slice_offset, slice_samples
 from .stats import FieldStatistics
-from .surface import FieldSliceData, _empty_slice, _surface
+from .surface import FieldSliceData, empty_slice, level_surface
 
 __all__ = ["Field4D", "slice_field"]
 
@@ -160,12 +160,12 @@ class Field4D(FieldLevels, FieldMemory):
         self._dims = None  # the array's dim names (from_xarray), for the readout
         self.axes_given = axes is not None
         if _function is None:
-            self._values, self._kind, self._axis_of, self.shape = _as_array(values, axes)
+            self._values, self._kind, self._axis_of, self.shape = as_array(values, axes)
             self.axes = axes
         else:
             self._values = None
             self._kind = "function"
-            self.axes = _AXES
+            self.axes = AXES
             self._axis_of = (0, 1, 2, 3)
             self.shape = None
 
@@ -178,7 +178,7 @@ class Field4D(FieldLevels, FieldMemory):
             wpu = 1.0 / h if w_per_unit is None else w_per_unit
             self.w_units = "sample" if w_units is None else str(w_units)
         else:
-            self.extent = _check_extent(extent)
+            self.extent = check_extent(extent)
             wpu = 1.0 if w_per_unit is None else w_per_unit
             self.w_units = None if w_units is None else str(w_units)
         self._coords = (None,) * 4 if _coords is None else tuple(_coords)
@@ -191,7 +191,7 @@ class Field4D(FieldLevels, FieldMemory):
         self._centre.flags.writeable = False
         #: (lo, hi, where) from the data's metadata (`from_xarray`: actual_range, valid_min/valid_max;
         #: a zarr array's own attributes likewise)
-        meta = _metadata_range(_zarr_attrs(self._values), None, self._values.dtype) if self._kind == "zarr" else None
+        meta = metadata_range(zarr_attrs(self._values), None, self._values.dtype) if self._kind == "zarr" else None
         self._stat = FieldStatistics(self, meta)
         self._coarse_copy = CoarseCopy(self, self._stat.counted)
         if _copy_of is not None:  # a coarse copy is its own, and its infinities are the field's to report
@@ -205,7 +205,7 @@ class Field4D(FieldLevels, FieldMemory):
         self._reader = None
         #: the last cut sampled from chunked data (`rot4d_widget.sources.field.slicing.LastCut`)
         self.last_cut = LastCut()
-        self._levels = None if levels is None else _as_levels(levels)
+        self._levels = None if levels is None else as_levels(levels)
         self.inside = inside
         self.caps = caps
         #: Where the values come from, for a state file to reopen them (`Field4D.open`; `from_xarray`
@@ -245,7 +245,7 @@ class Field4D(FieldLevels, FieldMemory):
         A dask-backed array stays lazy.  ``w_per_unit`` defaults to the mean w spacing over the mean
         spatial spacing (voxels are cubes).
         """
-        values, args, dims, meta_range, (origin, why), long_name = _xarray_arguments(
+        values, args, dims, meta_range, (origin, why), long_name = xarray_arguments(
             data, variable, x, y, z, w, w_per_unit, kwargs)
         field = cls(values, **args, **kwargs)
         field._dims, field.long_name = dims, long_name
@@ -273,7 +273,7 @@ class Field4D(FieldLevels, FieldMemory):
 
         Opening reads the file's metadata and coordinates, not its data.
         """
-        da, record = _open_dataarray(path, variable, engine, chunks, isel, sel, load)
+        da, record = open_dataarray(path, variable, engine, chunks, isel, sel, load)
         field = cls.from_xarray(da, x=x, y=y, z=z, w=w, **kwargs)
         field.origin = {**record, "kwargs": dict(zip(field.axes, field._dims)), "load": bool(load)}
         field.origin_missing = None
@@ -287,7 +287,7 @@ class Field4D(FieldLevels, FieldMemory):
 
     @w_per_unit.setter
     def w_per_unit(self, value) -> None:
-        wpu = _check_positive(value, "w_per_unit")
+        wpu = check_positive(value, "w_per_unit")
         e = np.array(self.extent)
         unit = np.array([1.0, 1.0, 1.0, wpu])  # data units per slice unit
         with np.errstate(over="ignore", under="ignore"):
@@ -362,7 +362,7 @@ class Field4D(FieldLevels, FieldMemory):
     def offset(self, c0) -> float:
         """d, the offset in slice units of the hyperplane w = ``c0`` (data w units): ``(c0 -
         origin) / w_per_unit`` (`w_frame`)."""
-        return (_real(c0, "c0") - float(self._centre[3])) / float(self._w_per_unit)
+        return (real_number(c0, "c0") - float(self._centre[3])) / float(self._w_per_unit)
 
     def w_range(self, matrix) -> tuple:
         """(lowest, highest) c0, in the data's w units, at which w = c0 touches the rotated box."""
@@ -390,18 +390,18 @@ class Field4D(FieldLevels, FieldMemory):
         m = as_rotation_matrix(matrix)  # validated once: what follows takes it as it is
         c0 = self.offset(c0)  # slice units from here on
         meanwhile = bool(coarse) and self._coarse_copy.building()
-        box = _box_slice(self, m, c0)
+        box = box_slice(self, m, c0)
         # held keys while the coarse copy is built: the full data sampled at the coarse resolution
         # (the chunks the cut touches, kept by the reader's cache; the build goes on)
         res = self.coarse_resolution if coarse else self.resolution
         if coarse and not meanwhile:
-            slices = _slice_offset(self, m, c0, self.levels, res, coarse=True, box=box)
+            slices = slice_offset(self, m, c0, self.levels, res, coarse=True, box=box)
         else:  # read first: a fresh chunked field takes its range and level from this cut's chunks
-            s = _sample(self, m, c0, _check_resolution(res), first_cut=True, box=box)
+            s = slice_samples(self, m, c0, check_resolution(res), first_cut=True, box=box)
             levels = self.levels
-            slices = (tuple(_empty_slice(lv, 0.0) for lv in levels) if s is None
-                      else tuple(_surface(s, lv, self.inside, self.caps) for lv in levels))
-        readout = _readout(self, m, c0, slices, box, coarse and not meanwhile)
+            slices = (tuple(empty_slice(lv, 0.0) for lv in levels) if s is None
+                      else tuple(level_surface(s, lv, self.inside, self.caps) for lv in levels))
+        readout = field_readout(self, m, c0, slices, box, coarse and not meanwhile)
         if meanwhile:
             done, total = self._coarse_copy.progress or (0, 0)
             readout = readout + (("resolution", f"{res} (from the full data: the coarse copy is being built, "
@@ -417,8 +417,8 @@ class Field4D(FieldLevels, FieldMemory):
         m, d = as_rotation_matrix(matrix), self.offset(c0)
         frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
                  "unit": _sealed(self._unit.copy())}
-        return FieldSliceData.assemble((_empty_slice(0.0, 0.0),), box := _box_slice(self, m, d),
-                                       _outline_readout(self, m, d, box), frame)
+        return FieldSliceData.assemble((empty_slice(0.0, 0.0),), box := box_slice(self, m, d),
+                                       outline_readout(self, m, d, box), frame)
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in grid)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; inputs._long_name)
@@ -428,7 +428,7 @@ class Field4D(FieldLevels, FieldMemory):
         and resolutions, where the values come from, and ``"rebuild"``: True (a module-level
         function, or a file `open` read) or why a state file cannot rebuild the field (an array held
         in memory, a lambda)."""
-        return _describe(self)
+        return describe_field(self)
 
     # -- read-only views for the step's functions ----------------------------------
     @property
@@ -478,17 +478,17 @@ class Field4D(FieldLevels, FieldMemory):
         (its chunk reader and cache), never assembled."""
         resident = self.resident
         if resident is not None:
-            return _resample_points(resident, idx, inside)
+            return resample_points(resident, idx, inside)
         if self._reader is None:
-            self._reader = _ChunkReader(self._values, self.chunk_cache_bytes)
-        return _chunked_values(self._reader, idx, inside, _SORT_PASSES)
+            self._reader = ChunkReader(self._values, self.chunk_cache_bytes)
+        return chunked_values(self._reader, idx, inside, _SORT_PASSES)
 
     def __repr__(self) -> str:
         if self._kind == "function":
             what = "function f(x, y, z, w)"
         else:
             kind = "array" if self._kind == "numpy" else f"{self._kind} array"
-            what = f"{kind} {tuple(int(n) for n in self._values.shape)} {_order_text(self)}"
+            what = f"{kind} {tuple(int(n) for n in self._values.shape)} {order_text(self)}"
         return f"Field4D({self.name or ''!s}{' ' if self.name else ''}{what}, axes={self.axes!r}, extent={self.extent})"
 
 
@@ -520,7 +520,7 @@ def slice_field(field, matrix, c0, level, resolution: int = 64, *, coarse: bool 
     d = field.offset(c0)
     m = as_rotation_matrix(matrix)
     many = not isinstance(level, (numbers.Real, np.integer, np.floating)) or isinstance(level, (bool, np.bool_))
-    levels = _as_levels(level)
-    res = _check_resolution(resolution)
-    out = _slice_offset(field, m, d, levels, res, coarse=coarse)
+    levels = as_levels(level)
+    res = check_resolution(resolution)
+    out = slice_offset(field, m, d, levels, res, coarse=coarse)
     return out if many else out[0]

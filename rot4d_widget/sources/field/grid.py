@@ -2,7 +2,7 @@
 
 Volume rendering, maximum intensity projections and colour-mapped sections need the values of
 the cut itself, not a surface through it.  `sample_field` reuses one step's resampling
-(`rot4d_widget.sources.field.slicing._sample_raw`: the same grid, the same kernels, the same
+(`rot4d_widget.sources.field.slicing.slice_samples_raw`: the same grid, the same kernels, the same
 numbers as the isosurfaces) and hands back a frozen `FieldGrid`: float32 values, read-only, NaN
 outside the data's box, with the grid's origin, spacing and extent in slice coordinates.
 """
@@ -16,8 +16,8 @@ import numpy as np
 from ...core import tolerances as tol
 from ...core._arrays import sealed
 from ...core.rotation import as_rotation_matrix
-from .checks import _check_resolution
-from .slicing import _box_slice, _sample_raw
+from .checks import check_resolution
+from .slicing import box_slice, slice_samples_raw
 
 __all__ = ["FieldGrid", "sample_field", "field_sample"]
 
@@ -94,12 +94,12 @@ def sample_field(field, matrix, c0, resolution: int = 64, *, coarse: bool = Fals
         raise TypeError(f"Expected `field` to be a Field4D, got {type(field).__name__}")
     d = field.offset(c0)
     m = as_rotation_matrix(matrix)
-    res = _check_resolution(resolution)
+    res = check_resolution(resolution)
     src = field.coarse() if coarse else field
-    box = _box_slice(field, m, d)
+    box = box_slice(field, m, d)
     outline = (sealed(np.asarray(box.vertices, dtype=np.float64).reshape(-1, 3).copy()),
                sealed(np.asarray(box.edges, dtype=np.intp).reshape(-1, 2).copy()))
-    s = _sample_raw(src, m, d, res, box=box)
+    s = slice_samples_raw(src, m, d, res, box=box)
     name, units = field.name, field.units
     rng = tuple(float(v) for v in field.known_range)  # never a full read of chunked data for it
     if s is None:

@@ -1,10 +1,10 @@
 """How values come into a `Field4D`: arrays checked, xarray DataArrays mapped to x, y, z, w,
 files opened, and what a state file keeps of them.
 
-`_as_array` checks an array and the ``axes`` naming its dims; `_xarray_arguments` maps a
-DataArray's dims and coordinates to a field's arguments (`Field4D.from_xarray`); `_open_dataarray`
+`as_array` checks an array and the ``axes`` naming its dims; `xarray_arguments` maps a
+DataArray's dims and coordinates to a field's arguments (`Field4D.from_xarray`); `open_dataarray`
 opens a netCDF file or zarr store (`Field4D.open`).  A variable's data range is read from its
-metadata (`_metadata_range`); a reopenable origin from xarray's encoding: the Dataset's
+metadata (`metadata_range`); a reopenable origin from xarray's encoding: the Dataset's
 ``encoding["source"]``, which xarray sets for every engine (`_dataset_origin`), or a DataArray's own,
 which only the netCDF4 and h5netcdf engines set (`_encoding_origin`); selections and chunks are
 written as JSON (`_selection_json`, `_chunks_json`) and read back.
@@ -20,8 +20,8 @@ import warnings
 import numpy as np
 
 from ...core._arrays import sealed as _sealed
-from .checks import _AXES, UnitsWarning
-from .chunks import _array_kind
+from .checks import AXES, UnitsWarning
+from .chunks import array_kind
 
 
 def _dataset_error(ds) -> TypeError:
@@ -51,7 +51,7 @@ def _dataset_variable(ds, variable):
     return variable, ds[variable]
 
 
-class _LazyXarray:
+class LazyXarray:
     """A DataArray whose data are neither dask nor loaded (an xarray backend's lazily indexed
     array: netCDF or zarr opened without chunks), seen as a plain sliceable array.
 
@@ -87,12 +87,12 @@ class _LazyXarray:
 
 def _xarray_values(da):
     """The array behind a DataArray for `Field4D`: dask stays dask, loaded data become numpy,
-    a lazily indexed backend array becomes `_LazyXarray` (never the DataArray itself)."""
+    a lazily indexed backend array becomes `LazyXarray` (never the DataArray itself)."""
     if da.chunks is not None:
         return da.data
     if getattr(da.variable, "_in_memory", True):
         return np.asarray(da.values)
-    return _LazyXarray(da)
+    return LazyXarray(da)
 
 
 def _is_xarray(obj, what: str) -> bool:
@@ -108,7 +108,7 @@ def _attr_numbers(v, n: int):
     return tuple(float(x) for x in a) if a.size == n and np.all(np.isfinite(a)) else None
 
 
-def _zarr_attrs(values) -> dict:
+def zarr_attrs(values) -> dict:
     """A zarr array's attributes as a plain dict ({} when it has none or they cannot be read)."""
     try:
         return dict(values.attrs)
@@ -116,7 +116,7 @@ def _zarr_attrs(values) -> dict:
         return {}
 
 
-def _metadata_range(attrs, encoding, dtype=None):
+def metadata_range(attrs, encoding, dtype=None):
     """(lo, hi, where) of a variable from its attributes, read without touching its data, or None.
 
     ``actual_range`` (CF: the data's own min and max, in unpacked units) first, else
@@ -252,7 +252,7 @@ def _selection_json(selection, name):
     return out
 
 
-def _selection_from_json(selection, name):
+def selection_from_json(selection, name):
     """The inverse of `_selection_json` (a state file's selection for isel / sel)."""
     if selection is None:
         return None
@@ -293,7 +293,7 @@ def _chunks_json(chunks):
     raise TypeError(f"Expected `chunks` to be None, 'auto', an int or a dict {{dim: size}}, got {chunks!r}")
 
 
-def _as_array(values, axes):
+def as_array(values, axes):
     """``(values, kind, axis_of, shape)`` of an array given to `Field4D`, checked: 4-D, real numbers,
     ``axes`` a permutation of "xyzw" (required), at least 2 samples along every axis.  An array in
     memory becomes numpy (float32 kept, other dtypes as float64; a memmap stays a memmap)."""
@@ -307,7 +307,7 @@ def _as_array(values, axes):
         if not hasattr(values, attr):
             raise TypeError(f"Expected `values` to be a 4-D array-like (numpy, dask, zarr ...) with shape, "
                             f"ndim and slicing; {type(values).__name__} has no {attr!r}")
-    kind = _array_kind(values)
+    kind = array_kind(values)
     if kind == "lazy" and not hasattr(values, "dtype"):
         values = np.asarray(values)
         kind = "numpy"
@@ -320,7 +320,7 @@ def _as_array(values, axes):
         values = np.asarray(values)  # a memmap stays a memmap underneath (no copy)
         if dtype not in (np.float32, np.float64):
             values = values.astype(np.float64)
-    if axes is not None and (not isinstance(axes, str) or sorted(axes) != sorted(_AXES)):
+    if axes is not None and (not isinstance(axes, str) or sorted(axes) != sorted(AXES)):
         raise ValueError(f"Expected `axes` to be a permutation of 'xyzw' naming each array axis "
                          f"(e.g. 'wzyx' for f[t, z, y, x]), got {axes!r}")
     if axes is None:  # a guess cannot tell time from x: the caller says which axis is which
@@ -329,15 +329,15 @@ def _as_array(values, axes):
             f"Field4D needs `axes`, which of x, y, z, w each array axis is (shape {sh}): "
             f"axes='wzyx' for f[t, z, y, x] (time first), axes='xyzw' for f[x, y, z, t]; "
             f"Field4D.from_xarray(da, w='time') takes them from the dims")
-    axis_of = tuple(axes.index(c) for c in _AXES)  # array axis of x, y, z, w
+    axis_of = tuple(axes.index(c) for c in AXES)  # array axis of x, y, z, w
     shape = tuple(int(values.shape[a]) for a in axis_of)
-    small = [f"{c}={n}" for c, n in zip(_AXES, shape) if n < 2]
+    small = [f"{c}={n}" for c, n in zip(AXES, shape) if n < 2]
     if small:
         raise ValueError(f"Expected at least 2 samples along every axis, got {', '.join(small)}")
     return values, kind, axis_of, shape
 
 
-def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
+def xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
     """``(values, arguments, dims, meta_range, (origin, why not), long_name)`` for
     `Field4D.from_xarray`: the values of the DataArray ``data`` (or of ``variable`` of the Dataset
     ``data``: `_dataset_variable`) (`_xarray_values`), the field's keyword arguments (``kwargs``
@@ -372,7 +372,7 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
             if len(cands) == 1:
                 chosen[k] = cands[0]
     left = [d for d in dims if d not in chosen.values()]
-    missing = [k for k in _AXES if k not in chosen]
+    missing = [k for k in AXES if k not in chosen]
     if len(missing) == 1 and len(left) == 1:
         chosen[missing[0]] = left[0]
     elif missing:
@@ -381,13 +381,13 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
             f"Field4D.from_xarray(da, x='lon', y='lat', z='depth', w='time')"
         )
     axes = "".join(next(k for k, v in chosen.items() if v == d) for d in dims)
-    few = [f"{chosen[k]}={int(da.sizes[chosen[k]])} ({k})" for k in _AXES if int(da.sizes[chosen[k]]) < 2]
+    few = [f"{chosen[k]}={int(da.sizes[chosen[k]])} ({k})" for k in AXES if int(da.sizes[chosen[k]]) < 2]
     if few:
         raise ValueError(
             f"Expected at least 2 samples along every dim (a surface needs a cell to cross), got "
             f"{', '.join(few)}; dims {dict((d, int(da.sizes[d])) for d in dims)}. A single time step is a "
             f"3-D field, not a 4-D one: select a range, e.g. da.isel({chosen['w']}=slice(0, 2))")
-    meta_range = _metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None), getattr(da, "dtype", None))
+    meta_range = metadata_range(getattr(da, "attrs", None), getattr(da, "encoding", None), getattr(da, "dtype", None))
     if ds is not None:
         origin = _dataset_origin(ds, variable, da, chosen)
     else:
@@ -397,7 +397,7 @@ def _xarray_arguments(data, variable, x, y, z, w, w_per_unit, kwargs):
             "into its encoding; scipy, which xarray uses when netCDF4 is not installed, and zarr do not)"))
     flips, coords, extent = {}, [None] * 4, []
     epoch = None
-    for d_i, k in enumerate(_AXES):
+    for d_i, k in enumerate(AXES):
         dim = chosen[k]
         n = int(da.sizes[dim])
         if dim in da.coords:
@@ -480,7 +480,7 @@ def _long_name(attrs):
     return v if v.strip() else None
 
 
-def _open_dataarray(path, variable, engine, chunks, isel, sel, load):
+def open_dataarray(path, variable, engine, chunks, isel, sel, load):
     """``(da, record)`` for `Field4D.open`: ``variable`` of the file or store at ``path``, selected
     (isel, then sel) and loaded as asked, and where it came from (``record``: kind, path,
     variable, engine, chunks, isel, sel as JSON; `Field4D.open` adds the dims and ``load``)."""

@@ -1,7 +1,7 @@
 """The resampling kernels of a `Field4D` step: quadrilinear interpolation compiled by numba.
 
-`_resample_affine` fills f (the field) and g (the signed in-slice distance to the box's faces) on
-an affine grid of index coordinates, `_resample_points` interpolates at a list of index points.
+`resample_affine` fills f (the field) and g (the signed in-slice distance to the box's faces) on
+an affine grid of index coordinates, `resample_points` interpolates at a list of index points.
 Both run numba kernels (parallel from `PARALLEL_MIN_POINTS` points on) and fall back to scipy's
 ``map_coordinates`` (order 1, the same numbers) without numba.
 
@@ -164,7 +164,7 @@ _lerp4_jit = _lerp4
 _affine_rows_jit = _affine_rows
 
 
-def _resample_affine(a, base, step, n, centre, halfn, inv_s):
+def resample_affine(a, base, step, n, centre, halfn, inv_s):
     """(f, g) on an affine grid of shape ``n`` in ``a`` (see `_affine_kernel`); float64."""
     n = tuple(int(v) for v in n)
     f = np.empty(n, dtype=np.float64)
@@ -185,7 +185,7 @@ def _resample_affine(a, base, step, n, centre, halfn, inv_s):
     return f, g
 
 
-def _resample_points(a, idx, inside):
+def resample_points(a, idx, inside):
     """Quadrilinear values at (N, 4) index coordinates where ``inside``; float64 (N,)."""
     out = np.empty(len(idx), dtype=np.float64)
     k = _get_kernels(len(idx) >= PARALLEL_MIN_POINTS)

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..protocol import SourceAction
-from .checks import _as_levels, _check_resolution
+from .checks import as_levels, check_resolution
 
 
 class FieldLevels:
@@ -51,7 +51,7 @@ class FieldLevels:
 
     @levels.setter
     def levels(self, value) -> None:
-        self._levels = _as_levels(value)
+        self._levels = as_levels(value)
 
     @property
     def level_step(self) -> float:
@@ -112,7 +112,7 @@ class FieldLevels:
 
     @resolution.setter
     def resolution(self, value) -> None:
-        self._resolution = _check_resolution(value)
+        self._resolution = check_resolution(value)
 
     @property
     def coarse_resolution(self) -> int:
@@ -121,4 +121,4 @@ class FieldLevels:
 
     @coarse_resolution.setter
     def coarse_resolution(self, value) -> None:
-        self._coarse_resolution = _check_resolution(value, "coarse_resolution")
+        self._coarse_resolution = check_resolution(value, "coarse_resolution")

@@ -9,11 +9,11 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..protocol import w_span_text
-from .checks import _axes_text
-from .inputs import _LazyXarray
+from .checks import axes_text
+from .inputs import LazyXarray
 
 
-def _readout(field, m, c0, slices, box, coarse) -> tuple:
+def field_readout(field, m, c0, slices, box, coarse) -> tuple:
     """The readout rows of a field's slice (`Field4D.slice`): what, its axes, the levels and
     the data range, the volumes, the w the box's cut spans, the resolution of a coarse step."""
     rows = list(_what_rows(field))
@@ -48,7 +48,7 @@ def _what_rows(field) -> tuple:
     """The rows naming the field: its name and units, the order of its axes and its shape."""
     rows = [("field", f"{field.name or 'field'}" + (f" [{field.units}]" if field.units else ""))]
     if field.kind != "function":
-        rows.append(("axes", f"{_order_text(field)}, shape {tuple(int(n) for n in field.values.shape)}"))
+        rows.append(("axes", f"{order_text(field)}, shape {tuple(int(n) for n in field.values.shape)}"))
         missing = field.missing
         if missing is not None:
             rows.append(("missing", missing))
@@ -76,13 +76,13 @@ def _cut_rows(field, m, c0, box) -> tuple:
     return tuple(rows)
 
 
-def _outline_readout(field, m, d, box) -> tuple:
+def outline_readout(field, m, d, box) -> tuple:
     """The readout rows of a field's cut without its surfaces (`Field4D.outline`): what it is and
-    the cut (``d`` the offset in slice units, as `_readout` takes it)."""
+    the cut (``d`` the offset in slice units, as `field_readout` takes it)."""
     return _what_rows(field) + _cut_rows(field, m, d, box)
 
 
-def _order_text(field) -> str:
+def order_text(field) -> str:
     """Which of x, y, z, w each array axis is: 'f[w, z, y, x]', with the dim names from xarray
     ('T[time, z, y, x] as [w, z, y, x]')."""
     if field.kind == "function":
@@ -90,7 +90,7 @@ def _order_text(field) -> str:
     if field.dims is not None:
         label = field.name or "f"
         return f"{label}[{', '.join(field.dims)}] as [{', '.join(field.axes)}]"
-    return _axes_text(field.axes)
+    return axes_text(field.axes)
 
 
 def _function_path(f):
@@ -106,7 +106,7 @@ def _function_path(f):
     return f"{module}:{qual}", None
 
 
-def _describe(field) -> dict:
+def describe_field(field) -> dict:
     """`Field4D.describe`: the field's frame, levels, surface and resolutions, where its values come
     from (a module-level function ``"module:qualname"``, the file `Field4D.open` read, or what
     array it holds) and ``"rebuild"``: True, or why a state file cannot rebuild it."""
@@ -119,7 +119,7 @@ def _describe(field) -> dict:
         d["function"] = f"{getattr(f, '__module__', '?')}.{getattr(f, '__qualname__', type(f).__name__)}"
     else:
         what = {"numpy": "in-memory numpy", "dask": "dask array", "zarr": "zarr array"}.get(
-            field.kind, "lazily read xarray array" if isinstance(values, _LazyXarray) else type(values).__name__)
+            field.kind, "lazily read xarray array" if isinstance(values, LazyXarray) else type(values).__name__)
         d["array"] = f"{what} (not recordable)"
         d["shape"] = list(values.shape)
         d["dtype"] = str(np.dtype(values.dtype))

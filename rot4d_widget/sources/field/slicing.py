@@ -1,11 +1,11 @@
 """The geometry of one `Field4D` step: the cut of the data's box and the samples on the slice.
 
-`_box_slice` cuts the data's 4-D box (an 8-cell scaled to its half widths) with the exact
-polytope slicer; `_sample` lays a 3-D grid over that cut (``resolution`` samples along its
+`box_slice` cuts the data's 4-D box (an 8-cell scaled to its half widths) with the exact
+polytope slicer; `slice_samples` lays a 3-D grid over that cut (``resolution`` samples along its
 longest side, one sample of padding) and pulls it back into the data: f through the resampling
 kernels (an array in memory), the chunk reader (a chunked or lazy array) or the function itself,
 and g, the signed in-slice distance to the planes where the box's faces cut the slice.
-`_slice_offset` turns a step's samples into one surface per level.
+`slice_offset` turns a step's samples into one surface per level.
 
 Every function here takes a rotation matrix already validated (`as_rotation_matrix`): a
 `Field4D.slice` or `slice_field` validates it once.
@@ -19,14 +19,14 @@ import numpy as np
 
 from ...geometry.mesh import Polytope
 from ...geometry.slicing.polytope_slice import slice_polytope
-from .checks import _AXES, _call
-from .kernels import _resample_affine
-from .surface import _empty_slice, _surface
+from .checks import AXES, checked_call
+from .kernels import resample_affine
+from .surface import empty_slice, level_surface
 
 _BOX_CACHE: dict = {}
 
 
-def _box_polytope(hw):
+def box_polytope(hw):
     key = tuple(float(v) for v in hw)
     p = _BOX_CACHE.get(key)
     if p is None:
@@ -38,10 +38,10 @@ def _box_polytope(hw):
     return p
 
 
-def _box_slice(field, m, c0):
+def box_slice(field, m, c0):
     """The exact cut of ``field``'s box (half widths `Field4D.half_widths`) at the offset ``c0``
     (slice units) after ``m``: a `rot4d_widget.geometry.slicing.Slice`."""
-    return slice_polytope(_box_polytope(field.half_widths), m, c0)
+    return slice_polytope(box_polytope(field.half_widths), m, c0)
 
 
 class _Samples:
@@ -51,7 +51,7 @@ class _Samples:
 
 
 class LastCut:
-    """The last cut sampled from a chunked or lazy array (`_sample_raw`), so that the same cut asked
+    """The last cut sampled from a chunked or lazy array (`slice_samples_raw`), so that the same cut asked
     twice -- the first cut that sets the default level and range, then the view's first picture,
     both at rest -- reads its chunks once (a big store's cut can hold more chunks than the chunk
     cache).  One entry, replaced whole (safe to read from another thread)."""
@@ -95,18 +95,18 @@ def _geometric_nodes(field, d):
     return (np.asarray(c) - field.centre[d]) / field.unit[d]
 
 
-def _sample(field, m, c0, res, first_cut: bool = False, box=None) -> _Samples | None:
+def slice_samples(field, m, c0, res, first_cut: bool = False, box=None) -> _Samples | None:
     """Resample ``field`` on the grid of one step, or None when w = c0 misses the box; with its
     cap scale K (`Field4D.cap_scale`: taken after the read, so a first cut needs nothing more).
-    ``box``: the box's cut at (m, c0) when the caller has it already (`_box_slice`)."""
-    s = _sample_raw(field, m, c0, res, box)
+    ``box``: the box's cut at (m, c0) when the caller has it already (`box_slice`)."""
+    s = slice_samples_raw(field, m, c0, res, box)
     if s is not None:
         s.k = field.cap_scale(s, first_cut)
     return s
 
 
-def _sample_raw(field, m, c0, res, box=None) -> _Samples | None:
-    """`_sample` without K (``s.k`` None).  Of a chunked or lazy array, the last cut is kept
+def slice_samples_raw(field, m, c0, res, box=None) -> _Samples | None:
+    """`slice_samples` without K (``s.k`` None).  Of a chunked or lazy array, the last cut is kept
     (`LastCut`): asked again for the same one, nothing is read."""
     chunked = field.kind not in ("numpy", "function") and field.resident is None
     key = (m.tobytes(), float(c0), int(res), tuple(field.half_widths)) if chunked else None
@@ -122,7 +122,7 @@ def _sample_raw(field, m, c0, res, box=None) -> _Samples | None:
 
 def _sample_grid(field, m, c0, res, box):
     if box is None:
-        box = _box_slice(field, m, c0)
+        box = box_slice(field, m, c0)
     if box.dim < 3:
         return None
     bv = np.asarray(box.vertices)
@@ -147,7 +147,7 @@ def _sample_grid(field, m, c0, res, box):
         g = _in_slice_distance(q, hw, m)
         unit, centre = field.unit, field.centre
         with np.errstate(all="ignore"):
-            f = _call(field.function, *[q[j] * unit[j] + centre[j] for j in range(4)])
+            f = checked_call(field.function, *[q[j] * unit[j] + centre[j] for j in range(4)])
         s.f, s.g = f, g
         return s
     uniform = all(c is None for c in field.coords)
@@ -167,10 +167,10 @@ def _sample_grid(field, m, c0, res, box):
             step[:, a] = step_d[:, j]
             centre[a] = (field.shape[j] - 1) / 2
             inv_s[a] = 1.0 / (sc[j] * _face_norms(m)[j])
-        halfn = np.where(_face_norms(m)[list(_AXES.index(c) for c in field.axes)] > _PARALLEL, centre, 1e300)
+        halfn = np.where(_face_norms(m)[list(AXES.index(c) for c in field.axes)] > _PARALLEL, centre, 1e300)
         resident = field.resident
         if resident is not None:  # in memory: given so, or read whole in the background
-            s.f, s.g = _resample_affine(resident, base, step, n, centre, halfn, inv_s)
+            s.f, s.g = resample_affine(resident, base, step, n, centre, halfn, inv_s)
             return s
         # chunked or lazy: the same numbers, each touched chunk read once (memory stays bounded)
         ijk = np.indices(tuple(int(v) for v in n), dtype=np.float64).reshape(3, -1).T
@@ -193,7 +193,7 @@ def _sample_grid(field, m, c0, res, box):
     return s
 
 
-def _slice_offset(field, m, d, levels, res, *, coarse, box=None) -> tuple:
+def slice_offset(field, m, d, levels, res, *, coarse, box=None) -> tuple:
     """One `FieldSlice` per level of ``levels`` (a tuple of floats) at the offset ``d`` (slice units)
     after the validated rotation ``m``, sampled at ``res`` along the longest side; of
     ``field.coarse()`` with ``coarse``.  ``box``: the box's cut there, when known (the coarse copy
@@ -201,7 +201,7 @@ def _slice_offset(field, m, d, levels, res, *, coarse, box=None) -> tuple:
     its cap scale comes from this cut's samples until the coarse copy is ready (`Field4D.cap_scale`),
     never from a coarse copy built for it."""
     src = field.coarse() if coarse else field
-    s = _sample(src, m, d, res, first_cut=not coarse, box=box)
+    s = slice_samples(src, m, d, res, first_cut=not coarse, box=box)
     if s is None:
-        return tuple(_empty_slice(lv, 0.0) for lv in levels)
-    return tuple(_surface(s, lv, field.inside, field.caps) for lv in levels)
+        return tuple(empty_slice(lv, 0.0) for lv in levels)
+    return tuple(level_surface(s, lv, field.inside, field.caps) for lv in levels)

@@ -13,10 +13,10 @@ import warnings
 
 import numpy as np
 
-from ...geometry.mesh import _power_of_two_unit
+from ...geometry.mesh import power_of_two_unit
 from ..protocol import w_span_text, w_value_text
-from .checks import NonFiniteWarning, _axes_text, _call
-from .slicing import _sample_raw
+from .checks import NonFiniteWarning, axes_text, checked_call
+from .slicing import slice_samples_raw
 
 #: Nodes per axis of the grid a function field is sampled on for its range.
 _FUNCTION_PROBE = 21
@@ -126,7 +126,7 @@ class FieldStatistics:
             return None
         rd = f.reader
         if (rd is None or rd.reads == 0) and first_cut:
-            _sample_raw(f, np.eye(4), 0.0, f.resolution)  # the picture at rest: its chunks only
+            slice_samples_raw(f, np.eye(4), 0.0, f.resolution)  # the picture at rest: its chunks only
             rd = f.reader
         if rd is None or rd.reads == 0:
             return None
@@ -163,7 +163,7 @@ class FieldStatistics:
         if self._probe is None:
             m = _FUNCTION_PROBE
             grids = np.meshgrid(*[np.linspace(a, b, m) for a, b in self._field.extent], indexing="ij")
-            self._probe = _call(self._field.function, *grids)
+            self._probe = checked_call(self._field.function, *grids)
         return self._probe
 
     def cap_scale(self, s=None, first_cut: bool = False) -> float:
@@ -176,7 +176,7 @@ class FieldStatistics:
         if ((first_cut or self._k_first is not None) and self._stats is None
                 and f.kind not in ("numpy", "function") and not f.coarse_ready):
             if self._k_first is None:
-                u = _power_of_two_unit(f.size)
+                u = power_of_two_unit(f.size)
                 inner = s.g > s.spacing  # both neighbours inside the box: no step to the zeros outside
                 with np.errstate(invalid="ignore", over="ignore"):
                     grads = np.gradient(np.asarray(s.f, dtype=np.float32), s.spacing / u)
@@ -222,7 +222,7 @@ class FieldStatistics:
         with np.errstate(invalid="ignore"):
             # spacings in units of the box's size (a power of two: exact), so a float32 gradient
             # neither overflows nor underflows at any scale; K is scaled back below
-            u = _power_of_two_unit(f.size)
+            u = power_of_two_unit(f.size)
             grads = np.gradient(a, *[sp / u for sp in spacing])
             gm = np.sqrt(sum(g * g for g in grads))
         ok = np.isfinite(gm) & (gm > 0)
@@ -295,7 +295,7 @@ class FieldStatistics:
         parts = []
         if npos or nneg:
             what = " and ".join(t for t in (f"{npos} +inf" if npos else "", f"{nneg} -inf" if nneg else "") if t)
-            where = f" (the first at index {first} of {_axes_text(f.axes)})" if first is not None else ""
+            where = f" (the first at index {first} of {axes_text(f.axes)})" if first is not None else ""
             parts.append(
                 f"the data hold {what} of {math.prod(int(n) for n in f.values.shape)} samples{where}. They are kept: "
                 f"+inf lies above and -inf below every level, the data range ignores them, and a point "

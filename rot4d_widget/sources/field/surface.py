@@ -1,6 +1,6 @@
 """A field's isosurfaces in one slice: marching cubes on a step's samples, and what it returns.
 
-`_surface` runs scikit-image's marching cubes (Lewiner) on ``min(±(f - level), K g)`` (capped on
+`level_surface` runs scikit-image's marching cubes (Lewiner) on ``min(±(f - level), K g)`` (capped on
 the box's faces) or on ``±(f - level)`` alone (open), in index space, and scales vertices,
 volume and area afterwards in float64; `FieldSlice` is one level's surface, `FieldSliceData`
 the `SliceData` a `Field4D` gives the widget.
@@ -60,7 +60,7 @@ _EMPTY3 = _sealed(np.zeros((0, 3)))
 _EMPTY_T = _sealed(np.zeros((0, 3), dtype=np.intp))
 
 
-def _empty_slice(level: float, spacing: float) -> FieldSlice:
+def empty_slice(level: float, spacing: float) -> FieldSlice:
     return FieldSlice(_EMPTY3, _EMPTY_T, _EMPTY3, 0.0, 0.0, level, spacing)
 
 
@@ -131,7 +131,7 @@ class FieldSliceData(SliceData):
         )
 
 
-def _surface(s, level: float, inside: str = "above", caps: bool = True) -> FieldSlice:
+def level_surface(s, level: float, inside: str = "above", caps: bool = True) -> FieldSlice:
     """Marching cubes of min(±(f - level), K g) = 0 on one step's samples (+ for inside="above",
     - for "below"); without caps, of ±(f - level) alone within the box (an open surface)."""
     d = s.spacing
@@ -149,7 +149,7 @@ def _surface(s, level: float, inside: str = "above", caps: bool = True) -> Field
     mask = None
     if not caps:
         if out.all():
-            return _empty_slice(level, d)
+            return empty_slice(level, d)
         if out.any():
             # outside the box: the nearest inside sample's value (so cells across a face see the data
             # carried on, not zeros); cells wholly outside are skipped; triangles beyond the faces dropped
@@ -157,9 +157,9 @@ def _surface(s, level: float, inside: str = "above", caps: bool = True) -> Field
             v = v[tuple(idx)]
             mask = binary_dilation(~out, structure=np.ones((3, 3, 3), dtype=bool))
         if not (v.max() > 0 and v.min() < 0):
-            return _empty_slice(level, d)
+            return empty_slice(level, d)
     elif not v.max() > 0:
-        return _empty_slice(level, d)
+        return empty_slice(level, d)
     # in index space (spacing 1): skimage scales in float32, which overflows beyond ~3e38; the
     # vertices, volume and area are scaled here in float64, so any field scale works alike
     try:
@@ -167,7 +167,7 @@ def _surface(s, level: float, inside: str = "above", caps: bool = True) -> Field
     except (ValueError, RuntimeError):
         if caps:
             raise
-        return _empty_slice(level, d)  # no crossing within the box
+        return empty_slice(level, d)  # no crossing within the box
     if not caps and len(faces):
         gc = map_coordinates(s.g, verts[faces].mean(axis=1).T, order=1, mode="nearest")
         faces = faces[gc >= 0]  # keep triangles centred in the box: the open edge lies within a cell of a face
@@ -176,7 +176,7 @@ def _surface(s, level: float, inside: str = "above", caps: bool = True) -> Field
         remap[used] = np.arange(len(used))
         verts, normals, faces = verts[used], normals[used], remap[faces]
     if len(faces) == 0:
-        return _empty_slice(level, d)
+        return empty_slice(level, d)
     iv = verts.astype(np.float64)  # index coordinates
     vertices = iv * d + s.origin
     tri = faces.astype(np.intp)

@@ -1,7 +1,7 @@
 // The page's own polytope slicer: the slice w = c0 of a turned polytope whose cells are convex,
 // array for array as rot4d_widget.geometry.slicing.slice_polytope computes it (section.py:
-// slice_level, _slice, _touching, _faces_in_h; slicetables.py: _fan,
-// _inplane_axes, _scaled, _scaled_volume), so the page can draw the slice of the state it
+// slice_level, _slice, touching, _faces_in_h; slicetables.py: fan,
+// inplane_axes, scaled, scaled_volume), so the page can draw the slice of the state it
 // predicts without waiting for the kernel.
 //
 // The polytope comes once from the kernel (rot4d_widget.view.pagegeometry.polytope_message: the
@@ -112,13 +112,13 @@ export function decodePolytope(msg) {
 const turned = (m, j, a, i) =>
   m[4 * j] * a[i] + m[4 * j + 1] * a[i + 1] + m[4 * j + 2] * a[i + 2] + m[4 * j + 3] * a[i + 3];
 
-// slicetables._inplane_axes of one normal: u = n x (e_x, or e_y near e_x), v = n x u, not unit.
+// slicetables.inplane_axes of one normal: u = n x (e_x, or e_y near e_x), v = n x u, not unit.
 function inplaneAxes(nx, ny, nz) {
   if (nx * nx < 0.5 * (ny * ny + nz * nz + nx * nx)) return [0.0, nz, -ny, -(ny * ny + nz * nz), nx * ny, nx * nz];
   return [-nz, 0.0, nx, nx * ny, -(nx * nx + nz * nz), ny * nz];
 }
 
-// A face chord without exactly two ends (section._Inconsistent): classification hit a
+// A face chord without exactly two ends (tables.Inconsistent): classification hit a
 // near-degenerate case; `sliceLevel` classifies again.
 class Inconsistent extends Error {}
 
@@ -374,7 +374,7 @@ function cornerOrder(vertices, polys) {
   return { flat, offsets };
 }
 
-// slicetables._fan: corners 1 .. k-2 of each polygon open a triangle with its first corner.
+// slicetables.fan: corners 1 .. k-2 of each polygon open a triangle with its first corner.
 function fan(flat, offsets, cellIds) {
   let n = 0;
   for (let r = 0; r + 1 < offsets.length; r++) n += Math.max(0, offsets[r + 1] - offsets[r] - 2);
@@ -419,7 +419,7 @@ function scaled(p, s) {
   return { ...s, vertices: s.vertices.map((v) => v * u), volume: s.volume * u * u * u };
 }
 
-// section._touching: no polygons; H touches P in faces (dim 2), edges (1) or vertices (0), or misses it.
+// section.touching: no polygons; H touches P in faces (dim 2), edges (1) or vertices (0), or misses it.
 function touching(p, vertices, edges, onIdx, faceIds) {
   let dim = -1;
   if (onIdx.length) dim = faceIds.length ? 2 : (edges.length ? 1 : 0);

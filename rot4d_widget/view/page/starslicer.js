@@ -8,7 +8,7 @@
 // Which slice slice_star returns still depends on steps past the segments, so those are here
 // too, reduced to what decides it: the winding-weighted volume (a cell lying in H: the side of
 // the larger one is kept), and the cells' cycles (chained as the kernel chains them; when none
-// keeps three distinct corners H only touches, and the slice is `_touching`'s).  The one later
+// keeps three distinct corners H only touches, and the slice is `touching`'s).  The one later
 // step that can make the kernel move H by a hair (`_slabs`, a slab with an odd number of
 // pieces) is part of the fill: the page does not see it.
 //
@@ -17,7 +17,7 @@
 
 import { dot3, pairwiseSum } from "./numpyorder.js";
 
-// A near-degenerate case the kernel's slicer meets by moving H a hair (slicetables._Inconsistent).
+// A near-degenerate case the kernel's slicer meets by moving H a hair (slicetables.Inconsistent).
 class Inconsistent extends Error {}
 
 // Per-polytope tables derived from the message's integers, once: each face side's face and next side.
@@ -42,7 +42,7 @@ function faceTables(p) {
 
 // starslice.slice_star on the turned unit vertices `x` (4V) and the unit level `c0`: {vertices
 // (3n, unit scale), edges (2m), volume (scaled, as the Slice has it), dim}.  H moved by a hair if
-// a cut is Inconsistent; a cell lying in H: the side with the larger volume; none: `_touching`.
+// a cut is Inconsistent; a cell lying in H: the side with the larger volume; none: `touching`.
 export function sliceStarUnit(p, x, m, c0) {
   let h = null, on = null, out = null;
   for (const nudge of [0.0, p.nudge, -p.nudge]) {
@@ -79,7 +79,7 @@ function cellLyingInH(p, on) {
   return false;
 }
 
-// section._touching: the vertices on H, the edges lying in H; dim 2 / 1 / 0, or -1 missed.
+// section.touching: the vertices on H, the edges lying in H; dim 2 / 1 / 0, or -1 missed.
 function touching(p, x, on) {
   const vert = new Int32Array(p.V).fill(-1);
   const pts = [];
@@ -264,7 +264,7 @@ function windingVolume(p, vertices, pts, sp, sd, sf, uf, segFace, two) {
   return pairwiseSum(terms, 0, terms.length) / 6.0;
 }
 
-// slicetables._scaled_volume: times unit**3, one factor at a time.
+// slicetables.scaled_volume: times unit**3, one factor at a time.
 function scaledVolume(p, v) {
   return p.unit === 1.0 ? v : v * p.unit * p.unit * p.unit;
 }
