@@ -81,10 +81,11 @@ That is geometry, not a promise a source has to make.
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 
 import numpy as np
@@ -94,6 +95,7 @@ from ..geometry.catalogue import polytope as get_polytope
 from ..geometry.mesh import Polytope
 from ..geometry.regular import POLYTOPE_NAMES
 from ..geometry.slicing.polytope_slice import slice_polytope
+from ..geometry.slicing.tables import Slice
 from .field_labels import axis_names, coordinate_text
 
 __all__ = [
@@ -103,6 +105,8 @@ __all__ = [
     "PolytopeSource",
     "as_source",
     "check_slice",
+    "as_slice",
+    "PolytopeSlice",
     "BadSlice",
     "data_w_text",
     "note_matrix",
@@ -193,22 +197,24 @@ class SliceData:
     readout: tuple = ()
     convex: bool = False
     show_points: bool = True
-    extra: Mapping = field(default_factory=dict)
     corner_only: np.ndarray | None = None
 
     def turned(self, rotation) -> "SliceData":
-        """The same slice turned by the 3-D ``rotation`` (3, 3): points and normals turned, rest shared.
+        """The same slice turned by the 3-D ``rotation`` (3, 3): points and normals turned, every
+        other field kept (a subclass turns what else it must: a stack's slices about their centres).
 
         The slice at ``R3 @ matrix`` equals the slice at ``matrix`` turned by R3 when R3 leaves w
         alone, so a view can turn what it shows without slicing again.
         """
-        r = np.asarray(rotation, dtype=np.float64)
-        if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9):
-            raise ValueError(f"Expected `rotation` to be a (3, 3) rotation matrix, got shape {r.shape}")
-        normals = None if self.normals is None else self.normals @ r.T
-        return SliceData.build(self.points @ r.T, self.segments, self.triangles, self.groups, normals=normals,
-                               volume=self.volume, readout=self.readout, convex=self.convex,
-                               show_points=self.show_points, extra=self.extra, corner_only=self.corner_only)
+        r = rotation_3d(rotation)
+        return self.replaced(points=self.points @ r.T, normals=None if self.normals is None else self.normals @ r.T)
+
+    def replaced(self, **changes) -> "SliceData":
+        """A copy of the same type with ``changes`` (field name -> value), validated and sealed as
+        `build` does; every other field, a subclass's too, kept as it is."""
+        kept = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        kept.update(changes)
+        return type(self).build(**kept)
 
     @classmethod
     def build(cls, points, segments=None, triangles=None, groups=None, **kwargs) -> "SliceData":
@@ -414,9 +420,44 @@ def check_slice(data, n_groups: int | None = None) -> None:
         raise ValueError("Expected `groups` to be integers >= 0")
     if n_groups is not None and g.size and g.max() >= n_groups:
         raise ValueError(f"Expected `groups` < n_groups = {n_groups}, got {int(g.max())}")
-    vol = getattr(data, "volume", None)
+    if isinstance(data, SliceData):  # any other object: its volume is checked as `as_slice` takes it
+        _check_volume(data.volume)
+
+
+def _check_volume(vol) -> None:
     if vol is not None and not (isinstance(vol, (int, float, np.floating, np.integer)) and math.isfinite(vol)):
         raise ValueError(f"Expected `volume` to be a finite number or None, got {vol!r}")
+
+
+#: A slice's optional members and what a slice without one means (`SliceData`'s defaults).
+_OPTIONAL_MEMBERS = {"normals": None, "volume": None, "readout": (), "convex": False, "show_points": True,
+                     "corner_only": None}
+
+
+def as_slice(data) -> SliceData:
+    """``data`` as a `SliceData`: itself when it is one, else (any object with ``points``,
+    ``segments``, ``triangles`` and ``groups``: a user's source's slice) one built from it, its
+    optional members (``normals``, ``volume``, ``readout``, ``convex``, ``show_points``,
+    ``corner_only``) read here, once, with `SliceData`'s defaults for those it lacks.  Where a
+    slice enters the package (the view, the mesh and picture exports, a stack's pieces) it is made
+    one, so that everything after reads those members directly.  TypeError / ValueError, naming
+    the member, for an object that breaks the protocol (`check_slice`)."""
+    if isinstance(data, SliceData):
+        return data
+    check_slice(data)
+    members = {name: getattr(data, name, default) for name, default in _OPTIONAL_MEMBERS.items()}
+    _check_volume(members["volume"])
+    members["readout"] = tuple(members["readout"] or ())
+    members["convex"], members["show_points"] = bool(members["convex"]), bool(members["show_points"])
+    return SliceData.build(data.points, data.segments, data.triangles, data.groups, **members)
+
+
+def rotation_3d(rotation) -> np.ndarray:
+    """``rotation`` as a (3, 3) float64 rotation matrix; ValueError for anything else."""
+    r = np.asarray(rotation, dtype=np.float64)
+    if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9):
+        raise ValueError(f"Expected `rotation` to be a (3, 3) rotation matrix, got shape {r.shape}")
+    return r
 
 
 # ----------------------------------------------------------------- polytopes
@@ -471,22 +512,12 @@ def census_text(s) -> str:
     return ", ".join(parts)
 
 
+@dataclass(frozen=True, eq=False)
 class PolytopeSlice(SliceData):
-    """`SliceData` of a polytope, keeping the full `Slice` as ``.slice``.
+    """`SliceData` of a polytope, keeping the full `Slice` as ``slice`` (``data.slice.face_census()``,
+    ``.vertices``, ``.cell_ids``, ``.dim`` ...).  `turned` keeps ``slice`` as it is, the unturned cut."""
 
-    Attribute access falls through to the `Slice` (``face_census()``,
-    ``vertices``, ``cell_ids``, ``dim`` ...), so code written for `Slice`
-    keeps working on what the widget shows.
-    """
-
-    def __getattr__(self, name):
-        if name.startswith("__") or name == "slice":
-            raise AttributeError(name)
-        return getattr(self.extra["slice"], name)
-
-    @property
-    def slice(self):
-        return self.extra["slice"]
+    slice: Slice | None = None
 
     def __repr__(self) -> str:
         return f"PolytopeSlice({self.slice!r})"
@@ -494,7 +525,7 @@ class PolytopeSlice(SliceData):
 
 def fill_flags(s):
     """(n,) bool, read-only, True at a `Slice`'s last ``n_fill`` vertices (fill corners), or None."""
-    n_fill = int(getattr(s, "n_fill", 0))
+    n_fill = int(s.n_fill)
     if not n_fill:
         return None
     flags = np.zeros(len(s.vertices), dtype=bool)
@@ -542,7 +573,7 @@ class PolytopeSource:
             volume=_volume_or_none(s),
             readout=(("slice", census_text(s)),) + winding_row(self.polytope),
             convex=bool(self.polytope.convex),  # the slice of a non-convex polytope may be non-convex
-            extra={"slice": s},
+            slice=s,
             corner_only=fill_flags(s),
         )
 

@@ -32,11 +32,13 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import dataclass
 from numbers import Integral, Real
 
 import numpy as np
 
 from ..core import colours, text
+from ..core._arrays import sealed as _sealed
 from ..core.rotation import as_rotation_matrix
 from ..geometry.slicing.polytope_slice import slice_polytope
 from .arrangements import arrangement_layout, check_arrangement
@@ -45,11 +47,13 @@ from .protocol import (
     SliceData,
     SourceAction,
     apply_setting,
+    as_slice,
     as_source,
     census_text,
     data_w_text,
     fill_flags,
     no_volume_row,
+    rotation_3d,
     settings_of,
     takes_coarse,
     w_frame,
@@ -150,33 +154,51 @@ def highlighted_index(n: int) -> int:
 
 
 # ------------------------------------------------------------------ the slice data
+@dataclass(frozen=True, eq=False)
 class StackSliceData(SliceData):
     """`SliceData` of a `StackSource`: N slices placed side by side in one scene.
 
-    ``extra`` holds: ``cuts`` (N,) the w of each slice (also under ``levels``, its old name);
-    ``centres`` (N, 3) and ``scales`` (N,) the placement (source units); ``highlighted`` the
-    index of the slice at w = c0; ``arrangement``; ``spacing``; ``volumes`` (N,) each slice's
-    3-volume (None where it has none); ``point_offsets``, ``segment_offsets``,
-    ``triangle_offsets`` (N + 1,) where slice k's rows start; ``slices`` the inner source's N
-    slice objects (unplaced, unturned);
-    ``group_rgb`` (n_groups, 3) the colours of the groups when coloured by w, else None.
+    cuts : (N,) float64 -- the w of each slice
+    centres : (N, 3) float64, scales : (N,) float64 -- the placement (source units): a point p of
+        slice k is drawn at ``centres[k] + scales[k] * p``
+    highlighted : int -- the index of the slice at w = c0
+    arrangement : str; spacing : float
+    volumes : tuple of N floats or None -- each slice's 3-volume (None where it has none)
+    point_offsets, segment_offsets, triangle_offsets : (N + 1,) intp -- where slice k's rows start
+    slices : tuple -- the inner source's N slices (unplaced, unturned): a polytope's bare `Slice`
+        s, any other source's `SliceData`
+    group_rgb : (n_groups, 3) float64 or None -- the colours of the groups when coloured by w
     """
+
+    cuts: np.ndarray | None = None
+    centres: np.ndarray | None = None
+    scales: np.ndarray | None = None
+    highlighted: int = 0
+    arrangement: str = ""
+    spacing: float = 0.0
+    volumes: tuple = ()
+    point_offsets: np.ndarray | None = None
+    segment_offsets: np.ndarray | None = None
+    triangle_offsets: np.ndarray | None = None
+    slices: tuple = ()
+    group_rgb: np.ndarray | None = None
+
+    def __post_init__(self):
+        for name in ("cuts", "centres", "scales", "point_offsets", "segment_offsets", "triangle_offsets",
+                     "group_rgb"):
+            a = getattr(self, name)
+            if a is not None:
+                object.__setattr__(self, name, _sealed(np.array(a)))  # a copy: never lock the caller's
 
     def turned(self, rotation) -> "StackSliceData":
         """The stack at ``R3 @ matrix``: each slice turned by ``rotation`` (3, 3) about its own centre.
 
-        The layout stays; normals are turned; ``extra["slices"]`` stays unturned.
+        The layout stays; normals are turned; ``slices`` stays unturned.
         """
-        r = np.asarray(rotation, dtype=np.float64)
-        if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9):
-            raise ValueError(f"Expected `rotation` to be a (3, 3) rotation matrix, got shape {r.shape}")
-        off = self.extra["point_offsets"]
-        centre = np.repeat(np.asarray(self.extra["centres"]), np.diff(off), axis=0)
+        r = rotation_3d(rotation)
+        centre = np.repeat(np.asarray(self.centres), np.diff(self.point_offsets), axis=0)
         points = (self.points - centre) @ r.T + centre
-        normals = None if self.normals is None else self.normals @ r.T
-        return type(self).build(points, self.segments, self.triangles, self.groups, normals=normals,
-                                volume=self.volume, readout=self.readout, convex=self.convex,
-                                show_points=self.show_points, extra=self.extra, corner_only=self.corner_only)
+        return self.replaced(points=points, normals=None if self.normals is None else self.normals @ r.T)
 
 
 _SHORT = {3: "tri", 4: "quad", 5: "pent", 6: "hex", 7: "hept", 8: "oct", 9: "non", 10: "dec"}
@@ -446,8 +468,8 @@ class StackSource:
                 return [_PolytopePiece(slice_polytope(self._polytope, matrix, float(cuts[0])), self._polytope)]
             return [_PolytopePiece(s, self._polytope) for s in slice_polytope(self._polytope, matrix, cuts)]
         if coarse:
-            return [self.source.slice(matrix, float(w), coarse=True) for w in cuts]
-        return [self.source.slice(matrix, float(w)) for w in cuts]
+            return [as_slice(self.source.slice(matrix, float(w), coarse=True)) for w in cuts]
+        return [as_slice(self.source.slice(matrix, float(w))) for w in cuts]
 
     def _slice(self, matrix, c0, coarse) -> StackSliceData:
         m = as_rotation_matrix(matrix)
@@ -461,11 +483,11 @@ class StackSource:
         pts, segs, tris, groups, nrms, corners = [], [], [], [], [], []
         p_off, s_off, t_off = [0], [0], [0]
         volumes = []
-        has_normals = all(getattr(p, "normals", None) is not None for p in pieces)
+        has_normals = all(p.normals is not None for p in pieces)
         for k, piece in enumerate(pieces):
             p = np.asarray(piece.points, dtype=np.float64).reshape(-1, 3)
             pts.append(p * scales[k] + centres[k] if n > 1 else p)
-            flags = getattr(piece, "corner_only", None)  # fill corners: no ball
+            flags = piece.corner_only  # fill corners: no ball
             corners.append(np.zeros(len(p), dtype=bool) if flags is None else np.asarray(flags, dtype=bool))
             segs.append(np.asarray(piece.segments, dtype=np.intp).reshape(-1, 2) + p_off[-1])
             t = np.asarray(piece.triangles, dtype=np.intp).reshape(-1, 3)
@@ -473,30 +495,29 @@ class StackSource:
             groups.append(np.full(len(t), k, dtype=np.intp) if by_w else np.asarray(piece.groups, dtype=np.intp))
             if has_normals:
                 nrms.append(np.asarray(piece.normals, dtype=np.float64).reshape(-1, 3))
-            v = getattr(piece, "volume", None)
+            v = piece.volume
             volumes.append(None if v is None else float(v))
             p_off.append(p_off[-1] + len(p))
             s_off.append(s_off[-1] + len(segs[-1]))
             t_off.append(t_off[-1] + len(t))
         hi = highlighted_index(n)
-        extra = {
-            "cuts": cuts, "levels": cuts, "centres": centres, "scales": scales, "highlighted": hi,
-            "arrangement": self._arrangement, "spacing": self.spacing, "volumes": tuple(volumes),
-            "point_offsets": np.array(p_off), "segment_offsets": np.array(s_off),
-            "triangle_offsets": np.array(t_off), "slices": tuple(getattr(p, "data", p) for p in pieces),
-            "group_rgb": self.group_colors(),
-        }
+        placed = dict(
+            cuts=cuts, centres=centres, scales=scales, highlighted=hi, arrangement=self._arrangement,
+            spacing=self.spacing, volumes=tuple(volumes), point_offsets=np.array(p_off),
+            segment_offsets=np.array(s_off), triangle_offsets=np.array(t_off),
+            slices=tuple(p.slice if isinstance(p, _PolytopePiece) else p for p in pieces),
+            group_rgb=self.group_colors(),
+        )
         if n == 1:  # today's view: the inner slice's volume and readout as they are
             return StackSliceData.build(
                 pts[0], segs[0], tris[0], groups[0], normals=nrms[0] if has_normals else None,
-                volume=volumes[0], readout=tuple(getattr(pieces[0], "readout", ())),
-                convex=bool(getattr(pieces[0], "convex", False)),
-                show_points=bool(getattr(pieces[0], "show_points", True)), extra=extra, corner_only=corners[0])
+                volume=volumes[0], readout=tuple(pieces[0].readout), convex=bool(pieces[0].convex),
+                show_points=bool(pieces[0].show_points), corner_only=corners[0], **placed)
         return StackSliceData.build(
             np.concatenate(pts), np.concatenate(segs), np.concatenate(tris), np.concatenate(groups),
             normals=np.concatenate(nrms) if has_normals else None, volume=None,
             readout=self._readout(cuts, pieces, volumes, hi, m), convex=False,
-            show_points=any(bool(getattr(p, "show_points", True)) for p in pieces), extra=extra,
+            show_points=any(bool(p.show_points) for p in pieces), **placed,
             corner_only=np.concatenate(corners) if corners else None)
 
     def _readout(self, cuts, pieces, volumes, hi, m) -> tuple:
@@ -537,7 +558,8 @@ class StackSource:
 
 
 class _PolytopePiece:
-    """A polytope `Slice` seen as slice data (what `PolytopeSource.slice` would give)."""
+    """A polytope `Slice` seen as slice data (what `PolytopeSource.slice` would give: every member
+    of a `SliceData`, made when read)."""
 
     __slots__ = ("slice", "convex", "rows")
 
@@ -555,7 +577,6 @@ class _PolytopePiece:
     readout = property(lambda self: (("slice", census_text(self.slice)),) + self.rows)
     show_points = True
     corner_only = property(lambda self: fill_flags(self.slice))  # as `PolytopeSource.slice` flags them
-    data = property(lambda self: self.slice)
 
 
 def _is_polytope_source(src) -> bool:

@@ -60,7 +60,6 @@ import numbers
 
 import numpy as np
 
-from ...core._arrays import sealed as _sealed
 from ...core.rotation import as_rotation_matrix
 from ...geometry.mesh import check_scale
 from .checks import (
@@ -81,7 +80,7 @@ from .memory import FieldMemory
 from .readout import describe_field, field_readout, order_text, outline_readout
 from .slicing import LastCut, box_slice, slice_offset, slice_samples
 from .stats import FieldStatistics
-from .surface import FieldSliceData, empty_slice, level_surface
+from .surface import CutFrame, FieldSliceData, empty_slice, level_surface
 
 __all__ = ["Field4D", "slice_field"]
 
@@ -384,7 +383,7 @@ class Field4D(FieldLevels, FieldMemory):
         """The slice as the widget draws it (`SliceData`): the isosurface of every level
         (group = level index) and the cut of the data's box as bars.  ``coarse``:
         the in-memory coarse copy at `coarse_resolution` (for held keys).  ``c0`` in the data's w
-        units (`w_frame`).  ``extra["data_frame"]`` records the cut and the field's frame then
+        units (`w_frame`).  Its ``frame`` (a `CutFrame`) records the cut and the field's frame then
         (``matrix``, ``d`` the offset in slice units, ``centre``, ``unit``: a point p is at data
         ``centre + (matrix.T @ (p, d)) * unit``, as `to_data`)."""
         m = as_rotation_matrix(matrix)  # validated once: what follows takes it as it is
@@ -406,19 +405,15 @@ class Field4D(FieldLevels, FieldMemory):
             done, total = self._coarse_copy.progress or (0, 0)
             readout = readout + (("resolution", f"{res} (from the full data: the coarse copy is being built, "
                                                 f"{done}/{total} chunks)"),)
-        frame = {"matrix": _sealed(m.copy()), "d": c0, "centre": _sealed(self._centre.copy()),
-                 "unit": _sealed(self._unit.copy())}
-        return FieldSliceData.assemble(slices, box, readout, frame)
+        return FieldSliceData.assemble(slices, box, readout, CutFrame(m, c0, self._centre, self._unit))
 
     def outline(self, matrix, c0) -> "FieldSliceData":
         """The slice's bars without its surface, and the readout rows that do not depend on it: the
         cut of the data's box at w = ``c0`` after ``matrix``, read from nothing (the source protocol's
         ``outline``: the widget sizes its buffers and ball radius from it, reading no chunk)."""
         m, d = as_rotation_matrix(matrix), self.offset(c0)
-        frame = {"matrix": _sealed(m.copy()), "d": d, "centre": _sealed(self._centre.copy()),
-                 "unit": _sealed(self._unit.copy())}
         return FieldSliceData.assemble((empty_slice(0.0, 0.0),), box := box_slice(self, m, d),
-                                       outline_readout(self, m, d, box), frame)
+                                       outline_readout(self, m, d, box), CutFrame(m, d, self._centre, self._unit))
 
     sample = field_sample  # the cut on a regular 3-D grid, a FieldGrid (defined in grid)
     long_name = None  # the colour bar's label: xarray's attrs["long_name"] (from_xarray, open; inputs._long_name)

@@ -8,6 +8,7 @@ the `SliceData` a `Field4D` gives the widget.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from dataclasses import dataclass
@@ -19,7 +20,7 @@ from skimage.measure import marching_cubes
 from ...core._arrays import sealed as _sealed
 from ..protocol import SliceData
 
-__all__ = ["FieldSlice", "FieldSliceData"]
+__all__ = ["FieldSlice", "FieldSliceData", "CutFrame"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,34 +81,64 @@ def _turned_slice(s: FieldSlice, t: np.ndarray) -> FieldSlice:
                       s.level, s.spacing)
 
 
+@dataclass(frozen=True, eq=False)
+class CutFrame:
+    """Where a field's cut lies in its data: a point p of the cut, ``d`` slice units along the turned
+    w axis from the box's centre, is at data ``centre + (matrix.T @ (p, d)) * unit`` (`Field4D.to_data`).
+
+    matrix : (4, 4) float64 -- the cut's rotation
+    d : float -- the cut's offset, in slice units
+    centre : (4,) float64 -- the data box's centre, in the data's units
+    unit : (4,) float64 -- the data's units per slice unit along x, y, z, w
+    """
+
+    matrix: np.ndarray
+    d: float
+    centre: np.ndarray
+    unit: np.ndarray
+
+    def __post_init__(self):
+        for name in ("matrix", "centre", "unit"):
+            object.__setattr__(self, name, _sealed(np.array(getattr(self, name), dtype=np.float64)))
+        object.__setattr__(self, "d", float(self.d))
+
+    def to_data(self, points) -> np.ndarray:
+        """(n, 4) data coordinates of slice points (n, 3) of this cut."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        return self.centre + (np.column_stack([p, np.full(len(p), self.d)]) @ self.matrix) * self.unit
+
+
+@dataclass(frozen=True, eq=False)
 class FieldSliceData(SliceData):
-    """`SliceData` of a `Field4D`: ``extra["levels"]`` holds one `FieldSlice` per level and
-    ``extra["box"]`` the exact cut of the data's box (a `rot4d_widget.geometry.slicing.Slice`);
-    ``extra["data_frame"]`` the cut's matrix and c0 and the field's centre and units (`Field4D.slice`)."""
+    """`SliceData` of a `Field4D`: ``levels`` holds one `FieldSlice` per level, ``box`` the exact
+    cut of the data's box (a `rot4d_widget.geometry.slicing.Slice`) and ``frame`` the cut's place
+    in the data (a `CutFrame`: the cut's matrix and offset and the field's centre and units,
+    `Field4D.slice`)."""
+
+    levels: tuple = ()
+    box: object = None
+    frame: CutFrame | None = None
 
     def turned(self, t) -> "FieldSliceData":
         """The same slice turned by the 3-D rotation ``t`` (3, 3): the slice at ``T @ matrix``
         when T turns x, y, z only (points and normals ``@ t.T``; nothing is resampled).
-        ``extra["box"]`` stays the unturned cut; ``extra["data_frame"]`` gets the turned matrix."""
+        ``box`` stays the unturned cut; ``frame`` gets the turned matrix."""
         t = np.asarray(t, dtype=np.float64)
         if t.shape != (3, 3) or not np.allclose(t @ t.T, np.eye(3), atol=1e-9):
             raise ValueError(f"Expected `t` to be a (3, 3) rotation, got shape {t.shape}")
-        extra = dict(self.extra)
-        extra["levels"] = tuple(_turned_slice(s, t) for s in self.extra.get("levels", ()))
-        if "data_frame" in extra:  # the slice at T @ matrix (T turning x, y, z only)
+        frame = self.frame
+        if frame is not None:  # the slice at T @ matrix (T turning x, y, z only)
             t4 = np.eye(4)
             t4[:3, :3] = t
-            extra["data_frame"] = {**extra["data_frame"], "matrix": _sealed(t4 @ extra["data_frame"]["matrix"])}
-        return type(self).build(
-            points=self.points @ t.T, segments=self.segments, triangles=self.triangles, groups=self.groups,
-            normals=None if self.normals is None else self.normals @ t.T, volume=self.volume,
-            readout=self.readout, convex=self.convex, show_points=self.show_points, extra=extra)
+            frame = dataclasses.replace(frame, matrix=t4 @ frame.matrix)
+        return self.replaced(points=self.points @ t.T, normals=None if self.normals is None else self.normals @ t.T,
+                             levels=tuple(_turned_slice(s, t) for s in self.levels), frame=frame)
 
     @classmethod
     def assemble(cls, slices, box, readout, frame) -> "FieldSliceData":
         """The slice a `Field4D` gives the widget: the surfaces of ``slices`` (one `FieldSlice` per
-        level, group = level index) and the box's cut ``box`` as bars; ``frame``: the cut's matrix,
-        offset and the field's centre and units (``extra["data_frame"]``)."""
+        level, group = level index) and the box's cut ``box`` as bars; ``frame``: the cut's place in
+        the data (a `CutFrame`)."""
         pts, tris, nrm, groups = [], [], [], []
         off = 0
         for g, s in enumerate(slices):
@@ -127,7 +158,7 @@ class FieldSliceData(SliceData):
             groups=np.concatenate(groups), normals=np.concatenate(nrm),
             volume=_representable(slices[0]) if len(slices) == 1 else None,
             readout=readout, convex=False, show_points=False,
-            extra={"levels": slices, "box": box, "data_frame": frame},
+            levels=tuple(slices), box=box, frame=frame,
         )
 
 
