@@ -196,7 +196,7 @@ def check_slice(p: Polytope, s, v: np.ndarray, e: np.ndarray, m: np.ndarray, c0:
     scale = float(np.max(np.linalg.norm(v, axis=1)))
     tol = POINT_TOL * scale
     allpts = np.asarray(s.vertices, dtype=float)
-    nfill = int(getattr(s, "n_fill", 0))  # extra corners of a non-convex section's fill, after the points
+    nfill = int(s.n_fill)  # extra corners of a non-convex section's fill, after the points
     pts, fill = allpts[: len(allpts) - nfill], allpts[len(allpts) - nfill :]
     want = crossings(v, e, m, c0, 1e-9 * scale)
     if not np.all(np.isfinite(allpts)):

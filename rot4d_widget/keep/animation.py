@@ -132,8 +132,9 @@ _PREPARE_KEYS = ("levels", "inside", "caps", "slices", "spacing", "arrangement",
 
 
 def _data_bytes(data) -> int:
-    return sum(int(getattr(np.asarray(getattr(data, name, ())), "nbytes", 0))
-               for name in ("points", "segments", "triangles", "groups", "normals"))
+    """The bytes of a stack's slice (`SliceData`) kept: its arrays."""
+    return sum(0 if a is None else int(np.asarray(a).nbytes)
+               for a in (data.points, data.segments, data.triangles, data.groups, data.normals))
 
 
 def render_frames(recording: Recording, initial_state=None, source="5-cell", *, per: str = "step",

@@ -23,7 +23,8 @@ import numpy as np
 
 from ..core import colours
 from ..geometry.slicing.tables import Slice
-from ..sources.protocol import SliceData
+from ..sources.protocol import PolytopeSlice, SliceData, as_slice
+from ..sources.tomography import StackSliceData
 
 #: What trimesh's writers keep of a `slice_mesh`, by extension.  Vertices are written as
 #: float32 by every format (float64 in none).
@@ -40,14 +41,12 @@ MESH_FORMATS = {
 }
 
 # ============================================================================ meshes
-def _is_stack_data(data) -> bool:
-    ex = getattr(data, "extra", None) or {}
-    return "triangle_offsets" in ex and "centres" in ex
+def _field_slice_types():
+    """(`FieldSlice`, `FieldSliceData`), imported when a mesh is made."""
+    # sources.field.surface imports scikit-image: imported when a mesh is made, not with keep
+    from ..sources.field.surface import FieldSlice, FieldSliceData
 
-
-def _is_field_data(data) -> bool:
-    ex = getattr(data, "extra", None) or {}
-    return "levels" in ex and "box" in ex
+    return FieldSlice, FieldSliceData
 
 
 def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
@@ -66,10 +65,10 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
     if group_colors is not None:
         palette = np.array([colours.as_rgb(c, f"group_colors[{i}]") for i, c in enumerate(group_colors)],
                            dtype=np.float64).reshape(-1, 3)
-    elif _is_stack_data(data) and data.extra.get("group_rgb") is not None:
-        palette = np.asarray(data.extra["group_rgb"], dtype=np.float64)
-    elif _is_field_data(data) and len(data.extra["levels"]):
-        levels = [s.level for s in data.extra["levels"]]
+    elif isinstance(data, StackSliceData) and data.group_rgb is not None:
+        palette = np.asarray(data.group_rgb, dtype=np.float64)
+    elif isinstance(data, _field_slice_types()[1]) and len(data.levels):
+        levels = [s.level for s in data.levels]
         palette = colours.level_colors(levels, min(levels), max(levels))
     else:
         palette = colours.group_palette(n).astype(np.float64)
@@ -78,62 +77,45 @@ def face_colors(data, *, color_by="group", group_colors=None) -> np.ndarray:
     return palette[groups].reshape(-1, 3)
 
 
-def _as_slice_data(obj):
-    """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; else as is."""
-    # sources.field.surface imports scikit-image: only a bare field slice needs it
-    from ..sources.field.surface import FieldSlice
-
+def _as_slice_data(obj) -> SliceData:
+    """A bare `Slice` (slice_polytope) or `FieldSlice` (slice_field) as slice data; any other slice
+    (a user's source's too) as `as_slice` makes it."""
+    FieldSlice, _ = _field_slice_types()
     # The two class tests left in keep/: they name the slicers' bare results (geometry's `Slice`,
     # `slice_field`'s `FieldSlice`), not source kinds -- any source's own slice is used as it is.
     if isinstance(obj, Slice):
-        return SliceData.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells,
-                               volume=None if obj.volume is None else float(obj.volume), extra={"slice": obj})
+        return PolytopeSlice.build(obj.vertices, obj.edges, obj.triangles, obj.triangle_cells,
+                                   volume=None if obj.volume is None else float(obj.volume), slice=obj)
     if isinstance(obj, FieldSlice):
         return SliceData.build(obj.vertices, None, obj.triangles, None, volume=float(obj.volume))
-    return obj
+    try:
+        return as_slice(obj)
+    except TypeError:
+        raise TypeError(
+            "Expected slice data (what a source's slice(matrix, c0) returns: points, triangles, groups), "
+            f"got {type(obj).__name__}"
+        ) from None
 
 
 def _data_frame(data):
-    """(matrix (4, 4), d, centre (4,), unit (4,)) of what a slice offers as ``extra["data_frame"]``
-    (a `Field4D`'s: a point p of the cut, d slice units along the turned w axis from the box's
-    centre, is at data ``centre + (matrix.T @ (p, d)) * unit``), or
-    None when it offers none, or not a usable one."""
-    ex = getattr(data, "extra", None)
-    fr = ex.get("data_frame") if isinstance(ex, Mapping) else None
-    if not isinstance(fr, Mapping):
+    """The `CutFrame` of a field's slice (where its points are in the data), or None for any other
+    slice or a frame that is not a usable one (non-finite, units not > 0)."""
+    fr = data.frame if isinstance(data, _field_slice_types()[1]) else None
+    if fr is None or not (np.all(np.isfinite(fr.matrix)) and math.isfinite(fr.d) and np.all(np.isfinite(fr.centre))
+                          and np.all(np.isfinite(fr.unit)) and np.all(fr.unit > 0)):
         return None
-    try:
-        m = np.asarray(fr["matrix"], dtype=np.float64)
-        c0 = float(fr["d"])
-        centre = np.asarray(fr["centre"], dtype=np.float64)
-        unit = np.asarray(fr["unit"], dtype=np.float64)
-    except (KeyError, TypeError, ValueError):
-        return None
-    if m.shape != (4, 4) or centre.shape != (4,) or unit.shape != (4,):
-        return None
-    if not (np.all(np.isfinite(m)) and math.isfinite(c0) and np.all(np.isfinite(centre))
-            and np.all(np.isfinite(unit)) and np.all(unit > 0)):
-        return None
-    return m, c0, centre, unit
-
-
-def _to_data(points, frame) -> np.ndarray:
-    """(n, 4) data coordinates of slice points (n, 3) in a `_data_frame`."""
-    m, c0, centre, unit = frame
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return centre + (np.column_stack([p, np.full(len(p), c0)]) @ m) * unit
+    return fr
 
 
 def _data_coordinates(data, n_points):
     """(xyzw (n, 4) per point, or None; (scale (3,), shift (3,)) to the data's frame, or None).
 
     A slice with a data frame (a field's): its points' data coordinates.  A stack: each slice's
-    points from its own slice's frame (``extra["slices"]``, row for row), when every slice has one.
+    points from its own slice's frame (``data.slices``, row for row), when every slice has one.
     """
-    if _is_stack_data(data):
-        ex = data.extra
-        pieces = ex.get("slices") or ()
-        off = np.asarray(ex.get("point_offsets", ()), dtype=np.intp)
+    if isinstance(data, StackSliceData):
+        pieces = data.slices
+        off = np.asarray(data.point_offsets, dtype=np.intp)
         frames = [_data_frame(pc) for pc in pieces]
         if not pieces or len(off) != len(pieces) + 1 or off[-1] != n_points or any(f is None for f in frames):
             return None, None
@@ -142,44 +124,36 @@ def _data_coordinates(data, n_points):
             pts = np.asarray(pc.points, dtype=np.float64).reshape(-1, 3)
             if len(pts) != off[k + 1] - off[k]:
                 return None, None
-            out[off[k]:off[k + 1]] = _to_data(pts, fr)
-        return out, (frames[0][3][:3], frames[0][2][:3])
+            out[off[k]:off[k + 1]] = fr.to_data(pts)
+        return out, (frames[0].unit[:3], frames[0].centre[:3])
     fr = _data_frame(data)
     if fr is None:
         return None, None
-    return _to_data(data.points, fr), (fr[3][:3], fr[2][:3])
+    return fr.to_data(data.points), (fr.unit[:3], fr.centre[:3])
 
 
 def _one_mesh_arrays(data, color_by, group_colors):
     """vertices (n, 3), faces (k, 3), rgb (k, 3), attributes {name: (k,)}, volume or None, kind,
     data coordinates (n, 4) or None, (scale, shift) to the data's frame or None."""
     data = _as_slice_data(data)
-    try:
-        points = np.asarray(data.points, dtype=np.float64).reshape(-1, 3)
-        tris = np.asarray(data.triangles, dtype=np.intp).reshape(-1, 3)
-        groups = np.asarray(data.groups, dtype=np.intp).reshape(-1)
-    except AttributeError:
-        raise TypeError(
-            "Expected slice data (what a source's slice(matrix, c0) returns: points, triangles, groups), "
-            f"got {type(data).__name__}"
-        ) from None
+    points = np.asarray(data.points, dtype=np.float64).reshape(-1, 3)
+    tris = np.asarray(data.triangles, dtype=np.intp).reshape(-1, 3)
+    groups = np.asarray(data.groups, dtype=np.intp).reshape(-1)
     rgb = face_colors(data, color_by=color_by, group_colors=group_colors)
     attrs = {"group": groups}
-    if _is_stack_data(data):
-        ex = data.extra
-        toff = np.asarray(ex["triangle_offsets"])
+    if isinstance(data, StackSliceData):
+        toff = np.asarray(data.triangle_offsets)
         attrs["slice"] = np.repeat(np.arange(len(toff) - 1), np.diff(toff))
-        scales = np.asarray(ex["scales"], dtype=np.float64)
-        vols = ex.get("volumes", ())  # each slice drawn scaled by scales[k] (1 for a single slice)
+        scales = np.asarray(data.scales, dtype=np.float64)
+        vols = data.volumes  # each slice drawn scaled by scales[k] (1 for a single slice)
         volume = None if any(v is None for v in vols) else float(sum(s**3 * v for s, v in zip(scales, vols)))
         kind = "stack"
-    elif _is_field_data(data):
-        volume = float(sum(s.volume for s in data.extra["levels"]))
+    elif isinstance(data, _field_slice_types()[1]):
+        volume = float(sum(s.volume for s in data.levels))
         kind = "field"
     else:
-        v = getattr(data, "volume", None)
-        volume = None if v is None else float(v)
-        kind = "polytope" if hasattr(data, "extra") and "slice" in data.extra else "slice"
+        volume = None if data.volume is None else float(data.volume)
+        kind = "polytope" if isinstance(data, PolytopeSlice) else "slice"
     xyzw, to_frame = _data_coordinates(data, len(points))
     return points, tris, rgb, attrs, volume, kind, xyzw, to_frame
 
@@ -209,8 +183,9 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
         `colours.FACE_OPACITY`).
     frame : "data" (default) or "view"
         Where a slice that knows its data coordinates (a `Field4D`'s, a stack of them: any slice
-        data whose ``extra["data_frame"]`` gives the cut's ``matrix``, offset ``d`` and the data's
-        ``centre`` and ``unit``, see `rot4d_widget.sources.field.container.Field4D.slice`) puts its vertices.
+        data whose ``frame``, a `rot4d_widget.sources.field.surface.CutFrame`, gives the cut's ``matrix``,
+        offset ``d`` and the data's ``centre`` and ``unit``, see
+        `rot4d_widget.sources.field.container.Field4D.slice`) puts its vertices.
         ``"data"``: in the data's units at the data's place -- the view's 3-D picture scaled by
         the data's units of x, y, z (1 for a field) and moved by the data box's centre, so at
         rest (identity orientation) a vertex is at its data (x, y, z).  After a turn the 3
@@ -230,8 +205,8 @@ def slice_mesh(data, *, color_by="group", group_colors=None, separate_groups: bo
       (``frame="data"``, above), or with ``frame="view"`` its *slice units* -- x, y, z in the
       data's units about the centre of its box, the w axis counted in units of
       ``field.w_per_unit`` (a turn mixes them); a stack in its inner source's units, slice k
-      moved to its place and shrunk by its scale (``data.extra["centres"]``,
-      ``data.extra["scales"]``) as in the view -- with ``frame="data"`` a stack of field slices
+      moved to its place and shrunk by its scale (``data.centres``,
+      ``data.scales``) as in the view -- with ``frame="data"`` a stack of field slices
       keeps that layout, moved as a whole by the data box's centre (so one slice is placed as
       a field's).
     * ``mesh.vertex_attributes["data_xyzw"]`` (n, 4) float64, when every slice knows its data

@@ -16,6 +16,7 @@ from ...core import colours
 from ...core.sizes import REFERENCE_RADIUS
 from ...sources.field_labels import axis_names
 from ...sources.protocol import c0_text
+from ...sources.tomography import StackSliceData
 from .slice_drawing import CAMERA_DISTANCE, CAMERA_FOV, Z_LABEL, perspective
 
 # --------------------------------------------------------------------------- framing and annotation
@@ -134,7 +135,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
     levels = tuple(getattr(inner, "levels", ()) or ())
     if levels:
         lines.append(("level " if len(levels) == 1 else "levels ") + ", ".join(f"{v:.4g}" for v in levels) + u)
-    rows = dict(tuple(r) for r in (getattr(data, "readout", ()) or ()) if len(r) == 2)
+    rows = dict(tuple(r) for r in (data.readout or ()) if len(r) == 2)
     if "w cut" in rows:
         lines.append(f"w cut {rows['w cut']}")
     elif "slice" in rows:
@@ -146,7 +147,7 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
         lines.append(f"{n} slices w = {ws[0]:+.4g} \u2026 {ws[-1]:+.4g}{wu}"
                      + (f", \u0394 = {spacing:.3g}{wu}" if spacing else ""))
     legend = []
-    group_rgb = (getattr(data, "extra", None) or {}).get("group_rgb")
+    group_rgb = data.group_rgb if isinstance(data, StackSliceData) else None
     if len(ws) and group_rgb is not None:
         picks = range(n) if n <= 8 else sorted({0, n // 4, n // 2, (3 * n) // 4, n - 1})
         legend = [(tuple(np.asarray(group_rgb[k], dtype=float)[:3]), f"w = {ws[k]:+.4g}{wu}") for k in picks]
@@ -453,11 +454,9 @@ def seen_from(data, view):
     view = np.asarray(view, dtype=np.float64).reshape(3, 3)
     if np.array_equal(view, np.eye(3)):
         return data
-    extra = {**data.extra, "centres": np.asarray(data.extra["centres"], dtype=np.float64) @ view.T}
     normals = None if data.normals is None else np.asarray(data.normals) @ view.T
-    return type(data).build(np.asarray(data.points) @ view.T, data.segments, data.triangles, data.groups,
-                            normals=normals, volume=data.volume, readout=data.readout, convex=data.convex,
-                            show_points=data.show_points, extra=extra, corner_only=data.corner_only)
+    return data.replaced(points=np.asarray(data.points) @ view.T, normals=normals,
+                         centres=np.asarray(data.centres, dtype=np.float64) @ view.T)
 
 
 #: A fitted frame with box labels grows by this factor at a time until every label has room.

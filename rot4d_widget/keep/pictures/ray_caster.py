@@ -372,7 +372,7 @@ def cut_grids(stack, data, matrix):
     if not callable(sample):
         raise TypeError(f"A volume rendering needs a source sampled on a grid (a Field4D: `sample`), "
                         f"got {type(inner).__name__}")
-    return [sample(matrix, float(w)) for w in np.asarray(data.extra["cuts"], dtype=np.float64)]
+    return [sample(matrix, float(w)) for w in np.asarray(data.cuts, dtype=np.float64)]
 
 
 def grids_clim(grids) -> tuple:
@@ -392,8 +392,7 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
     cuts (`grids_clim`).  ``progress``: as `render_grid`'s, one bar for the sampling and every
     slice.  Returns the ``AxesImage``, whose ``get_clim()`` is the (lo, hi) coloured (None when
     no cut meets the data)."""
-    ex = data.extra
-    n = len(ex["cuts"])
+    n = len(data.cuts)
     tick, close = _progress_sink(progress, f"rendering the cut ({rendering})")
     try:
         if grids is None:
@@ -402,8 +401,8 @@ def draw_volume(ax, stack, data, matrix, rendering: str, *, size, cmap="viridis"
         if clim is None:
             clim = grids_clim(grids)
         scale = REFERENCE_RADIUS / stack.size  # source units -> displayed units (the live view's)
-        centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
-        scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+        centres = np.asarray(data.centres, dtype=np.float64).reshape(-1, 3)
+        scales = np.asarray(data.scales, dtype=np.float64).ravel()
         limits = (tuple(ax.get_xlim()), tuple(ax.get_ylim()))
         depth = centres[:, 2] if view is None else (centres @ np.asarray(view, dtype=np.float64).reshape(3, 3).T)[:, 2]
         order = np.argsort(depth, kind="stable") if n > 1 else np.arange(n)

@@ -347,14 +347,14 @@ def draw_slice(
 
 def _n_balls(slice, n_points: int) -> int:
     """Balls drawn: every vertex but the last ``n_fill`` (fill corners of non-convex sections)."""
-    return n_points - int(getattr(slice, "n_fill", 0))
+    return n_points - int(slice.n_fill)
 
 
 def _face_patches(slice, xy, z, colormap):
     """``(corners (k, 2), rgba, depth)`` per face patch: a convex slice's polygons with corners
     ordered by angle about their projected centroid; a slice with fill corners (``n_fill`` > 0:
     its non-convex sections are even-odd filled) its triangles, coloured by ``triangle_cells``."""
-    if int(getattr(slice, "n_fill", 0)):
+    if int(slice.n_fill):
         tri = np.asarray(slice.triangles, dtype=np.int64).reshape(-1, 3)
         if not len(tri):
             return []
@@ -420,7 +420,7 @@ def slice_collection(slice: Slice, *, scale: float, ball_radius: float, bar_radi
     # a slice with fill corners: its triangles (as draw_slice)
     off = np.asarray(slice.polygon_offsets, dtype=np.int64)
     lens = np.diff(off)
-    if int(getattr(slice, "n_fill", 0)):
+    if int(slice.n_fill):
         for corners, rgba, depth in _face_patches(slice, xy, z, cmap):
             paths.append(Path(np.concatenate([corners, corners[:1]]), _closed_codes(len(corners))))
             face.append((*rgba[:3], face_alpha))

@@ -175,14 +175,13 @@ def render_tomography(
     view = view_rotation(camera.default_eye(rendering) if eye is None else eye)
     cut = data  # the slice in the scene's coordinates (labels, grids); `data` as the camera sees it
     data = seen_from(data, view)
-    ex = data.extra
     n = src.slices
     scale = REFERENCE_RADIUS / src.size  # source units -> displayed units (the live view's)
-    centres = np.asarray(ex["centres"]) * scale
-    scales = np.asarray(ex["scales"])
-    cuts = np.asarray(ex["cuts"])
-    hi = int(ex["highlighted"])
-    group_rgb = ex.get("group_rgb")
+    centres = np.asarray(data.centres) * scale
+    scales = np.asarray(data.scales)
+    cuts = np.asarray(data.cuts)
+    hi = int(data.highlighted)
+    group_rgb = data.group_rgb
 
     top = TITLE_HEIGHT if title else 0.0
     right = colorbar_width(height) if colorbar and (field or volume) else 0.0
@@ -220,7 +219,7 @@ def render_tomography(
             (x0, x1), (y0, y1) = below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
     box_text = None  # a single field's box labels: ``(labels, extent)`` of the data's extent
     if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
-        extent = _slice_box(cut, data.extra["point_offsets"], data.extra["segment_offsets"])
+        extent = _slice_box(cut, data.point_offsets, data.segment_offsets)
         if extent is not None:  # the data's extent, never the padded sampling grid
             box_text = (box_labels(inner, matrix, c0, extent), extent.corners)
     if box_text is not None and box is not None:  # a fitted frame: out until every label has room
@@ -233,9 +232,9 @@ def render_tomography(
         ax.set_aspect("equal")
 
     poly = getattr(src.source, "polytope", None)
-    offs = np.asarray(ex["point_offsets"])
-    toff = np.asarray(ex["triangle_offsets"])
-    soff = np.asarray(ex["segment_offsets"])
+    offs = np.asarray(data.point_offsets)
+    toff = np.asarray(data.triangle_offsets)
+    soff = np.asarray(data.segment_offsets)
     # back to front by the depth of each slice's centre; zorders of slices never interleave
     jobs = []  # labels, placed after every slice is drawn
     for rank, k in enumerate(np.argsort(centres[:, 2], kind="stable")):
@@ -243,11 +242,11 @@ def render_tomography(
         ball = base_ball * scales[k] if ball_radius is None else ball_radius
         bar = sizes.default_bar_radius(ball) if bar_radius is None else bar_radius
         if poly is not None:
-            s = ex["slices"][k]
-            vertices = np.asarray(s.vertices) * scales[k] + np.asarray(cut.extra["centres"][k]) if n > 1 else s.vertices
+            s = data.slices[k]
+            vertices = np.asarray(s.vertices) * scales[k] + np.asarray(cut.centres[k]) if n > 1 else s.vertices
             placed = Slice(np.asarray(vertices, dtype=np.float64) @ view.T if data is not cut else vertices,
                            s.edges, s.polygon_indices, s.polygon_offsets, s.cell_ids, s.triangles, s.triangle_cells,
-                           s.volume, s.dim, n_fill=int(getattr(s, "n_fill", 0)))
+                           s.volume, s.dim, n_fill=s.n_fill)
             if palette is not None:
                 cmap = ListedColormap(palette)
             else:
