@@ -45,7 +45,7 @@ import numpy as np
 
 from ..core.colours import as_rgb, cell_palette, group_palette
 from ..core.rotation import random_rotation
-from ..sources.protocol import BadSlice, outline_of
+from ..sources.protocol import BadSlice, as_slice, outline_of
 
 __all__ = [
     "ROW_FLOATS",
@@ -104,13 +104,13 @@ HEADROOM = 0.125
 
 def _shown(data):
     """(n,) bool: the points that get a ball, or None for all of them (``show_points`` aside)."""
-    corner = getattr(data, "corner_only", None)
+    corner = data.corner_only
     return None if corner is None else ~np.asarray(corner, dtype=bool)
 
 
 def ball_count(data) -> int:
     """Balls a slice draws: its points, less the fill corners (``corner_only``); 0 without ``show_points``."""
-    if not getattr(data, "show_points", True):
+    if not data.show_points:
         return 0
     shown = _shown(data)
     return len(data.points) if shown is None else int(shown.sum())
@@ -122,7 +122,7 @@ def rows_needed(data) -> int:
     A smooth surface's triangles (a slice with ``normals``) travel in the surface
     layer (`surface_arrays`), not in rows: they do not count.
     """
-    n_triangles = 0 if getattr(data, "normals", None) is not None else len(data.triangles)
+    n_triangles = 0 if data.normals is not None else len(data.triangles)
     return max(ball_count(data), len(data.segments), n_triangles)
 
 
@@ -143,7 +143,7 @@ def update_bytes(data) -> int:
     """The bytes a slice's update carries (rows at `ROW_BYTES`, a smooth surface's 12 per point and
     12 per triangle), before any is built: what `check_update_size` holds to the cap."""
     n = rows_needed(data) * ROW_BYTES
-    if getattr(data, "normals", None) is not None:
+    if data.normals is not None:
         n += 12 * (len(data.points) + len(data.triangles))
     return n
 
@@ -175,7 +175,7 @@ def estimate_capacity(source, samples: int = 6, seed: int = 0, *, name: str = "t
     rng = np.random.default_rng(seed)
     most = 0
     for _ in range(int(samples)):
-        data = outline_of(source, random_rotation(rng), 0.0)
+        data = as_slice(outline_of(source, random_rotation(rng), 0.0))
         check_update_size(data, name=name)
         most = max(most, rows_needed(data))
     return capacity_for(most)
@@ -221,7 +221,7 @@ def slice_rows(
         raise ValueError(f"Expected `triangles` to have shape (k, 3), got {t.shape}")
     if tc.shape != (len(t),):
         raise ValueError(f"Expected `groups` to have shape ({len(t)},), got {tc.shape}")
-    shown = _shown(data) if getattr(data, "show_points", True) else np.zeros(len(v), dtype=bool)
+    shown = _shown(data) if data.show_points else np.zeros(len(v), dtype=bool)
     if shown is not None and shown.shape != (len(v),):
         raise ValueError(f"Expected `corner_only` to have one flag per point ({len(v)}), got {shown.shape}")
     nv = len(v) if shown is None else int(shown.sum())
@@ -253,7 +253,7 @@ def slice_rows(
     p = v * float(scale)
     if eye is not None and nt:
         corners = p[t]  # (k, 3, 3)
-        if getattr(data, "convex", False):
+        if data.convex:
             a = corners[:, 0]
             normal = np.cross(corners[:, 1] - a, corners[:, 2] - a)
             facing = np.einsum("ij,ij->i", normal, o - a) > 0.0
@@ -277,6 +277,7 @@ class _NoTriangles:
     """A slice's points and segments only (its triangles go to the surface layer)."""
 
     __slots__ = ("points", "segments", "triangles", "groups", "convex", "show_points")
+    normals = corner_only = None  # the surface layer has the normals; the rows every point
 
     def __init__(self, data):
         self.points = data.points
@@ -284,7 +285,7 @@ class _NoTriangles:
         self.triangles = np.zeros((0, 3), dtype=np.intp)
         self.groups = np.zeros(0, dtype=np.intp)
         self.convex = False
-        self.show_points = getattr(data, "show_points", True)
+        self.show_points = data.show_points
 
 
 def without_triangles(data):

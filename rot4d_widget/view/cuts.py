@@ -57,7 +57,7 @@ def _part(grid, lo_shift, scale):
 def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
     """The cut w = ``c0`` after ``matrix`` on grids, placed as the view places the slice: a single
     field's grid scaled by ``scale`` (source units -> displayed units); a stack's slices each at
-    its centre and scale (``extra["cuts"]``, ``"centres"``, ``"scales"`` of the stack's slice, as
+    its centre and scale (``cuts``, ``centres``, ``scales`` of the stack's slice, as
     the static renders place them).  ``lock`` guards the source while it is read."""
     inner = inner_source(source)
     with lock:
@@ -70,16 +70,16 @@ def grid_cut(source, matrix, c0, coarse: bool, lock, scale: float) -> GridCut:
             data = SliceData.build(pts, segs, show_points=False, readout=rows)
             return GridCut(data, (_part(grid, np.zeros(3), scale),), (grid,))
         sliced = source.slice(matrix, c0, coarse=True) if coarse else source.slice(matrix, c0)
-        ex = sliced.extra
-        cuts = np.asarray(ex["cuts"], dtype=np.float64)
-        centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
-        scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+        cuts = np.asarray(sliced.cuts, dtype=np.float64)
+        centres = np.asarray(sliced.centres, dtype=np.float64).reshape(-1, 3)
+        scales = np.asarray(sliced.scales, dtype=np.float64).ravel()
         res = getattr(inner, "coarse_resolution" if coarse else "resolution", 64)
         res = max(8, min(int(res), int(round((STACK_NODES / max(len(cuts), 1)) ** (1.0 / 3.0)))))
         grids = tuple(_sample(inner, matrix, float(w), res, coarse) for w in cuts)
     parts = tuple(_part(g, scale * centres[k], scale * scales[k]) for k, g in enumerate(grids))
-    data = SliceData.build(sliced.points, sliced.segments, show_points=False, readout=sliced.readout,
-                           extra=sliced.extra)
+    # the stack's placement kept (its labels); no faces, no balls: the picture is the grids'
+    data = sliced.replaced(triangles=None, groups=None, normals=None, volume=None, convex=False, show_points=False,
+                           corner_only=None)
     return GridCut(data, parts, grids)
 
 
@@ -151,13 +151,12 @@ def cut_labels(source, matrix, c0, data) -> CutLabels:
 
 
 def _slice_labels(stack, matrix, c0, data) -> CutLabels:
-    """A stack's labels: under each slice (its centre and scale, ``data.extra``), the w it cuts at in
+    """A stack's labels: under each slice (its centre and scale, ``data.centres``, ``data.scales``), the w it cuts at in
     the data's own units (`data_w_text`: "time 0.0025 s", "(outside the data)" for a slice that
     misses it), kind "slice" -- every slice carries its w, an empty one too."""
-    ex = data.extra
-    cuts = np.asarray(ex["cuts"], dtype=np.float64)
-    centres = np.asarray(ex["centres"], dtype=np.float64).reshape(-1, 3)
-    scales = np.asarray(ex["scales"], dtype=np.float64).ravel()
+    cuts = np.asarray(data.cuts, dtype=np.float64)
+    centres = np.asarray(data.centres, dtype=np.float64).reshape(-1, 3)
+    scales = np.asarray(data.scales, dtype=np.float64).ravel()
     if len(cuts) < 2:
         return CutLabels()
     radius = float(inner_source(stack).size)

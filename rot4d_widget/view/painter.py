@@ -13,7 +13,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core import colours
-from ..sources.protocol import BadSlice, c0_text, check_slice, data_w_text, inner_source, known_range, outline_of
+from ..sources.protocol import (
+    BadSlice,
+    as_slice,
+    c0_text,
+    check_slice,
+    data_w_text,
+    inner_source,
+    known_range,
+    outline_of,
+)
 from . import markup as ro
 from .buffers import check_update_size
 from .cuts import can_sample, cut_labels, grid_cut, rendering_rows
@@ -81,6 +90,7 @@ def checked_slice(source, matrix, c0, coarse, lock, *, outline: bool = False):
         n_groups = int(source.n_groups)
     try:
         check_slice(data, n_groups)
+        data = as_slice(data)  # a user's slice object made a `SliceData`: read as one from here on
     except (TypeError, ValueError) as exc:
         raise BadSlice(f"{title(source)}.slice(matrix, c0={c0:.6g}) returned a bad slice: {exc}") from None
     check_update_size(data, name=title(source))
@@ -368,7 +378,7 @@ class Painter:
                                  text=c0_text(inner_source(source), st.c0))),
             ("last", last),
         ]
-        rows += [(k, str(v)) for k, v in getattr(data, "readout", ())]
+        rows += [(k, str(v)) for k, v in data.readout]
         cast = self.cast_shown
         single = inner_source(source) is source
         if cast and single and self.labelled:  # what the ray-cast picture shows, and where its planes are
@@ -382,7 +392,7 @@ class Painter:
         bar = self.colourbar(colors if labels is not None and single else None)
         if bar:
             rows.append(("colour", bar))
-        volume = getattr(data, "volume", None)
+        volume = data.volume
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
         elif cast and single and getattr(inner_source(source), "levels", None):

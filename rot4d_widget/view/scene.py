@@ -334,7 +334,7 @@ class Scene:
         if self._closed:
             raise RuntimeError("this Scene is closed")
         bf.check_update_size(data, volume=volume)  # before anything is built
-        smooth = getattr(data, "normals", None) is not None
+        smooth = data.normals is not None
         surface = None
         if smooth:  # the triangles go to the surface layer, quantised; the rows carry the rest
             arrays = bf.surface_arrays(data, scale=self.scale, eye=self.eye, single_rgb=single_rgb,
