@@ -22,13 +22,16 @@ from rot4d_widget.sources.protocol import PolytopeSource, SliceData
 
 
 def fake_slice(n_points=5, n_segments=7, n_triangles=4, n_groups=3, seed=0):
-    """A slice object with only the protocol's four required members (no convex / show_points)."""
+    """A slice's members as a `SliceData` has them (the optional ones at their defaults: what
+    `as_slice` makes of a slice with only the four required ones), unvalidated and writable, so a
+    test can hand the buffers a bad shape."""
     rng = np.random.default_rng(seed)
     return SimpleNamespace(
         points=rng.standard_normal((n_points, 3)),
         segments=rng.integers(0, max(n_points, 1), (n_segments, 2)).astype(np.intp),
         triangles=rng.integers(0, max(n_points, 1), (n_triangles, 3)).astype(np.intp),
         groups=rng.integers(0, n_groups, n_triangles).astype(np.intp),
+        normals=None, volume=None, readout=(), convex=False, show_points=True, corner_only=None,
     )
 
 

@@ -38,7 +38,7 @@ def _field(**kw):
 
 
 def _radii(data):
-    return np.linalg.norm(data.extra["levels"][0].vertices, axis=1)
+    return np.linalg.norm(data.levels[0].vertices, axis=1)
 
 
 def test_at_rest_c0_is_the_data_s_time():
@@ -50,7 +50,7 @@ def test_at_rest_c0_is_the_data_s_time():
         assert np.abs(r - radius(t)).max() < 0.02, t  # the sphere of that time
         s = slice_field(f, np.eye(4), t, 0.0)
         assert abs(s.volume / (4 / 3 * math.pi * radius(t) ** 3) - 1) < 0.03
-    assert f.slice(np.eye(4), 31.0).extra["levels"][0].empty  # after the data's last time: nothing
+    assert f.slice(np.eye(4), 31.0).levels[0].empty  # after the data's last time: nothing
     assert dict(f.slice(np.eye(4), 31.0).readout)["w cut"].startswith("none")
 
 
@@ -60,7 +60,7 @@ def test_a_turned_cut_puts_each_vertex_on_the_sphere_of_its_own_time():
     f = _field()
     m = simple_rotation("xw", 0.3)
     data = f.slice(m, 26.0)
-    p = data.extra["levels"][0].vertices
+    p = data.levels[0].vertices
     q = f.to_data(p, m, 26.0)  # x, y, z in m and t in s of each vertex
     inside = (q[:, 3] > 20.2) & (q[:, 3] < 29.8)  # off the caps at the data's first and last time
     assert inside.mean() > 0.8
@@ -110,7 +110,7 @@ def test_stack_cuts_and_labels_are_in_the_data_s_time():
     np.testing.assert_allclose(cuts, [25.0, 26.0, 27.0])  # 1 s apart
     data = src.slice(np.eye(4), 26.0)
     for k, t in enumerate(cuts):
-        assert np.abs(_radii(data.extra["slices"][k]) - radius(t)).max() < 0.02
+        assert np.abs(_radii(data.slices[k]) - radius(t)).max() < 0.02
     labels = [row[0] for row in data.readout][1:4]
     assert labels == ["w 25 s", "\u25b8 w 26 s", "w 27 s"]
     assert data_w_text(src, 26.0) == "w 26 s"

@@ -155,7 +155,7 @@ def field_data():
 
 def test_field_mesh_groups_by_level_and_volume_is_the_field_slices(field_data, tmp_path):
     field, data = field_data
-    levels = data.extra["levels"]
+    levels = data.levels
     mesh = slice_mesh(data)
     assert len(mesh.faces) == sum(len(s.triangles) for s in levels)
     counts = np.bincount(mesh.face_attributes["group"], minlength=2)
@@ -179,20 +179,19 @@ def test_stack_mesh_keeps_the_placement_and_the_slice_of_each_face(tmp_path):
     src = StackSource("24-cell", slices=5, spacing=0.5, arrangement="grid")
     data = src.slice(M, 0.1)
     mesh = slice_mesh(data)
-    ex = data.extra
-    scales = np.asarray(ex["scales"])
-    want = sum(s**3 * v for s, v in zip(scales, ex["volumes"]))
+    scales = np.asarray(data.scales)
+    want = sum(s**3 * v for s, v in zip(scales, data.volumes))
     assert mesh.volume == pytest.approx(want, rel=1e-12)
     assert mesh.metadata["rot4d_widget"]["volume"] == pytest.approx(want, rel=1e-12)
-    toff = np.asarray(ex["triangle_offsets"])
+    toff = np.asarray(data.triangle_offsets)
     np.testing.assert_array_equal(np.bincount(mesh.face_attributes["slice"], minlength=5), np.diff(toff))
     np.testing.assert_array_equal(mesh.face_attributes["group"], mesh.face_attributes["slice"])  # colour by w
     np.testing.assert_array_equal(mesh.visual.face_colors[:, :3],
-                                  np.rint(np.asarray(ex["group_rgb"])[mesh.face_attributes["slice"]] * 255))
+                                  np.rint(np.asarray(data.group_rgb)[mesh.face_attributes["slice"]] * 255))
     # each slice's faces are around its centre in the layout
     for k in range(5):
         v = mesh.vertices[np.unique(mesh.faces[mesh.face_attributes["slice"] == k])]
-        assert np.linalg.norm(v - ex["centres"][k], axis=1).max() <= scales[k] * src.size * (1 + 1e-9)
+        assert np.linalg.norm(v - data.centres[k], axis=1).max() <= scales[k] * src.size * (1 + 1e-9)
     back = _assert_round_trip(mesh, tmp_path / "stack.ply", "ply")
     np.testing.assert_array_equal(back.face_attributes["slice"], mesh.face_attributes["slice"])
 
@@ -204,7 +203,7 @@ def test_a_list_of_slices_is_concatenated_with_an_item_attribute(polytope_data, 
     assert len(mesh.faces) == na + len(b.triangles)
     assert (mesh.face_attributes["item"][:na] == 0).all() and (mesh.face_attributes["item"][na:] == 1).all()
     assert mesh.metadata["rot4d_widget"]["kind"] == "mixed"
-    assert mesh.volume == pytest.approx(a.volume + sum(s.volume for s in b.extra["levels"]), rel=1e-9)
+    assert mesh.volume == pytest.approx(a.volume + sum(s.volume for s in b.levels), rel=1e-9)
     with pytest.raises(ValueError, match="empty sequence"):
         slice_mesh([])
 
@@ -374,7 +373,7 @@ def test_bare_slices_from_the_slicers(field_data):
     mesh = slice_mesh(cut)
     assert mesh.volume == pytest.approx(cut.volume, rel=1e-12)
     np.testing.assert_array_equal(mesh.face_attributes["group"], cut.triangle_cells)
-    fs = field_data[1].extra["levels"][0]
+    fs = field_data[1].levels[0]
     assert slice_mesh(fs).volume == pytest.approx(fs.volume, rel=1e-12)
 
 

@@ -100,7 +100,7 @@ def _assert_same_field(back, field):
         assert len(a.triangles) > 0
         np.testing.assert_array_equal(b.points, a.points)
         np.testing.assert_array_equal(b.triangles, a.triangles)
-        for sa, sb in zip(a.extra["levels"], b.extra["levels"]):
+        for sa, sb in zip(a.levels, b.levels):
             np.testing.assert_array_equal(sb.vertices, sa.vertices)
             assert sb.volume == sa.volume or (np.isnan(sb.volume) and np.isnan(sa.volume))
 

@@ -74,7 +74,7 @@ def test_three_sphere_slices_to_a_sphere(kind):
     field.levels = 0.0
     t = (simple_rotation("xz", 0.7) @ simple_rotation("xy", -0.4))[:3, :3]
     d = field.slice(m, 0.35).turned(t)
-    n = len(d.extra["levels"][0].vertices)
+    n = len(d.levels[0].vertices)
     p, nrm = d.points[:n], d.normals[:n]
     assert np.abs(np.linalg.norm(p, axis=1) - math.sqrt(R * R - 0.35**2)).max() < tol_r
     assert np.all(np.einsum("ij,ij->i", nrm, p / np.linalg.norm(p, axis=1, keepdims=True)) > 0.99)
@@ -387,7 +387,7 @@ def test_field_is_a_source():
     assert field.n_groups == 2
     d = field.slice(m, 5.5 + 0.1 * field.w_per_unit)  # c0 in samples: 0.1 slice units past the middle
     assert isinstance(d, SliceData) and not d.show_points and not d.convex and d.volume is None
-    levels = d.extra["levels"]
+    levels = d.levels
     assert [s.level for s in levels] == [0.3, 0.6]
     assert np.bincount(d.groups).tolist() == [len(s.triangles) for s in levels]
     assert levels[0].volume > levels[1].volume > 0  # nested
@@ -438,8 +438,8 @@ def test_field_is_a_source():
     assert turned.volume == pytest.approx(direct.volume, rel=0.03)
     np.testing.assert_allclose(np.sort(np.linalg.norm(turned.points[-len(box.vertices):], axis=1)),
                                np.sort(np.linalg.norm(direct.points[-len(box.vertices):], axis=1)))
-    np.testing.assert_allclose(turned.extra["levels"][0].vertices.mean(axis=0),
-                               direct.extra["levels"][0].vertices.mean(axis=0), atol=0.02)
+    np.testing.assert_allclose(turned.levels[0].vertices.mean(axis=0),
+                               direct.levels[0].vertices.mean(axis=0), atol=0.02)
     assert not turned.points.flags.writeable
     assert dict(field.slice(m, at(field, 5 * field.size)).readout)["w cut"].startswith("none")
 

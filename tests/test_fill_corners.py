@@ -73,10 +73,10 @@ def test_a_stack_keeps_each_slices_fill_flags():
     stack = StackSource(NAME, slices=3)
     m = random_rotation(np.random.default_rng(6))
     data = stack.slice(m, 0.0)
-    pieces = data.extra["slices"]
+    pieces = data.slices
     want = sum(int(getattr(pc, "n_fill", 0)) for pc in pieces)
     assert want > 0 and data.corner_only is not None and int(data.corner_only.sum()) == want
-    off = data.extra["point_offsets"]
+    off = data.point_offsets
     for k, pc in enumerate(pieces):  # each slice's fill corners are its own last ones
         flags = data.corner_only[off[k]:off[k + 1]]
         assert flags.sum() == pc.n_fill and (pc.n_fill == 0 or flags[-pc.n_fill:].all())

@@ -183,7 +183,7 @@ def test_no_volume_reads_none_everywhere(hemi, tmp_path):
     assert not any("None" in str(v) for _, v in d.readout)
     for n in (1, 3, 20):
         data = StackSource(p, slices=n, spacing=0.2).slice(m, 0.3)
-        assert data.volume is None and all(v is None for v in data.extra["volumes"])
+        assert data.volume is None and all(v is None for v in data.volumes)
         assert ("volume", f"none ({why})") in data.readout
         assert not any("None" in str(v) for _, v in data.readout)
     from rot4d_widget.keep.meshes import slice_mesh

@@ -44,7 +44,7 @@ def _array_field(levels=(0.0,)):
 
 def _spacing(data):
     """The grid spacing of the slice's resampling (slice units = metres here)."""
-    return max(s.spacing for s in data.extra["levels"] if not s.empty)
+    return max(s.spacing for s in data.levels if not s.empty)
 
 
 def _hyperplane(xyzw, m):
@@ -70,7 +70,7 @@ def test_at_rest_the_mesh_is_the_ball_at_its_data_place(make_field):
     np.testing.assert_allclose(xyzw[:, 3], C0, rtol=0, atol=1e-12)  # the cut's time, 135 s = 130 + 10 D0
     # the shape is the slice's: the same volume, watertight
     assert mesh.is_watertight
-    assert mesh.volume == pytest.approx(data.extra["levels"][0].volume, rel=1e-9)
+    assert mesh.volume == pytest.approx(data.levels[0].volume, rel=1e-9)
     assert mesh.volume == pytest.approx(4 / 3 * np.pi * R**3, rel=0.03)
 
 
@@ -78,7 +78,7 @@ def test_frame_view_is_the_view_s_slice_coordinates_with_the_data_coordinates_ke
     data = _field().slice(np.eye(4), C0)
     data_mesh = slice_mesh(data)
     view = slice_mesh(data, frame="view")
-    s = data.extra["levels"][0]
+    s = data.levels[0]
     np.testing.assert_array_equal(view.vertices, s.vertices)  # today's export: centred, w scaled
     np.testing.assert_allclose(data_mesh.vertices, view.vertices + CENTRE[:3], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(view.vertex_attributes["data_xyzw"], data_mesh.vertex_attributes["data_xyzw"])
@@ -194,7 +194,7 @@ def test_data_xyzw_survives_ply(tmp_path):
 def test_a_stack_keeps_its_layout_and_each_slice_s_own_time():
     src = StackSource(_field(resolution=32), slices=3, spacing=0.5, arrangement="grid")
     data = src.slice(np.eye(4), C0)
-    cuts = np.asarray(data.extra["cuts"])
+    cuts = np.asarray(data.cuts)
     mesh = slice_mesh(data)
     view = slice_mesh(data, frame="view")
     np.testing.assert_allclose(mesh.vertices, view.vertices + CENTRE[:3], rtol=0, atol=1e-12)  # the layout, moved
@@ -205,7 +205,7 @@ def test_a_stack_keeps_its_layout_and_each_slice_s_own_time():
         rows = np.unique(mesh.faces[sl == k])
         np.testing.assert_allclose(xyzw[rows, 3], cuts[k], rtol=0, atol=1e-12)  # cuts in s
         assert cuts[k] == C0 + (k - 1) * 0.5  # the spacing is in the data's w units (s), like c0
-        piece = data.extra["slices"][k]
+        piece = data.slices[k]
         assert np.abs(np.linalg.norm(xyzw[rows, :3] - CENTRE[:3], axis=1) - R).max() < _spacing(piece)
     assert len(set(np.round(xyzw[:, 3], 9))) == 3
     # one slice: placed as a field's own mesh

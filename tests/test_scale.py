@@ -331,7 +331,7 @@ def widget_case(make, src, unit_src, s):
     press_all(u)
     assert not w.errors.outputs, w.errors.outputs
     assert np.all(np.isfinite(np.asarray(w.slice.points)))
-    spacing = min([lv.spacing for lv in u.slice.extra.get("levels", ())] or [1e-9])  # fields: see above
+    spacing = min([lv.spacing for lv in getattr(u.slice, "levels", ())] or [1e-9])  # fields: see above
     close_sets(np.asarray(w.slice.points) / s, np.asarray(u.slice.points), atol=spacing)
     return w, u
 

@@ -53,7 +53,7 @@ def test_a_polytope_is_a_source_whose_slice_is_the_exact_slice():
     data, s = src.slice(m, 0.2), slice_polytope("24-cell", m, 0.2)
     assert np.array_equal(data.points, s.vertices) and np.array_equal(data.triangles, s.triangles)
     assert np.array_equal(data.groups, s.triangle_cells) and data.volume == s.volume and data.convex
-    assert data.face_census() == s.face_census()  # the full Slice stays reachable
+    assert data.slice.face_census() == s.face_census()  # the full Slice stays reachable
     assert dict(data.readout) == {"slice": census_text(s)}
     assert census_text(s) == ", ".join(
         f"{c} {({3: 'triangle', 4: 'quadrilateral', 5: 'pentagon', 6: 'hexagon'})[n]}{'' if c == 1 else 's'}"

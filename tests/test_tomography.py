@@ -141,7 +141,7 @@ def test_cavalieri_through_stack_source():
     lo, hi = src.w_range(m)
     src.spacing = (hi - lo) / 64
     data = src.slice(m, (lo + hi) / 2)
-    total = sum(data.extra["volumes"]) * src.spacing
+    total = sum(data.volumes) * src.spacing
     v4 = ConvexHull(polytope("24-cell").vertices).volume
     assert abs(total - v4) <= 1.0 * v4 / (hi - lo) ** 2 * src.spacing**2
 
@@ -155,30 +155,29 @@ def test_stack_slices_equal_single_slices_placed(arrangement, name):
     m = random_rotation(4)
     c0 = 0.1
     data = src.slice(m, c0)
-    ex = data.extra
-    np.testing.assert_allclose(ex["cuts"], c0 + (np.arange(7) - 3) * src.spacing)
-    off = ex["point_offsets"]
-    toff = ex["triangle_offsets"]
-    for k, w in enumerate(ex["cuts"]):
+    np.testing.assert_allclose(data.cuts, c0 + (np.arange(7) - 3) * src.spacing)
+    off = data.point_offsets
+    toff = data.triangle_offsets
+    for k, w in enumerate(data.cuts):
         single = slice_polytope(name, m, float(w))
-        assert_same_slice(ex["slices"][k], single, f"k={k}")
+        assert_same_slice(data.slices[k], single, f"k={k}")
         np.testing.assert_array_equal(data.points[off[k]:off[k + 1]],
-                                      single.vertices * ex["scales"][k] + ex["centres"][k])
+                                      single.vertices * data.scales[k] + data.centres[k])
         np.testing.assert_array_equal(data.triangles[toff[k]:toff[k + 1]] - off[k], single.triangles)
         np.testing.assert_array_equal(data.groups[toff[k]:toff[k + 1]], single.triangle_cells)
-        assert ex["volumes"][k] == pytest.approx(single.volume, rel=1e-12, abs=1e-15)
+        assert data.volumes[k] == pytest.approx(single.volume, rel=1e-12, abs=1e-15)
 
 
 def test_color_by_w_groups_are_slice_indices_with_a_colormap():
     src = StackSource("24-cell", slices=5)
     data = src.slice(random_rotation(1), 0.0)
-    toff = data.extra["triangle_offsets"]
+    toff = data.triangle_offsets
     for k in range(5):
         assert set(data.groups[toff[k]:toff[k + 1]].tolist()) <= {k}
     assert src.n_groups == 5
     rgb = src.group_colors()
     assert rgb.shape == (5, 3) and len({tuple(c) for c in rgb.round(3)}) == 5
-    np.testing.assert_array_equal(data.extra["group_rgb"], rgb)
+    np.testing.assert_array_equal(data.group_rgb, rgb)
     src.color_by = "cell"
     assert src.n_groups == 24 and src.group_colors() is None
 
@@ -198,12 +197,12 @@ def test_highlighted_slice_is_at_c0():
     m = random_rotation(2)
     for n in (1, 3, 5, 9, 63):
         data = StackSource("16-cell", slices=n, spacing=0.3).slice(m, 0.7)
-        hi = data.extra["highlighted"]
-        assert data.extra["cuts"][hi] == 0.7  # exactly
+        hi = data.highlighted
+        assert data.cuts[hi] == 0.7  # exactly
     for n in (2, 4, 64):  # even: no slice at c0, the first above it
         data = StackSource("16-cell", slices=n, spacing=0.3).slice(m, 0.7)
-        hi = data.extra["highlighted"]
-        assert data.extra["cuts"][hi] == pytest.approx(0.85)
+        hi = data.highlighted
+        assert data.cuts[hi] == pytest.approx(0.85)
         assert hi == highlighted_index(n) == n // 2
 
 
@@ -290,13 +289,13 @@ def test_field_stack_keeps_normals_and_coarse():
     assert "coarse" in __import__("inspect").signature(src.slice).parameters
     m = random_rotation(1)
     data = src.slice(m, 0.05)
-    off = data.extra["point_offsets"]
-    for k, w in enumerate(data.extra["cuts"]):
+    off = data.point_offsets
+    for k, w in enumerate(data.cuts):
         single = f.slice(m, float(w))
         np.testing.assert_allclose(data.points[off[k]:off[k + 1]],
-                                   single.points * data.extra["scales"][k] + data.extra["centres"][k])
+                                   single.points * data.scales[k] + data.centres[k])
         np.testing.assert_array_equal(data.normals[off[k]:off[k + 1]], single.normals)
-        assert data.extra["volumes"][k] == single.volume
+        assert data.volumes[k] == single.volume
     assert data.normals is not None and not data.show_points
     coarse = src.slice(m, 0.05, coarse=True)
     assert len(coarse.points) < len(data.points)
@@ -318,7 +317,7 @@ def test_user_source_without_coarse():
     src = StackSource(Dots(), slices=3, arrangement="stack")
     assert list(__import__("inspect").signature(src.slice).parameters) == ["matrix", "c0"]
     data = src.slice(np.eye(4), 0.0)
-    assert data.points.shape == (3, 3) and data.extra["volumes"] == (None, None, None)
+    assert data.points.shape == (3, 3) and data.volumes == (None, None, None)
     assert src.describe() == {"kind": "stack", "source": {"kind": "dots"}, "slices": 3, "spacing": None,
                               "arrangement": "stack", "color_by": "w"}
 
@@ -461,10 +460,8 @@ def test_a_stack_tells_the_protocol_what_it_wraps_its_settings_and_copies_its_in
 
 
 def test_a_stack_s_cuts_keep_their_old_names():
-    """``cuts_at`` / ``extra["cuts"]`` (the w of each slice) were ``levels_at`` / ``extra["levels"]``,
-    a name a field uses for its iso values: the old names still give the same numbers."""
+    """``cuts_at`` (the w of each slice, a stack slice's ``cuts``) was ``levels_at``, a name a field
+    uses for its iso values: the old name still gives the same numbers."""
     src = StackSource("8-cell", slices=5, spacing=0.1)
     np.testing.assert_array_equal(src.levels_at(0.2), src.cuts_at(0.2))
-    ex = src.slice(np.eye(4), 0.2).extra
-    np.testing.assert_array_equal(ex["levels"], ex["cuts"])
-    np.testing.assert_allclose(ex["cuts"], 0.2 + (np.arange(5) - 2) * 0.1)
+    np.testing.assert_allclose(src.slice(np.eye(4), 0.2).cuts, 0.2 + (np.arange(5) - 2) * 0.1)

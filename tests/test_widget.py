@@ -254,7 +254,7 @@ def test_builds_a_displayable_hbox_with_canvas_readout_help(make):
     assert w.events.prevent_default_action
     # the initial slice is the regular tetrahedron of the paper's Fig. 3(a)
     assert len(w.scene.shown) == 1 and w.scene.shown[0] is w.slice
-    assert w.slice.face_census() == {3: 4}
+    assert w.slice.slice.face_census() == {3: 4}
     assert not w.in_flight
     assert "4 triangles" in w.readout.value and "c0" in w.readout.value
     assert not w.help_visible
@@ -433,7 +433,7 @@ def test_at_most_three_updates_in_flight_and_the_next_is_the_latest_state(make, 
     w.companion.drawn(first)  # the oldest drawn: the latest state goes out
     assert len(w.scene.shown) == 5 and w.in_flight
     latest = slice_polytope(w.polytope, w.state.matrix, w.state.c0)
-    assert np.allclose(w.scene.shown[-1].vertices, latest.vertices)
+    assert np.allclose(w.scene.shown[-1].points, latest.vertices)
     w.companion.drawn()  # the newest drawn (and so every older one): nothing changed since
     w.companion.drawn()
     assert len(w.scene.shown) == 5 and not w.in_flight
@@ -489,7 +489,7 @@ def test_after_release_the_view_settles_at_once(make, clock):
         run_ticker(w, clock, clock.t + 0.2)
         w.companion.drawn()
     assert len(w.scene.shown) == shown  # no replay, no trailing updates
-    assert np.allclose(w.scene.shown[-1].vertices, slice_polytope(w.polytope, final, 0.0).vertices)
+    assert np.allclose(w.scene.shown[-1].points, slice_polytope(w.polytope, final, 0.0).vertices)
     assert not w.in_flight
 
 
@@ -506,7 +506,7 @@ def test_without_acknowledgements_the_latest_state_is_sent_after_the_timeout(mak
     run_ticker(w, clock, t0 + 10.0)
     # one update per timeout while the state changes; the final state is shown; then nothing
     assert len(w.scene.shown) == 1 + wmod.MAX_IN_FLIGHT + w.stats.timeouts
-    assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
+    assert np.allclose(w.scene.shown[-1].points, w.slice.points)
     n = len(w.scene.shown)
     run_ticker(w, clock, t0 + 20.0)
     assert len(w.scene.shown) == n
@@ -521,7 +521,7 @@ def test_scripting_press_redraws_and_respects_flow_control(make, clock):
     assert w.press("c", shift=True) is True  # pending while three are in flight
     expected = simple_rotation("zw", -3 * w.state.theta0) @ simple_rotation("xw", w.state.theta0)
     assert np.allclose(w.state.matrix, expected)
-    assert np.allclose(w.slice.vertices, slice_polytope(w.polytope, expected, 0.0).vertices)
+    assert np.allclose(w.slice.points, slice_polytope(w.polytope, expected, 0.0).vertices)
     assert len(w.scene.shown) == 4
     clock.t += w.ack_timeout  # no view (nbval): the timeout sends the latest
     service(w)
@@ -569,7 +569,7 @@ def test_readout_shows_parameters_last_action_census_and_volume(make):
     assert f"{w.state.theta0:.5f}" in text and f"{w.state.beta:.5f}" in text
     # in the source's own units (issue 19: "as drawn" scaled numbers were not the object's)
     assert f"<td>volume</td><td>{w.slice.volume:.4g}</td>" in text
-    census = w.slice.face_census()
+    census = w.slice.slice.face_census()
     assert str(sum(census.values())) in text or any(f"{c} " in text for c in census.values())
     down(w, "2", code="Digit2", shift=True)
     up(w, "2", code="Digit2", shift=True)  # at rest: the readout is exact
@@ -731,7 +731,7 @@ def test_the_ticker_thread_rotates_in_real_time_and_stops_on_keyup():
         assert w.errors.outputs == ()
         # with no acknowledgement (no view), the timeout still delivered the latest state
         assert w.stats.timeouts >= 1
-        assert np.allclose(w.scene.shown[-1].vertices, w.slice.vertices)
+        assert np.allclose(w.scene.shown[-1].points, w.slice.points)
     finally:
         w.close()
 
