@@ -19,7 +19,7 @@ import pytest
 from rot4d_widget import SliceData, polytope, simple_rotation, slice_polytope
 from rot4d_widget.core.sizes import REFERENCE_RADIUS
 from rot4d_widget import PolytopeSource, SourceAction
-from rot4d_widget.sources.protocol import as_source, census_text
+from rot4d_widget.sources.protocol import PolytopeSlice, as_slice, as_source, census_text
 from rot4d_widget.view.widget import Rot4DWidget
 
 from widget_time import sent, service
@@ -59,6 +59,38 @@ def test_a_polytope_is_a_source_whose_slice_is_the_exact_slice():
         f"{c} {({3: 'triangle', 4: 'quadrilateral', 5: 'pentagon', 6: 'hexagon'})[n]}{'' if c == 1 else 's'}"
         for n, c in sorted(s.face_census().items())
     )
+
+
+def test_as_slice_takes_a_user_slice_s_optional_members_once_with_the_defaults():
+    """A user's slice object becomes a `SliceData` where it enters: its optional members as given,
+    the ones it lacks at `SliceData`'s defaults; a `SliceData` passes as it is."""
+    from types import SimpleNamespace
+
+    bare = SimpleNamespace(points=[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]], segments=[[0, 1]], triangles=[[0, 1, 2]],
+                           groups=[0])
+    data = as_slice(bare)
+    assert type(data) is SliceData and not data.points.flags.writeable
+    assert (data.normals, data.volume, data.readout, data.convex, data.show_points, data.corner_only) == (
+        None, None, (), False, True, None)
+    full = SimpleNamespace(**vars(bare), normals=np.eye(3), volume=0.5, readout=[("k", "v")], convex=1,
+                           show_points=0, corner_only=[False, False, True])
+    data = as_slice(full)
+    assert data.volume == 0.5 and data.readout == (("k", "v"),) and data.convex is True and data.show_points is False
+    np.testing.assert_array_equal(data.corner_only, [False, False, True])
+    assert as_slice(data) is data
+    with pytest.raises(ValueError, match="volume"):
+        as_slice(SimpleNamespace(**vars(bare), volume=float("nan")))
+    with pytest.raises(TypeError, match="points"):
+        as_slice(object())
+
+
+def test_turned_keeps_a_subclass_s_fields():
+    data = PolytopeSource("24-cell").slice(random_rotation(np.random.default_rng(5)), 0.1)
+    r = simple_rotation("xy", 0.3)[:3, :3]
+    turned = data.turned(r)
+    assert isinstance(turned, PolytopeSlice) and turned.slice is data.slice  # the unturned cut kept
+    np.testing.assert_allclose(turned.points, data.points @ r.T)
+    assert turned.readout == data.readout and turned.convex == data.convex
 
 
 @pytest.mark.parametrize(

@@ -173,6 +173,11 @@ def _readonly(a, dtype, shape_tail, name):
 class SliceData:
     """One slice as the widget draws it; every array read-only, in the source's units.
 
+    A kind of slice with more to say is a subclass with typed fields (`PolytopeSlice`,
+    `rot4d_widget.sources.field.surface.FieldSliceData`, `rot4d_widget.sources.tomography.StackSliceData`);
+    readers tell the kinds apart by class.  A source may return any object with the four required
+    members: `as_slice` makes it one of these where it enters the package.
+
     points : (n, 3) float64 -- balls (and the corners that triangles and segments index)
     segments : (m, 2) intp -- bars, as pairs of indices into ``points``
     triangles : (k, 3) intp -- faces, indices into ``points``, counter-clockwise
