@@ -519,10 +519,32 @@ def census_text(s) -> str:
 
 @dataclass(frozen=True, eq=False)
 class PolytopeSlice(SliceData):
-    """`SliceData` of a polytope, keeping the full `Slice` as ``slice`` (``data.slice.face_census()``,
-    ``.vertices``, ``.cell_ids``, ``.dim`` ...).  `turned` keeps ``slice`` as it is, the unturned cut."""
+    """`SliceData` of a polytope, keeping the full `Slice` as ``slice``.  `turned` keeps ``slice`` as it
+    is, the unturned cut.  The `Slice`'s own members users read (``w.slice.face_census()``,
+    ``.vertices``, ``.cell_ids``, ``.dim`` ...) are named here one by one, each the unturned cut's."""
 
     slice: Slice | None = None
+
+    vertices = property(lambda self: self.slice.vertices, doc="The cut's vertices (`Slice.vertices`).")
+    edges = property(lambda self: self.slice.edges, doc="The cut's edges (`Slice.edges`).")
+    polygon_indices = property(lambda self: self.slice.polygon_indices, doc="`Slice.polygon_indices`.")
+    polygon_offsets = property(lambda self: self.slice.polygon_offsets, doc="`Slice.polygon_offsets`.")
+    cell_ids = property(lambda self: self.slice.cell_ids, doc="Each polygon's 4-D cell (`Slice.cell_ids`).")
+    triangle_cells = property(lambda self: self.slice.triangle_cells, doc="`Slice.triangle_cells`.")
+    dim = property(lambda self: self.slice.dim, doc="The cut's dimension (`Slice.dim`).")
+    n_fill = property(lambda self: self.slice.n_fill, doc="Fill corners at the end of ``vertices``.")
+
+    def polygons(self) -> list:
+        """`Slice.polygons`: each polygon's vertex indices."""
+        return self.slice.polygons()
+
+    def polygon_sizes(self) -> np.ndarray:
+        """`Slice.polygon_sizes`."""
+        return self.slice.polygon_sizes()
+
+    def face_census(self) -> dict:
+        """`Slice.face_census`: ``{sides: how many polygons}``."""
+        return self.slice.face_census()
 
     def __repr__(self) -> str:
         return f"PolytopeSlice({self.slice!r})"
