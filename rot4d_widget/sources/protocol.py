@@ -282,6 +282,12 @@ class UserSource(SourceBase):
     def __copy__(self) -> "UserSource":
         return UserSource(copy.copy(self._user))
 
+    def __deepcopy__(self, memo) -> "UserSource":
+        return UserSource(copy.deepcopy(self._user, memo))
+
+    def __reduce__(self):
+        return UserSource, (self._user,)
+
     def __repr__(self) -> str:
         return f"UserSource({self._user!r})"
 
@@ -444,9 +450,9 @@ def w_frame(source) -> tuple:
 
 
 def inner_source(source):
-    """The source whose geometry ``source`` shows: its ``wraps`` (a stack's inner source), else itself."""
-    source = _read(source)
-    inner = source.wraps
+    """The source whose geometry ``source`` shows: its ``wraps`` (a stack's inner source), else
+    ``source`` itself, as given."""
+    inner = _read(source).wraps
     return source if inner is None else inner
 
 
@@ -539,7 +545,7 @@ def data_w_text(source, w: float, matrix=None) -> str:
 def w_value_text(source, w: float) -> str:
     """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits -- or, for times
     that were datetime64 (``w_epoch``), the date and time."""
-    inner = inner_source(source)
+    inner = inner_source(_read(source))
     lo, hi = (float(v) for v in inner.extent[3])
     if inner.w_epoch is not None:
         return coordinate_text(inner, 3, float(w), max(abs(lo), abs(hi)))
@@ -551,7 +557,7 @@ def c0_text(source, c0: float):
     """How c0 reads for ``source`` when a number with its unit would not do: the date and time for a
     field whose times were datetime64 (``w_epoch``; c0 counts seconds from it), with those seconds
     -- "2021-03-04 12:05:00 (c0 = 300 s)" -- else None."""
-    inner = inner_source(source)
+    inner = inner_source(_read(source))
     if inner.w_epoch is None:
         return None
     return f"{w_value_text(inner, c0)} (c0 = {number_text(float(c0), 0.0, 6)} s)"
@@ -559,7 +565,7 @@ def c0_text(source, c0: float):
 
 def w_span_text(source, a: float, b: float) -> str:
     """Two of a field's w as a range: "0.0021 … 0.0026 s" (the unit once), or two date-times."""
-    inner = inner_source(source)
+    inner = inner_source(_read(source))
     if inner.w_epoch is not None:
         return f"{w_value_text(inner, a)} \u2026 {w_value_text(inner, b)}"
     lo, hi = (float(v) for v in inner.extent[3])

@@ -282,7 +282,12 @@ class Rot4DWidget(widgets.HBox):
     # ------------------------------------------------------------------ API
     @property
     def source(self):
-        """The source shown (a stack around the one given once parallel slices are asked for)."""
+        """The source shown (a stack around the one given once parallel slices are asked for).
+
+        A polytope name gives a `PolytopeSource`; a source that inherits `SourceBase` (a `Field4D`,
+        a `StackSource`, a user's subclass) is itself; any other object given is read through the
+        `UserSource` that wraps it (``w.source.user_object`` is the object; its attributes read and
+        set through the wrapper, ``w.source.thickness = 2`` then `refresh`)."""
         return self._showing.source
 
     @property
