@@ -37,7 +37,7 @@ A source has
 
 What the widget, exports, figures and recordings need to know of a source beyond
 that comes from these optional members, never from its class (`inner_source`,
-`settings_of`, `apply_setting`, `takes_coarse` read them):
+`settings_of`, `apply_setting`, `takes_coarse` read them; each has its default in `SourceBase`):
 
 ``wraps`` (optional)
     The source this one cuts in its own way, for a source made around another
@@ -67,11 +67,31 @@ that comes from these optional members, never from its class (`inner_source`,
     The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
     spacing, units, data range): what the volume and maximum-intensity renderings
     draw (`rot4d_widget.keep.pictures.ray_caster`); a source without it has only surfaces.
+Descriptions (optional) a view, a picture, a readout or an export shows when a source has them,
+each None by default: ``name`` (a title; else its class's name, `source_title`), ``edge_length``
+(the default ball radius), ``polytope``, a field's ``levels``, ``level_step``, ``inside``,
+``caps``, ``units``, ``long_name``, ``data_range``, ``known_range``, ``extent``, ``half_widths``,
+``dims``, ``axes``, ``space_units``, ``w_units``, ``w_epoch``, ``w_per_unit``, ``to_data(points,
+matrix, c0)``, ``coarse_resolution`` and ``coarse_ready`` (True); a stack's ``slices`` (1),
+``spacing``, ``spacing_is_default`` (False), ``cuts_at(c0)`` and ``color_by`` ("w").
+
+**Defaults live in one place**, `SourceBase`: every optional member above (`OPTIONAL_MEMBERS`)
+with its default -- a class attribute, or a method doing what a source without it gets
+(``outline`` is ``slice``, ``w_range`` is ``(-size, size)``, ``prepare`` returns None,
+``note_matrix`` does nothing).  The package's sources (`PolytopeSource`, `StackSource`,
+`rot4d_widget.Field4D`) inherit it, and a user's may (then it is used as it is); `as_source` wraps
+any other object with the four required members, once, in a `UserSource`, which reads each member
+from the object every time (a change before `Rot4DWidget.refresh` is seen), the default where the
+object has none, and sets every attribute on the object.  So the package reads
+``source.levels``, never ``getattr(source, "levels", None)``; the helpers below (`w_frame`,
+`settings_of`, `apply_setting`, `takes_coarse` ...) stay where they validate, and take a user's
+object too.
+
 ``describe()`` returns everything a state file needs to rebuild the source: its
 ``"kind"`` and, when it cannot be rebuilt from the description, ``"rebuild"``:
 the reason (a string; True or absent when it can).  A copy of a source
 (``copy.copy``) is one that replaying its own actions may change without
-changing the original (a stack copies its inner source too).
+changing the original (a stack copies its inner source too; a `UserSource` copies its object).
 
 Rotations in the planes xy, xz and yz never change which part of a source
 the hyperplane cuts, only how the cut is turned in 3-D: the slice at
