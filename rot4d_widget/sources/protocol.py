@@ -268,8 +268,6 @@ class UserSource(SourceBase):
     itself; ``copy.copy`` copies it.  This is the only place the package probes a user's object.
     """
 
-    __slots__ = ("_user",)
-
     def __init__(self, obj):
         object.__setattr__(self, "_user", obj)
 
@@ -285,8 +283,23 @@ class UserSource(SourceBase):
 
     @property
     def wraps(self):
+        """The object's ``wraps``, read through its own `UserSource` (the same one while it is the same)."""
         inner = getattr(self._user, "wraps", None)
-        return None if inner is None else as_source(inner)
+        if inner is None:
+            return None
+        kept = self.__dict__.get("_wrapped")
+        if kept is None or kept[0] is not inner:
+            kept = (inner, as_source(inner))
+            self.__dict__["_wrapped"] = kept
+        return kept[1]
+
+    @property
+    def w_frame(self):
+        """The object's ``w_frame``; without one, a source made around another answers for it."""
+        frame = getattr(self._user, "w_frame", None)
+        if frame is None and self.wraps is not None:
+            return self.wraps.w_frame
+        return SourceBase.w_frame if frame is None else frame
 
     def __getattr__(self, name):
         if name.startswith("__") or name == "_user":
@@ -326,7 +339,7 @@ def _forward(name: str):
 
 
 for _name in OPTIONAL_MEMBERS:
-    if _name != "wraps":
+    if _name not in ("wraps", "w_frame"):
         setattr(UserSource, _name, _forward(_name))
 del _name
 
