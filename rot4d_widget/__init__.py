@@ -35,6 +35,8 @@ _LAZY = {
     "Source": "sources.protocol",
     "SliceData": "sources.protocol",
     "SourceAction": "sources.protocol",
+    "SourceBase": "sources.protocol",
+    "UserSource": "sources.protocol",
     "PolytopeSource": "sources.protocol",
     "Rot4DWidget": "view.widget",
     "Field4D": "sources.field.container",

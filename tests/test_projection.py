@@ -10,7 +10,7 @@ import pytest
 from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.keep.recorder import ViewSetting
 from rot4d_widget.sources.field.container import Field4D
-from rot4d_widget.sources.protocol import PolytopeSource
+from rot4d_widget.sources.protocol import PolytopeSource, as_source
 from rot4d_widget.sources.tomography import StackSource
 from rot4d_widget.view import projection as pj
 from rot4d_widget.view.widget import Rot4DWidget
@@ -269,8 +269,12 @@ def test_page_projection_shows_nothing_without_a_skeleton(tmp_path):
         def slice(self, m, c0):  # pragma: no cover - never sliced here
             raise AssertionError
 
-    assert pj.skeleton_message(Bare()) == {"n_vertices": 0, "n_edges": 0}
-    assert pj.projection_arrays(Bare(), np.eye(4), 0.0) is None
+        def describe(self):  # pragma: no cover - never described here
+            return {"kind": "bare"}
+
+    bare = as_source(Bare())  # the view is handed the widget's source: a user's object wrapped once
+    assert pj.skeleton_message(bare) == {"n_vertices": 0, "n_edges": 0}
+    assert pj.projection_arrays(bare, np.eye(4), 0.0) is None
 
 
 def test_projection_trait_recorded_saved_loaded(widgets, tmp_path):

@@ -272,6 +272,7 @@ def test_source_settings_are_recorded_saved_and_loaded(tmp_path):
 
 
 def test_replay_sets_the_source_settings_on_a_stack_and_its_inner_field():
+    from rot4d_widget.sources.protocol import inner_source
     from rot4d_widget.sources.tomography import StackSource
 
     r, st = _source_recording()
@@ -323,16 +324,18 @@ def test_a_single_view_given_stack_settings_is_refused_before_any_change():
 
 
 def test_animations_follow_the_source_settings_on_their_copy():
+    from rot4d_widget.sources.protocol import inner_source
     from rot4d_widget.sources.tomography import StackSource
 
     r, st = _source_recording()
     field = _ball_field()
     before = field.levels
-    seen = [(type(src).__name__, tuple(getattr(src, "source", src).levels), getattr(src, "slices", None),
-             getattr(src, "spacing", None) if isinstance(src, StackSource) and not src.spacing_is_default else None,
+    # every source has `slices` (1: the protocol's default, `SourceBase`); a field has no arrangement
+    seen = [(type(src).__name__, tuple(inner_source(src).levels), src.slices,
+             src.spacing if isinstance(src, StackSource) and not src.spacing_is_default else None,
              getattr(src, "arrangement", None)) for _, _, src in animation_states(r, None, field)]
-    assert seen[0] == ("Field4D", before, None, None, None)
-    assert seen[1] == ("Field4D", (2.0, 3.0), None, None, None)  # after levels set
+    assert seen[0] == ("Field4D", before, 1, None, None)
+    assert seen[1] == ("Field4D", (2.0, 3.0), 1, None, None)  # after levels set
     assert seen[3][:3] == ("StackSource", (2.0, 3.0), 3)  # slices made a stack of the copy, as the widget
     assert seen[5][3] == 0.3 and seen[-2][4] == "grid" and seen[-1][1] == (2.5,)
     assert field.levels == before  # the source given is left alone

@@ -11,6 +11,12 @@
   unit that reached the widget's children or other units through it would fail here.  Every
   other collaborator is handed over by name (the constructor, or ``connect`` for a loop).
 
+* **Sources are read through the protocol.**  No module but ``sources/protocol.py`` asks an
+  object whether it has one of the source protocol's optional members (``getattr(source,
+  "levels", None)``, ``hasattr(source, "sample")``): `SourceBase` gives every source each of them
+  with its default, and a user's object is read only by the `UserSource` wrapping it.  An object
+  that is not a source but has a member of the same name is allowed where `NOT_A_SOURCE` says so.
+
 Each rule is seen failing on a snippet that breaks it (the ``..._sees_...`` tests).  Counts of
 what was reached into before these rules: ``python benchmarks/structure.py``.
 """
@@ -223,3 +229,60 @@ def test_the_traits_check_sees_a_reach_through_the_widget(use):
     body = f"class P:\n    def f(self):\n        x = self.traits.rendering\n        {use}\n"
     got = traits_use_problems(body, {"rendering"})
     assert len(got) == 1, got
+
+
+# ------------------------------------------------------------------ sources read through the protocol
+#: ``(module path, member)``: a ``getattr`` / ``hasattr`` with an optional protocol member's name
+#: on an object that is not a source, and what the object is.
+NOT_A_SOURCE = {
+    ("geometry/offfile.py", "name"): "a file handle's name (an OFF file read from an open file)",
+    ("keep/recorder.py", "name"): "a source action's name (any object in a source's `actions`)",
+    ("sources/field/inputs.py", "dims"): "an xarray DataArray's or Dataset's dims (telling one by its members)",
+}
+
+
+def optional_member_probes(rel: str, text: str) -> list:
+    """``getattr(x, "levels", ...)`` or ``hasattr(x, "levels")`` with one of the protocol's optional
+    members (`OPTIONAL_MEMBERS`) as a literal: asking a source whether it has a member that
+    `SourceBase` gives every source (with its default) -- outside sources/protocol.py, whose
+    `UserSource` alone reads a user's object."""
+    from rot4d_widget.sources.protocol import OPTIONAL_MEMBERS
+
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in ("getattr", "hasattr") and len(node.args) >= 2
+                and isinstance(node.args[1], ast.Constant) and node.args[1].value in OPTIONAL_MEMBERS
+                and (node.func.id == "hasattr" or len(node.args) == 3)
+                and (rel, node.args[1].value) not in NOT_A_SOURCE):
+            out.append(f"{rel}:{node.lineno}: {ast.unparse(node)}")
+    return out
+
+
+def test_sources_are_read_through_the_protocol_not_probed():
+    problems = [p for rel, text in _modules() if rel != "sources/protocol.py"
+                for p in optional_member_probes(rel, text)]
+    assert problems == []
+
+
+def test_every_not_a_source_exception_is_still_used():
+    from rot4d_widget.sources.protocol import OPTIONAL_MEMBERS
+
+    texts = dict(_modules())
+    for rel, member in NOT_A_SOURCE:
+        assert member in OPTIONAL_MEMBERS and f'"{member}"' in texts[rel], (rel, member)
+
+
+@pytest.mark.parametrize("body", [
+    'def f(source):\n    return getattr(source, "levels", None)\n',
+    'def f(source):\n    return getattr(inner_source(source), "w_units", "")\n',
+    'def f(source):\n    return hasattr(source, "sample")\n',
+])
+def test_the_protocol_check_sees_a_probe(body):
+    assert len(optional_member_probes("view/x.py", body)) == 1
+
+
+def test_the_protocol_check_lets_plain_reads_and_other_objects_be():
+    body = ('def f(source, da):\n    return source.levels, getattr(da, "encoding", None), '
+            'getattr(source, "levels")\n')
+    assert optional_member_probes("view/x.py", body) == []

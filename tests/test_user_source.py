@@ -187,3 +187,27 @@ def test_a_state_file_says_the_user_source_cannot_be_rebuilt(tmp_path):
     # a stack around it is described with it, and is no more rebuildable
     stack = describe_source(state_source(src, slices=3))
     assert stack["kind"] == "stack" and stack["source"]["kind"] == "thick-torus" and stack["rebuild"] == d["rebuild"]
+
+
+def test_a_user_source_is_wrapped_once_and_read_through_every_time():
+    from rot4d_widget.sources.protocol import OPTIONAL_MEMBERS, SourceBase, UserSource, w_frame
+
+    torus = ThickTorus()
+    src = as_source(torus)
+    assert isinstance(src, UserSource) and src.user_object is torus and as_source(src) is src
+    assert src.describe() == torus.describe() and src.size == torus.size
+    # what the object has is read from it each time; what it lacks is SourceBase's default
+    assert src.levels is None and src.extent is None and w_frame(src) == (0.0, 1.0) and src.actions == {}
+    assert src.w_range(np.eye(4)) == (-1.0, 1.0) and src.prepare() is None and src.sample is None
+    torus.name = "torus"
+    assert src.name == "torus"
+    src.thickness = 0.3  # sets go to the object
+    assert torus.thickness == 0.3 and src.settings == {"thickness": 0.3}
+    outline = src.outline(np.eye(4), 0.0)  # the default outline is the object's own slice
+    assert len(outline.triangles) == len(torus.slice(np.eye(4), 0.0).triangles)
+    twin = copy.copy(src)
+    assert isinstance(twin, UserSource) and twin.user_object is not torus
+    twin.apply_setting("thickness", 0.5)
+    assert torus.thickness == 0.3
+    # every optional member has its default on the base, none only on the wrapper
+    assert all(hasattr(SourceBase, name) for name in OPTIONAL_MEMBERS)

@@ -139,9 +139,12 @@ def test_a_stack_is_a_source_that_wraps_another_whatever_its_class():
 
 
 def test_a_user_sources_settings_are_recorded_on_refresh_and_replayed(make):
-    w = make(Slab())
+    slab = Slab()
+    w = make(slab)
     assert w.recording.initial_source == {"thickness": 0.5}
+    assert w.source.user_object is slab  # the source shown is the UserSource wrapping it (issue 38)
     w.source.thickness = 0.25
+    assert slab.thickness == 0.25
     w.refresh()
     rec = w.recording
     assert [(e.name, e.value) for e in rec.events if hasattr(e, "name") and e.name == "thickness"] == [

@@ -21,7 +21,7 @@ from ..geometry.catalogue import polytope
 from ..geometry.mesh import Polytope
 from ..sources.field.checks import UnitsWarning
 from ..sources.field.inputs import selection_from_json
-from ..sources.protocol import PolytopeSource
+from ..sources.protocol import PolytopeSource, as_source, class_name
 from ..sources.tomography import StackSource
 
 
@@ -95,14 +95,15 @@ def describe_source(source) -> dict:
     is rebuildable exactly when that one is.  A description without ``"rebuild"`` can be rebuilt
     when `rebuild_source` knows its kind (a polytope, a stack, a field), else it carries the reason.
     """
+    source = as_source(source)
     d = dict(source.describe())
-    inner = getattr(source, "wraps", None)
+    inner = source.wraps
     if inner is not None:
         d["source"] = describe_source(inner)
         d["rebuild"] = d["source"]["rebuild"]
         return d
     if "rebuild" not in d:
-        kind = d.get("kind", type(source).__name__)
+        kind = d.get("kind", class_name(source))
         d["rebuild"] = (True if kind in _KNOWN_KINDS
                         else f"a source of kind {kind!r} cannot be rebuilt from its description")
     return jsonable(d, "source.describe()")

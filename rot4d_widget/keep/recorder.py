@@ -53,7 +53,16 @@ from ..core.keymap import Action
 from ..core.rotation import as_rotation_matrix
 from ..core.state import STATE_FORMAT, RotationState, action_from_data, action_to_data, spacing_factor
 from ..sources.arrangements import ARRANGEMENTS
-from ..sources.protocol import apply_setting, inner_source, note_matrix, settings_of, w_frame
+from ..sources.protocol import (
+    apply_setting,
+    as_source,
+    class_name,
+    inner_source,
+    note_matrix,
+    settings_of,
+    source_title,
+    w_frame,
+)
 from ..sources.tomography import StackSource
 from .jsonfile import read_json
 from .rebuild import jsonable
@@ -285,7 +294,7 @@ def _event_from_dict(d):
 
 # ============================================================================ applying
 def _source_action(source, name: str):
-    actions = getattr(source, "actions", None) or {}
+    actions = source.actions or {}
     for sa in actions.values():
         if getattr(sa, "name", None) == name:
             return sa
@@ -294,7 +303,7 @@ def _source_action(source, name: str):
 
 def _is_stack(source) -> bool:
     """A source made around another (the protocol's ``wraps``): parallel slices."""
-    return getattr(source, "wraps", None) is not None
+    return source.wraps is not None
 
 
 def _set_on_source(source, name: str, value) -> None:
@@ -304,9 +313,9 @@ def _set_on_source(source, name: str, value) -> None:
     if name not in settings_of(source):
         if name in _FIELD_SETTINGS:
             raise ValueError(f"A recorded {name!r} applies to a source that has it (a field), not "
-                             f"{type(inner_source(source)).__name__}")
+                             f"{class_name(inner_source(source))}")
         if name in _STACK_SETTINGS and not _is_stack(source):
-            raise ValueError(f"A recorded {name!r} applies to parallel slices, and {type(source).__name__} is a "
+            raise ValueError(f"A recorded {name!r} applies to parallel slices, and {class_name(source)} is a "
                              "single view: replay with set_source= (Rot4DWidget.replay turns its view into a "
                              "stack), or on a StackSource")
     apply_setting(source, name, value)
@@ -336,6 +345,7 @@ def apply_event(state: RotationState, event, source=None, set_source=None, set_v
             return True
         if source is None:
             return False
+        source = as_source(source)
         note_matrix(source, state.matrix)  # as the widget tells it: a default spacing along today's w
         _set_on_source(source, event.name, event.value)
         return True
@@ -344,7 +354,7 @@ def apply_event(state: RotationState, event, source=None, set_source=None, set_v
         return True
     action = event.action
     if action.kind == "custom":
-        sa = _source_action(source, action.name) if source is not None else None
+        sa = _source_action(as_source(source), action.name) if source is not None else None
         if sa is None:
             return False
         note_matrix(source, state.matrix)
@@ -508,6 +518,8 @@ class Recording:
         for name, f in (("set_source", set_source), ("set_view", set_view)):
             if f is not None and not callable(f):
                 raise TypeError(f"Expected `{name}` to be a callable (name, value), got {type(f).__name__}")
+        if source is not None and set_source is None:
+            source = as_source(source)  # read by the protocol alone
         if source is not None and self._initial.get("format", STATE_FORMAT) < STATE_FORMAT:
             return self.for_source(source).replay(state, source, restart=restart, set_source=set_source,
                                                   set_view=set_view)
@@ -546,15 +558,15 @@ class Recording:
         missing = [n for n in _FIELD_SETTINGS if n in names and n not in have]
         if missing:
             raise ValueError(f"The recording sets {', '.join(map(repr, missing))}, which apply to a field "
-                             f"(a source with iso levels), not {type(inner_source(source)).__name__}")
+                             f"(a source with iso levels), not {class_name(inner_source(source))}")
         stack_names = sorted(n for n in names & set(_STACK_SETTINGS) if n not in have)
         if stack_names and not _is_stack(source):
             raise ValueError(f"The recording sets {', '.join(map(repr, stack_names))}, which apply to parallel "
-                             f"slices, and {type(source).__name__} is a single view: replay with set_source= "
+                             f"slices, and {class_name(source)} is a single view: replay with set_source= "
                              "(Rot4DWidget.replay turns its view into a stack), or on a StackSource")
         other = sorted(n for n in names if n not in have)
         if other:
-            title = getattr(source, "name", None) or type(source).__name__
+            title = source_title(source)
             raise ValueError(f"The recording sets {', '.join(map(repr, other))}, which {title} does not have; "
                              f"its settings: {', '.join(sorted(have)) or 'none'}")
 

@@ -38,7 +38,7 @@ from typing import Mapping, NamedTuple
 
 from ..core.state import RotationState, spacing_factor
 from ..core.version import __version__
-from ..sources.protocol import as_source
+from ..sources.protocol import as_source, user_object
 from .jsonfile import read_json
 from .rebuild import (
     CannotRebuild,
@@ -72,8 +72,8 @@ def settings_of(widget) -> dict:
     for name in SETTING_NAMES:
         if hasattr(widget, name):
             out[name] = getattr(widget, name)
-    src = getattr(widget, "source", None)
-    if out.get("spacing") is not None and getattr(src, "spacing_is_default", False):
+    src = getattr(widget, "source", None)  # a widget's, or None for another object
+    if out.get("spacing") is not None and src is not None and as_source(src).spacing_is_default:
         out["spacing"] = None
     return jsonable(out, "settings")
 
@@ -254,8 +254,8 @@ def load_state(path, source=None, *, allow_code: bool = False, function=None) ->
             except (TypeError, ValueError) as exc:
                 raise ValueError(f"{path!r}: bad setting {name!r}: {exc}") from None
     desc = doc["source"]
-    if source is not None:
-        source = as_source(source)
+    if source is not None:  # a user's object is handed back as given, not its `UserSource`
+        source = user_object(as_source(source))
         if desc is not None:
             want, got = inner_identity(desc), inner_identity(describe_source(source))
             if want != got:

@@ -24,7 +24,7 @@ def axis_names(field) -> tuple:
     """(x, y, z, w): each data axis's name -- the field's dim names when it has them (``dims``
     in the array's order, ``axes`` saying which of x, y, z, w each is: "time" for w ...), else
     the letters x, y, z, w."""
-    dims, axes = getattr(field, "dims", None), getattr(field, "axes", None)
+    dims, axes = field.dims, field.axes
     if dims is not None and isinstance(axes, str) and len(dims) == len(axes) == 4 and set(axes) == set(_LETTERS):
         return tuple(str(dims[axes.index(c)]) for c in _LETTERS)
     return tuple(_LETTERS)
@@ -33,7 +33,7 @@ def axis_names(field) -> tuple:
 def axis_units(field) -> tuple:
     """(x, y, z, w) units: the field's ``space_units`` three times and its ``w_units`` (None where
     it names none)."""
-    space, w = getattr(field, "space_units", None), getattr(field, "w_units", None)
+    space, w = field.space_units, field.w_units
     return (space, space, space, w)
 
 
@@ -54,7 +54,7 @@ def coordinate_text(field, c: int, value: float, span: float, digits: int = 3) -
     a number for people (`number_text`, rounding noise next to ``span`` shown as 0) and its unit, or
     -- w of a field whose times were datetime64 (``w_epoch``: c0 counts seconds from it) -- the date
     and time."""
-    epoch = getattr(field, "w_epoch", None) if c == 3 else None
+    epoch = field.w_epoch if c == 3 else None
     if epoch is not None:
         lo, hi = (float(v) for v in field.extent[3])
         return date_time_text(epoch, value, (hi - lo) / max(int(field.shape[3]) - 1, 1))
@@ -84,7 +84,7 @@ def box_labels(field, matrix, c0, grid) -> tuple:
     points = np.vstack([origin[None, :], ends])
     data = np.asarray(field.to_data(points, matrix, c0), dtype=np.float64).reshape(4, 4)
     names, units = axis_names(field), axis_units(field)
-    extent = getattr(field, "extent", None)
+    extent = field.extent
     if extent is not None:
         span = np.abs(np.diff(np.asarray(extent, dtype=np.float64).reshape(4, 2), axis=1)).ravel()
     else:  # no data box: the change across the grid itself
@@ -95,7 +95,7 @@ def box_labels(field, matrix, c0, grid) -> tuple:
         return f" {units[c]}" if units[c] else ""
 
     def change(c, a, b):  # "0.01 → 0.05 m", or two date-times
-        if c == 3 and getattr(field, "w_epoch", None) is not None:
+        if c == 3 and field.w_epoch is not None:
             return f"{coordinate_text(field, c, a, span[c])} \u2192 {coordinate_text(field, c, b, span[c])}"
         return f"{number_text(a, span[c], 3)} \u2192 {number_text(b, span[c], 3)}{unit(c)}"
 

@@ -37,7 +37,7 @@ A source has
 
 What the widget, exports, figures and recordings need to know of a source beyond
 that comes from these optional members, never from its class (`inner_source`,
-`settings_of`, `apply_setting`, `takes_coarse` read them):
+`settings_of`, `apply_setting`, `takes_coarse` read them; each has its default in `SourceBase`):
 
 ``wraps`` (optional)
     The source this one cuts in its own way, for a source made around another
@@ -67,11 +67,31 @@ that comes from these optional members, never from its class (`inner_source`,
     The cut's values on a regular 3-D grid (a field's `FieldGrid`: values, origin,
     spacing, units, data range): what the volume and maximum-intensity renderings
     draw (`rot4d_widget.keep.pictures.ray_caster`); a source without it has only surfaces.
+Descriptions (optional) a view, a picture, a readout or an export shows when a source has them,
+each None by default: ``name`` (a title; else its class's name, `source_title`), ``edge_length``
+(the default ball radius), ``polytope``, a field's ``levels``, ``level_step``, ``inside``,
+``caps``, ``units``, ``long_name``, ``data_range``, ``known_range``, ``extent``, ``half_widths``,
+``dims``, ``axes``, ``space_units``, ``w_units``, ``w_epoch``, ``w_per_unit``, ``to_data(points,
+matrix, c0)``, ``coarse_resolution`` and ``coarse_ready`` (True); a stack's ``slices`` (1),
+``spacing``, ``spacing_is_default`` (False), ``cuts_at(c0)`` and ``color_by`` ("w").
+
+**Defaults live in one place**, `SourceBase`: every optional member above (`OPTIONAL_MEMBERS`)
+with its default -- a class attribute, or a method doing what a source without it gets
+(``outline`` is ``slice``, ``w_range`` is ``(-size, size)``, ``prepare`` returns None,
+``note_matrix`` does nothing).  The package's sources (`PolytopeSource`, `StackSource`,
+`rot4d_widget.Field4D`) inherit it, and a user's may (then it is used as it is); `as_source` wraps
+any other object with the four required members, once, in a `UserSource`, which reads each member
+from the object every time (a change before `Rot4DWidget.refresh` is seen), the default where the
+object has none, and sets every attribute on the object.  So the package reads
+``source.levels``, never ``getattr(source, "levels", None)``; the helpers below (`w_frame`,
+`settings_of`, `apply_setting`, `takes_coarse` ...) stay where they validate, and take a user's
+object too.
+
 ``describe()`` returns everything a state file needs to rebuild the source: its
 ``"kind"`` and, when it cannot be rebuilt from the description, ``"rebuild"``:
 the reason (a string; True or absent when it can).  A copy of a source
 (``copy.copy``) is one that replaying its own actions may change without
-changing the original (a stack copies its inner source too).
+changing the original (a stack copies its inner source too; a `UserSource` copies its object).
 
 Rotations in the planes xy, xz and yz never change which part of a source
 the hyperplane cuts, only how the cut is turned in 3-D: the slice at
@@ -81,11 +101,13 @@ That is geometry, not a promise a source has to make.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 import math
 import sys
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any, Callable, Mapping, Protocol, runtime_checkable
 
 import numpy as np
@@ -100,6 +122,12 @@ from .field_labels import axis_names, coordinate_text
 
 __all__ = [
     "Source",
+    "SourceBase",
+    "UserSource",
+    "OPTIONAL_MEMBERS",
+    "user_object",
+    "class_name",
+    "source_title",
     "SliceData",
     "SourceAction",
     "PolytopeSource",
@@ -137,6 +165,203 @@ class Source(Protocol):
     def slice(self, matrix: np.ndarray, c0: float) -> Any: ...
 
     def describe(self) -> dict: ...
+
+
+_NO_MAPPING: Mapping = MappingProxyType({})
+
+#: The optional members a source may have, each with the default `SourceBase` gives it (a method's
+#: default is `SourceBase`'s method of that name).  What the package reads of a source beyond
+#: `Source`'s four required members is one of these, read as a plain attribute.
+OPTIONAL_MEMBERS = (
+    # the protocol's own (module docstring)
+    "actions", "w_range", "w_frame", "wraps", "settings", "apply_setting", "coarse_steps", "outline",
+    "prepare", "sample", "note_matrix",
+    # descriptions a view, a picture or a readout shows when a source has them (a field's, a polytope's)
+    "name", "edge_length", "polytope", "levels", "level_step", "inside", "caps", "units", "long_name",
+    "data_range", "known_range", "extent", "half_widths", "dims", "axes", "space_units", "w_units",
+    "w_epoch", "w_per_unit", "to_data", "coarse_ready", "coarse_resolution",
+    # parallel slices' (a stack's)
+    "slices", "spacing", "spacing_is_default", "cuts_at", "color_by",
+)
+_METHODS = ("w_range", "apply_setting", "outline", "prepare", "note_matrix")
+
+
+class SourceBase:
+    """Every optional member of the source protocol with its default, in one place.
+
+    The package's sources (`PolytopeSource`, `rot4d_widget.sources.tomography.StackSource`,
+    `rot4d_widget.Field4D`) inherit it, and so may a user's own source; any other object with the
+    four required members is wrapped once by `as_source` in a `UserSource`, which reads each
+    optional member from the object when it has it and gives this default otherwise.  So the
+    package reads ``source.levels``, never ``getattr(source, "levels", None)``.
+
+    Defaults are plain class attributes (None where "absent" has a meaning of its own: a source
+    without ``sample`` has only surfaces, one without ``levels`` no iso levels) and methods doing
+    what a source without the member gets; a subclass overrides any of them with an attribute, a
+    property or a method (put this class last among the bases: a mixin's property wins).
+    """
+
+    # -- the protocol's optional members ------------------------------------------------------
+    actions: Mapping = _NO_MAPPING  #: key -> SourceAction: none
+    w_frame: tuple = (0.0, 1.0)  #: (origin, per_unit): c0 is the source's own w
+    wraps = None  #: the source this one is made around (a stack's): none
+    settings: Mapping = _NO_MAPPING  #: {name: JSON-able value} a recording keeps: none
+    coarse_steps = None  #: None: whether ``slice`` takes ``coarse=`` is read from its signature
+    sample = None  #: sample(matrix, c0, resolution=None, *, coarse=False) -> FieldGrid: surfaces only
+
+    def w_range(self, matrix) -> tuple:
+        """(lowest, highest) c0 that still touches the rotated object: (-size, size) by default."""
+        return -float(self.size), float(self.size)
+
+    def apply_setting(self, name: str, value) -> None:
+        """Set one of `settings`: a source without settings has none to set."""
+        raise ValueError(f"{source_title(self)} has no setting {name!r}; its settings: "
+                         f"{', '.join(sorted(self.settings)) or 'none'}")
+
+    def outline(self, matrix, c0):
+        """The slice's balls and bars without reading data: by default the slice itself."""
+        return self.slice(matrix, c0)
+
+    def prepare(self, progress: bool = True):
+        """Start background work; None: nothing to do."""
+        return None
+
+    def note_matrix(self, matrix) -> None:
+        """The orientation the view shows now: nothing to note by default."""
+
+    # -- descriptions read when a source has them ----------------------------------------------
+    name = None  #: a title (else its class's name, `source_title`)
+    edge_length = None  #: sets the default ball radius (else the first outline's median bar)
+    polytope = None  #: the `Polytope` shown (a polytope source's)
+    levels = None  #: iso levels (a field's); None: a source without levels
+    level_step = None
+    inside = None  #: "above" / "below" (a field's)
+    caps = None  #: close the cut surfaces at the box (a field's)
+    units = None  #: the data's units (colour bar, readout)
+    long_name = None  #: the colour bar's label
+    data_range = None  #: (lo, hi) of the data, when known
+    known_range = None  #: (lo, hi) known without reading all the data (`known_range`)
+    extent = None  #: ((x0, x1), ... (w0, w1)): a data box; None: not a record (a polytope's own w)
+    half_widths = None  #: the data box's half widths in slice units
+    dims = None  #: the data's dim names, in the array's order
+    axes = None  #: which of x, y, z, w each array axis is ("wzyx")
+    space_units = None
+    w_units = None
+    w_epoch = None  #: w = 0's date (numpy datetime64) when w was datetime64
+    w_per_unit = None  #: w units per unit of space
+    to_data = None  #: to_data(points, matrix, c0) -> (n, 4) data coordinates; None: no data box
+    coarse_ready = True  #: held keys can take coarse slices now
+    coarse_resolution = None
+
+    # -- parallel slices' (a stack's) -----------------------------------------------------------
+    slices = 1  #: how many parallel cuts a view shows
+    spacing = None  #: their spacing in w
+    spacing_is_default = False
+    cuts_at = None  #: cuts_at(c0) -> the cuts' w; None: one cut at c0
+    color_by = "w"
+
+
+class UserSource(SourceBase):
+    """A user's source as the package reads it: `as_source` wraps any object with ``slice``,
+    ``size``, ``n_groups`` and ``describe()`` that does not inherit `SourceBase` in one of these.
+
+    The required members and each optional one the object has are read from it every time (a
+    user changing their object and calling `Rot4DWidget.refresh` is seen); an optional member it
+    lacks has `SourceBase`'s default.  Any other attribute is the object's (``src.thickness``), and
+    every attribute set goes to the object (``src.levels = ...``).  ``user_object`` is the object
+    itself; ``copy.copy`` copies it.  This is the only place the package probes a user's object.
+    """
+
+    def __init__(self, obj):
+        object.__setattr__(self, "_user", obj)
+
+    @property
+    def user_object(self):
+        """The object given (`Rot4DWidget.source` of a user's source is this wrapper around it)."""
+        return self._user
+
+    size = property(lambda self: self._user.size)
+    n_groups = property(lambda self: self._user.n_groups)
+    slice = property(lambda self: self._user.slice, doc="The object's own ``slice`` (its signature too).")
+    describe = property(lambda self: self._user.describe)
+
+    @property
+    def wraps(self):
+        """The object's ``wraps``, read through its own `UserSource` (the same one while it is the same)."""
+        inner = getattr(self._user, "wraps", None)
+        if inner is None:
+            return None
+        kept = self.__dict__.get("_wrapped")
+        if kept is None or kept[0] is not inner:
+            kept = (inner, as_source(inner))
+            self.__dict__["_wrapped"] = kept
+        return kept[1]
+
+    @property
+    def w_frame(self):
+        """The object's ``w_frame``; without one, a source made around another answers for it."""
+        frame = getattr(self._user, "w_frame", None)
+        if frame is None and self.wraps is not None:
+            return self.wraps.w_frame
+        return SourceBase.w_frame if frame is None else frame
+
+    def __getattr__(self, name):
+        if name.startswith("__") or name == "_user":
+            raise AttributeError(name)
+        return getattr(self._user, name)
+
+    def __setattr__(self, name, value) -> None:
+        setattr(self._user, name, value)
+
+    def __delattr__(self, name) -> None:
+        delattr(self._user, name)
+
+    def __copy__(self) -> "UserSource":
+        return UserSource(copy.copy(self._user))
+
+    def __deepcopy__(self, memo) -> "UserSource":
+        return UserSource(copy.deepcopy(self._user, memo))
+
+    def __reduce__(self):
+        return UserSource, (self._user,)
+
+    def __repr__(self) -> str:
+        return f"UserSource({self._user!r})"
+
+
+def _forward(name: str):
+    default = getattr(SourceBase, name)
+    if name in _METHODS:
+        def get(self):
+            own = getattr(self._user, name, None)
+            return default.__get__(self) if own is None else own
+    else:
+        def get(self):
+            return getattr(self._user, name, default)
+    return property(get, lambda self, value: setattr(self._user, name, value),
+                    doc=f"The object's ``{name}``, else `SourceBase`'s default.")
+
+
+for _name in OPTIONAL_MEMBERS:
+    if _name not in ("wraps", "w_frame"):
+        setattr(UserSource, _name, _forward(_name))
+del _name
+
+
+def user_object(source):
+    """The object a user gave (a `UserSource`'s), else ``source`` itself."""
+    return source.user_object if isinstance(source, UserSource) else source
+
+
+def class_name(source) -> str:
+    """The class's name of what a user gave as ``source`` (a `UserSource`'s object's), for messages."""
+    return type(user_object(source)).__name__
+
+
+def source_title(source) -> str:
+    """What a message calls ``source``: its ``name``, else its class's name (a user's object's)."""
+    source = as_source(source)
+    return str(source.name) if source.name else class_name(source)
 
 
 @dataclass(frozen=True)
@@ -247,14 +472,16 @@ class SliceData:
         return data
 
 
+def _read(source):
+    """``source`` as the package reads it: itself when it inherits `SourceBase`, else `as_source`'s."""
+    return source if isinstance(source, SourceBase) else as_source(source)
+
+
 def w_frame(source) -> tuple:
     """``(origin, per_unit)`` of ``source``'s c0 (its ``w_frame``, default ``(0.0, 1.0)``): c0 =
     origin + per_unit * d, d the offset in the drawn units.  A stack answers for its inner source.
     TypeError / ValueError when a source offers a frame that is not two finite numbers, per_unit > 0."""
-    inner = getattr(source, "source", None)
-    frame = getattr(source, "w_frame", None)
-    if frame is None and inner is not None and inner is not source:
-        frame = getattr(inner, "w_frame", None)
+    frame = _read(source).w_frame
     if frame is None:
         return 0.0, 1.0
     try:
@@ -267,14 +494,15 @@ def w_frame(source) -> tuple:
 
 
 def inner_source(source):
-    """The source whose geometry ``source`` shows: its ``wraps`` (a stack's inner source), else itself."""
-    inner = getattr(source, "wraps", None)
+    """The source whose geometry ``source`` shows: its ``wraps`` (a stack's inner source), else
+    ``source`` itself, as given."""
+    inner = _read(source).wraps
     return source if inner is None else inner
 
 
 def settings_of(source) -> dict:
     """A copy of ``source``'s ``settings`` ({} for a source without), JSON-able values (tuples as lists)."""
-    settings = getattr(source, "settings", None)
+    settings = _read(source).settings
     if settings is None:
         return {}
     if not isinstance(settings, Mapping):
@@ -285,17 +513,18 @@ def settings_of(source) -> dict:
 def apply_setting(source, name: str, value) -> None:
     """Set one of ``source``'s `settings` (its ``apply_setting``); ValueError for a source without
     that setting, naming the ones it has."""
+    source = _read(source)
     names = settings_of(source)
-    apply = getattr(source, "apply_setting", None)
-    if name not in names or apply is None:
-        title = getattr(source, "name", None) or type(source).__name__
-        raise ValueError(f"{title} has no setting {name!r}; its settings: {', '.join(sorted(names)) or 'none'}")
-    apply(name, value)
+    if name not in names:
+        raise ValueError(f"{source_title(source)} has no setting {name!r}; its settings: "
+                         f"{', '.join(sorted(names)) or 'none'}")
+    source.apply_setting(name, value)
 
 
 def takes_coarse(source) -> bool:
     """True when ``source.slice`` takes ``coarse=`` (its ``coarse_steps``, else its signature)."""
-    declared = getattr(source, "coarse_steps", None)
+    source = _read(source)
+    declared = source.coarse_steps
     if declared is not None:
         return bool(declared)
 
@@ -306,30 +535,27 @@ def takes_coarse(source) -> bool:
 
 
 def outline_of(source, matrix, c0):
-    """``source.outline(matrix, c0)`` (the slice's balls and bars, no surface, nothing read), or
-    ``source.slice(matrix, c0)`` for a source without one."""
-    outline = getattr(source, "outline", None)
-    return source.slice(matrix, c0) if outline is None else outline(matrix, c0)
+    """``source.outline(matrix, c0)`` (the slice's balls and bars, no surface, nothing read; a
+    source without one: ``source.slice(matrix, c0)``, `SourceBase.outline`)."""
+    return _read(source).outline(matrix, c0)
 
 
 def note_matrix(source, matrix) -> None:
     """Tell ``source`` the orientation the view shows now (its optional ``note_matrix``: a stack
     spreads its default spacing along that w when N next changes); nothing for a source without one.
     Whoever runs a source's action or changes its settings (the widget, a replay) tells it first."""
-    note = getattr(source, "note_matrix", None)
-    if note is not None:
-        note(matrix)
+    _read(source).note_matrix(matrix)
 
 
 def known_range(source, default) -> tuple:
     """``(lo, hi)`` of ``source``'s data as far as it is known without reading all of it: its
     optional ``known_range`` (a chunked field's first cut until its background read is done), else
     its ``data_range``, else ``default``.  What a view asks for colours: never a whole read."""
-    for name in ("known_range", "data_range"):
-        rng = getattr(source, name, None)
-        if rng is not None:
-            return rng
-    return default
+    source = _read(source)
+    rng = source.known_range
+    if rng is None:
+        rng = source.data_range
+    return default if rng is None else rng
 
 
 def prepare_in_background(source, progress: bool = True):
@@ -337,8 +563,7 @@ def prepare_in_background(source, progress: bool = True):
     copy) and return what counts it, a `rot4d_widget.core.progress.Progress`, or None (a source
     without ``prepare``, or nothing left to do).  ``progress``: also show the kernel's own bar
     (in the cell's output); the widget passes False and shows the returned progress in its own."""
-    prepare = getattr(source, "prepare", None)
-    return None if prepare is None else prepare(progress=progress)
+    return _read(source).prepare(progress=progress)
 
 
 def data_w_text(source, w: float, matrix=None) -> str:
@@ -347,13 +572,13 @@ def data_w_text(source, w: float, matrix=None) -> str:
     is a c0 (`w_frame`).  With ``matrix``, a field's cut that misses its data (``w`` outside
     ``w_range(matrix)``: before or after the record along that w) says so: ``"time 0.5 s (outside
     the data)"``."""
-    inner = getattr(source, "source", source)
-    extent = getattr(inner, "extent", None)
-    if extent is None:
-        text = number_text(w, getattr(source, "size", 1.0), 3)
+    source = _read(source)
+    inner = inner_source(source)
+    if inner.extent is None:
+        text = number_text(w, source.size, 3)
         return f"w {'+' if not text.startswith('-') else ''}{text}"
     text = f"{axis_names(inner)[3]} {w_value_text(inner, w)}"
-    if matrix is not None and callable(getattr(inner, "w_range", None)):
+    if matrix is not None:
         lo, hi = (float(v) for v in inner.w_range(matrix))
         slack = 1e-9 * max(abs(lo), abs(hi), hi - lo)
         if not lo - slack <= float(w) <= hi + slack:
@@ -364,11 +589,11 @@ def data_w_text(source, w: float, matrix=None) -> str:
 def w_value_text(source, w: float) -> str:
     """A field's w as a number in its ``w_units`` ("30 s"), 4 significant digits -- or, for times
     that were datetime64 (``w_epoch``), the date and time."""
-    inner = getattr(source, "source", source)
+    inner = inner_source(_read(source))
     lo, hi = (float(v) for v in inner.extent[3])
-    if getattr(inner, "w_epoch", None) is not None:
+    if inner.w_epoch is not None:
         return coordinate_text(inner, 3, float(w), max(abs(lo), abs(hi)))
-    unit = getattr(inner, "w_units", None)
+    unit = inner.w_units
     return f"{number_text(float(w), max(abs(lo), abs(hi)), 4)}{' ' + unit if unit else ''}"
 
 
@@ -376,19 +601,19 @@ def c0_text(source, c0: float):
     """How c0 reads for ``source`` when a number with its unit would not do: the date and time for a
     field whose times were datetime64 (``w_epoch``; c0 counts seconds from it), with those seconds
     -- "2021-03-04 12:05:00 (c0 = 300 s)" -- else None."""
-    inner = getattr(source, "source", source)
-    if getattr(inner, "w_epoch", None) is None:
+    inner = inner_source(_read(source))
+    if inner.w_epoch is None:
         return None
     return f"{w_value_text(inner, c0)} (c0 = {number_text(float(c0), 0.0, 6)} s)"
 
 
 def w_span_text(source, a: float, b: float) -> str:
     """Two of a field's w as a range: "0.0021 … 0.0026 s" (the unit once), or two date-times."""
-    inner = getattr(source, "source", source)
-    if getattr(inner, "w_epoch", None) is not None:
+    inner = inner_source(_read(source))
+    if inner.w_epoch is not None:
         return f"{w_value_text(inner, a)} \u2026 {w_value_text(inner, b)}"
     lo, hi = (float(v) for v in inner.extent[3])
-    unit = getattr(inner, "w_units", None)
+    unit = inner.w_units
     big = max(abs(lo), abs(hi))
     return f"{number_text(float(a), big, 4)} \u2026 {number_text(float(b), big, 4)}{' ' + unit if unit else ''}"
 
@@ -561,7 +786,7 @@ def fill_flags(s):
     return flags
 
 
-class PolytopeSource:
+class PolytopeSource(SourceBase):
     """A 4-polytope (convex or not) as a source: groups are its cells, the slice is exact."""
 
     def __init__(self, polytope):
@@ -640,12 +865,17 @@ def _data_hint(obj) -> str:
 
 
 def as_source(obj):
-    """A polytope name, a `Polytope` or any `Source` -> a source.
+    """A polytope name, a `Polytope` or any `Source` -> a source the package reads by plain
+    attributes: a `SourceBase` as it is (the package's own sources, or a user's that inherits it),
+    any other object with the required members wrapped in a `UserSource` (once: as_source of a
+    `UserSource` is itself).
 
     Raises TypeError naming what is allowed.
     """
     if isinstance(obj, (str, Polytope)):
         return PolytopeSource(obj)
+    if isinstance(obj, UserSource):  # checked when it was made
+        return obj
     missing = [m for m in ("slice", "size", "n_groups", "describe") if not hasattr(obj, m)]
     if missing:
         raise TypeError(
@@ -663,4 +893,4 @@ def as_source(obj):
     n = obj.n_groups
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ValueError(f"Expected `source.n_groups` to be an int >= 1, got {n!r}")
-    return obj
+    return obj if isinstance(obj, SourceBase) else UserSource(obj)

@@ -46,6 +46,7 @@ from .protocol import (
     PolytopeSource,
     SliceData,
     SourceAction,
+    SourceBase,
     apply_setting,
     as_slice,
     as_source,
@@ -55,6 +56,7 @@ from .protocol import (
     no_volume_row,
     rotation_3d,
     settings_of,
+    source_title,
     takes_coarse,
     w_frame,
     w_value_text,
@@ -114,7 +116,7 @@ def default_spacing(source, n: int, matrix=None) -> float:
     about the middle of it each take one N-th of it.  Any other source (a polytope): 2 size / N, as
     before there were records (times its w per unit of space)."""
     n = _check_slices(n)
-    if getattr(source, "extent", None) is not None:
+    if source.extent is not None:
         lo, hi = _w_range(source, np.eye(4) if matrix is None else as_rotation_matrix(matrix))
         if math.isfinite(lo) and math.isfinite(hi) and hi > lo:
             return (hi - lo) / n
@@ -123,13 +125,12 @@ def default_spacing(source, n: int, matrix=None) -> float:
 
 def _w_range(source, matrix) -> tuple:
     """``source.w_range(matrix)``, or (-size, size) for a source without one (a polytope's own w)."""
-    f = getattr(source, "w_range", None)
-    return tuple(float(v) for v in f(matrix)) if f is not None else (-float(source.size), float(source.size))
+    return tuple(float(v) for v in source.w_range(matrix))
 
 
 def _w_units(source):
     """The unit of ``source``'s w (a field's ``w_units``), or None."""
-    return getattr(source, "w_units", None)
+    return source.w_units
 
 
 def stack_offsets(n: int, spacing: float) -> np.ndarray:
@@ -213,7 +214,7 @@ def _short_census(s) -> str:
     return " ".join(f"{c} {_SHORT.get(n, f'{n}-gon')}" for n, c in sorted(census.items()))
 
 
-class StackSource:
+class StackSource(SourceBase):
     """N parallel slices of ``source`` under one orientation, placed by an arrangement, as ONE source.
 
     Parameters
@@ -241,7 +242,7 @@ class StackSource:
         self.spacing = spacing
         self.arrangement = arrangement
         self.color_by = color_by
-        self._polytope = getattr(self.source, "polytope", None) if _is_polytope_source(self.source) else None
+        self._polytope = self.source.polytope if _is_polytope_source(self.source) else None
         if not takes_coarse(self.source):
             self.slice = self._slice_exact  # same signature as the inner source: (matrix, c0)
 
@@ -340,13 +341,13 @@ class StackSource:
 
     @property
     def name(self) -> str:
-        inner = getattr(self.source, "name", None) or type(self.source).__name__
+        inner = source_title(self.source)
         return f"{inner}, {self._slices} slice{'s' if self._slices != 1 else ''}"
 
     @property
     def edge_length(self):
         """The inner source's edge length times the largest scale (the widget sizes balls by it)."""
-        e = getattr(self.source, "edge_length", None)
+        e = self.source.edge_length
         if e is None:
             return None
         return float(e) * float(self.layout()[1].max())
@@ -424,7 +425,7 @@ class StackSource:
     def actions(self) -> dict:
         """n / b: one slice more / fewer; g / f: Δ times / divided by 2^(1/4) (Shift inverts each);
         and the inner source's own keys (a field's o / i), which act on every slice."""
-        inner = getattr(self.source, "actions", None) or {}
+        inner = self.source.actions or {}
         return {
             **inner,
             "n": SourceAction("slice +", "add a parallel slice", lambda sign=1: self.step_slices(sign), repeat=False),
@@ -537,11 +538,11 @@ class StackSource:
                 if polytope:
                     parts.append(_short_census(piece.slice))
                 if v is not None and not label.endswith("(outside the data)"):
-                    space = getattr(self.source, "space_units", None)
+                    space = self.source.space_units
                     parts.append(f"vol {text.number_text(v)}" + (f" {space}\u00b3" if space else ""))
                 rows.append((label, ", ".join(parts) or "\u2014"))
         else:
-            if getattr(self.source, "extent", None) is None:  # a polytope's own w
+            if self.source.extent is None:  # a polytope's own w
                 ends = [data_w_text(self.source, cuts[i])[2:] for i in (0, -1, hi)]
             else:
                 ends = [w_value_text(self.source, cuts[i]) for i in (0, -1, hi)]

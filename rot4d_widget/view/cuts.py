@@ -44,7 +44,7 @@ class GridCut:
 
 def can_sample(source) -> bool:
     """True when the (inner) source gives its cut on a grid (the protocol's optional ``sample``)."""
-    return callable(getattr(inner_source(source), "sample", None))
+    return callable(inner_source(source).sample)
 
 
 def _part(grid, lo_shift, scale):
@@ -140,7 +140,7 @@ def cut_labels(source, matrix, c0, data) -> CutLabels:
     ``to_data``) or a cut that misses the data."""
     if inner_source(source) is not source:
         return _slice_labels(source, matrix, c0, data)
-    if not callable(getattr(source, "to_data", None)):
+    if not callable(source.to_data):
         return CutLabels()
     extent = data_extent(data)
     if not len(extent):
@@ -168,8 +168,8 @@ def _slice_labels(stack, matrix, c0, data) -> CutLabels:
 def _sample(inner, matrix, c0, resolution, coarse):
     """``inner.sample``; a coarse one from the full data while the source's coarse copy is still
     being built (``coarse_ready`` False: the copy is not waited for, as `Field4D.slice` does)."""
-    if coarse and not getattr(inner, "coarse_ready", True):
-        res = resolution if resolution is not None else getattr(inner, "coarse_resolution", None)
+    if coarse and not inner.coarse_ready:
+        res = resolution if resolution is not None else inner.coarse_resolution
         return inner.sample(matrix, c0, res)
     return inner.sample(matrix, c0, resolution, coarse=coarse)
 

@@ -112,7 +112,7 @@ class Keeper:
 
     def _on_view_trait(self, change) -> None:
         name, new = change["name"], change["new"]
-        samples = callable(getattr(inner_source(self.showing.source), "sample", None))  # the protocol's optional grid
+        samples = callable(inner_source(self.showing.source).sample)  # the protocol's optional grid
         if name == "rendering" and new != "surface" and not samples:
             return  # refused by the widget's own observer (only a field has more than the surface)
         self.record_view(name, new)

@@ -395,7 +395,7 @@ def key_id(event: Mapping):
 
 def source_actions(source) -> dict:
     """``{key: (Action, run, repeat)}`` for the source's optional ``actions`` mapping."""
-    actions = getattr(source, "actions", None)
+    actions = source.actions
     if not actions:
         return {}
     if not isinstance(actions, Mapping):

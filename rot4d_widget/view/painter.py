@@ -22,6 +22,7 @@ from ..sources.protocol import (
     inner_source,
     known_range,
     outline_of,
+    source_title,
 )
 from . import markup as ro
 from .buffers import check_update_size
@@ -72,8 +73,7 @@ class ViewKey:
 
 
 def title(source) -> str:
-    name = getattr(source, "name", None)
-    return str(name) if name else type(source).__name__
+    return source_title(source)
 
 
 def checked_slice(source, matrix, c0, coarse, lock, *, outline: bool = False):
@@ -368,13 +368,12 @@ class Painter:
             last = "\u2014"
         else:
             last = label + (f" \u00d7{count}" if count > 1 else "")
-        w_range = getattr(source, "w_range", None)
-        lo, hi = w_range(st.matrix) if w_range is not None else (-source.size, source.size)
+        lo, hi = source.w_range(st.matrix)
         rows = [
             ("\u03b80", ro.angle_text(st.theta0)),
             ("\u03b1", ro.angle_text(st.alpha)),
             ("\u03b2", ro.angle_text(st.beta)),
-            ("c0", ro.gauge_html(st.c0, lo, hi, getattr(inner_source(source), "w_units", None),
+            ("c0", ro.gauge_html(st.c0, lo, hi, inner_source(source).w_units,
                                  text=c0_text(inner_source(source), st.c0))),
             ("last", last),
         ]
@@ -395,7 +394,7 @@ class Painter:
         volume = data.volume
         if volume is not None and math.isfinite(float(volume)):
             rows.append(("volume", volume_text(source, float(volume), st.matrix)))
-        elif cast and single and getattr(inner_source(source), "levels", None):
+        elif cast and single and inner_source(source).levels:
             rows.append(("volume", "\u2014 (inside the level: the surface rendering's)"))
         turning = self.turning_text()
         if turning is not None:
@@ -420,7 +419,7 @@ class Painter:
         its colours used (``clim``, or the cut's 1st-99th percentile) and marks no level.  "" for
         a source without levels."""
         inner = inner_source(self.showing.source)
-        levels = getattr(inner, "levels", None)
+        levels = inner.levels
         if not levels:
             return ""
         cast = self.cast_shown
@@ -428,15 +427,15 @@ class Painter:
             lo, hi = self.cast_clim
         else:
             clim = self.traits.clim
-            lo, hi = clim if clim is not None else getattr(inner, "data_range", (min(levels), max(levels)))
+            lo, hi = clim if clim is not None else inner.data_range or (min(levels), max(levels))
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
             return f"no colour scale (the data's range is {lo:.4g} \u2026 {hi:.4g})"
         if level_rgb is None or self.traits.color_by != "group":
             level_rgb = [(0.0, 0.0, 0.0)] * len(levels)
-        label = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
+        label = inner.long_name or inner.name or "value"
         marks = [] if cast else [(float(v), colours.hex_color(c)) for v, c in zip(levels, level_rgb)]
         cmap = self.traits.cmap
-        return ro.colourbar_html(colours.cmap_stops(cmap), lo, hi, str(label), getattr(inner, "units", None),
+        return ro.colourbar_html(colours.cmap_stops(cmap), lo, hi, str(label), inner.units,
                                  marks, cmap=cmap)
 
     def group_colors(self):
@@ -463,7 +462,7 @@ def level_colors(source, cmap: str = colours.LEVEL_COLORMAP, clim=None):
     """Colours of a source's iso levels along the colour map ``cmap``, or None: spread over it by
     rank (``clim`` None: the data's range as known without a full read -- a chunked store's first
     cut until its background read is done -- today's look), else each at its value in ``clim``."""
-    levels = getattr(source, "levels", None)
+    levels = source.levels
     if not levels:
         return None
     if clim is not None:
@@ -477,11 +476,11 @@ def volume_text(source, volume: float, matrix) -> str:
     them, ``space_units``); a field turned so that w is mixed in counts w at ``w_per_unit`` data
     w per unit of space, and says so."""
     inner = inner_source(source)
-    unit = getattr(inner, "space_units", None)
+    unit = inner.space_units
     text = ro.number_text(volume) + (f" {unit}³" if unit else "")
-    wpu = getattr(inner, "w_per_unit", None)
+    wpu = inner.w_per_unit
     if wpu is not None and abs(abs(float(np.asarray(matrix)[3, 3])) - 1.0) > 1e-12:
-        wu = getattr(inner, "w_units", None)
+        wu = inner.w_units
         text += (f" (w counted at {ro.number_text(wpu)}{' ' + wu if wu else ''} per "
                  f"{unit if unit else 'unit of space'})")
     return text

@@ -104,11 +104,11 @@ def skeleton(source):
     from the protocol's members (a stack's inner source): ``polytope`` (its vertices and edges)
     or ``half_widths`` (a field's box: `tesseract`)."""
     inner = inner_source(source)
-    poly = getattr(inner, "polytope", None)
+    poly = inner.polytope
     if poly is not None:
         return (np.asarray(poly.vertices, dtype=np.float64).reshape(-1, 4),
                 np.asarray(poly.edges, dtype=np.intp).reshape(-1, 2))
-    hw = getattr(inner, "half_widths", None)
+    hw = inner.half_widths
     if hw is not None:
         return tesseract(hw)
     return None
@@ -118,7 +118,7 @@ def hyperplane_offsets(source, c0) -> np.ndarray:
     """(K,) float64: the offsets d of the hyperplanes shown (slice units along the turned w axis,
     c0 = origin + per_unit * d, `w_frame`): one, or a stack's every slice (``cuts_at(c0)``)."""
     origin, per = w_frame(source)
-    cuts_at = getattr(source, "cuts_at", None) if inner_source(source) is not source else None
+    cuts_at = source.cuts_at if inner_source(source) is not source else None
     cuts = np.atleast_1d(np.asarray(cuts_at(c0) if cuts_at is not None else c0, dtype=np.float64))
     return (cuts - origin) / per
 

@@ -58,11 +58,11 @@ class TraitSync:
         """Copy the source's settings (a field's levels, inside, caps; a stack's N, spacing and
         arrangement) into the traits of the same names."""
         inner = inner_source(self.showing.source)
-        levels = getattr(inner, "levels", None)
+        levels = inner.levels
         if levels is not None:
             self.set_quietly("levels", tuple(float(v) for v in levels))
         for name in ("inside", "caps"):
-            if hasattr(inner, name):
+            if getattr(inner, name) is not None:  # inside, caps: a field's (None: the protocol's default)
                 self.set_quietly(name, getattr(inner, name))
         if is_stack(self.showing.source):
             src = self.showing.source
@@ -104,7 +104,7 @@ class TraitSync:
         """``levels``, ``inside``, ``caps``: settings of the (inner) source, where it has them."""
         name = change["name"]
         inner = inner_source(self.showing.source)
-        has = hasattr(inner, name)
+        has = getattr(inner, name) is not None  # levels, inside, caps: None where a source has none
         if name == "levels":
             why = f"{title(self.showing.source)} has no iso levels: `levels` applies to field sources"
         else:

@@ -282,7 +282,12 @@ class Rot4DWidget(widgets.HBox):
     # ------------------------------------------------------------------ API
     @property
     def source(self):
-        """The source shown (a stack around the one given once parallel slices are asked for)."""
+        """The source shown (a stack around the one given once parallel slices are asked for).
+
+        A polytope name gives a `PolytopeSource`; a source that inherits `SourceBase` (a `Field4D`,
+        a `StackSource`, a user's subclass) is itself; any other object given is read through the
+        `UserSource` that wraps it (``w.source.user_object`` is the object; its attributes read and
+        set through the wrapper, ``w.source.thickness = 2`` then `refresh`)."""
         return self._showing.source
 
     @property
@@ -297,7 +302,7 @@ class Rot4DWidget(widgets.HBox):
     @property
     def polytope(self):
         """The `Polytope` shown, or None when the source is not a polytope."""
-        return getattr(self.source, "polytope", None)
+        return self.source.polytope
 
     @property
     def slice(self):
@@ -638,7 +643,7 @@ def _source_and_state(source, theta0, alpha, c0, keymap, c0_step, levels, slices
     source's own actions, validated before any widget exists."""
     src = as_source(source)
     if levels is not None:
-        if not hasattr(src, "levels"):
+        if src.levels is None:
             raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {title(src)}")
         src.levels = levels
     if slices is not None:  # parallel slices (4-D tomography): a source that wraps the source
@@ -661,7 +666,7 @@ def _source_and_state(source, theta0, alpha, c0, keymap, c0_step, levels, slices
 def _default_ball_radius(source, scale, state) -> float:
     """min(0.07, 0.1 x displayed edge): the polytope's edge, else the first slice's median segment
     (of its outline, `outline_of`: a field's box cut, nothing read)."""
-    edge = getattr(source, "edge_length", None)
+    edge = source.edge_length
     if edge is None:
         data = checked_slice(source, state.matrix, state.c0, False, threading.RLock(), outline=True)
         seg = np.asarray(data.segments)

@@ -15,7 +15,7 @@ import numpy as np
 from ...core import colours
 from ...core.sizes import REFERENCE_RADIUS
 from ...sources.field_labels import axis_names
-from ...sources.protocol import c0_text
+from ...sources.protocol import c0_text, inner_source
 from ...sources.tomography import StackSliceData
 from .slice_drawing import CAMERA_DISTANCE, CAMERA_FOV, Z_LABEL, perspective
 
@@ -101,12 +101,12 @@ def level_rgb(inner, cmap: str = colours.LEVEL_COLORMAP, clim=None):
     """(n, 3) colours of ``inner``'s iso ``levels`` along ``cmap`` (None without levels): the live
     view's rule (`rot4d_widget.view.painter.level_colors`) -- ``clim`` None: spread by rank over the
     map (the data's range orders them), else each at its value over ``clim``."""
-    levels = tuple(getattr(inner, "levels", ()) or ())
+    levels = tuple(inner.levels or ())
     if not levels:
         return None
     if clim is not None:
         return _level_colors(levels, float(clim[0]), float(clim[1]), cmap, True)
-    lo, hi = getattr(inner, "data_range", (min(levels), max(levels)))
+    lo, hi = inner.data_range if inner.data_range is not None else (min(levels), max(levels))
     return _level_colors(levels, lo, hi, cmap)
 
 
@@ -120,19 +120,19 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
     and ``legend``, ``[(rgb, label), ...]``: the colours of a field's levels (along ``cmap``, by
     value over ``clim`` when given: `level_rgb`) or of a stack's slices.  Only attributes the
     sources have are read, never their class."""
-    inner = getattr(source, "source", source)
+    inner = inner_source(source)
     lines = []
-    wu = getattr(inner, "w_units", None)
+    wu = inner.w_units
     wu = f" {wu}" if wu else ""  # c0 and the slices' w are in the source's w units (a field's time)
     state = c0_text(inner, c0) or f"c0 = {float(c0):+.4g}{wu}"
     lines.append(state if theta0 is None else f"\u03b80 = {_fmt_angle(float(theta0))}, {state}")
     if matrix is not None:
         lines.append(turn_text(matrix, axis_names(inner)))
-    name, units = getattr(inner, "name", None), getattr(inner, "units", None)
+    name, units = inner.name, inner.units
     u = f" {units}" if units else ""
     if name:
         lines.append(f"{name}" + (f" [{units}]" if units else ""))
-    levels = tuple(getattr(inner, "levels", ()) or ())
+    levels = tuple(inner.levels or ())
     if levels:
         lines.append(("level " if len(levels) == 1 else "levels ") + ", ".join(f"{v:.4g}" for v in levels) + u)
     rows = dict(tuple(r) for r in (data.readout or ()) if len(r) == 2)
@@ -140,10 +140,10 @@ def annotation(source, data, c0: float, *, theta0: float | None = None, cmap: st
         lines.append(f"w cut {rows['w cut']}")
     elif "slice" in rows:
         lines.append(str(rows["slice"]))
-    n = int(getattr(source, "slices", 1) or 1)
-    ws = np.asarray(source.cuts_at(c0)) if n > 1 and hasattr(source, "cuts_at") else np.zeros(0)
+    n = int(source.slices or 1)
+    ws = np.asarray(source.cuts_at(c0)) if n > 1 and source.cuts_at is not None else np.zeros(0)
     if len(ws):
-        spacing = getattr(source, "spacing", None)  # in the source's w units, as c0 (issue 37)
+        spacing = source.spacing  # in the source's w units, as c0 (issue 37)
         lines.append(f"{n} slices w = {ws[0]:+.4g} \u2026 {ws[-1]:+.4g}{wu}"
                      + (f", \u0394 = {spacing:.3g}{wu}" if spacing else ""))
     legend = []
@@ -253,8 +253,8 @@ def colorbar_width(height: float) -> float:
 def value_label(inner) -> str:
     """The colour bar's title: the variable's ``long_name`` (xarray's attribute, when the source
     keeps it), else its ``name``, else "value", with its ``units`` in brackets."""
-    name = getattr(inner, "long_name", None) or getattr(inner, "name", None) or "value"
-    units = getattr(inner, "units", None)
+    name = inner.long_name or inner.name or "value"
+    units = inner.units
     return f"{name} [{units}]" if units else str(name)
 
 

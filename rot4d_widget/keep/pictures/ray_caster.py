@@ -52,6 +52,7 @@ from ...core.colours import default_clim
 from ...core.progress import progress as make_progress
 from ...core.renderings import DEFAULT_DENSITY, DEFAULT_SECTIONS
 from ...core.sizes import REFERENCE_RADIUS
+from ...sources.protocol import class_name, inner_source
 from . import ray_caster_kernels
 
 #: How far the live view's camera is from the centre (`rot4d_widget.keep.pictures.slice_drawing.CAMERA_DISTANCE`,
@@ -367,11 +368,11 @@ def cut_grids(stack, data, matrix):
     """The grids (`FieldGrid`, one per slice of ``data``, the stack's slice at ``matrix``) of the
     cuts of ``stack``'s field: its inner source's ``sample(matrix, w)`` at each cut w (the source
     protocol's optional ``sample``; a TypeError naming it for a source without)."""
-    inner = getattr(stack, "wraps", None) or getattr(stack, "source", stack)
-    sample = getattr(inner, "sample", None)
+    inner = inner_source(stack)
+    sample = inner.sample
     if not callable(sample):
         raise TypeError(f"A volume rendering needs a source sampled on a grid (a Field4D: `sample`), "
-                        f"got {type(inner).__name__}")
+                        f"got {class_name(inner)}")
     return [sample(matrix, float(w)) for w in np.asarray(data.cuts, dtype=np.float64)]
 
 

@@ -22,7 +22,16 @@ from ...core.sizes import REFERENCE_RADIUS
 from ...core.state import RotationState
 from ...geometry.slicing.tables import Slice
 from ...sources.field_labels import box_labels
-from ...sources.protocol import apply_setting, as_source, data_w_text, inner_source, note_matrix, settings_of
+from ...sources.protocol import (
+    apply_setting,
+    as_source,
+    class_name,
+    data_w_text,
+    inner_source,
+    note_matrix,
+    settings_of,
+    source_title,
+)
 from ...sources.tomography import StackSource
 from .canvas import LiteralTextFigure
 from .framing import (
@@ -143,9 +152,9 @@ def render_tomography(
     front of the cut, so that no plane is edge-on).
     """
     # a source that wraps another is parallel slices already (the protocol's ``wraps``)
-    src = source if getattr(source, "wraps", None) is not None else None
+    inner = as_source(source)
+    src = inner if inner.wraps is not None else None
     if src is None:
-        inner = as_source(source)
         src = StackSource(inner, slices=slices, spacing=spacing, arrangement=arrangement, color_by=color_by)
     matrix = np.eye(4) if matrix is None else matrix
     c0 = checked_real("c0", c0)
@@ -167,7 +176,7 @@ def render_tomography(
     rendering = check_rendering(rendering)
     cmap, clim = colours.check_cmap(cmap), colours.check_clim(clim)
     inner = inner_source(src)
-    field = getattr(inner, "data_range", None) is not None  # a field: values to colour
+    field = inner.data_range is not None  # a field: values to colour
     volume = rendering != "surface"
     data = src.slice(matrix, c0) if _data is None else _data
     # a volume rendering's cuts, sampled once (drawn, and the box labelled); no `sample`: a TypeError here
@@ -194,7 +203,7 @@ def render_tomography(
     else:  # an animation's next frame: the same figure, this frame's artists only
         fig, ax = _canvas.begin(width, height, top, dpi, background, right)
     aspect = width / height
-    edge = getattr(src.source, "edge_length", None)
+    edge = src.source.edge_length
     base_ball = sizes.default_ball_radius(edge * scale) if edge else sizes.default_ball_radius(REFERENCE_EDGE)
     if isinstance(frame, str) and frame == "fit":
         box = frame_extent(data, src, ball_radius=(ball_radius if ball_radius is not None else base_ball)
@@ -209,7 +218,7 @@ def render_tomography(
         lines, legend = annotation(src, cut, c0, theta0=_theta0, cmap=cmap, clim=clim, matrix=matrix)
         if volume:
             legend = []  # no surfaces and no slice colours: the colour bar says what a colour is
-            name = getattr(inner, "name", None) or "the value"  # no level drawn: say what is
+            name = inner.name or "the value"  # no level drawn: say what is
             cast_text = renderings.RENDERING_TEXT[rendering].format(name=name)
             lines = [cast_text if ln.startswith(("level ", "levels ")) else ln for ln in lines]
         if isinstance(annotate, str):
@@ -218,7 +227,7 @@ def render_tomography(
         if box is not None:  # a fitted frame: the picture moves down, out from under the text
             (x0, x1), (y0, y1) = below_notes(box, (x0, x1), (y0, y1), notes[2][0], height * dpi)
     box_text = None  # a single field's box labels: ``(labels, extent)`` of the data's extent
-    if axis_labels and (field or volume) and n == 1 and callable(getattr(inner, "to_data", None)):
+    if axis_labels and (field or volume) and n == 1 and callable(inner.to_data):
         extent = _slice_box(cut, data.point_offsets, data.segment_offsets)
         if extent is not None:  # the data's extent, never the padded sampling grid
             box_text = (box_labels(inner, matrix, c0, extent), extent.corners)
@@ -231,7 +240,7 @@ def render_tomography(
     if _canvas is None:
         ax.set_aspect("equal")
 
-    poly = getattr(src.source, "polytope", None)
+    poly = src.source.polytope
     offs = np.asarray(data.point_offsets)
     toff = np.asarray(data.triangle_offsets)
     soff = np.asarray(data.segment_offsets)
@@ -298,7 +307,7 @@ def render_tomography(
         draw_box_labels(ax, box_text[0], scale, box_text[1], small_font(height) - 0.5, height, placed=taken,
                         view=view)
     if title:
-        name = getattr(src.source, "name", None) or type(src.source).__name__
+        name = source_title(src.source)
         text = title if isinstance(title, str) else (
             f"{name}: {n} slice{'s' if n != 1 else ''} w = c0 + (k \u2212 {(n - 1) / 2:g})\u0394, "
             f"c0 = {c0:.3g}, \u0394 = {src.spacing:.3g}, {src.arrangement}")
@@ -324,7 +333,7 @@ def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top
     else by rank: `level_rgb`) for the surface rendering."""
     clim = used if used is not None else given
     if clim is None:
-        lo, hi = (float(v) for v in getattr(inner, "data_range", (0.0, 1.0)))
+        lo, hi = (float(v) for v in (inner.data_range if inner.data_range is not None else (0.0, 1.0)))
         if not (np.isfinite(lo) and np.isfinite(hi)):
             lo, hi = 0.0, 1.0
         if not hi > lo:
@@ -334,7 +343,7 @@ def _field_colorbar(fig, inner, rendering, cmap, given, used, width, height, top
     if rendering == "surface":
         rgb = level_rgb(inner, cmap, given)
         if rgb is not None:
-            marks = tuple(zip(tuple(getattr(inner, "levels", ())), rgb))
+            marks = tuple(zip(tuple(inner.levels), rgb))
     total_w, total_h = width + right, height + top
     rect = ((width + 0.12) / total_w, 0.15 * height / total_h, 0.14 / total_w, 0.7 * height / total_h)
     draw_colorbar(fig, rect, cmap, clim, value_label(inner), marks, small_font(height))
@@ -471,7 +480,7 @@ def _draw_surface(ax, data, k, offs, toff, soff, scale, group_rgb, inner, face_a
         z = pts[:, 2]
         depth = (z[t0] + z[t1] + z[t2]) / 3.0
         order = np.argsort(depth, kind="stable")
-        alpha = 1.0 if len(getattr(inner, "levels", ()) or ()) <= 1 else max(face_alpha, colours.SURFACE_OPACITY)
+        alpha = 1.0 if len(inner.levels or ()) <= 1 else max(face_alpha, colours.SURFACE_OPACITY)
         coll = _Triangles(xy[tri[order]], np.column_stack([rgb[order], np.full(len(order), alpha)]),
                           zorder=z_base, gid="surface")
         ax.add_collection(coll, autolim=False)
@@ -490,9 +499,9 @@ def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=
     protocol (``wraps``, ``settings``, ``apply_setting``), never from its class."""
     src = as_source(source)
     inner, color_by, n, spc, arr = src, "w", 1, None, "oval"
-    if getattr(src, "wraps", None) is not None:
+    if src.wraps is not None:
         own = settings_of(src)
-        inner, color_by = src.wraps, getattr(src, "color_by", "w")
+        inner, color_by = src.wraps, src.color_by
         n, spc, arr = own.get("slices", n), own.get("spacing", spc), own.get("arrangement", arr)
     if slices is not None:
         n = slices
@@ -503,7 +512,7 @@ def state_source(source, *, levels=None, slices=None, spacing=None, arrangement=
     have = settings_of(inner)
     if levels is not None:
         if "levels" not in have:
-            raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {type(inner).__name__}")
+            raise TypeError(f"`levels` applies to sources with iso levels (a Field4D), not {class_name(inner)}")
         wanted = tuple(np.atleast_1d(np.asarray(levels, dtype=np.float64)).tolist())
         if wanted != tuple(have["levels"]):
             inner = copy.copy(inner)
@@ -645,7 +654,7 @@ def prepare_render(state, source, *, levels=None, slices=None, spacing=None, arr
                          inside=inside, caps=caps)
     note_matrix(stack, state.matrix)  # a default spacing not spread yet: along this picture's w
     if ball_radius is None:
-        edge = getattr(stack, "edge_length", None)
+        edge = stack.edge_length
         if edge:
             ball_radius = sizes.default_ball_radius(edge * REFERENCE_RADIUS / stack.size)
     if data is None:

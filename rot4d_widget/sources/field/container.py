@@ -62,6 +62,7 @@ import numpy as np
 
 from ...core.rotation import as_rotation_matrix
 from ...geometry.mesh import check_scale
+from ..protocol import SourceBase
 from .checks import (
     AXES,
     as_levels,
@@ -89,7 +90,7 @@ __all__ = ["Field4D", "slice_field"]
 _SORT_PASSES = True
 
 
-class Field4D(FieldLevels, FieldMemory):
+class Field4D(FieldLevels, FieldMemory, SourceBase):
     """A scalar field on a 4-D box: a source for `Rot4DWidget` and the input of `slice_field`.
 
     Parameters
