@@ -8,7 +8,8 @@ focus lost (`on_focus_lost`) and screenshots (`request_screenshot`, `on_screensh
 what the projection view's canvas needs (``projection_model_ids``, ``projection_class``).  The
 page also applies what travels with each update, keeps Notebook 7's shortcuts off keys over the
 canvas and removes ipyevents' listener when a hovered canvas is destroyed.  Listeners are removed
-when the view is removed.  The messages and the reasons: docs/design.md, "The companion".
+when the view is removed.  The messages and the reasons: docs/design.md, "The page predicts,
+the kernel decides" (The companion).
 """
 
 from __future__ import annotations
