@@ -1,7 +1,7 @@
 """The general slicer: a polytope with star faces or non-convex (star) cells cut by w = c0.
 
 `Polytope.star` is not None (some face is not a convex polygon or some cell not a convex
-polyhedron), or the polytope has no inside: `rot4d_widget.geometry.slicing` sends every level
+polyhedron, or the polytope has no inside): `rot4d_widget.geometry.slicing` sends every level
 here.  The slice's points are the edges' crossings of H; a face's crossings sorted along its line
 are paired by the even-odd rule into segments; each cell's section is the cycles its segments
 chain into, fanned when the cell is convex and otherwise filled even-odd (from centroids, by
