@@ -267,8 +267,8 @@ def _built(canon: str):
 def build(name):
     """The polychoron called ``name`` as a `rot4d_widget.geometry.mesh.Polytope` (edge 2, centred).
 
-    ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see the module
-    docstring; `polytope_names` lists the canonical names).  The regular six are the core's own
+    ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see
+    `canonical_name`; `polytope_names` lists the canonical names).  The regular six are the core's own
     objects (``build("x3o3o3o") is polytope("5-cell")``).  Built once and cached.
 
     Raises TypeError for a non-str and ValueError, saying where the names are listed, for an

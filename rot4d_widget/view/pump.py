@@ -82,14 +82,14 @@ class UpdatePump:
         update left (an acknowledgement is then awaited), None when nothing
         changed on screen.  A generator yields once a callable (the slow
         part, run without the lock on the ticker thread), receives its result
-        and returns the id (see the module docs).
+        and returns the id (docs/design.md, "Flow control").
     tick : callable (now) -> None, optional
         Advance time-driven state (held keys) to ``now``.
     deadline : callable () -> float or None, optional
         When ``tick`` next wants to run.
     clock : callable () -> seconds
     ack_timeout : float
-        Seconds to wait for an acknowledgement at least (see the module docs).
+        Seconds to wait for an acknowledgement at least (docs/design.md, "Flow control").
     max_in_flight : int >= 1
         The bound near the page; far from it, ``ceil(round trip x tick_rate)`` (`limit`).
     tick_rate : float, optional

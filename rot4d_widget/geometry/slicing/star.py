@@ -69,7 +69,7 @@ def star_tables(p, t: SliceTables) -> _StarTables:
 
 
 def slice_star(p, t: SliceTables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
-    """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
+    """One level of a polytope with star faces or non-convex cells (docs/design.md, "Slicing polytopes")."""
     st = star_tables(p, t)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol
