@@ -1,15 +1,15 @@
 """`Companion`: the front-end JavaScript the widget needs, as an invisible anywidget.
 
 Display it next to the scene's renderer (e.g. in the same box).  Its module is the page's code,
-``rot4d_widget/view/page/*.js`` joined by `rot4d_widget.view.bundle` (no build step), and runs in
+``rot4d_widget/view/page/*.js`` joined by `rot4d_widget.view.bundle` (no build step), for
 JupyterLab 4 and Notebook 7 alike.  The kernel side here hears the page and calls back: "drawn"
 after a frame that shows an update (`on_drawn`, `last_draw_time`: the pump's acknowledgement),
-focus lost (`on_focus_lost`) and screenshots (`request_screenshot`, `on_screenshot`); it carries
-what the projection view's canvas needs (``projection_model_ids``, ``projection_class``).  The
-page also applies what travels with each update, keeps Notebook 7's shortcuts off keys over the
-canvas and removes ipyevents' listener when a hovered canvas is destroyed.  Listeners are removed
-when the view is removed.  The messages and the reasons: docs/design.md, "The page predicts,
-the kernel decides" (The companion).
+the page's clock (`on_clock`), one-time transfers held (`on_holds`), focus lost
+(`on_focus_lost`) and screenshots (`request_screenshot`, `on_screenshot`).  The page also applies
+what travels with each update, draws the projection, keeps Notebook 7's shortcuts off keys over
+the canvas and removes ipyevents' listener when a hovered canvas is destroyed; its listeners go
+when the view goes.  How and why: docs/design.md, "The page predicts, the kernel decides" (The
+companion).
 """
 
 from __future__ import annotations
