@@ -1,36 +1,11 @@
 """The ten regular star polychora (Schläfli–Hess), built from the 600-cell's and 120-cell's vertices.
 
-Construction (nothing is read from a file or a table of faces): on the unit 3-sphere, nine of the
-ten share the 600-cell's 120 vertices and the great grand stellated 120-cell has the 120-cell's
-600.  Each cell lies in a hyperplane ``v . u = h``: ``u`` runs over the 600-cell's vertex
-directions (120 cells; the 120-cell's 600 directions for the grand 600-cell's 600 cells), and
-the vertices at that level form the cell's convex hull -- an icosahedron (12), a dodecahedron
-(20) or a tetrahedron (4) of hull edge ``a``, so ``h = sqrt(1 - R(a)**2)``, R the hull's
-circumradius.  Within a cell the faces are the regular polygons of the cell's symbol on its
-vertices: triangles {3} and pentagons {5} of side ``edge``, pentagrams {5/2} of side ``edge``
-(their hull pentagons have side ``edge / phi``) listed as 5-cycles in pentagram order.  A face
-shared by two cells is one face.  The edges are the faces' sides.
-
-=============================  ============  ============  ======  ===============  =====
-name                           symbol        hull, a       cell    edge (unit)      dens.
-=============================  ============  ============  ======  ===============  =====
-icosahedral 120-cell           {3,5,5/2}     ico, 1/phi    {3,5}   1/phi            4
-small stellated 120-cell       {5/2,5,3}     ico, 1/phi    {5/2,5} 1                4
-great 120-cell                 {5,5/2,5}     ico, 1/phi    {5,5/2} 1/phi            6
-grand 120-cell                 {5,3,5/2}     doe, 1/phi    {5,3}   1/phi            20
-great stellated 120-cell       {5/2,3,5}     doe, 1/phi    {5/2,3} phi              20
-grand stellated 120-cell       {5/2,5,5/2}   ico, 1        {5/2,5} phi              66
-great grand 120-cell           {5,5/2,3}     ico, 1        {5,5/2} 1                76
-great icosahedral 120-cell     {3,5/2,5}     ico, 1        {3,5/2} phi              76
-grand 600-cell                 {3,3,5/2}     tet, phi      {3,3}   phi              191
-great grand stellated 120-cell {5/2,3,3}     doe, 1/sqrt2  {5/2,3} phi**2/sqrt2     191
-=============================  ============  ============  ======  ===============  =====
-
-Scale: every one has **edge length 2** and is centred on the origin, like the regular six
-(`rot4d_widget.geometry.regular`), so its circumradius is ``2 / edge(unit)``: 2*phi (the
-600-cell's) for edge 1/phi, 2 for edge 1, 2/phi for edge phi.  Counts and densities are those
-published (Wikipedia's "Schläfli–Hess polychoron", the Polytope Wiki); tests/test_star_regular.py
-checks them, the density by the boundary's winding number round the centre.
+Nothing is read from a file or a table of faces: each cell is the vertices at one level
+``v . u = h`` of the 600-cell's 120 vertices (the 120-cell's 600 for the great grand stellated
+120-cell), and its faces are the regular polygons of the cell's symbol on them (`SPECS` holds each
+one's hull, edges, published counts and density).  Every one has edge length 2 and is centred on
+the origin, like the regular six (`rot4d_widget.geometry.regular`).  The construction and its
+checks: docs/design.md, "Slicing polytopes" (The regular star polychora).
 
 >>> star_name("{5/2,3,3}"), star_name("Great Grand Stellated 120-cell"), star_name("600-cell")
 ('great grand stellated 120-cell', 'great grand stellated 120-cell', None)

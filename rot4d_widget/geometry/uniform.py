@@ -1,47 +1,15 @@
 """Convex uniform 4-polytopes (polychora): the Wythoff construction, its combinatorics, names.
 
-What is here
-------------
-* the 45 distinct polychora of the 60 ring patterns of the linear Coxeter–Dynkin diagrams
-  A4 ``[3,3,3]``, B4 ``[4,3,3]``, F4 ``[3,4,3]`` and H4 ``[5,3,3]``;
-* the snub 24-cell and the grand antiprism (the two non-Wythoffian convex ones; both are
-  600-cells with vertices cut away);
-* prismatic families: prisms over the Platonic and Archimedean solids, the p-q duoprisms and
-  the p-antiprismatic prisms for 3 <= p, q <= 32.
-
-Every one has edge length 2 and is centred on the origin, like the regular six of
-:mod:`rot4d_widget.geometry.regular` — and the regular six *are* those objects: ``build("x3o3o3o")``
-returns ``polytope("5-cell")`` itself (its vertex array unchanged).
-
-Combinatorics from the group, not from the geometry
----------------------------------------------------
-A Wythoff polytope is the orbit ``W v0`` of a seed point ``v0`` under a finite reflection group
-``W`` with simple reflections ``r0 .. r3`` (the diagram's nodes).  ``v0`` is at distance 1 from
-the mirror of each ringed node and on the mirrors of the others, so each ringed reflection moves
-it by 2 (the edge length).  The group is enumerated once (its elements as 4x4 matrices, at most
-14400 for H4) together with the permutations ``g -> g r_i`` (right multiplication).  Then, by
-Wythoff's rule, for every set K of nodes whose connected parts each contain a ringed node, the
-k-faces of type K are the sets ``g W_K v0``; two elements give the same face exactly when they
-lie in the same left coset of ``W_K x W_U'`` (U' the unringed nodes not joined to K, which fix the
-face pointwise).  So vertices, edges, 2-faces and cells are *connected components* of the Cayley
-graph restricted to a few generators (``scipy.sparse.csgraph.connected_components``), a 2-face's
-vertex cycle is the walk ``g, g r_i, g r_i r_j, ...`` around its dihedral group, and a cell's
-2-faces are the faces of the group elements in the cell's coset.  No distances are compared and
-no hull is taken.  Only the two non-Wythoffian polychora (96 and 100 vertices) and the faces of
-the two snub polyhedra (24 and 60 vertices) come from a convex hull.
-
-Names
------
-``canonical_name`` accepts the common names ("rectified 5-cell", "omnitruncated 120-cell",
-"snub 24-cell", "grand antiprism", "5-7 duoprism", "truncated cubic prism", "pentagonal prism
-prism", "7-antiprismatic prism", ...), the linear Dynkin notation of the polytope community
-("x3o3o3o", "o3x3o3o", "x4x3o3o", "x5x3x3x", "s3s4o3o"; a diagram read backwards is the same
-polytope; prismatic ones "x5o x7o", "x4x3o x", "s2s14o x"), and the aliases of the regular six.
-``polytope_names()`` lists the canonical names by family.
-
-Where it lives: the groups and the construction in `rot4d_widget.geometry.wythoff`, the snub
-24-cell, the grand antiprism, the polyhedra and the prismatic families in
-`rot4d_widget.geometry.constructions`; here the table of names and the public API.
+Here: the 45 distinct polychora of the 60 ring patterns of the linear diagrams A4, B4, F4 and H4;
+the snub 24-cell and the grand antiprism (the two non-Wythoffian convex ones); prisms over the
+Platonic and Archimedean solids, the p-q duoprisms and the p-antiprismatic prisms for
+3 <= p, q <= 32.  Every one has edge length 2 and is centred on the origin, like the regular six
+of :mod:`rot4d_widget.geometry.regular`, and ``build("x3o3o3o")`` returns ``polytope("5-cell")``
+itself.  The combinatorics come from the group, not from the geometry (docs/design.md, "Uniform
+polychora from the group").  This module holds the table of names (`canonical_name`,
+``polytope_names()``) and the public API; the groups and the construction are in
+`rot4d_widget.geometry.wythoff`, the snubs, the grand antiprism, the polyhedra and the prismatic
+families in `rot4d_widget.geometry.constructions`.
 """
 
 from __future__ import annotations
@@ -196,6 +164,12 @@ def _norm(name: str) -> str:
 def canonical_name(name) -> str | None:
     """The canonical name of a polychoron given by any accepted name or Dynkin symbol, else None.
 
+    Accepted: the common names ("rectified 5-cell", "omnitruncated 120-cell", "snub 24-cell",
+    "grand antiprism", "5-7 duoprism", "truncated cubic prism", "pentagonal prism prism",
+    "7-antiprismatic prism", ...), the linear Dynkin notation ("x3o3o3o", "o3x3o3o", "x4x3o3o",
+    "x5x3x3x", "s3s4o3o"; a diagram read backwards is the same polytope; prismatic ones "x5o x7o",
+    "x4x3o x", "s2s14o x") and the aliases of the regular six.
+
     >>> canonical_name("o3x3o3o"), canonical_name("Truncated Tesseract"), canonical_name("7-5 duoprism")
     ('rectified 5-cell', 'truncated tesseract', '5-7 duoprism')
     """
@@ -293,8 +267,8 @@ def _built(canon: str):
 def build(name):
     """The polychoron called ``name`` as a `rot4d_widget.geometry.mesh.Polytope` (edge 2, centred).
 
-    ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see the module
-    docstring; `polytope_names` lists the canonical names).  The regular six are the core's own
+    ``name``: a canonical or common name, an alias or a linear Dynkin symbol (see
+    `canonical_name`; `polytope_names` lists the canonical names).  The regular six are the core's own
     objects (``build("x3o3o3o") is polytope("5-cell")``).  Built once and cached.
 
     Raises TypeError for a non-str and ValueError, saying where the names are listed, for an

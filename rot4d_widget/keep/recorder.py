@@ -1,36 +1,13 @@
 """Recorded key sequences: the events, a `Recording` and the `Recorder` that makes one.
 
-A `Recorder` is the widget's hook: created with the `RotationState` as it is when recording
-starts, it is told every action the widget applies (``recorder.record(key, shift, action,
-inverted)``, a repeat tick as well as a key press) and every parameter set from outside the keys
-(``recorder.record_set("c0", 0.3)``, a slider) and every setting of the source
-(``recorder.record_source("levels", (2.0, 3.0))``: ``levels``, ``slices``, ``spacing``,
-``arrangement``, or any of a source's own ``settings``: the source protocol's) and every view
-setting (``recorder.record_view("rendering", "mip")``: how a field's cut is drawn, `VIEW_SETTINGS`),
-with a time stamp.  It keeps at most
-``max_events``; older events are folded into the starting state, so a recording always replays
-to the live state.  ``recorder.recording()`` is an immutable `Recording`:
-
-* ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
-  so a recorded ``r`` resets where the live one did);
-* ``initial_source``: the source settings the events start from (``{"levels": [...], ...}``, those
-  the recorder was told with ``source_settings=``, and those folded in), possibly empty;
-* ``initial_view``: the view settings the events start from (``{"rendering": "surface", ...}``,
-  told with ``view_settings=``), possibly empty: a renderer then draws with its own;
-* ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value),
-  `SourceSetting` (t, name, value) and `ViewSetting` (t, name, value);
-* ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
-
-A recording is data: loading one imports nothing and runs nothing it names (a source's own
-action is looked up by name among the actions of the source the caller passes).
-
-Replaying applies the same floating-point operations in the same order, so the final state is
-the recorded one bit for bit (tested).  A source's own actions (a field's level keys, a stack's
-slice keys) and the source's settings are replayed on a source when one is given
-(`Recording.replay`; ``set_source=`` lets the widget apply a setting itself, as turning a single
-view into a stack replaces its source), else skipped; view settings change neither state nor
-source: they go to ``set_view=`` (the widget sets its traits), else are skipped.
-The animations are `rot4d_widget.keep.animation`'s.
+A `Recorder` is the widget's hook: told every action the widget applies, every parameter set from
+outside the keys, every setting of the source and every view setting, with a time stamp, it keeps
+at most ``max_events`` (older ones fold into the starting state, so a recording always replays
+to the live state).  ``recorder.recording()`` is an immutable `Recording`: a starting state, the
+source and view settings it starts from and the events (`Step`, `Setting`, `SourceSetting`,
+`ViewSetting`), saved and loaded as JSON.  A recording is data: loading one imports nothing and
+runs nothing it names.  Replaying applies the same floating-point operations in the same order,
+so it ends on the recorded state bit for bit.  The animations are `rot4d_widget.keep.animation`'s.
 """
 
 from __future__ import annotations
@@ -366,7 +343,25 @@ def apply_event(state: RotationState, event, source=None, set_source=None, set_v
 
 # ============================================================================ recordings
 class Recording:
-    """A starting state and the events applied to it (immutable; see the module docstring)."""
+    """A starting state and the events applied to it (immutable).
+
+    * ``initial``: the state the events start from (`RotationState.to_dict` with its reset point,
+      so a recorded ``r`` resets where the live one did);
+    * ``initial_source``: the source settings the events start from (``{"levels": [...], ...}``,
+      those the recorder was told with ``source_settings=``, and those folded in), possibly empty;
+    * ``initial_view``: the view settings the events start from (``{"rendering": "surface", ...}``,
+      told with ``view_settings=``), possibly empty: a renderer then draws with its own;
+    * ``events``: `Step` (t, key, shift, action, inverted, label), `Setting` (t, name, value),
+      `SourceSetting` (t, name, value) and `ViewSetting` (t, name, value);
+    * ``to_dict`` / ``from_dict``, ``save(path)`` / ``load(path)`` (JSON), ``replay(state, source)``.
+
+    Loading imports nothing and runs nothing a recording names: a source's own action is looked up
+    by name among the actions of the source the caller passes.  ``replay`` applies a source's own
+    actions (a field's level keys, a stack's slice keys) and the source settings to a source when
+    one is given (``set_source=`` lets the widget apply a setting itself, as turning a single view
+    into a stack replaces its source), else skips them; view settings change neither state nor
+    source: they go to ``set_view=`` (the widget sets its traits), else are skipped.
+    """
 
     def __init__(self, initial: Mapping, events=(), *, dropped: int = 0, initial_source: Mapping | None = None,
                  initial_view: Mapping | None = None):

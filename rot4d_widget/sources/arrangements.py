@@ -1,41 +1,12 @@
 """Where a stack's N parallel slices sit in the view: the oval, the grid and the row.
 
-`arrangement_layout` is designed in displayed units -- the object's circumradius
-`sizes.REFERENCE_RADIUS`, the eye at (0, 0, 5) looking down -z, vertical fov 40 degrees, the
-default canvas aspect 600 / 500 -- and scaled to the source's units.  A point p of slice k is
-drawn at ``centre_k + scale_k * p`` (`rot4d_widget.sources.tomography.StackSource`).
-
-The arrangements:
-
-``"oval"``
-    Kageyama's follow-up (J. Visualization 2016): the slice centres lie on the parabola
-    ``P(u) = (A u, Y0 + C u^2, -B u^2)`` with A = 2.6, B = 3.0, C = 1.2, |u| <= 2.0 and Y0
-    chosen for each N so that the picture is centred in the frame (the slices' bounding spheres
-    reach as far above the frame's middle as below it: -0.05 for N = 5, -0.49 for N = 12, -0.95
-    for N = 64): it opens away from the eye and rises with depth, so its perspective image is
-    an oval (the points at infinity would close it at the horizon y' = 5 C / B = 2).  The
-    central slice (w = c0) sits at the vertex P(0) = (0, Y0, 0), nearest the eye and
-    lowest; slices of higher w go right, lower w left.  World scales are
-    ``s0 (1 - 0.4 tau^2) / max``, tau = (k - (N-1)/2) / ((N-1)/2), on top of perspective.
-    Slices are laid along the parabola from the vertex at arc-length steps proportional to
-    their sizes (touching spheres at scale 0.6 plus a 5 % gap) until the arc |u| <= 2 is
-    used up; then the steps shrink.  ``s0`` is the largest scale, at most 0.6, for which
-    every pair of bounding spheres (radius ``radius * scale``) is disjoint with a 5 % gap
-    and every sphere's image lies in the 600 x 500 camera frame with a 3 % margin.  Why these
-    numbers: A, B, C make the oval's image span |x'| <= 1.68 and -0.65 ... 1.22 in y' (the
-    frame is |x'| <= 2.18, |y'| <= 1.82 at z = 0, with Y0 = -0.65); u = 2 is past the widest point
-    u* = sqrt(5 / B) = 1.29, so the ends curl back towards each other (an oval, not a U)
-    while the farthest slice, 12 units deep, is still drawn at 29 % of its size.  With
-    N = 16 every slice gets scale 0.56, with 64 about 0.2.
-``"grid"``
-    Small multiples like a CT film: ``ceil(sqrt(N))`` columns, rows from top to bottom,
-    slice 0 (lowest w) top left, all at z = 0 and one scale, the largest (at most 1) for
-    which the grid of bounding spheres, 5 % apart, fits the frame with a 3 % margin.
-``"stack"``
-    One row along x at z = 0, lowest w on the left, one scale chosen the same way.
-
-N = 1 is the identity in every arrangement (centre 0, scale 1).
-
+`arrangement_layout` gives slice k a centre and a scale: a point p of it is drawn at
+``centre_k + scale_k * p`` (`rot4d_widget.sources.tomography.StackSource`).  It is designed in
+displayed units (the circumradius `sizes.REFERENCE_RADIUS`, the eye at (0, 0, 5), the default
+600 x 500 canvas) and scaled to the source's.  ``"oval"``: centres on a parabola that perspective
+draws as an oval, the central slice nearest the eye (Kageyama's follow-up, J. Visualization
+2016); ``"grid"``: small multiples like a CT film; ``"stack"``: one row along x.  N = 1 is the
+identity in every arrangement.  The constants and why: docs/design.md, "Parallel slices".
 Pure numpy: geometry of the picture, nothing about slicing or widgets.
 """
 
@@ -146,8 +117,8 @@ def arrangement_layout(name: str, n: int, radius: float = sizes.REFERENCE_RADIUS
     Slice k of an object of circumradius ``radius`` is drawn at ``centres[k] + scales[k] * p``.
     Designed for ``radius = sizes.REFERENCE_RADIUS`` (what the widget shows) and the camera of
     `rot4d_widget.core.camera`; other radii scale the centres (``radius / REFERENCE_RADIUS``), so the
-    picture is the same once the widget scales the source to its displayed size.  See the
-    module docstring for each arrangement's constants.  ``n = 1``: centre 0, scale 1.
+    picture is the same once the widget scales the source to its displayed size.  Each
+    arrangement's constants: docs/design.md, "Parallel slices".  ``n = 1``: centre 0, scale 1.
     """
     check_arrangement(name)
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, Integral) or n < 1:

@@ -1,72 +1,15 @@
-"""`Companion`: the few lines of front-end JavaScript the widget needs (anywidget).
+"""`Companion`: the front-end JavaScript the widget needs, as an invisible anywidget.
 
-An invisible widget (display it next to the scene's renderer, e.g. in the
-same box) whose module -- the page's code, ``rot4d_widget/view/page/*.js``, joined by
-`rot4d_widget.view.bundle` (no build step) -- does these things in JupyterLab 4 and
-Notebook 7 alike:
-
-1. **drawn acknowledgement** -- after the page has *rendered* a frame
-   containing the latest buffer assignment (not merely on arrival): at the
-   pythreejs Scene's ``afterRender`` the buffer's three.js object must hold
-   the array that arrived with ``change:array`` and its ``version`` must
-   have moved since the previous render (so three.js uploaded it); one
-   animation frame later it sends ``{"event": "drawn", "seq": n}``, n being
-   the scene's ``update_id`` of that buffer, and ``draw_ms``, the page's
-   milliseconds from the update's arrival to that message (`last_draw_time`,
-   in seconds: the pump gives a slow page fewer updates in flight).  Callbacks
-   registered with `on_drawn` get ``n``.  Acknowledgements coalesce: if two updates arrive
-   before one frame, only the later one is acknowledged; an id is
-   acknowledged once per view (a growth step re-sending the shown picture
-   with the same id is not).  Each displayed view of the companion
-   acknowledges (several views: several acks with the same n).  No view, a
-   hidden tab or a frozen WebGL context: no acknowledgement.
-   As each update arrives it also applies what travels in the same message:
-   ``_rot4d_counts`` (the rows each layer draws: it sets the geometries'
-   ``maxInstancedCount``, never above the rows held, in the event that
-   applied the array, so no frame draws one update's count with another's
-   rows) and ``_rot4d_turn`` (a 3-D turn of the whole view, set on every
-   mesh; a turn alone changes no buffer, so it asks the scene to render and
-   is acknowledged at the next frame drawn).
-2. **focus loss** -- window ``blur`` or ``document.visibilityState ==
-   "hidden"`` sends ``{"event": "focus_lost", "reason": "blur" | "hidden"}``;
-   `on_focus_lost` callbacks get the reason.
-3. **Notebook 7 shortcut guard** -- while the pointer is over the canvas
-   (found by its per-scene CSS class, ``Scene.canvas_class``) a
-   capture-phase ``keydown``/``keypress``/``keyup`` listener on ``window``
-   calls ``preventDefault()``, so Notebook 7's command shortcuts (m turns
-   the cell to markdown, x cuts it, ...) skip the key, while ipyevents still
-   receives it.  Ctrl/Meta/Alt chords pass untouched.
-4. **ipyevents leak guard** -- a canvas view destroyed while hovered (the
-   cell re-run) gets no mouseleave, so ipyevents' capture key listener on
-   ``document`` stayed behind and, in JupyterLab, swallowed every key on the
-   page.  Each canvas element of the scene (found on render, soon after,
-   after each scene render and on mouseover) gets a hidden
-   ``<rot4d-leave-guard>`` child (custom element, defined once per page)
-   whose ``disconnectedCallback`` dispatches ``mouseleave`` on the canvas
-   element once it has left the document; ipyevents' own handler then
-   removes its listener.  The guard lives in the canvas element, so it works
-   whichever of the canvas and companion views goes first.
-
-5. **screenshot** -- `request_screenshot` sends ``{"event": "screenshot", "id": n}``;
-   the view asks the scene to render and, in that render's ``afterRender``
-   (the WebGL drawing buffer holds the picture only then), replies with the
-   canvas as a PNG data URL (``{"event": "screenshot", "id": n, "png": ...,
-   "width": w, "height": h}`` or ``{"error": ...}`` when no canvas of the
-   view is in the page).  `on_screenshot` callbacks get ``(n, png_bytes,
-   error)``.  Every displayed view answers; the widget keeps the first.
-
-6. **projection** -- with the projection view shown (`rot4d_widget.view.projection`), the
-   kernel sets ``projection_model_ids`` (its edges' and crossings' meshes and its Scene) and
-   ``projection_class`` (its canvas's CSS class).  As each update of the scene's buffer
-   arrives, the companion reads its ``_rot4d_skeleton`` (once per source) and ``_rot4d_project``
-   (the 4x4 matrix and the hyperplanes' offsets), rotates, projects and colours the vertices and
-   finds the crossings (``projectSkeleton``, as `projection.projection_arrays` does), writes them
-   into geometries of its own that the two meshes draw, and asks the projection's scene to
-   render: both canvases change from the same message.  The keys' guards (3, 4) cover the
-   projection's canvas too.  For tests, the canvas element gets ``rot4dProjection()``: the
-   arrays last computed (plain lists) and the state they were computed from.
-
-Listeners are removed when the view is removed.
+Display it next to the scene's renderer (e.g. in the same box).  Its module is the page's code,
+``rot4d_widget/view/page/*.js`` joined by `rot4d_widget.view.bundle` (no build step), for
+JupyterLab 4 and Notebook 7 alike.  The kernel side here hears the page and calls back: "drawn"
+after a frame that shows an update (`on_drawn`, `last_draw_time`: the pump's acknowledgement),
+the page's clock (`on_clock`), one-time transfers held (`on_holds`), focus lost
+(`on_focus_lost`) and screenshots (`request_screenshot`, `on_screenshot`).  The page also applies
+what travels with each update, draws the projection, keeps Notebook 7's shortcuts off keys over
+the canvas and removes ipyevents' listener when a hovered canvas is destroyed; its listeners go
+when the view goes.  How and why: docs/design.md, "The page predicts, the kernel decides" (The
+companion).
 """
 
 from __future__ import annotations

@@ -1,41 +1,15 @@
-"""Whether the page holds a field's 4-D data itself (issue 36), and the copy it is sent.
+"""Whether the page holds a field's 4-D data itself, and the copy it is sent.
 
-A field (`rot4d_widget.sources.field.container.Field4D`, alone or inside a stack of parallel slices) whose
-values are an array on evenly spaced nodes is cut in the page while the page is ahead of the
-kernel: the page's fragment shader turns each sample point of the slice into a 4-D point through
-its predicted rotation and c0 and reads the value there (``page/field.js``, ``glsl/field.frag``).
-For that the page holds a copy of the data, sent once (`rot4d_widget.view.transfer`, the
-one-time transfer ``"field"``, in chunks the page acknowledges, counted on the widget's bar):
-
-* **which copy**: the data themselves when they are in memory (`Field4D.resident`: given so, or
-  read whole by the background read) and their texture fits `PAGE_FIELD_BUDGET`; otherwise the
-  coarse copy (`Field4D.coarse`: at most 48 nodes a side) once the background read has made it.
-  Until then nothing is offered and every picture is the kernel's.  Exactly one copy is sent.
-* **quantised over its own range**: each finite value becomes a 16-bit code over the copy's
-  (min, max) -- ``value = lo + code * (hi - lo) / 65535`` -- so changing ``clim``, ``cmap`` or the
-  levels re-sends nothing, and every number the page shows is turned back into the data's units.
-  A node that is not finite gets code 0 and a 0 in a mask (255 where finite), sent only when some
-  node is not finite.
-* **laid out as one 3-D texture**: time (w) tiled -- tile k holds the x, y, z nodes of time k, the
-  tiles placed ``tiles = (tx, ty, tz)`` a side, k = (kz ty + ky) tx + kx -- each texel two bytes
-  (luminance: the code's high byte, alpha: its low byte; linear filtering of both, recombined, is
-  linear filtering of the code: docs/design.md "The field on the GPU").  The shader clamps sample
-  points half a texel inside each tile, so filtering never reads a neighbouring tile.
-
-With the data goes their **block ranges**: the least and greatest code over each block of `BLOCK`
-cells a side in x, y, z and w (its `BLOCK` + 1 nodes, so a cell is inside one block whole), as
-an RGBA texture laid out as the data (a block's min's two bytes, its max's two), 1/256 of the
-data's size.  The shader skips a block along a ray where no level crosses it (isosurfaces) or it
-is below the colour limits (volume) or below the brightest sample so far (maximum intensity):
-the samples skipped would add nothing, so the picture is the same, sooner (empty-space skipping,
-Engel et al., *Real-Time Volume Graphics*).  A block holding a node that is not finite is never
-skipped.
-
-The box's cut (the outline bars) the page makes with its polytope slicer from the box's own tables
-(`rot4d_widget.view.pagegeometry.polytope_message` of the field's box), the small one-time
-transfer ``"field_box"``.  How the page draws -- the half widths, the layout of a stack, the
-colours, the rendering's settings -- is the companion's synced ``field_config``
-(`rot4d_widget.view.fieldview`).
+A field (`rot4d_widget.sources.field.container.Field4D`, alone or in a stack) whose values are
+an array on evenly spaced nodes is cut in the page while the page is ahead of the kernel
+(``page/field.js``, ``glsl/field.frag``).  For that the page holds one copy of the data, sent
+once as the one-time transfer ``"field"`` (`rot4d_widget.view.transfer`): the data themselves
+when in memory and their texture fits `PAGE_FIELD_BUDGET`, else the coarse copy once made;
+quantised to 16 bits over the copy's own range (`CODES`), time tiled into one 3-D texture
+(`tile_layout`), with the least and greatest code of each `BLOCK`-cell block for empty-space
+skipping (`block_ranges`).  The box's outline travels as ``"field_box"``; how the page draws is
+the companion's ``field_config`` (`rot4d_widget.view.fieldview`).  The layout and why:
+docs/design.md, "The field on the GPU".
 """
 
 from __future__ import annotations

@@ -1,50 +1,12 @@
 """What the page needs to cut a polytope itself: the slicer's own tables, as one flat message.
 
-The page (``page/slicer.js``) slices the polytope of its latest state without waiting for the
-kernel, and must get what `rot4d_widget.geometry.slicing.polytope_slice.slice_polytope` gets, array for array.
-So the message is built from the slicer's own tables (`rot4d_widget.geometry.slicing.tables.tables`),
-in their scale: the *unit* vertices (the polytope's divided by the power of two ``unit``), the
-tolerance and circumradius in that scale, the cells' outward normals and vertex means as the
-slicer computed them (the page never recomputes a float the kernel has), and the ragged incidence
-tables as offsets and entries.  Sent once per polytope (the sender splits it into chunks).
-
-A flat dict: scalars as JSON numbers and flags, arrays as little-endian bytes (memoryview; int32
-for indices, float64 for coordinates), each named below with its length:
-
-========================  =======  ===========================================================
-name                      type     what
-========================  =======  ===========================================================
-vertices                  f64 4V   the unit vertices, row by row
-edges                     i32 2E   each edge's two vertices
-face_ptr                  i32 F+1  where each face's corners start in ``face_vidx``
-face_vidx, face_eidx      i32 ΣF   each face's corners in cycle order; the edge from each corner
-                                   to the next
-cell_vptr, cell_vidx      i32      each cell's vertices, ascending (offsets C+1, entries)
-cell_eptr, cell_eidx      i32      each cell's edges, ascending (offsets C+1, entries)
-face_cells                i32 2F   each face's two cells, ascending
-cell_normals              f64 4C   each cell's outward unit normal
-cell_centres              f64 4C   each cell's vertex mean, in the unit scale
-========================  =======  ===========================================================
-
-A polytope with star faces or non-convex cells (``star``) adds what the star slicer's points
-and segments need (`rot4d_widget.geometry.slicing.star.star_tables`; ``page/starslicer.js``):
-
-========================  =======  ===========================================================
-face_basis                f64 8F   each face's two orthonormal in-plane axes (4 numbers each)
-face_rho                  f64 2F   +-1 per (face, its cell in ``face_cells``): which way the
-                                   face's chord runs in that cell's section (for the volume
-                                   that picks the side of a cell lying in H)
-slot_mate                 i32 2ΣF  per (face side k, cell j of the face), slot 2k + j: the slot
-                                   of the cell's other face at that side's edge, or -1
-========================  =======  ===========================================================
-
-and the flag ``volume_defined`` (False: a hemi or non-orientable polytope, its slices' volume None).
-
-Scalars: ``n_vertices`` V, ``n_edges`` E, ``n_faces`` F, ``n_cells`` C; ``unit`` (the power of
-two), ``tol`` (on H when ``|w - c0| <= tol``, unit scale), ``radius`` (circumradius, unit
-scale), ``nudge`` (how far the slicer's fallbacks move H, unit scale); ``convex``, ``star``
-(star faces or non-convex cells: the page draws only their points and segments) and ``n_groups``
-(the source's colour groups, its cells); ``name``.
+The page (``page/slicer.js``, ``page/starslicer.js``) slices the polytope of its latest state
+without waiting for the kernel, and must get what
+`rot4d_widget.geometry.slicing.polytope_slice.slice_polytope` gets, array for array.  So the
+message is built from the slicer's own tables (`rot4d_widget.geometry.slicing.tables.tables`,
+and `rot4d_widget.geometry.slicing.star.star_tables` for a star polytope) in their unit scale:
+the page never recomputes a float the kernel has.  It is sent once per polytope (the sender splits
+it into chunks); `polytope_message` lists its names.
 """
 
 from __future__ import annotations
@@ -82,7 +44,46 @@ def _offsets(owner: np.ndarray, n: int) -> np.ndarray:
 
 def polytope_message(polytope: Polytope) -> dict:
     """Everything ``page/slicer.js`` (``decodePolytope``, ``slicePolytope``) needs to cut
-    ``polytope`` as `slice_polytope` does: see the module docstring for the names."""
+    ``polytope`` as `slice_polytope` does.
+
+    A flat dict: scalars as JSON numbers and flags, arrays as little-endian bytes (memoryview; int32
+    for indices, float64 for coordinates), each named below with its length:
+
+    ========================  =======  ===========================================================
+    name                      type     what
+    ========================  =======  ===========================================================
+    vertices                  f64 4V   the unit vertices, row by row
+    edges                     i32 2E   each edge's two vertices
+    face_ptr                  i32 F+1  where each face's corners start in ``face_vidx``
+    face_vidx, face_eidx      i32 ΣF   each face's corners in cycle order; the edge from each corner
+                                       to the next
+    cell_vptr, cell_vidx      i32      each cell's vertices, ascending (offsets C+1, entries)
+    cell_eptr, cell_eidx      i32      each cell's edges, ascending (offsets C+1, entries)
+    face_cells                i32 2F   each face's two cells, ascending
+    cell_normals              f64 4C   each cell's outward unit normal
+    cell_centres              f64 4C   each cell's vertex mean, in the unit scale
+    ========================  =======  ===========================================================
+
+    A polytope with star faces or non-convex cells (``star``) adds what the star slicer's points
+    and segments need (`rot4d_widget.geometry.slicing.star.star_tables`; ``page/starslicer.js``):
+
+    ========================  =======  ===========================================================
+    face_basis                f64 8F   each face's two orthonormal in-plane axes (4 numbers each)
+    face_rho                  f64 2F   +-1 per (face, its cell in ``face_cells``): which way the
+                                       face's chord runs in that cell's section (for the volume
+                                       that picks the side of a cell lying in H)
+    slot_mate                 i32 2ΣF  per (face side k, cell j of the face), slot 2k + j: the slot
+                                       of the cell's other face at that side's edge, or -1
+    ========================  =======  ===========================================================
+
+    and the flag ``volume_defined`` (False: a hemi or non-orientable polytope, its slices' volume None).
+
+    Scalars: ``n_vertices`` V, ``n_edges`` E, ``n_faces`` F, ``n_cells`` C; ``unit`` (the power of
+    two), ``tol`` (on H when ``|w - c0| <= tol``, unit scale), ``radius`` (circumradius, unit
+    scale), ``nudge`` (how far the slicer's fallbacks move H, unit scale); ``convex``, ``star``
+    (star faces or non-convex cells: the page draws only their points and segments) and ``n_groups``
+    (the source's colour groups, its cells); ``name``.
+    """
     t = tables(polytope)
     msg = {
         "name": polytope.name,

@@ -1,72 +1,15 @@
 """The update pump: at most ``max_in_flight`` scene updates in flight, acknowledged by the page.
 
-After an update is sent the pump may send the next one, computed from the
-latest state at that moment, while fewer than ``max_in_flight`` updates await
-the page's "drawn" acknowledgement.  With more than one in flight the kernel
-computes and sends the next picture while the page draws the previous one, so
-the round trip to the kernel is no longer in series with the page's frames;
-the page always draws the newest picture it holds.  Three, not two: the
-page's acknowledgement comes one frame after the draw (so it follows what
-the renderer really finished), and with two the held key waited on it; the
-measurements behind the bound are in docs/performance.md.  Nothing queues beyond that
-bound, so the view never falls behind and settles as soon as the state stops
-changing.  An acknowledgement names an update and retires it and every older
-one (the page acknowledges only the newest of several arriving before a frame).
-With several views the first acknowledgement counts; stale and unknown ones
-are ignored.
-
-**A page far away gets more in flight**: with the widget's tick rate, the bound is what leaves in
-one round trip, ``ceil(round_trip * tick_rate)`` (at most `MAX_IN_FLIGHT_CAP`), the round trip being
-the median time from sending to the acknowledgement less the page's own time in it: a kernel
-120 ms away then keeps a page that cannot predict the picture (a field, a user's source) drawing a
-new one every tick instead of waiting a round trip per three.
-
-**A slow page gets fewer in flight** (never fewer than two, which keep it busy while the next
-update travels): the page says with each acknowledgement how long it took from the update's
-arrival to the acknowledgement (``draw_time``), and while the recent median of that times
-``max_in_flight`` exceeds `PAGE_BUDGET` the bound in force (`limit`) is what fits in it.  What
-is in flight when a key is released is drawn after the release, so this bounds how long the
-picture goes on moving then (measurements: docs/performance.md, "Updates in flight").
-
-Without an answer (no view: scripting, nbval; a hidden tab) the latest state
-is sent anyway once the oldest update in flight is ``timeout`` old, where
-``timeout`` is ``ack_timeout`` or, when the page has been slower than that,
-four times the median of its recent acknowledgement times (a slow page must
-not be flooded by timeouts).
-
-Time advances through ``service(now)``: it runs the owner's ``tick(now)``
-(held keys), then sends if allowed, and returns when it wants to run next.
-A daemon thread calls it at those times while there is something to wait for
-(``autotick``); tests pass ``autotick=False`` and call ``service`` with their
-own clock.  Every entry point runs under one re-entrant lock, shared with the
-owner (``pump.lock``), so comm handlers and the ticker thread interleave
-safely.  Exceptions raised by ``tick``/``send`` go to ``on_error`` and never
-escape into the event loop.
-
-The rules that keep a slow kernel from freezing the keys:
-
-* **The lock is released between ticks whatever a tick costs.**  The thread
-  takes the lock for one ``service`` and gives it up before the next (it
-  always waits at least `MIN_WAIT`), so a keyup waiting on the lock is
-  handled after at most one tick.  A tick that overruns drops the ticks it
-  missed (the owner's ``tick`` reschedules them; see
-  `rot4d_widget.view.keyhold.KeyRepeater.drop_missed`).
-* **Expensive work runs outside the lock, and ticks go on meanwhile.**  ``send``
-  may be a generator: it yields a callable (the slow part: slicing) after
-  reading the state under the lock; with the ticker running, a worker thread
-  runs that callable without the lock and sends its result back into the
-  generator under the lock again, which returns the update's id.  Meanwhile
-  keys change the state and held keys keep ticking on time (a slow slice does
-  not eat their steps); one send at a time.
-* **Queued changes coalesce.**  With ``autotick``, `flush` only wakes the
-  thread: the thread alone sends, always the latest state, so ten taps that
-  arrive while a slow slice is computed make one more picture, not ten.
-  Without ``autotick`` (scripts, tests) `flush` sends at once.
-* **A failed send is not lost.**  When ``send`` raises (a comm that fails, a
-  bad slice) the state stays dirty: the next acknowledgement, key or
-  `flush` tries again.
-* **The adaptive timeout is capped** at `MAX_ACK_TIMEOUT`, so one very late
-  acknowledgement cannot silence a page that then stops answering.
+`UpdatePump` sends an update computed from the latest state whenever fewer than its bound in force
+(`limit`) await the page's "drawn"; an acknowledgement retires its update and every older one, so
+nothing queues and the view settles as soon as the state stops changing.  The bound grows for a
+page far away (what leaves in one round trip, at most `MAX_IN_FLIGHT_CAP`) and shrinks for a slow
+page (what it draws in `PAGE_BUDGET`, never below two); with no answer the oldest update is given
+up after a timeout (at most `MAX_ACK_TIMEOUT`).  Time advances through ``service(now)``, called by
+a daemon thread (``autotick``) or by tests with their own clock.  Every entry point runs under one
+re-entrant lock shared with the owner (``pump.lock``); a ``send`` that is a generator does its slow
+part outside it.  Errors from ``tick``/``send`` go to ``on_error``.  Why, and the rules that keep
+a slow kernel from freezing the keys: docs/design.md, "Flow control".
 """
 
 from __future__ import annotations
@@ -139,14 +82,14 @@ class UpdatePump:
         update left (an acknowledgement is then awaited), None when nothing
         changed on screen.  A generator yields once a callable (the slow
         part, run without the lock on the ticker thread), receives its result
-        and returns the id (see the module docs).
+        and returns the id (docs/design.md, "Flow control").
     tick : callable (now) -> None, optional
         Advance time-driven state (held keys) to ``now``.
     deadline : callable () -> float or None, optional
         When ``tick`` next wants to run.
     clock : callable () -> seconds
     ack_timeout : float
-        Seconds to wait for an acknowledgement at least (see the module docs).
+        Seconds to wait for an acknowledgement at least (docs/design.md, "Flow control").
     max_in_flight : int >= 1
         The bound near the page; far from it, ``ceil(round trip x tick_rate)`` (`limit`).
     tick_rate : float, optional

@@ -1,36 +1,13 @@
 """The even-odd fill of a cell's section by its segments' arrangement: the general slicer's fill
 for sections whose cycles cross.
 
-`rot4d_widget.geometry.slicing.star` cuts a non-convex cell into segments (one per stretch of a face's
-line inside the face) that chain into cycles; where the cycles cross, the section is their
-**even-odd** region.  That region's boundary is every segment, split where segments cross: the
-segments' *arrangement*.  Its faces (the pieces of the plane the split segments bound) are
-alternately inside and outside (crossing any piece of a segment flips the parity), so the region
-is the disjoint union of its odd faces, which touch only at crossings.  Here, vectorised over
-every cell at once (no Python loop over geometry):
-
-* **crossings**: every pair of a cell's segments (rows of a padded table), crossing inside both;
-  each crossing is one new corner (`Slice.n_fill`);
-* **pieces**: each segment split at its crossings, in order along it (one float sort);
-* **parity**: a ray square to a segment, leftwards from the middle of its first piece, crosses the
-  cell's other segments an odd or even number of times: the parity on that piece's left; each
-  crossing along the segment flips it.  So exactly one way along each piece has the odd face on
-  its left (its *odd half*): from here on a piece stands for its odd half;
-* **faces**: an odd half goes on, at a crossing, along the other segment the way that turns left
-  (the sign of the two directions' cross product: no sort by angle round a point), and at a
-  segment's end along the other segment ending there in the cell (the cycles' pairing).  That
-  next piece's odd half must run that way (the parity and the faces agree: a check of the whole
-  construction); the faces are labelled by pointer jumping (each by its least piece);
-* **triangles**: an odd face that is a convex polygon (every turn left, its heading passing any
-  one direction once) is fanned from its first corner, counter-clockwise about the cell's
-  normal like its boundary.
-
-A cell whose segments do not cross (its cycles apart or nested: a hole is no convex face), where
-a crossing falls within `_EPS` of a segment's end, or where any check fails or any odd face is
-not convex, is left whole to the slab fill (`star._slabs`), with the crossings found here.
-The fill's corners are the section's points and the crossings: none where a slab line would cut
-a segment, and about (segments + crossings) triangles a cell, against slabs x segments for the
-slab fill.
+Where a non-convex cell's cycles (`rot4d_widget.geometry.slicing.star`) cross, the section is their
+even-odd region: the odd faces of the segments' arrangement (the segments split where they
+cross).  Here, vectorised over every cell at once (no Python loop over geometry): the crossings
+(each a new corner, `Slice.n_fill`), the pieces, their parity, the odd faces traced by turning
+left, and the convex ones fanned.  A cell this cannot fill (no crossing, a crossing within `_EPS`
+of a segment's end, a failed check, an odd face not convex) is left whole to the slab fill
+(`star._slabs`).  The steps and why: docs/design.md, "Slicing polytopes" (The even-odd fill).
 """
 
 from __future__ import annotations

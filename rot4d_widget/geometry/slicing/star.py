@@ -1,49 +1,15 @@
 """The general slicer: a polytope with star faces or non-convex (star) cells cut by w = c0.
 
 `Polytope.star` is not None (some face is not a convex polygon or some cell not a convex
-polyhedron): `rot4d_widget.geometry.slicing` sends every level here.  What the slice is:
-
-* **points**: where the edges cross H (as for a convex polytope);
-* **segments** (the slice's edges): a face meets H in a line; its crossing points, sorted along
-  that line, are paired by the **even-odd rule** -- 1st with 2nd, 3rd with 4th, ... -- so a
-  segment covers the stretches of the line inside the face by parity (a line through a
-  pentagram {5/2} gives two segments, skipping its inner pentagon, whose points the boundary
-  winds round twice);
-* **polygons**: a cell's cross-section is the set of cycles its faces' segments chain into (each
-  crossing point of a cell ends exactly two of them, one from each of the cell's two faces at that
-  edge), each run the way the boundary's orientation runs its segments (so a segment runs opposite
-  ways in its two cells' cycles, as on a convex polytope's slice); where a star face's segments
-  disagree about it, the way that winds counter-clockwise about the cell's outward normal;
-* **triangles**: a convex cell's one cycle is fanned as before; a non-convex cell's section whose
-  cycles are each star-shaped round their corners' centroid (and apart) is fanned from those
-  centroids; a section of cycles that cross is filled even-odd from its segments' arrangement
-  (`rot4d_widget.geometry.slicing.even_odd_fill`: its odd faces, convex, fanned; the crossings are the new
-  corners); any other section (nested cycles, a polygon star-shaped round no such point, an odd
-  face that is not convex) by the even-odd rule with a slab decomposition (the plane cut into
-  slabs at the corners' and crossings' heights, the segments crossing each slab paired left to
-  right into trapezoids), vectorised over every slab of every cell.  Centroids, crossings and
-  trapezoid corners off the segments' ends are extra vertices, appended after the slice's points
-  (`Slice.n_fill` says how many); a non-convex polygon is never fanned from a corner;
-* **volume**: winding-weighted, ``(1/6) sum over cells, faces, stretches k of rho * W_k *
-  det(a_c, p_k, p_k+1)``, where W_k is the number of times the face winds round the stretch
-  p_k -> p_k+1 of its line (the running sum of the +-1 its sides add where they cross H), rho the
-  direction of the chord in the cell's section (`StarData.pair_rho`), a_c a point of the cell's
-  section plane.  Each region counts as often as the boundary winds round it: the true volume
-  for an embedded polytope, and for a star polytope the slice of its density-weighted content,
-  so the slices' volumes integrate over c0 to the 4-volume the divergence theorem gives
-  (Cavalieri).
-
-Vertices on H are resolved by simulation of simplicity: for the segments, polygons, fill and
-volume they count as above H (the slice just below c0, as a limit) unless some cell lies in H,
-when the side whose slice has the larger volume is kept (so the cap of a prism at its end level
-is there).  The crossing points of the edges at such a vertex are that vertex, kept once;
-stretches of no length are dropped from the segments and polygons.  The limit alone is not P ∩ H:
-it has no point at a vertex on H whose neighbours all lie on the side it is counted on (a vertex
-whose edges all rise, as many do at once unturned), nor the edges lying in H.  So, as in the
-convex-cell slicer's case table (`rot4d_widget.geometry.slicing`), every vertex on H is a vertex
-of the slice and every edge lying in H an edge of it, on a polygon or not (issue 33: a user who
-cuts at a vertex's height sees that vertex).  Per level: no Python loop over geometry
-(per-polytope tables built once).
+polyhedron, or the polytope has no inside): `rot4d_widget.geometry.slicing` sends every level
+here.  The slice's points are the edges' crossings of H; a face's crossings sorted along its line
+are paired by the even-odd rule into segments; each cell's section is the cycles its segments
+chain into, fanned when the cell is convex and otherwise filled even-odd (from centroids, by
+`rot4d_widget.geometry.slicing.even_odd_fill`, or by slabs: extra corners after the slice's
+points, `Slice.n_fill`); the volume is winding-weighted.  A vertex on H counts as just above it
+for all of these, yet every vertex on H and edge in H is in the slice.  Per level no Python loop
+over geometry (per-polytope tables built once).  The rules and why: docs/design.md, "Slicing
+polytopes" (Star faces and non-convex cells).
 """
 
 from __future__ import annotations
@@ -103,7 +69,7 @@ def star_tables(p, t: SliceTables) -> _StarTables:
 
 
 def slice_star(p, t: SliceTables, x: np.ndarray, m: np.ndarray, c0: float) -> Slice:
-    """One level of a polytope with star faces or non-convex cells (see the module docstring)."""
+    """One level of a polytope with star faces or non-convex cells (docs/design.md, "Slicing polytopes")."""
     st = star_tables(p, t)
     h = x[:, 3] - c0
     on = np.abs(h) <= t.tol

@@ -1,43 +1,15 @@
-"""Volume renderings of a field's cut without a browser: numpy ray casting through a `FieldGrid`.
+"""Volume renderings of a field's cut without a browser: ray casting through a `FieldGrid`.
 
-The camera is the static renders' and the live view's (`rot4d_widget.keep.pictures.slice_drawing`): the eye at
-(0, 0, ``distance``) looking down -z, the picture plane z = 0 with its limits ``(x0, x1)``,
-``(y0, y1)`` (what `render_state` sets on its axes).  Pixel (row r, column c) of an H x W picture
-looks along the ray from the eye through its centre,
-
-    X = x0 + (c + 1/2) (x1 - x0) / W,    Y = y1 - (r + 1/2) (y1 - y0) / H,
-
-so a point (x, y, z) lands where `perspective` puts it: (x, y) d / (d - z).  The grid is placed in
-that scene as ``shift + scale * p`` (p its slice coordinates: a stack's slice k has its centre and
-scale, the widget its displayed size).
-
-Rays are sampled every ``step`` grid spacings between where they enter and leave the grid's box,
-all pixels at once (a loop over depth, never over pixels); the value at a sample is the trilinear
-interpolant of the nodes (``scipy.ndimage.map_coordinates``, order 1).  A sample counts only in a
-cell whose eight nodes are finite: the rendered medium is the cells inside the data's box (it
-ends within one spacing inside the box's faces where they cut the grid obliquely).
-
-* ``"mip"`` -- maximum intensity projection: the largest value along each ray, coloured by
-  ``cmap`` over ``clim`` (clamped); rays that meet no cell are transparent.
-* ``"volume"`` -- emission-absorption, composited front to back: a sample of value v emits the
-  colour ``cmap(v)`` and absorbs with extinction ``density * ramp(v) / L`` per unit length, ramp
-  rising linearly from 0 at ``clim[0]`` to 1 at ``clim[1]`` (clamped), L the grid's longest side.
-  A uniform medium at the top of the ramp crossed over a length ``l`` is opaque by
-  ``1 - exp(-density l / L)`` (Beer-Lambert); each sample is weighted by the length of its piece
-  of the ray, so that holds up to the cells' edges.
-* ``"sections"`` -- three orthogonal colour-mapped planes through the grid's box, at fractions
-  ``sections`` = (fx, fy, fz) of its extent: x = x0 + fx (x1 - x0), y = y0 + fy (y1 - y0),
-  z = z0 + fz (z1 - z0), with (x0, x1) ... the grid's extent (first to last node, slice
-  coordinates), placed at ``shift + scale * p`` like the rest.  A pixel shows the *nearest*
-  crossing of its ray with any of the three planes that is in the box (t_in <= t <= t_out, t_in
-  where the ray enters the box, never behind the eye; a millionth of a spacing of slack for
-  rounding) and lies in a cell with eight finite nodes (the rule above): the trilinear value v
-  there, coloured ``cmap(clip((v - lo) / (hi - lo), 0, 1))``, opaque (alpha 1).  A ray with no
-  such crossing is transparent, so a NaN cell leaves a hole through which a farther plane shows.
-  No shading and no blending: the same definition as the page's shader, so both show one picture.
-  One ray per pixel (the planes' edges stay sharp).
-
-Results are straight (not premultiplied) RGBA, (H, W, 4) float64 in [0, 1].
+The camera is the static renders' and the live view's (`rot4d_widget.keep.pictures.slice_drawing`):
+the eye at (0, 0, ``distance``) looking down -z through the picture plane z = 0 (`pixel_rays`),
+the grid placed in that scene at ``shift + scale * p``.  `render_grid` casts all pixels' rays at
+once (a loop over depth, never over pixels; numba kernels when numba is installed), samples the
+grid's trilinear interpolant every ``step`` spacings inside its box and counts a sample only in
+a cell whose eight nodes are finite.  The renderings, `VOLUME_RENDERINGS`: ``"mip"``,
+``"volume"`` (emission-absorption, front to back) and ``"sections"`` (three orthogonal planes),
+defined as the page's shader defines them, so both show one picture (docs/design.md, "The cut as
+a grid, and the ray-cast renderings").  Results are straight (not premultiplied) RGBA,
+(H, W, 4) float64 in [0, 1].
 """
 
 from __future__ import annotations
@@ -160,7 +132,7 @@ def render_grid(grid, rendering: str, *, size, limits, cmap="viridis", clim=None
                 step: float = 0.5, pixels_per_ray=1, sections=DEFAULT_SECTIONS, progress=True,
                 view=None) -> np.ndarray:
     """(H, W, 4) straight RGBA: ``grid`` (a `rot4d_widget.sources.field.grid.FieldGrid`) ray-cast as
-    ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, see the module) for a picture of
+    ``rendering`` (``"mip"``, ``"volume"`` or ``"sections"``, defined in docs/design.md) for a picture of
     ``size`` = (W, H) pixels whose picture plane spans ``limits`` = ((x0, x1), (y0, y1)), the grid
     placed at ``shift + scale * p``.  ``cmap``: a matplotlib colour map name; ``clim``: (lo, hi),
     default `default_clim` of the grid's values (1st-99th percentile); ``density``: the volume's
