@@ -29,7 +29,7 @@ great grand stellated 120-cell {5/2,3,3}     doe, 1/sqrt2  {5/2,3} phi**2/sqrt2 
 Scale: every one has **edge length 2** and is centred on the origin, like the regular six
 (`rot4d_widget.geometry.regular`), so its circumradius is ``2 / edge(unit)``: 2*phi (the
 600-cell's) for edge 1/phi, 2 for edge 1, 2/phi for edge phi.  Counts and densities are those
-published (Wikipedia's "Schläfli–Hess polychoron", the Polytope Wiki); tests/test_star_regular.py
+published (Wikipedia's "Schläfli–Hess polychoron", the Polytope Wiki); tests/geometry/test_star_regular.py
 checks them, the density by the boundary's winding number round the centre.
 
 >>> star_name("{5/2,3,3}"), star_name("Great Grand Stellated 120-cell"), star_name("600-cell")
