@@ -2,7 +2,7 @@
 
     python benchmarks/chunk_reads.py [--base REV] [--seeds 0,1]
 
-The case of ``tests/test_chunk_reads.py``: a 64^4 float32 dask array in 8^4 chunks (4096), read
+The case of ``tests/sources/test_chunk_reads.py``: a 64^4 float32 dask array in 8^4 chunks (4096), read
 through a wrapper counting the chunks dask fetches from it.  For each version of the package
 (``--base``, a git revision exported clean, and the working tree: `benchmarks/revisions.py`) a
 fresh process takes, at random orientations (``--seeds``) and c0 = 0.05, one full-resolution

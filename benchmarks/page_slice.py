@@ -3,7 +3,7 @@
 the kernel's `slice_polytope` and `slice_rows` on the same orientations and levels.
 
 For each polytope, ``--slices`` random orientations, each at a random level within 0.8 of its
-circumradius; the page's arrays are the kernel's (tests/test_page_slicer.py), so only time is
+circumradius; the page's arrays are the kernel's (tests/page/test_page_slicer.py), so only time is
 measured here.  Printed: milliseconds per slice, the median of ``--repeats`` passes over all the
 slices (the first pass, before V8 optimises the code, in brackets), and the rows built from each
 slice seen from an eye (the sort for blending included); the message's size sent once.

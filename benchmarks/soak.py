@@ -37,7 +37,7 @@ goes on, so one run lists every kind of failure; `SoakReport.failures` holds the
 
     python benchmarks/soak.py [--events 100000] [--seed 1] [--no-threads]
 
-tests/test_soak.py runs the same driver at a small scale (marked slow).
+tests/view/test_soak.py runs the same driver at a small scale (marked slow).
 """
 
 from __future__ import annotations

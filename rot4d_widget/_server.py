@@ -10,7 +10,7 @@ are in docs/performance.md.
 
 This module and the package's ``__init__`` import nothing heavy (no numpy,
 scipy or widget library): every Jupyter server in the environment loads it at
-start (tests/test_server_extension.py checks this in a fresh interpreter).
+start (tests/project/test_server_extension.py checks this in a fresh interpreter).
 
 This extension wraps whatever kernel WebSocket connection class the server
 is configured with (it does not replace it) so that the connection turns

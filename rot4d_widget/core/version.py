@@ -1,4 +1,4 @@
-"""The package's version, the same as pyproject.toml's (tests/test_wheel.py checks it).
+"""The package's version, the same as pyproject.toml's (tests/project/test_wheel.py checks it).
 
 A module that imports nothing, so that what records the version (a state file,
 `rot4d_widget.keep.statefile`) takes it from here and never imports the root package, whose

@@ -9,7 +9,7 @@ it through ``Markup.format`` / ``Markup.join``, which escape anything that is no
 from one of them is escaped wherever it lands, whichever row or attribute it fills.
 
 The widgets' HTML goes through `html_widget` and `show`, which refuse a plain ``str``.
-``tests/test_markup.py`` reads the package's source and fails on HTML built or assigned
+``tests/view/test_markup.py`` reads the package's source and fails on HTML built or assigned
 anywhere else (a tag in a string outside this module, an HTML widget made or its ``value`` set
 outside it, an f-string or ``+`` building markup here, ``innerHTML`` in the page's code).
 

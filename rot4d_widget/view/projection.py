@@ -32,7 +32,7 @@ the page, as `projection_arrays` does here, and writes them into the projection'
 geometries.  The geometry functions
 (`skeleton`, `hyperplane_offsets`, `perspective`, `crossings`, `w_colours`, `projection_arrays`)
 need no browser: they serve static pictures and exports, and are the reference the page's
-arrays are tested against (tests/test_projection.py under Node, the browser suite in the page).
+arrays are tested against (tests/view/test_projection.py under Node, the browser suite in the page).
 `ProjectionView` builds the pythreejs objects only when the projection is first shown:
 ``projection=False`` (the default) makes no widget and changes nothing of the picture.
 

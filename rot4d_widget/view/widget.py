@@ -8,7 +8,7 @@ The only module that makes the widget's ipyevents `Event`.  A key travels one wa
 The widget holds the traits and the public API and wires small units together, handing each
 the collaborators it uses by name (its constructor, and ``connect`` where two units call each
 other); none is handed the widget, except as its ``traits`` (the settings it reads and observes,
-nothing else: `tests/test_rules.py`).  What they share:
+nothing else: `tests/project/test_rules.py`).  What they share:
 
 * `rot4d_widget.view.showing.Showing` -- the source shown, its scale, its lock and version;
 * `rot4d_widget.view.errors.ErrorArea` -- where an exception of a callback is shown;

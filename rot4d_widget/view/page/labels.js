@@ -8,7 +8,7 @@
 // next side is tried when none of 9 places is free.  A "slice" label (a stack's slice) is centred
 // under its point, moved down a row at a time past labels placed before it.  When no place is
 // free the first is taken, clamped into the canvas.  keep/framing.py `place_labels` is the same
-// rule for the static pictures (tests/test_labels.py runs both on the same cases).
+// rule for the static pictures (tests/view/test_labels.py runs both on the same cases).
 // `drawLabels` builds the overlay: a span per label (its text as text, never markup), a dot at
 // each point and a thin line from it to its label when the label was moved away from it.
 

@@ -2,7 +2,7 @@
 // (one, or a stack's several at their offsets), a box to cast rays through and the affine map
 // from a scene point of that box to the data's 4-D index coordinates; and the outline bars of
 // the box's cut.  Plain arrays from the state and the field's config (rot4d_widget.view.fieldview:
-// `field_config`), nothing of three.js: Node runs it (tests/test_page_field.py).
+// `field_config`), nothing of three.js: Node runs it (tests/page/test_page_field.py).
 //
 // A cut k lies at w = c0 + dc_k (data w), d_k = (c0 + dc_k - origin) / per_unit slice units from
 // the box's centre along the turned w axis, and is drawn at X = scale (centre_k + sigma_k p) for a

@@ -8,7 +8,7 @@
 // offset (float(c0) + offsets, as StackSource.cuts_at does) and places each slice's points with
 // the kernel's two roundings (p * scale_k, then + centre_k).  Each cut is the single slicer's
 // (slicer.js): the kernel's batched slice_polytope gives every level the single slice's arrays
-// (tests/test_tomography.py; only the volumes may differ in the last bits, and rows carry none).
+// (tests/sources/test_tomography.py; only the volumes may differ in the last bits, and rows carry none).
 
 import { sliceData } from "./slicer.js";
 import { pairwiseSum } from "./numpyorder.js";

@@ -13,7 +13,7 @@ import pathlib
 import numpy as np
 import pytest
 
-PKG = pathlib.Path(__file__).resolve().parent.parent / "rot4d_widget"
+PKG = pathlib.Path(__file__).resolve().parents[2] / "rot4d_widget"
 CORE = sorted(f"rot4d_widget.core.{p.stem}" for p in (PKG / "core").glob("*.py") if p.stem != "__init__")
 #: geometry modules with examples (each is listed so that one losing its examples is noticed)
 GEOMETRY = ["rot4d_widget.geometry._ragged", "rot4d_widget.geometry.catalogue",

@@ -206,7 +206,7 @@ def test_the_readme_field_example_runs_as_written_and_shows_a_surface(clock):
 
     from rot4d_widget.view.widget import Rot4DWidget as Real
 
-    readme = (pathlib.Path(__file__).resolve().parents[1] / "README.md").read_text()
+    readme = (pathlib.Path(__file__).resolve().parents[2] / "README.md").read_text()
     # the first field example (the next, on inside/caps/sample_field, is test_readme_data's)
     blocks = [b for b in re.findall(r"```python\n(.*?)```", readme, re.S) if "Field4D(" in b]
     assert blocks and "inside=" not in blocks[0], "the README's first field example"

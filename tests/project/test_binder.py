@@ -7,7 +7,7 @@ the repository root as working directory: ``.[notebooks]``, the package built fr
 tree with its ``notebooks`` extra.
 
 The slow tests share one fresh venv (module-scoped: built once): Binder's base image, then the
-wheel that ``python -m build --no-isolation`` made from this repository (tests/test_wheel.py)
+wheel that ``python -m build --no-isolation`` made from this repository (tests/project/test_wheel.py)
 with the extra that ``binder/requirements.txt`` names -- the same install as Binder's, but from
 the release artefact, so the wheel is proven to install and work away from the source tree.
 Then: the package is imported from the venv, its server extension is enabled, the lab extensions
@@ -30,7 +30,7 @@ import pytest
 
 from test_wheel import build_dists
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BINDER = ROOT / "binder"
 REQUIREMENTS = BINDER / "requirements.txt"
 NOTEBOOK = "notebooks/01_pentachoron.ipynb"

@@ -29,7 +29,7 @@ import pathlib
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 PKG = ROOT / "rot4d_widget"
 #: ``(module path, member)``: a private member of a third-party object the package uses, and why.
 THIRD_PARTY_PRIVATE = {

@@ -21,7 +21,7 @@ from rot4d_widget.keep import rebuild
 from rot4d_widget.sources import datasets
 from rot4d_widget.sources.protocol import PolytopeSource
 
-HERE = pathlib.Path(__file__).resolve().parent / "fixtures"
+HERE = pathlib.Path(__file__).resolve().parents[1] / "fixtures"
 EXPECTED = json.loads((HERE / "expected.json").read_text())
 
 

@@ -1,6 +1,6 @@
 """Keeping it: pictures and animations frame the object, can be annotated, and show progress.
 
-Runs against the old code too (``PYTHONPATH=/tmp/old-anim pytest tests/test_keep_render.py``):
+Runs against the old code too (``PYTHONPATH=/tmp/old-anim pytest tests/keep/test_keep_render.py``):
 the framing test fails there (the object filled about a third of the picture).
 """
 

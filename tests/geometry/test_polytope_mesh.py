@@ -463,7 +463,7 @@ def edit(lineno, new):
         (edit(3, "16 24 32"), r"line 3: three counts"),
         (edit(3, "16 24 32 8 1"), r"line 3: expected four counts V F E C"),
         (edit(3, "16 24 x 8"), r"line 3: expected four integer counts"),
-        # a wrong E is read with a warning (issue 22: other tools' files): tests/test_off_tools.py
+        # a wrong E is read with a warning (issue 22: other tools' files): tests/geometry/test_off_tools.py
         (edit(8, "1 1 -1"), r"line 8: vertex 3 has 3 numbers; expected 4 coordinates x y z w"),
         (edit(8, "1 1 -1 one"), r"line 8: vertex 3 has a coordinate that is not a number"),
         (edit(8, "1 1 -1 nan"), r"line 8: vertex 3 is not finite"),

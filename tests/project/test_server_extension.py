@@ -11,7 +11,7 @@ import pytest
 
 from rot4d_widget._server import _load_jupyter_server_extension, nodelay_connection_class
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 class FakeHandler:

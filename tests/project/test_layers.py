@@ -43,7 +43,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 PKG = ROOT / "rot4d_widget"
 WINGS = ("core", "geometry", "sources", "keep", "view")
 #: package modules that may be imported inside a function: what importing them pulls in
@@ -56,7 +56,7 @@ HEAVY_MODULES = {
     "rot4d_widget.sources.field.surface": "scikit-image (marching cubes)",
     "rot4d_widget.view.scene": "pythreejs (~0.3 s)",
 }
-#: modules whose import must stay cheap (tests/test_server_extension.py): anything inside functions
+#: modules whose import must stay cheap (tests/project/test_server_extension.py): anything inside functions
 LAZY_MODULES = {
     "rot4d_widget": "resolves every public name on first use; a Jupyter server imports it at start",
     "rot4d_widget._server": "the server extension, loaded by every Jupyter server at start",

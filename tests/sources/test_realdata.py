@@ -28,7 +28,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10: the test extra brings tomli
     import tomli as tomllib
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PATH = os.path.join(data_path, "functional.nii")
 
 

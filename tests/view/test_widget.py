@@ -4,7 +4,7 @@ The rendering path is replaced by fakes here (a Scene that records what it is
 asked to show, a Companion whose "drawn" / "focus lost" callbacks the test
 fires), so these tests pin the widget's own logic.  Events reach the widget
 the way ipyevents delivers them: as a custom comm message to the Event model.
-tests/test_widget_scene.py runs the real Scene and Companion.
+tests/view/test_widget_scene.py runs the real Scene and Companion.
 """
 
 from __future__ import annotations
@@ -159,10 +159,10 @@ class FakeCompanion(ipywidgets.DOMWidget):
         self._clock(t_ms)
 
     def on_screenshot(self, callback, remove=False):
-        pass  # screenshots: tests/test_widget_screenshot.py, with the real companion
+        pass  # screenshots: tests/view/test_widget_screenshot.py, with the real companion
 
     def on_holds(self, callback, remove=False):
-        pass  # the page's copies: tests/test_page_field.py, with the real companion
+        pass  # the page's copies: tests/page/test_page_field.py, with the real companion
 
     def request_screenshot(self, request_id):
         pass

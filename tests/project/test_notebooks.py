@@ -25,7 +25,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10: the test extra brings tomli
     import tomli as tomllib
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NB_DIR = ROOT / "notebooks"
 #: The project's notebooks, numbered 01, 02, ... without gaps; a new one is one line here.
 PROJECT_NOTEBOOKS = [

@@ -8,7 +8,7 @@ from __future__ import annotations
 import pathlib
 import re
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 OFF = ROOT / "tests" / "data" / "off_library" / "polytopeviewer" / "Gaghi.off"
 
 

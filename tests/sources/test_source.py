@@ -26,7 +26,7 @@ from widget_time import sent, service
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
-README = pathlib.Path(__file__).resolve().parents[1] / "README.md"
+README = pathlib.Path(__file__).resolve().parents[2] / "README.md"
 
 
 def readme_source():

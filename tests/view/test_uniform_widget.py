@@ -1,7 +1,7 @@
 """Every uniform polychoron by name in the widget (issue 11): built through `polytope(name)`,
 shown (the scene's capacity grows to the biggest slice), turned by keys.
 
-The combinatorics and slices themselves are tests/test_uniform.py's; here the path a user
+The combinatorics and slices themselves are tests/geometry/test_uniform.py's; here the path a user
 takes: ``Rot4DWidget("x5x3x3x")``.
 """
 

@@ -3,7 +3,7 @@
 ``build`` and ``hatchling`` are in the test extra, so building needs no download of a build
 backend (no isolated build environment).  ``build`` makes the sdist first and the wheel *from the
 sdist*, so a file the sdist forgets is missing from the wheel too.  The checks here read the
-archives; tests/test_binder.py installs the built wheel into a fresh venv (slow).
+archives; tests/project/test_binder.py installs the built wheel into a fresh venv (slow).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 NAME, VERSION = PROJECT["name"], PROJECT["version"]
 SERVER_CONFIG = "etc/jupyter/jupyter_server_config.d/rot4d_widget.json"

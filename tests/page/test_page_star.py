@@ -12,7 +12,7 @@ multiply-adds, the page does not) in three orientations at vertex heights and at
 segments and dimension exactly and points within 1e-12 of the circumradius; the volume too (it
 picks the side of a cell lying in H), exactly unturned.  The page's slices of every non-convex
 polytope pass test_vertex_heights' property against its oracle, at its levels.  ``python
-tests/test_page_star.py`` compares the page with the kernel at every level of that property test
+tests/page/test_page_star.py`` compares the page with the kernel at every level of that property test
 and prints the worst deviation.
 """
 

@@ -39,10 +39,10 @@ from rot4d_widget.core.rotation import random_rotation
 from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.geometry.star_regular import STAR_FAMILY
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks"))
 from off_library import load  # noqa: E402  (the default tolerance, else the one the refusal names)
 
-DATA = pathlib.Path(__file__).resolve().parent / "data" / "off_library"
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "off_library"
 ON = 1e-9  #: a vertex is on H within this times the circumradius
 SAME = 1e-7  #: a slice point and a point of P ∩ H agree within this times the circumradius
 SEEDS = (1, 2, 3)  #: the random orientations
@@ -121,7 +121,7 @@ def mismatch(p, m, c0) -> str | None:
 
 def points_mismatch(p, m, c0, got, edges) -> str | None:
     """What differs between a slice's points ``got`` (its fill corners left out) and edges and P ∩ H
-    at ``c0``, or None: the kernel's slices here, the page's in tests/test_page_star.py."""
+    at ``c0``, or None: the kernel's slices here, the page's in tests/page/test_page_star.py."""
     got = np.asarray(got, dtype=float).reshape(-1, 3)
     want = points_of_p_cap_h(p, m, c0)
     tol = SAME * _radius(p)

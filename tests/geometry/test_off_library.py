@@ -37,10 +37,10 @@ from rot4d_widget.geometry.mesh import Polytope
 from rot4d_widget.geometry.slicing.polytope_slice import slice_polytope
 from rot4d_widget.sources.protocol import PolytopeSource
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks"))
 from off_library import check_slice, edges_of, flatness, levels, load, read_file  # noqa: E402
 
-DATA = pathlib.Path(__file__).resolve().parent / "data" / "off_library"
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "off_library"
 
 
 def _key(f):

@@ -15,7 +15,7 @@ round the other way; the test asserts every index and colour equal, every point 
 the size and every row's position within one float32 step, and prints how many differ (``-s``:
 none of the 1,246,840 turned floats here, on numpy's OpenBLAS Haswell kernel).  Stacks of more
 than one slice come from the kernel's batched `slice_polytope`, the page cuts each level alone:
-the same arrays (tests/test_tomography.py), which this test sees again through the rows.
+the same arrays (tests/sources/test_tomography.py), which this test sees again through the rows.
 """
 
 from __future__ import annotations

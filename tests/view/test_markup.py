@@ -24,7 +24,7 @@ import re
 
 import pytest
 
-PKG = pathlib.Path(__file__).resolve().parent.parent / "rot4d_widget"
+PKG = pathlib.Path(__file__).resolve().parents[2] / "rot4d_widget"
 MARKUP = PKG / "view" / "markup.py"
 
 #: A piece of markup in a string: a tag's start (``<b>``, ``</td``, ``<span style=``, ``<br/``) or

@@ -10,7 +10,7 @@ Field4D, a stack; ``slices`` and key n on a single view), and phases where the c
 check names the seed, the first event and the last events; every kind of failure of the run is
 listed, the first one first.
 
-    SOAK_EVENTS=20000 SOAK_SEED=7 pytest -m slow tests/test_soak.py
+    SOAK_EVENTS=20000 SOAK_SEED=7 pytest -m slow tests/view/test_soak.py
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import sys
 
 import pytest
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "benchmarks"))
 import soak  # noqa: E402  (the driver lives with the benchmark that runs it at 10^5 events)
 
 #: Events of the default run: about 30 s here (~600 events/s), well under 3 min on a busy 2-core machine.
