@@ -225,7 +225,7 @@ class StackSource(SourceBase):
         default, the record's extent along the current w over N (`default_spacing`), spread when the
         stack is made and whenever N changes, for the orientation noted last (`note_matrix`)
     matrix : (4, 4) rotation or None -- the orientation the default is spread for at first
-    arrangement : "oval", "grid" or "stack" (see the module docstring)
+    arrangement : "oval", "grid" or "stack" (`rot4d_widget.sources.arrangements`; docs/design.md, "Parallel slices")
     color_by : "w" (a colormap over the N levels) or "cell" (the inner source's groups)
 
     ``slices``, ``spacing``, ``arrangement`` and ``color_by`` are validated properties; keys

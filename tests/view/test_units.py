@@ -235,7 +235,6 @@ def test_one_very_late_ack_does_not_set_a_huge_timeout():
 def test_a_slow_tick_releases_the_lock_between_ticks():
     # issue 18 item 1: a tick longer than the period kept the ticker's lock for good (its
     # release happened only inside a wait() that was skipped when the timeout was <= 0)
-    import threading
     import time
 
     period = 0.01
