@@ -198,7 +198,7 @@ class Painter:
                 cut = yield (lambda: grid_cut(source, m, c0, coarse_, lock, scale))  # the slow part, unlocked
                 if self.pump.closed:
                     return None
-                if self.showing.version != version or self.showing.source is not source:
+                if not self.showing.still(source, version):
                     self.pump.mark_dirty()
                     return None
                 self.grid_cache = (m, c0, version, coarse_, cut)
@@ -227,7 +227,7 @@ class Painter:
                     data = yield (lambda: checked_slice(source, m, c0, coarse_, lock))
                     if self.pump.closed:
                         return None
-                    if self.showing.version != version or self.showing.source is not source:
+                    if not self.showing.still(source, version):
                         self.pump.mark_dirty()  # the source changed meanwhile: never show the old one
                         return None
                     self.cache = (m, c0, version, coarse_, data)
