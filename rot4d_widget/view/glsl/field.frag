@@ -177,18 +177,23 @@ void main() {
             }
         }
         float tPrev = b_in;
+        float blockEnd = -1.0;  // the block of the last step's start lasts to here along the ray
+        bool crossed = true;  // some level crosses that block
         for (int k = 1; k < MAX_STEPS; k++) {
             if (acc.a > 0.996 || tPrev >= b_out) break;
-            // a block no level crosses: on to where the ray leaves it (no side changes there)
-            vec4 blk = blockOf(gE + tPrev * gD);
-            vec2 range = blockRange(blk);
-            bool crossed = false;
-            for (int i = 0; i < MAX_LEVELS; i++) {
-                if (i >= nl) break;
-                crossed = crossed || (u_levels[i] >= range.x && u_levels[i] <= range.y);
+            if (tPrev >= blockEnd) {  // (steps are shorter than blocks: asked once a block)
+                vec4 blk = blockOf(gE + tPrev * gD);
+                vec2 range = blockRange(blk);
+                crossed = false;
+                for (int i = 0; i < MAX_LEVELS; i++) {
+                    if (i >= nl) break;
+                    crossed = crossed || (u_levels[i] >= range.x && u_levels[i] <= range.y);
+                }
+                blockEnd = blockExit(gE, gD, blk);
             }
+            // a block no level crosses: on to where the ray leaves it (no side changes there)
             if (!crossed) {
-                tPrev = min(max(blockExit(gE, gD, blk), tPrev) + 1e-4 * u_march, b_out);
+                tPrev = min(max(blockEnd, tPrev) + 1e-4 * u_march, b_out);
                 continue;
             }
             float t = min(tPrev + u_march, b_out);
@@ -298,7 +303,12 @@ void main() {
         s_out = min(s_out, max(a, b));
     }
     float fi = 0.0;  // the sample's index: samples stay where the kernel's are, skipped or not
-    float blockEnd = -1.0;  // the block of the last sample lasts to here along the ray
+    // The block ranges are asked only where samples lie closer than half a block along the ray
+    // (index units, the longest axis's): at longer steps nearly every sample is in a block of its
+    // own, and the lookup and exit cost what the sample it may save would (the held picture of a
+    // 64^4 field samples every 4 cells: docs/performance.md, "Turning a field").
+    bool skips = dt * max(max(abs(gD.x), abs(gD.y)), max(abs(gD.z), abs(gD.w))) < 0.5 * u_block;
+    float blockEnd = skips ? -1.0 : 1e30;  // the block of the last sample lasts to here along the ray
     float peak = 1.0;  // the greatest value of that block, on the colour ramp
     for (int i = 0; i < MAX_STEPS; i++) {
         float start = t_in + fi * dt;
@@ -323,7 +333,7 @@ void main() {
             float x = ramp(s.x);
             if (mip) {
                 best = max(best, x);
-            } else {
+            } else if (x >= 0.5 / 255.0) {  // (as a skipped block's: 0 in the kernel's 8 bits)
                 float alpha = 1.0 - exp(-extinction * x * piece);
                 colour += trans * alpha * lut(x);
                 trans *= 1.0 - alpha;
