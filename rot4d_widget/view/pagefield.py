@@ -29,10 +29,11 @@ from .transfer import pack
 __all__ = ["PageField", "page_field", "field_copy", "field_transfer", "tile_layout", "PAGE_FIELD_BUDGET",
            "MAX_SIDE", "CODES"]
 
-#: Bytes of texture the page's copy of a field may take (two a node, one more where a mask is
-#: needed): the data themselves up to this, else their coarse copy.  64 MiB: a 64^4 field (32 MiB)
-#: is held whole; a 96^4 one (162 MiB) sends its 48^4 coarse copy (10 MiB).
-PAGE_FIELD_BUDGET = 64 * 2**20
+#: Bytes of texture the page's copy of a field may take (`texture_bytes`: four a node, each node's
+#: code beside the next time's, one more where a mask is needed): the data themselves up to this,
+#: else their coarse copy.  128 MiB: a 64^4 field (64 MiB of texture, 32 MiB sent) is held whole; a
+#: 96^4 one (324 MiB) sends its 48^4 coarse copy (10 MiB).
+PAGE_FIELD_BUDGET = 128 * 2**20
 #: The longest side of the 3-D texture, in texels: MAX_3D_TEXTURE_SIZE measured in Chromium on
 #: SwiftShader (tests/browser/test_webgl_probe_browser.py); a page whose limit is lower does not ask.
 MAX_SIDE = 2048
@@ -64,8 +65,9 @@ def field_copy(field):
 
 
 def texture_bytes(shape, masked: bool) -> int:
-    """Bytes of the texture of an array of ``shape`` (2 a node, 3 with a mask), tiles padded aside."""
-    return math.prod(int(n) for n in shape) * (3 if masked else 2)
+    """Bytes of the page's textures of an array of ``shape``: 4 a node (its 16-bit code and the next
+    time's: page/field.js pairedTexels), 5 with a mask; tiles padded aside.  Twice what is sent."""
+    return math.prod(int(n) for n in shape) * (5 if masked else 4)
 
 
 def tile_layout(shape, max_side: int = MAX_SIDE) -> tuple:

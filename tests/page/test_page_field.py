@@ -62,6 +62,38 @@ def test_every_node_is_where_the_shader_reads_it_within_one_code(axes):
         assert abs(value - xyzw[i, j, k, t]) <= 0.5 * (hi - lo) / pf.CODES + 1e-6
 
 
+PAIRED = """
+import { decodeField, pairedTexels } from "page:field.js";
+const bytes = Buffer.from(INPUT.payload, "base64");
+const copy = decodeField(INPUT.meta, new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.length));
+console.log(JSON.stringify(Buffer.from(pairedTexels(copy)).toString("base64")));
+"""
+
+
+def test_the_page_s_texture_holds_each_node_beside_the_next_time_s():
+    """page/field.js pairedTexels: the texel of node (i, j, k) at time t holds its code and time
+    t + 1's (the last time's own again), as the shader's one read mixes them; the rest stays 0."""
+    import base64
+
+    a = _blob(nw=7) * 3.0 - 1.0  # 7 times of 12^3: tiles left over
+    field = Field4D(a, axes="xyzw", extent=[(-1, 1)] * 4)
+    meta, payload = pf.field_transfer(a, field.axis_of)
+    sc = meta["scalars"]
+    assert math.prod(sc["tiles"]) > 7
+    tex = np.frombuffer(payload, dtype=np.uint8, count=meta["arrays"]["texels"]["length"],
+                        offset=meta["arrays"]["texels"]["offset"]).reshape(-1, 2)
+    got = np.frombuffer(base64.b64decode(run_page(PAIRED, {"meta": meta, "payload": base64.b64encode(payload).decode()})),
+                        dtype=np.uint8).reshape(-1, 4)
+    assert len(got) == len(tex)
+    want = np.zeros_like(got)
+    for t in range(7):
+        for i, j, k in np.ndindex(12, 12, 12):
+            at = _texel_of(sc, i, j, k, t)
+            want[at, :2] = tex[at]
+            want[at, 2:] = tex[_texel_of(sc, i, j, k, min(t + 1, 6))]
+    assert np.array_equal(got, want)
+
+
 def test_values_that_are_not_finite_get_a_mask_and_do_not_widen_the_range():
     a = _blob().astype(np.float64)
     a[3, 4, 5, 2] = np.nan

@@ -1,8 +1,10 @@
 // The page's copy of a field's 4-D data (rot4d_widget/view/pagefield.py): one 3-D texture whose
 // tiles are the times (w), tile k at (kx, ky, kz) = (k mod tx, (k div tx) mod ty, k div (tx ty)),
-// each texel a node's 16-bit code over the copy's range as two bytes (luminance: high, alpha: low;
-// filtered linearly each, recombined: the code filtered linearly).  A mask texture of the same
-// layout (255 where the node is finite) is read only when the copy has a node that is not.
+// each texel a node's 16-bit code over the copy's range at time k as two bytes (r: high, g: low)
+// and at time k + 1 (b, a; page/field.js pairedTexels), filtered linearly each and recombined: the
+// codes filtered linearly, both times of a quadrilinear value in one read.  A mask texture of the
+// same layout (255 where the node is finite; one time a texel) is read only when the copy has a
+// node that is not.
 precision highp sampler3D;
 uniform sampler3D u_data;
 uniform sampler3D u_mask;
@@ -24,9 +26,10 @@ vec3 texel(vec3 p, float k) {
     return (tileOrigin(k) + p + 0.5) / u_size;
 }
 
-float code(vec3 p, float k) {
+// the codes at node coordinates p at times k and k + 1 (the last time's twice), in [0, 1]
+vec2 codes(vec3 p, float k) {
     vec4 t = texture(u_data, texel(p, k));
-    return (t.r * 65280.0 + t.a * 255.0) / 65535.0;
+    return vec2(t.r * 65280.0 + t.g * 255.0, t.b * 65280.0 + t.a * 255.0) / 65535.0;
 }
 
 // (the value at 4-D index coordinates g, in [0, 1] over the copy's range -- quadrilinear: trilinear
@@ -36,9 +39,9 @@ vec2 field(vec4 g) {
     float w = clamp(g.w, 0.0, u_shape.w - 1.0);
     float k0 = min(floor(w), max(u_shape.w - 2.0, 0.0));
     float f = w - k0;
-    float v = code(p, k0);
+    vec2 c = codes(p, k0);
     bool two = u_shape.w > 1.5 && f > 0.0;
-    if (two) v = mix(v, code(p, k0 + 1.0), f);
+    float v = two ? mix(c.x, c.y, f) : c.x;
     float ok = 1.0;
     if (u_masked > 0.5) {
         float m = texture(u_mask, texel(p, k0)).r;

@@ -14,7 +14,6 @@ import { transferStore, unpack } from "./transfer.js";
 
 // three.js r97 constants
 const LUMINANCE = 1024;
-const LUMINANCE_ALPHA = 1025;
 const RGBA = 1023;
 const NEAREST = 1003;
 const UNSIGNED_BYTE = 1009;
@@ -92,8 +91,40 @@ export function fieldArrived(model) {
   return h.copy && h.box && h.key === offered.field && h.boxKey === offered.field_box ? h : null;
 }
 
-// The copy's 3-D textures ({data, mask, blocks}: the mask a 1-texel one when every node is finite), made
-// once with the class `T3` (THREE.DataTexture3D).
+// The texels of the data texture the shader reads (glsl/field_data.glsl): each node's code at its
+// time k (r, g: high, low byte) and at time k + 1 (b, a; the last time's own again), in time k's
+// tile, so one trilinear read gives both times a quadrilinear value mixes.  `copy`: decodeField's
+// (`texels` two bytes a texel, `shape` [nx, ny, nz, nw], `tiles`, `size`).  Texels of no time stay 0.
+export function pairedTexels(copy) {
+  const [nx, ny, nz, nw] = copy.shape;
+  const [tx, ty] = copy.tiles;
+  const [W, H, D] = copy.size;
+  const src = copy.texels;
+  const out = new Uint8Array(4 * W * H * D);
+  const origin = (k) => [(k % tx) * nx, (Math.floor(k / tx) % ty) * ny, Math.floor(k / (tx * ty)) * nz];
+  for (let k = 0; k < nw; k++) {
+    const [ax, ay, az] = origin(k);
+    const [bx, by, bz] = origin(Math.min(k + 1, nw - 1));
+    for (let z = 0; z < nz; z++) {
+      for (let y = 0; y < ny; y++) {
+        let a = 2 * ((az + z) * H * W + (ay + y) * W + ax);
+        let b = 2 * ((bz + z) * H * W + (by + y) * W + bx);
+        let o = 2 * a;
+        for (let x = 0; x < nx; x++, a += 2, b += 2, o += 4) {
+          out[o] = src[a];
+          out[o + 1] = src[a + 1];
+          out[o + 2] = src[b];
+          out[o + 3] = src[b + 1];
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// The copy's 3-D textures ({data, mask, blocks}: the data's texels paired in time (`pairedTexels`),
+// the mask a 1-texel one when every node is finite), made once with the class `T3`
+// (THREE.DataTexture3D).
 export function fieldTextures(h, T3) {
   if (h.textures) return h.textures;
   const c = h.copy;
@@ -110,7 +141,7 @@ export function fieldTextures(h, T3) {
   };
   const [w, ht, d] = c.size;
   h.textures = {
-    data: make(c.texels, LUMINANCE_ALPHA, w, ht, d),
+    data: make(pairedTexels(c), RGBA, w, ht, d),
     mask: c.mask ? make(c.mask, LUMINANCE, w, ht, d) : make(new Uint8Array([255]), LUMINANCE, 1, 1, 1),
     blocks: make(c.blocks, RGBA, c.blockSize[0], c.blockSize[1], c.blockSize[2], NEAREST),
   };
