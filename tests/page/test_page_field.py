@@ -94,6 +94,58 @@ def test_the_page_s_texture_holds_each_node_beside_the_next_time_s():
     assert np.array_equal(got, want)
 
 
+RELEASED = """
+import { fieldArrived, fieldTextures } from "page:field.js";
+import { transferStore } from "page:transfer.js";
+const b64 = (s) => { const b = Buffer.from(s, "base64"); return new Uint8Array(b.buffer, b.byteOffset, b.length); };
+const model = { send() {}, get: (k) => (k === "page_data" ? { field: "f1", field_box: "b1" } : null) };
+const store = transferStore(model);
+store.done.set("field", { key: "f1", meta: INPUT.field.meta, bytes: b64(INPUT.field.payload) });
+store.done.set("field_box", { key: "b1", meta: INPUT.box.meta, bytes: b64(INPUT.box.payload) });
+const transfer = store.done.get("field").bytes.buffer;
+const h = fieldArrived(model);
+class T3 { constructor(data) { this.image = { data }; } dispose() {} }
+const tex = fieldTextures(h, T3);
+const again = fieldArrived(model);
+console.log(JSON.stringify({
+  same: again === h && fieldTextures(again, T3) === tex,
+  storeBytes: store.done.get("field").bytes, storeKey: store.done.get("field").key,
+  copy: [h.copy.texels, h.copy.mask, h.copy.blocks], masked: h.copy.masked, shape: h.copy.shape,
+  own: Object.values(tex).map((t) => t.image.data.buffer !== transfer),
+  mask: Buffer.from(tex.mask.image.data).toString("base64"),
+  blocks: Buffer.from(tex.blocks.image.data).toString("base64"),
+}));
+"""
+
+
+def test_the_transfer_s_bytes_go_once_the_textures_hold_the_copy():
+    """page/field.js fieldTextures: the textures' arrays are their own (the mask and the block
+    ranges copied out of the transfer, the data paired), and the transfer's bytes are let go -- the
+    copy's and the store's -- its key kept, so the page neither asks for the same copy again nor
+    decodes it again."""
+    import base64
+
+    from rot4d_widget.view.pagecut import polytope_transfer
+
+    a = _blob(nw=5).astype(np.float64)
+    a[1, 2, 3, 4] = np.nan  # a mask too
+    field = Field4D(a, axes="xyzw", extent=[(-1, 1)] * 4)
+    meta, payload = pf.field_transfer(a, field.axis_of)
+    bmeta, bpayload = polytope_transfer(box_polytope(np.ones(4)))
+    got = run_page(RELEASED, {"field": {"meta": meta, "payload": base64.b64encode(payload).decode()},
+                              "box": {"meta": bmeta, "payload": base64.b64encode(bpayload).decode()}})
+    assert got["same"] and got["storeKey"] == "f1" and got["storeBytes"] is None
+    assert got["copy"] == [None, None, None] and got["masked"] and got["shape"] == [12, 12, 12, 5]
+    assert got["own"] == [True, True, True]
+
+    def array(name):
+        m = meta["arrays"][name]
+        return np.frombuffer(payload, dtype=np.uint8, count=m["length"], offset=m["offset"])
+
+    assert np.array_equal(np.frombuffer(base64.b64decode(got["mask"]), np.uint8), array("mask"))
+    assert np.array_equal(np.frombuffer(base64.b64decode(got["blocks"]), np.uint8), array("blocks"))
+
+
 def test_values_that_are_not_finite_get_a_mask_and_do_not_widen_the_range():
     a = _blob().astype(np.float64)
     a[3, 4, 5, 2] = np.nan

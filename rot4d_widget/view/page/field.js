@@ -19,7 +19,7 @@ const NEAREST = 1003;
 const UNSIGNED_BYTE = 1009;
 const LINEAR = 1006;
 
-const held = new WeakMap();  // model -> {key, boxKey, copy, box, textures}
+const held = new WeakMap();  // model -> {store, key, boxKey, copy, box, textures}
 let context = null;  // {webgl2, max3d}: what the page's WebGL can hold, once a renderer was seen
 
 // The renderer's context (a THREE.WebGLRenderer): WebGL2?  its 3-D texture limit.  True the first
@@ -42,7 +42,7 @@ export function wantsTransfer(model, name) {
 function entry(model) {
   let h = held.get(model);
   if (!h) {
-    h = { key: null, boxKey: null, copy: null, box: null, textures: null };
+    h = { store: transferStore(model), key: null, boxKey: null, copy: null, box: null, textures: null };
     held.set(model, h);
   }
   return h;
@@ -124,7 +124,9 @@ export function pairedTexels(copy) {
 
 // The copy's 3-D textures ({data, mask, blocks}: the data's texels paired in time (`pairedTexels`),
 // the mask a 1-texel one when every node is finite), made once with the class `T3`
-// (THREE.DataTexture3D).
+// (THREE.DataTexture3D).  Once made, the textures hold all the page needs of the copy (each
+// renderer uploads from their arrays): the transfer's bytes -- two a node, the mask's one -- are
+// let go (`releaseBytes`), so the page keeps the paired texels alone beside the GPU's copy.
 export function fieldTextures(h, T3) {
   if (h.textures) return h.textures;
   const c = h.copy;
@@ -142,10 +144,20 @@ export function fieldTextures(h, T3) {
   const [w, ht, d] = c.size;
   h.textures = {
     data: make(pairedTexels(c), RGBA, w, ht, d),
-    mask: c.mask ? make(c.mask, LUMINANCE, w, ht, d) : make(new Uint8Array([255]), LUMINANCE, 1, 1, 1),
-    blocks: make(c.blocks, RGBA, c.blockSize[0], c.blockSize[1], c.blockSize[2], NEAREST),
+    mask: c.mask ? make(c.mask.slice(), LUMINANCE, w, ht, d) : make(new Uint8Array([255]), LUMINANCE, 1, 1, 1),
+    blocks: make(c.blocks.slice(), RGBA, c.blockSize[0], c.blockSize[1], c.blockSize[2], NEAREST),
   };
+  releaseBytes(h);
   return h.textures;
+}
+
+// The transfer's bytes of a copy whose textures are made: gone from the copy (its arrays) and
+// from the widget's transfer store (its key stays, so the same copy is not asked for again).  A
+// new copy comes as a new transfer and is decoded from that.
+function releaseBytes(h) {
+  h.copy = { ...h.copy, texels: null, mask: null, blocks: null };
+  const t = h.store.done.get("field");
+  if (t && t.key === h.key) t.bytes = null;
 }
 
 function disposeTextures(h) {
