@@ -90,8 +90,9 @@ COLUMNS = {
 #: One update message carries at most this many bytes (32 MiB).  The largest legitimate ones,
 #: measured by ``python benchmarks/update_size.py`` (docs/performance.md), are about 1.6 MB (12
 #: slices of a 64^4 field ray-cast; the great icosahedral 120-cell's 12,000 faces; a 64^4 field's
-#: three surfaces): the cap leaves room for a field sampled at 128 a side, 8 times the bytes, while a slice of millions of points -- 240 MB for 3 M points, which freezes a
-#: browser tab for seconds -- is refused before its rows are built.
+#: three surfaces): the cap leaves room for a field sampled at 128 a side, 8 times the bytes,
+#: while a slice of millions of points -- 240 MB for 3 M points, which freezes a browser tab for
+#: seconds -- is refused before its rows are built.
 MAX_UPDATE_BYTES = 32 * 2**20
 
 #: capacities are multiples of this many rows
