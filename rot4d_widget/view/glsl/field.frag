@@ -26,7 +26,13 @@
 // bits (r, g, b high to low), a = 1 where hit.
 // @include field_data.glsl
 uniform sampler2D u_lut;
+// The rendering is compiled in (FIELD_MODE, set by page/fieldpicture.js: one program a rendering,
+// each without the others' code, which software WebGL runs faster); u_mode without it.
+#ifdef FIELD_MODE
+const float u_mode = float(FIELD_MODE);
+#else
 uniform float u_mode;
+#endif
 uniform vec2 u_clim;
 uniform vec3 u_sections;
 uniform float u_density;

@@ -204,6 +204,11 @@ export class FieldPicture {
     put("u_block_shape", c.blockShape.slice());
     put("u_block_tiles", c.blockTiles.slice());
     put("u_mode", MODES[view.rendering]);
+    if (!m.defines) m.defines = {};
+    if (m.defines.FIELD_MODE !== MODES[view.rendering]) {  // the rendering's own program (field.frag)
+      m.defines.FIELD_MODE = MODES[view.rendering];
+      relink = true;
+    }
     put("u_clim", [norm(clim[0]), norm(clim[1])]);
     put("u_sections", view.sections.slice());
     put("u_density", cfg.density);
