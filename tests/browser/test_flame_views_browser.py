@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
 import pytest
 
 from jupyter_page import JupyterPage, write_notebook
@@ -109,8 +110,21 @@ def _page_steps(jp):
     return None if down is not None else net
 
 
+def _kernel_is_at(jp, steps):
+    """Whether the kernel's orientation is R_xw turned by ``steps`` theta0 (to 1e-9).
+
+    Compared as matrices, which are the same for steps a whole turn apart: a busy browser's holds
+    can carry the count past half a turn, where an angle read back would fold.
+    """
+    got = np.asarray(jp.kernel_json("w.state.matrix.tolist()"))
+    a = steps * jp.kernel_json("w.state.theta0")
+    want = np.eye(4)
+    want[[0, 0, 3, 3], [0, 3, 0, 3]] = np.cos(a), -np.sin(a), np.sin(a), np.cos(a)
+    return bool(np.allclose(got, want, atol=1e-9))
+
+
 def _kernel_steps(jp):
-    """The kernel's orientation as R_xw steps of theta0 (it is turned in x-w alone)."""
+    """The kernel's orientation as R_xw steps of theta0, within a half turn (for messages)."""
     return jp.kernel_json("round(float(np.arctan2(w.state.matrix[3, 0], w.state.matrix[0, 0]) / w.state.theta0), 6)")
 
 
@@ -126,17 +140,18 @@ def test_the_flame_seen_as_a_scientist_would(jupyter_server, page, artifacts):
     _hover(jp, sel)
     page.evaluate(_TAP_LOG)
     steps, made, rounds = 0, 0, []
-    for _ in range(4):  # 90 degrees in x-w, tapped in the page; a tap the browser saw held repeats
+    for _ in range(6):  # 90 degrees in x-w, tapped in the page; a tap the browser saw held repeats
         for _ in range(abs(32 - steps)):
             page.keyboard.press("4" if steps < 32 else "Shift+4")
             time.sleep(0.05)
         made = jp.wait_for(lambda: (e := _page_steps(jp)) is not None and e, timeout=30)
         assert made is not None, f"the page's key events did not pair up: {jp.page.evaluate('window.__taps')}"
-        got = jp.wait_for(lambda: _kernel_steps(jp) == made, timeout=60)
+        got = jp.wait_for(lambda: _kernel_is_at(jp, made), timeout=60)
         assert got, (f"the page's taps and holds call for {made} R_xw steps, the kernel made "
-                     f"{_kernel_steps(jp)}; {jp.kernel_json('w.stats.as_dict()')}")
-        steps = made
-        rounds.append(steps)
+                     f"{_kernel_steps(jp)} (within a half turn); {jp.kernel_json('w.stats.as_dict()')}")
+        turn = round(2 * np.pi / jp.kernel_json("w.state.theta0"))  # steps a whole turn apart look alike
+        steps = 32 + (made - 32 + turn // 2) % turn - turn // 2
+        rounds.append(made)
         if steps == 32:
             break
     assert steps == 32, f"the taps did not come to 90 degrees: R_xw steps after each round {rounds}"
