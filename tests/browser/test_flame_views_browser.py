@@ -16,7 +16,6 @@ import time
 
 import numpy as np
 import pytest
-
 from jupyter_page import JupyterPage, write_notebook
 from test_labels_browser import RECTS, projected_rect
 from test_widget_browser import _canvas, _hover
