@@ -79,6 +79,7 @@ def describe(case: str, keys: str | None = None) -> dict:
             "name": name, "count": int(count), "vert": m.vertexShader, "frag": m.fragmentShader,
             "uniforms": {k: v["value"] for k, v in m.uniforms.items()},
             "transparent": bool(m.transparent), "depthWrite": bool(m.depthWrite), "depthTest": bool(m.depthTest),
+            "side": m.side,
             "template": np.asarray(g.attributes["position"].array, dtype=np.float64).ravel().tolist(),
             "columns": {n: [a.offset, a.itemSize] for n, a in g.attributes.items() if n != "position"},
         })
@@ -233,7 +234,9 @@ window.setup = async (codes, size) => {
     const order = built[key].filter((d) => !d.layer.transparent).concat(built[key].filter((d) => d.layer.transparent));
     for (const d of order) {
       gl.useProgram(d.p); gl.bindVertexArray(d.vao);
-      gl.disable(gl.CULL_FACE);
+      // three.js: FrontSide culls the back faces (counter-clockwise in front), DoubleSide none
+      if (d.layer.side === 'FrontSide') { gl.enable(gl.CULL_FACE); gl.cullFace(gl.BACK); gl.frontFace(gl.CCW); }
+      else gl.disable(gl.CULL_FACE);
       if (d.layer.depthTest) { gl.enable(gl.DEPTH_TEST); gl.depthFunc(depthFunc === 'never' ? gl.NEVER : gl.LEQUAL); }
       else gl.disable(gl.DEPTH_TEST);
       gl.depthMask(d.layer.depthWrite);
