@@ -42,15 +42,9 @@ w = Rot4DWidget(field, width=360, height=300, show_bars=False, rendering="volume
 w
 """
 
-_READ = """(sel) => { const c = document.querySelector(sel); const g = document.createElement('canvas');
-  g.width = c.width; g.height = c.height; const x = g.getContext('2d'); x.drawImage(c, 0, 0);
-  return [g.width, g.height, Array.from(x.getImageData(0, 0, g.width, g.height).data)]; }"""
-
-
 def _pixels(jp, sel):
     time.sleep(0.5)  # a few frames drawn
-    w, h, data = jp.page.evaluate(_READ, sel)
-    return np.asarray(data, dtype=np.int16).reshape(h, w, 4)
+    return jp.canvas_rgba(sel).astype(np.int16)
 
 
 def _host(sel):

@@ -23,15 +23,9 @@ pytestmark = pytest.mark.browser
 
 CASES = ["5-cell", "8-cell", "16-cell", "24-cell", "120-cell", "600-cell", "omnitruncated 120-cell"]
 
-_READ = """(sel) => { const c = document.querySelector(sel); const g = document.createElement('canvas');
-  g.width = c.width; g.height = c.height; const x = g.getContext('2d'); x.drawImage(c, 0, 0);
-  return Array.from(x.getImageData(0, 0, g.width, g.height).data); }"""
-
-
 def _pixels(jp, sel):
     time.sleep(0.4)  # a few frames drawn
-    a = np.asarray(jp.page.evaluate(_READ, sel), dtype=np.int16)
-    return a.reshape(-1, 4)[:, :3]
+    return jp.canvas_rgba(sel).reshape(-1, 4)[:, :3].astype(np.int16)
 
 
 def _host(sel):
