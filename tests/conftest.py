@@ -5,10 +5,22 @@ import pytest
 import recording_comm
 
 
-@pytest.fixture
-def recording_comms(monkeypatch):
-    """Widgets created in the test send through RecordingComm; yields its log."""
-    yield recording_comm.install(monkeypatch)
+def pytest_xdist_make_scheduler(config, log):
+    """Run in two processes (``python -m pytest -n 2``, the README's command), the browser tests
+    stay together in one of them -- one JupyterLab server and one Chromium at a time, which is
+    what their timings are written for -- while the other runs the rest a file at a time (a
+    module's fixtures are built once; a notebook's cells run in order in one kernel).  The browser
+    tests are collected first (``--no-loadscope-reorder``), so the longest work starts first.
+
+    (xdist's own ``--dist loadgroup`` cannot do this under pytest 9.2: it renames items by
+    assigning ``item._nodeid``, which pytest no longer reads.)"""
+    from xdist.scheduler import LoadFileScheduling
+
+    class BrowserTogether(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return "tests/browser" if nodeid.startswith("tests/browser/") else super()._split_scope(nodeid)
+
+    return BrowserTogether(config, log)
 
 
 class FakeClock:
