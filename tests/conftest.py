@@ -23,6 +23,12 @@ def pytest_xdist_make_scheduler(config, log):
     return BrowserTogether(config, log)
 
 
+@pytest.fixture
+def recording_comms(monkeypatch):
+    """Widgets created in the test send through RecordingComm; yields its log."""
+    yield recording_comm.install(monkeypatch)
+
+
 class FakeClock:
     def __init__(self, t=100.0):
         self.t = t
