@@ -182,6 +182,8 @@ class KeyPath:
             self.sync.state_traits()
             # the page learns the kernel answers; the picture of this state is owed (the pump sends it)
             self.painter.send_state("pending", throttle=bool(self.page.held))
+        else:
+            self.painter.send_id(throttle=bool(self.page.held))
 
     def settle(self) -> None:
         """At rest (no key held): bring the readout up to date and the rows into the turned frame,

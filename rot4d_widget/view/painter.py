@@ -267,9 +267,7 @@ class Painter:
             return
         self.keys.page.sync_external()  # a change from the kernel since the last step: a new epoch
         epoch, upto = self.keys.page.state_id
-        msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None,
-               "state": state_message(self.state, view_message(self.showing.source, self.traits.rendering,
-                                                                self.traits.sections)),
+        msg = {"epoch": epoch, "upto": upto if math.isfinite(upto) else None, "state": self._state_message(),
                "keys": self.keys.page.held_since(),
                "picture": picture}
         old = self.companion.kernel_state
@@ -278,6 +276,22 @@ class Painter:
             return  # unchanged: nothing to send (the picture named before still shows it)
         self.companion.kernel_state = msg
         self.state_at = now
+
+    def send_id(self, *, throttle: bool = False) -> None:
+        """The kernel's state id moved on with no change of state (it heard the page's clock
+        further: a heartbeat, a release without a step): the same state under the new id, the
+        picture named as before -- else the page would rest on the older id until the next change."""
+        old = self.companion.kernel_state
+        if not old or old.get("state") != self._state_message():
+            return  # none sent yet, or the state changed meanwhile (from the kernel): the pump sends it
+        epoch, upto = self.keys.page.state_id
+        if old.get("epoch") == epoch and old.get("upto") == (upto if math.isfinite(upto) else None):
+            return
+        self.send_state(old.get("picture"), throttle=throttle)
+
+    def _state_message(self) -> dict:
+        return state_message(self.state, view_message(self.showing.source, self.traits.rendering,
+                                                      self.traits.sections))
 
     def sync_field(self) -> None:
         """Offer the page the field's copy once it is in memory (`pagefield.PageField`) and say how

@@ -271,6 +271,26 @@ def test_the_kernel_s_state_names_the_keys_it_holds(make, clock):
     assert w.companion.kernel_state["keys"] == [] and w.companion.kernel_state["upto"] == 1500.0
 
 
+def test_the_kernel_s_id_moved_on_without_a_step_reaches_the_page(make, clock):
+    """A heartbeat heard after the last step (at rest) names the same state by a later page time:
+    the page is told, the picture named as before (CI once saw the page rest on the older id for a
+    minute, waiting for a change that never came), and never for a state the picture does not show."""
+    w = make("24-cell")
+    down(w, "4", t=1.0)
+    up(w, "4", t=1.1)
+    before = dict(w.companion.kernel_state)
+    assert before["upto"] == 1100.0
+    clock.t += 1.0
+    heartbeat(w, 1100.4)
+    after = w.companion.kernel_state
+    assert after["upto"] == 1100.4 and after["epoch"] == before["epoch"]
+    assert after["state"] == before["state"] and after["picture"] == before["picture"]
+    # a change from the kernel not drawn yet: the id is not sent with the old picture's name
+    w.state.apply(*DEFAULT_KEYMAP.resolve("2", False))
+    heartbeat(w, 1100.8)
+    assert w.companion.kernel_state["upto"] == 1100.4
+
+
 ADOPT = """
 import { Prediction } from "page:predict.js";
 const p = new Prediction(INPUT.config, INPUT.start);
