@@ -44,7 +44,7 @@ async (code) => {
 )
 
 # A canvas's pixels as base64 of its RGBA bytes: playwright hands a JavaScript array of numbers
-# back as JSON, ~5 s for a 360 x 300 canvas here; a string takes ~40 ms.
+# back as JSON, slowly for a canvas's hundreds of thousands (docs/performance.md, "The test suite").
 _CANVAS_RGBA = """
 (selector) => {
   const c = document.querySelector(selector);
