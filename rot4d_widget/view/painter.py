@@ -282,11 +282,11 @@ class Painter:
         further: a heartbeat, a release without a step): the same state under the new id, the
         picture named as before -- else the page would rest on the older id until the next change."""
         old = self.companion.kernel_state
-        if not old or old.get("state") != self._state_message():
-            return  # none sent yet, or the state changed meanwhile (from the kernel): the pump sends it
         epoch, upto = self.keys.page.state_id
-        if old.get("epoch") == epoch and old.get("upto") == (upto if math.isfinite(upto) else None):
-            return
+        if not old or (old.get("epoch"), old.get("upto")) == (epoch, upto if math.isfinite(upto) else None):
+            return  # none sent yet, or the id it names is the kernel's (the common case: no work)
+        if old.get("state") != self._state_message():
+            return  # the state changed meanwhile (from the kernel): the pump sends it with its picture
         self.send_state(old.get("picture"), throttle=throttle)
 
     def _state_message(self) -> dict:
