@@ -24,7 +24,7 @@ from rot4d_widget.view.keyhold import steps_for
 from rot4d_widget.core.keymap import DEFAULT_KEYMAP
 from rot4d_widget.core.state import ALPHA_MAX, THETA0_MAX, THETA0_MIN, RotationState
 from rot4d_widget.sources.tomography import SPACING_MAX, SPACING_MIN
-from test_widget import deliver, down, run_ticker, up, xw_steps
+from test_widget import deliver, down, key_event, run_ticker, up, xw_steps
 
 pytestmark = pytest.mark.usefixtures("recording_comms")
 
@@ -158,9 +158,12 @@ def test_taps_queued_behind_a_slow_source_coalesce():
     w = Rot4DWidget(src, ack_timeout=0.05)
     try:
         calls = src.calls
-        for i in range(10):  # taps from the page (`press` from code waits for its step to be sent)
-            w._handle_event({"type": "keydown", "key": "l", "code": "KeyL"})
-            w._handle_event({"type": "keyup", "key": "l", "code": "KeyL"})
+        # taps from the page (`press` from code waits for its step to be sent), each with its page
+        # time: 50 ms down, a second apart, so each is one step however late this (busy) machine
+        # hands the events over (without a timeStamp the kernel's clock would count the steps)
+        for i in range(10):
+            w._handle_event(key_event("keydown", "l", t=10.0 + i))
+            w._handle_event(key_event("keyup", "l", t=10.05 + i))
         limit = time.monotonic() + 60
         while (w._pump.dirty or w._pump._sending or w.stats.updates < 1) and time.monotonic() < limit:
             time.sleep(0.05)
