@@ -114,7 +114,7 @@ _PIXEL_WATCH = r"""
   };
   const loop = () => { if (!P.run) return; requestAnimationFrame(loop); ch.port2.postMessage(0); };
   requestAnimationFrame(loop);
-  const onKey = (e) => P.keys.push([e.type, e.code, e.repeat, performance.now()]);
+  const onKey = (e) => P.keys.push([e.type, e.code, e.repeat, performance.now(), c.matches(':hover')]);
   window.addEventListener('keydown', onKey, true);
   window.addEventListener('keyup', onKey, true);
   P.stop = () => {
@@ -125,6 +125,9 @@ _PIXEL_WATCH = r"""
   return true;
 }
 """
+
+
+_HOVERED = "(sel) => { const c = document.querySelector(sel); return c !== null && c.matches(':hover'); }"
 
 
 def write_notebook(path, cells: list[str]) -> None:
@@ -141,6 +144,7 @@ class JupyterPage:
         self.page = page
         self.server = server
         self.name = name
+        self._watched: str | None = None  # the canvas watch_pixels watches
 
     def open(self, timeout: float = 120.0) -> "JupyterPage":
         self.page.goto(self.server.notebook_url(self.name))
@@ -216,6 +220,7 @@ class JupyterPage:
     def watch_pixels(self, selector: str) -> None:
         """Start stamping, in the page, every frame of this canvas whose pixels changed, and every key."""
         assert self.page.evaluate(_PIXEL_WATCH, selector), f"no canvas {selector!r}"
+        self._watched = selector
 
     def page_now(self) -> float:
         """The page's clock (performance.now()), in ms."""
@@ -227,8 +232,27 @@ class JupyterPage:
 
     def key_stamps(self, kind: str, code: str | None = None) -> list[float]:
         """Page times (ms) of ``kind`` ('keydown'/'keyup') events, not repeats, optionally of one ``code``."""
-        return [t for k, c, rep, t in self.page.evaluate("() => window.__pw.keys")
+        return [t for k, c, rep, t, _ in self.page.evaluate("() => window.__pw.keys")
                 if k == kind and not rep and (code is None or c == code)]
+
+    def hover(self, selector: str, timeout: float = 10.0) -> dict:
+        """Point at the centre of ``selector``'s element until the page has it hovered; its box.
+
+        The pointer first goes to the page's corner: the page is reused between tests, and an
+        element that appears under a pointer at rest is not entered until the pointer moves
+        (ipyevents listens for keys from the canvas's mouseenter on).  The centre is taken again
+        while the layout still moves (outputs rendering above the canvas).
+        """
+        loc = self.page.locator(selector)
+        self.page.mouse.move(1, 1)
+        deadline = time.monotonic() + timeout
+        while True:
+            box = loc.bounding_box()
+            self.page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+            time.sleep(0.2)
+            if loc.bounding_box() == box and self.page.evaluate(_HOVERED, selector):
+                return box
+            assert time.monotonic() < deadline, f"{selector!r} not hovered after {timeout} s (box {box})"
 
     def wait_quiet(self, quiet: float, timeout: float = 30.0) -> bool:
         """Wait until the watched canvas has not changed for ``quiet`` s (page time)."""
@@ -250,13 +274,17 @@ class JupyterPage:
         out = []
         for key in keys:
             self.wait_quiet(max(0.3, 2 * out[-1]) if out else 0.3)
+            if not self.page.evaluate(_HOVERED, self._watched):  # the layout moved under the pointer
+                self.hover(self._watched)
             n = len(self.key_stamps("keydown"))
             self.page.keyboard.press(key)
             got = self.wait_for(lambda: len(self.key_stamps("keydown")) > n, timeout=5)
             assert got, f"tap {key!r}: the page saw no keydown"
             down = self.key_stamps("keydown")[n]
             first = self.wait_for(lambda: self.pixel_changes(down), timeout=timeout)
-            assert first, f"tap {key!r}: the canvas did not change within {timeout} s"
+            hovered = [h for k, _, rep, t, h in self.page.evaluate("() => window.__pw.keys")
+                       if k == "keydown" and t == down]
+            assert first, f"tap {key!r}: the canvas did not change within {timeout} s (hovered at keydown: {hovered})"
             out.append((first[0] - down) / 1000)
         self.wait_quiet(max(0.3, 2 * out[-1]))
         return out

@@ -168,12 +168,8 @@ def busy_core():
 
 def _hover(jp, sel):
     """Scroll the canvas into view (the long set-up cell pushes it below the fold), point at it."""
-    loc = jp.page.locator(sel)
-    loc.scroll_into_view_if_needed()
-    box = loc.bounding_box()
-    jp.page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
-    time.sleep(0.2)
-    return box
+    jp.page.locator(sel).scroll_into_view_if_needed()
+    return jp.hover(sel)
 
 
 def _keylog(jp, code=None):
