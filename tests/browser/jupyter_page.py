@@ -265,11 +265,12 @@ class JupyterPage:
             time.sleep(0.05)
         return False
 
-    def tap_round_trips(self, keys, timeout: float = 20.0) -> list[float]:
+    def tap_round_trips(self, keys, timeout: float = 20.0, diagnose=None) -> list[float]:
         """Press each key once (isolated taps); the round trip of each, keydown -> pixels changed, in s.
 
         Measured in the page (watch_pixels first).  Between taps the view is
         left to settle (quiet for twice the last round trip, at least 0.3 s).
+        ``diagnose()``: what a failed tap's message adds (the page's and the kernel's states).
         """
         out = []
         for key in keys:
@@ -284,7 +285,10 @@ class JupyterPage:
             first = self.wait_for(lambda: self.pixel_changes(down), timeout=timeout)
             hovered = [h for k, _, rep, t, h in self.page.evaluate("() => window.__pw.keys")
                        if k == "keydown" and t == down]
-            assert first, f"tap {key!r}: the canvas did not change within {timeout} s (hovered at keydown: {hovered})"
+            if not first:
+                more = diagnose() if diagnose is not None else ""
+                raise AssertionError(f"tap {key!r}: the canvas did not change within {timeout} s "
+                                     f"(hovered at keydown: {hovered}); {more}")
             out.append((first[0] - down) / 1000)
         self.wait_quiet(max(0.3, 2 * out[-1]))
         return out

@@ -80,6 +80,21 @@ def _hover(jp, sel):
     return jp.hover(sel)
 
 
+def _diagnosis(jp, sel, var="w"):
+    """The page's and the kernel's sides of a view, for a failure's message."""
+    page = jp.page.evaluate(
+        "(sel) => { const c = document.querySelector(sel); const h = c && c.closest('[class*=rot4d]');"
+        " let host = c; while (host && !host.rot4dPage) host = host.parentElement;"
+        " const a = document.activeElement;"
+        " return {focus: document.hasFocus(), active: a ? a.tagName + '.' + a.className : null,"
+        " page: host ? host.rot4dPage() : 'no hook', side: h ? h.className : null}; }", sel)
+    kernel = jp.kernel_json(
+        f"dict(id=list({var}._keys.page.state_id), stats={var}.stats.as_dict(), held=list(map(str, {var}.held_keys)), "
+        f"c0={var}.state.c0, m=[round(x, 4) for x in {var}.state.matrix.ravel()])")
+    console = [t for _, t in jp.page.console_messages[-8:]]
+    return f"page {page}; kernel {kernel}; console {console}"
+
+
 def _wait_kernel_change(jp, before, var="w", timeout=5.0):
     deadline = time.monotonic() + timeout
     while True:
@@ -455,7 +470,7 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     sel = _canvas(jp)
     _hover(jp, sel)
     jp.watch_pixels(sel)
-    taps = jp.tap_round_trips(TAP_KEYS)
+    taps = jp.tap_round_trips(TAP_KEYS, diagnose=lambda: _diagnosis(jp, sel))
     settle_bound = _timing_bound(taps, 6, 1.0)
     cdp = page.context.new_cdp_session(page)
     models_before = jp.kernel_json("live_models()")
