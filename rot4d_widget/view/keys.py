@@ -160,8 +160,10 @@ class KeyPath:
                     kid, down, t, found = edge
                     if not down:
                         released = self.page.release(kid, t) or released
-                    elif found is not None and found[0].kind in PREDICTED_KINDS and not self.no_view() \
-                            and self.repeater.held(kid) is None:
+                    # (whatever view count the kernel last heard: the page steps only keys over a
+                    # canvas of this widget it shows, and the count comes on the canvas's own comm,
+                    # which may be handled later -- no step the page has shown is dropped)
+                    elif found is not None and found[0].kind in PREDICTED_KINDS and self.repeater.held(kid) is None:
                         self.page.press(kid, found[0], found[1], t, found[0].kind in REPEATING_KINDS)
                 self.page.heartbeat(float(t_ms))
                 self.advance()

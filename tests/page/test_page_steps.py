@@ -291,6 +291,24 @@ def test_the_kernel_s_id_moved_on_without_a_step_reaches_the_page(make, clock):
     assert w.companion.kernel_state["upto"] == 1100.4
 
 
+def test_a_step_the_page_made_counts_while_the_kernel_has_heard_of_no_view(make, clock):
+    """The page steps only for a key over a canvas of this widget it shows, so the steps its
+    heartbeats repeat are kept whatever view count the kernel last heard (the canvas's count comes
+    on another comm, which may be handled after the companion's): none dropped that the page has
+    shown.  ipyevents' own keydown from a leaked listener still acts on nothing."""
+    from test_widget import front_end_view_count, xw_steps
+    w = make("24-cell")
+    front_end_view_count(w, 1)  # displayed
+    front_end_view_count(w, 0)  # the kernel hears of no view (a view re-made: its count comes late)
+    down(w, "4", t=1.0)  # ipyevents: a listener a destroyed view may have left behind
+    up(w, "4", t=1.05)
+    assert xw_steps(w) == 0
+    heartbeat(w, 2000.0, [edge("4", True, 2000.0)])  # the page stepped a key over its canvas
+    heartbeat(w, 2050.0, [edge("4", True, 2000.0), edge("4", False, 2050.0)])
+    assert xw_steps(w) == 1 and w.held_keys == ()
+    assert w.companion.kernel_state["upto"] == 2050.0
+
+
 ADOPT = """
 import { Prediction } from "page:predict.js";
 const p = new Prediction(INPUT.config, INPUT.start);
