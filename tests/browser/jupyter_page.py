@@ -98,7 +98,7 @@ _PIXEL_WATCH = r"""
   const W = Math.max(1, Math.round(c.width * k)), H = Math.max(1, Math.round(c.height * k));
   const tmp = document.createElement('canvas'); tmp.width = W; tmp.height = H;
   const ctx = tmp.getContext('2d', {willReadFrequently: true});
-  const P = window.__pw = {changes: [], keys: [], frames: 0, run: true};
+  const P = window.__pw = {changes: [], keys: [], frames: 0, run: true, canvas: c, selector: sel};
   let prev = null;
   const ch = new MessageChannel();
   ch.port1.onmessage = () => {

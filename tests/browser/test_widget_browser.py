@@ -85,14 +85,20 @@ def _diagnosis(jp, sel, var="w"):
     page = jp.page.evaluate(
         "(sel) => { const c = document.querySelector(sel); const h = c && c.closest('[class*=rot4d]');"
         " let host = c; while (host && !host.rot4dPage) host = host.parentElement;"
-        " const a = document.activeElement;"
+        " const a = document.activeElement; const w = window.__pw;"
         " return {focus: document.hasFocus(), active: a ? a.tagName + '.' + a.className : null,"
-        " page: host ? host.rot4dPage() : 'no hook', side: h ? h.className : null}; }", sel)
+        " page: host ? host.rot4dPage() : 'no hook', side: h ? h.className : null,"
+        " watched: w ? {connected: w.canvas.isConnected, current: w.canvas === c, frames: w.frames} : null,"
+        " frozen: h ? h.querySelectorAll('img').length : null}; }", sel)
     kernel = jp.kernel_json(
         f"dict(id=list({var}._keys.page.state_id), stats={var}.stats.as_dict(), held=list(map(str, {var}.held_keys)), "
         f"views={var}.scene.view_count, displayed={var}._keys.was_displayed, "
         f"c0={var}.state.c0, m=[round(x, 4) for x in {var}.state.matrix.ravel()])")
-    console = [t for _, t in jp.page.console_messages[-8:]]
+    # pythreejs's renderers: a view whose WebGL renderer is taken back (a pool of 8) or whose
+    # context is lost shows a still image until it renders again
+    lifecycle = ("freeze", "Pool", "reclaim", "context", "lost", "acquir")
+    console = [t for _, t in jp.page.console_messages if any(w in t for w in lifecycle)][-12:]
+    console += [t for _, t in jp.page.console_messages[-4:]]
     return f"page {page}; kernel {kernel}; console {console}"
 
 
