@@ -414,7 +414,11 @@ def test_drawn_acks_follow_the_pixels_and_at_most_three_updates_are_in_flight(ju
     cdp.send("Emulation.setCPUThrottlingRate", {"rate": 6})
     # this run's round trip on the throttled page, from isolated taps (no flow control at work)
     taps = jp.tap_round_trips(TAP_KEYS)
-    bound = _timing_bound(taps, 4, 1.0)
+    # after the release: the keyup's way to the kernel, up to three updates in flight drawn one by
+    # one on the throttled page, then the latest state's round trip (4 tap round trips was the edge:
+    # 1.28 s against 1.27 s in a two-process run); a key that kept turning changes the view to the
+    # end of the watch, past any bound
+    bound = _timing_bound(taps, 6, 1.0)
     page.evaluate(_WATCH_ACKS, sel)
     initial = jp.canvas_stats(sel)["hash"]
     start = jp.kernel_json("w.stats.as_dict()")
