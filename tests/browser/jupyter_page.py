@@ -98,7 +98,7 @@ _PIXEL_WATCH = r"""
   const W = Math.max(1, Math.round(c.width * k)), H = Math.max(1, Math.round(c.height * k));
   const tmp = document.createElement('canvas'); tmp.width = W; tmp.height = H;
   const ctx = tmp.getContext('2d', {willReadFrequently: true});
-  const P = window.__pw = {changes: [], keys: [], frames: 0, run: true, canvas: c, selector: sel};
+  const P = window.__pw = {changes: [], keys: [], frames: 0, run: true, canvas: c};
   let prev = null;
   const ch = new MessageChannel();
   ch.port1.onmessage = () => {
@@ -290,9 +290,9 @@ class JupyterPage:
             assert got, f"tap {key!r}: the page saw no keydown"
             down = self.key_stamps("keydown")[n]
             first = self.wait_for(lambda: self.pixel_changes(down), timeout=timeout)
-            hovered = [h for k, _, rep, t, h in self.page.evaluate("() => window.__pw.keys")
-                       if k == "keydown" and t == down]
             if not first:
+                hovered = [h for k, _, rep, t, h in self.page.evaluate("() => window.__pw.keys")
+                           if k == "keydown" and t == down]
                 more = diagnose() if diagnose is not None else ""
                 message = (f"tap {key!r}: the canvas did not change within {timeout} s "
                            f"(hovered at keydown: {hovered}); {more}")

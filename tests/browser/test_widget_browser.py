@@ -482,8 +482,8 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     _hover(jp, sel)
     jp.watch_pixels(sel)
     # the taps calibrate the settle bound: one that changes nothing is a warning with what the
-    # page and the kernel hold (two CI runs saw the first tap change nothing for 20 s, not seen
-    # here since), a second fails
+    # page and the kernel hold (two-process runs see the first tap change nothing for 20 s now and
+    # then, the cause not known: docs/performance.md, "The test suite"), a second fails
     taps = jp.tap_round_trips(TAP_KEYS, diagnose=lambda: _diagnosis(jp, sel), again=True)
     settle_bound = _timing_bound(taps, 6, 1.0)
     cdp = page.context.new_cdp_session(page)
