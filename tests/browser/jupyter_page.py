@@ -266,15 +266,16 @@ class JupyterPage:
             time.sleep(0.05)
         return False
 
-    def tap_round_trips(self, keys, timeout: float = 20.0, diagnose=None, again: bool = False) -> list[float]:
+    def tap_round_trips(self, keys, timeout: float = 20.0, diagnose=None, again: bool = True) -> list[float]:
         """Press each key once (isolated taps); the round trip of each, keydown -> pixels changed, in s.
 
         Measured in the page (watch_pixels first).  Between taps the view is
         left to settle (quiet for twice the last round trip, at least 0.3 s).
         ``diagnose()``: what a failed tap's message adds (the page's and the kernel's states).
         ``again``: a tap that changed nothing is reported as a warning (with the diagnosis) and
-        tapped once more, for tests that only calibrate their bounds by the taps; a second such
-        tap fails.
+        tapped once more; a second such tap fails.  Every caller calibrates timing bounds by these
+        taps (a lost first tap, seen now and then in two-process runs, is not understood yet:
+        docs/performance.md, "The test suite"); one step a tap is asserted by the key tests.
         """
         out = []
         keys = list(keys)

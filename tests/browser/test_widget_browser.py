@@ -484,7 +484,7 @@ def test_key_storm_on_the_600_cell(jupyter_server, page):
     # the taps calibrate the settle bound: one that changes nothing is a warning with what the
     # page and the kernel hold (two-process runs see the first tap change nothing for 20 s now and
     # then, the cause not known: docs/performance.md, "The test suite"), a second fails
-    taps = jp.tap_round_trips(TAP_KEYS, diagnose=lambda: _diagnosis(jp, sel), again=True)
+    taps = jp.tap_round_trips(TAP_KEYS, diagnose=lambda: _diagnosis(jp, sel))
     settle_bound = _timing_bound(taps, 6, 1.0)
     cdp = page.context.new_cdp_session(page)
     models_before = jp.kernel_json("live_models()")
